@@ -1,0 +1,261 @@
+/*
+ * amfi.h: the numerical core of amfi: acceleration-based moving force
+ * identification (A-MFI) on a finite-element beam bridge.
+ *
+ * Pure computation: no I/O, no printing, no exit. Every function that can fail
+ * returns an int status (0 ok, negative AMFI_E* on error) and, when `err` is
+ * not NULL, writes a one-line message of at most `errlen` bytes into it.
+ *
+ * Matrices are row-major doubles; every matrix argument states its shape.
+ * Sign convention (MODEL.md §1): deflection, acceleration and axle forces
+ * are positive downward. Units are SI unless a name says otherwise.
+ *
+ * Workload: one bridge model per site (created once), one solver workspace
+ * per worker thread (created once per problem size), then many passages of
+ * about 1 s at 5000 Hz, each solved in milliseconds. Nothing here allocates
+ * inside a time-step loop. A handle is not thread-safe; distinct handles are
+ * independent (the bridge model is read-only after creation and may be
+ * shared by several solvers and threads).
+ */
+#ifndef AMFI_AMFI_H
+#define AMFI_AMFI_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- status codes ------------------------------------------------------ */
+#define AMFI_OK 0
+#define AMFI_EINVAL (-1)  /* an argument is out of range or inconsistent */
+#define AMFI_ENOMEM (-2)  /* allocation failed */
+#define AMFI_ENUM (-3)    /* a numerical step failed (LAPACK info != 0, NaN) */
+#define AMFI_ERANGE (-4)  /* the data does not cover the passage window */
+
+#define AMFI_MAX_SUPPORTS 16
+#define AMFI_MAX_SENSORS 8
+#define AMFI_MAX_AXLES 12
+#define AMFI_GRAVITY 9.81 /* m/s², paper §3.2 */
+
+const char *amfi_strerror(int status); /* static string; never NULL */
+
+/* ---- bridge: Euler-Bernoulli FE beam (MODEL.md §1) --------------------- */
+
+typedef struct amfi_support {
+    double x_m;         /* position along the beam, m, snapped to the nearest node */
+    int restrain_w;     /* 1: vertical displacement fixed */
+    int restrain_theta; /* 1: rotation fixed */
+} amfi_support;
+
+typedef struct amfi_bridge_params {
+    double span_m;         /* beam length L, m, > 0 */
+    int n_elements;        /* equal beam elements, 1 .. 1000 */
+    double E_pa;           /* Young's modulus (healthy), Pa, > 0 */
+    double A_m2;           /* cross-section area, m², > 0 */
+    double I_m4;           /* second moment of area, m⁴, > 0 */
+    double density_kgm3;   /* ρ, kg/m³, > 0; mass per length μ = ρA */
+    double damping_ratio;  /* Rayleigh ξ at the two modes below, 0 .. 1 */
+    int rayleigh_mode_a;   /* 1-based mode numbers where ξ is matched */
+    int rayleigh_mode_b;   /* (a != b) */
+    int n_supports;        /* 1 .. AMFI_MAX_SUPPORTS */
+    amfi_support supports[AMFI_MAX_SUPPORTS];
+    double damage;         /* δ: E_used = (1 − δ)·E in every element, 0 <= δ < 1 */
+} amfi_bridge_params;
+
+/* The paper-20m reference values of MODEL.md §1 (simply supported, 20 m). */
+void amfi_bridge_params_paper20(amfi_bridge_params *p);
+
+typedef struct amfi_bridge amfi_bridge; /* opaque, read-only once created */
+
+/* Assemble M, K (consistent mass), apply supports, solve K ψ = ω² M ψ
+ * (LAPACK dsygvd), build Rayleigh C. Free with amfi_bridge_destroy(). */
+int amfi_bridge_create(const amfi_bridge_params *p, amfi_bridge **out,
+                       char *err, size_t errlen);
+void amfi_bridge_destroy(amfi_bridge *b); /* NULL-safe */
+
+const amfi_bridge_params *amfi_bridge_params_of(const amfi_bridge *b);
+int amfi_bridge_ndof(const amfi_bridge *b);        /* n: free DOFs */
+const double *amfi_bridge_mass(const amfi_bridge *b);      /* n × n */
+const double *amfi_bridge_stiffness(const amfi_bridge *b); /* n × n */
+const double *amfi_bridge_damping(const amfi_bridge *b);   /* n × n */
+/* ω_k, rad/s, ascending, k = 0 .. n−1 */
+const double *amfi_bridge_omega(const amfi_bridge *b);
+/* modal damping ratio ζ_k = a0/(2ω_k) + a1·ω_k/2 */
+const double *amfi_bridge_zeta(const amfi_bridge *b);
+/* Ψ: n × n, column k is mode k, M-orthonormal (Ψᵀ M Ψ = I) */
+const double *amfi_bridge_modes(const amfi_bridge *b);
+/* Rayleigh coefficients: C = a0·M + a1·K */
+void amfi_bridge_rayleigh(const amfi_bridge *b, double *a0, double *a1);
+
+/* Shape row of a point at x (m): out[n] such that w(x) = out · u (Hermitian
+ * cubic interpolation in the element holding x). A downward point force F at
+ * x has the nodal load vector F·out. Returns 1 and zeros out when x is off
+ * the beam (x < 0 or x > L), 0 otherwise. */
+int amfi_bridge_shape(const amfi_bridge *b, double x_m, double *out /* n */);
+
+/* Free-DOF index of node `node` (0 .. n_elements), `rot` 0 for w, 1 for θ;
+ * −1 when that DOF is restrained or out of range. */
+int amfi_bridge_dof(const amfi_bridge *b, int node, int rot);
+
+/* ---- discretisation (MODEL.md §4) -------------------------------------- */
+
+/* E = expm(A) by scaling and squaring with Padé approximants (Higham 2005,
+ * SIAM J. Matrix Anal. Appl. 26(4), Algorithm 2.3). A, E: n × n. E may not
+ * alias A. Allocates its own scratch (called once per problem, not per step). */
+int amfi_expm(int n, const double *A, double *E);
+
+/* One mode's closed form, exact for every damping regime: for
+ * q'' + 2ζω q' + ω² q = f (f held over the step), state [q; q'],
+ * Phi = expm(A h) (2 × 2) and G = ∫0^h expm(A s) ds · [0; 1] (2). ω > 0. */
+void amfi_modal_block(double omega, double zeta, double h, double Phi[4],
+                      double G[2]);
+
+/* Nodal zero-order hold: Phi = expm(A h) (2n × 2n) and
+ * G = ∫0^h expm(A s) ds · [0; M⁻¹] (2n × n), A = [[0, I], [−M⁻¹K, −M⁻¹C]],
+ * state [u; u']. G is computed with Van Loan's augmented exponential (1978),
+ * which equals A⁻¹(Φ − I)[0; M⁻¹] without inverting A. */
+int amfi_nodal_discretise(const amfi_bridge *b, double h, double *Phi,
+                          double *G);
+
+/* ---- forward response (independent of the solver's discretisation) ---- */
+
+/* Bridge response to moving point forces by Newmark average acceleration
+ * (γ = 1/2, β = 1/4) in nodal coordinates, starting at rest at t = 0, with
+ * the force positions evaluated at every integration step. Used by tests and
+ * tools as an independent reference for the inverse solver.
+ *   force(t, a, user) returns the downward force of axle a at time t, N;
+ *   position x_a(t) = speed·t − offset_m[a].
+ *   accel_out: n_out × n_sensors, vertical acceleration at sensor_x_m at
+ *   t_k = k / out_rate_hz, k = 0 .. n_out−1.
+ * dt_s is the integration step; out_rate_hz·dt_s must give an integer number
+ * of steps per output sample. */
+typedef double (*amfi_force_fn)(double t_s, int axle, void *user);
+int amfi_forward_newmark(const amfi_bridge *b, double speed_mps, int n_axles,
+                         const double *offset_m, amfi_force_fn force,
+                         void *user, int n_sensors, const double *sensor_x_m,
+                         double dt_s, double out_rate_hz, int n_out,
+                         double *accel_out, char *err, size_t errlen);
+
+/* ---- the A-MFI solver -------------------------------------------------- */
+
+typedef enum amfi_formulation {
+    AMFI_FORM_PAPER = 0 /* eqs 13-20: backward-difference acceleration */
+} amfi_formulation;
+
+typedef enum amfi_coords {
+    AMFI_COORDS_MODAL = 0, /* block-diagonal Φ, reduced state 2m + n_a */
+    AMFI_COORDS_NODAL = 1  /* dense reference path, full state 4n + n_a */
+} amfi_coords;
+
+typedef enum amfi_modes {
+    AMFI_MODES_ALL = 0,        /* every mode */
+    AMFI_MODES_OBSERVABLE = 1, /* modes some sensor sees (|ψ(x_s)| > 1e-9·max) */
+    AMFI_MODES_COUNT = 2       /* the n_modes lowest observable modes */
+} amfi_modes;
+
+typedef struct amfi_solver_params {
+    amfi_formulation formulation;
+    amfi_coords coords;
+    amfi_modes modes;
+    int n_modes;            /* for AMFI_MODES_COUNT, >= 1 */
+    double calc_rate_hz;    /* calculation rate 1/h, Hz (paper: 5000) */
+    int n_sensors;          /* 1 .. AMFI_MAX_SENSORS */
+    double sensor_x_m[AMFI_MAX_SENSORS];   /* position along the span, m */
+    double sensor_weight[AMFI_MAX_SENSORS];/* W = diag(weights), > 0 */
+    int max_axles;          /* workspace capacity, 1 .. AMFI_MAX_AXLES */
+    double max_duration_s;  /* workspace capacity in time (grown on demand) */
+    int fix_initial_force;  /* 0 (default): g_0 free, from min x0ᵀR0x0 + x0ᵀs0;
+                               1: g_0 = 0 (use with pre_roll_s > 0) */
+    double pre_roll_s;      /* window starts this long before entry, >= 0 */
+    double post_roll_s;     /* window ends this long after the last exit, >= 0 */
+} amfi_solver_params;
+
+/* Defaults: paper formulation, modal, observable modes, 5000 Hz, one sensor
+ * at mid-span of `span_m` with weight 1, 2 axles, 2 s, g_0 free, no rolls. */
+void amfi_solver_params_default(amfi_solver_params *p, double span_m);
+
+/* λ policy. λ is stored rate-independent (MODEL.md §4): the residual sum has
+ * N ∝ 1/h terms and r ∝ h, so the per-step λ_h = lambda_ref·(h_ref/h)², with
+ * h_ref = 1/ref_rate_hz. lambda_ref is the λ one would use at ref_rate_hz
+ * (the paper's 7.94e-9 at 5000 Hz). */
+typedef struct amfi_lambda {
+    int automatic;       /* 0: fixed lambda_ref; 1: L-curve */
+    double lambda_ref;   /* fixed value, at ref_rate_hz, > 0 */
+    double ref_rate_hz;  /* default 5000 */
+    /* L-curve search, all λ at ref_rate_hz: a log grid from lo to hi with
+     * per_decade points; then the best interior point's neighbourhood
+     * (± one coarse step) refined with refine_points more points. */
+    double lcurve_lo, lcurve_hi;
+    int lcurve_per_decade;
+    int lcurve_refine_points;
+} amfi_lambda;
+
+void amfi_lambda_default(amfi_lambda *l); /* fixed 7.94e-9 at 5000 Hz; grid 1e-14..1e-4, 1/decade, 8 refine */
+
+/* One passage as recorded: accelerations sampled uniformly at scan_rate_hz,
+ * sample k at time t_first_s + k/scan_rate_hz, where t = 0 is the moment the
+ * first axle reaches x = 0. The window (entry − pre_roll .. last exit +
+ * post_roll) must lie within the samples. */
+typedef struct amfi_passage {
+    int n_samples;
+    double scan_rate_hz;
+    double t_first_s;
+    const double *accel[AMFI_MAX_SENSORS]; /* per sensor, n_samples, m/s² */
+    double speed_mps;                      /* > 0 */
+    int n_axles;                           /* 1 .. max_axles */
+    double axle_spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1 spacings, > 0 */
+} amfi_passage;
+
+typedef struct amfi_result {
+    double lambda_h;     /* per-step λ actually used */
+    double lambda_ref;   /* the same, at ref_rate_hz */
+    double h_s;          /* calculation step */
+    int n_steps;         /* N: forces at t_0 .. t_N, N + 1 values per axle */
+    double t0_s;         /* time of step 0 (relative to entry) */
+    int n_axles;
+    const double *force_N; /* (N + 1) × n_axles, row-major; owned by the
+                              solver, valid until the next solve */
+    const double *model_accel; /* N × n_sensors: fitted y_1 .. y_N */
+    double mean_force_N[AMFI_MAX_AXLES]; /* mean of g_a while axle a is on span */
+    double axle_kg[AMFI_MAX_AXLES];      /* mean_force / g */
+    double gvw_kg;                       /* Σ axle_kg */
+    double residual_norm;  /* sqrt Σ_j (y_j − d_j)ᵀ W (y_j − d_j) */
+    double smoothing_norm; /* sqrt Σ_j r_jᵀ r_j, N */
+    double residual_rms;   /* residual_norm / sqrt(N·n_sensors), m/s² */
+    double signal_rms;     /* RMS of the data d_1..d_N, m/s² */
+    int n_modes;           /* modes used (modal), or n (nodal) */
+    int n_solves;          /* sweeps run (1, or the L-curve's count) */
+    /* L-curve (automatic λ only): points sorted by λ, owned by the solver */
+    int lcurve_n;
+    const double *lcurve_lambda_ref; /* lcurve_n */
+    const double *lcurve_residual;   /* lcurve_n, residual norm */
+    const double *lcurve_smoothing;  /* lcurve_n, smoothing norm */
+    const double *lcurve_curvature;  /* lcurve_n, signed; NaN at the ends */
+} amfi_result;
+
+typedef struct amfi_solver amfi_solver;
+
+/* Discretise (once) and size the workspace for passages of up to
+ * max_duration_s + rolls and max_axles axles. `b` must outlive the solver.
+ * Free with amfi_solver_destroy(). */
+int amfi_solver_create(const amfi_bridge *b, const amfi_solver_params *p,
+                       amfi_solver **out, char *err, size_t errlen);
+void amfi_solver_destroy(amfi_solver *s); /* NULL-safe */
+
+/* Solve one passage. The workspace grows (once, before any time loop) when a
+ * passage is longer than its capacity. Arrays in `res` point into the
+ * solver and stay valid until the next call. */
+int amfi_solve(amfi_solver *s, const amfi_passage *p, const amfi_lambda *lam,
+               amfi_result *res, char *err, size_t errlen);
+
+/* Bytes held by the solver's workspace (for benchmarks). */
+size_t amfi_solver_workspace_bytes(const amfi_solver *s);
+
+const char *amfi_formulation_name(amfi_formulation f);
+int amfi_formulation_parse(const char *name, amfi_formulation *f); /* 0 ok */
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* AMFI_AMFI_H */
