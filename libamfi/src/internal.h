@@ -1,0 +1,37 @@
+/*
+ * internal.h: helpers shared by libamfi's sources; not part of the API.
+ */
+#ifndef AMFI_INTERNAL_H
+#define AMFI_INTERNAL_H
+
+#include <stdarg.h>
+#include <stddef.h>
+
+#include "amfi/amfi.h"
+
+/* Write a formatted message to err (if not NULL) and return status. */
+int amfi_fail(char *err, size_t errlen, int status, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+/* Everything amfi_bridge_create computes; read-only afterwards. */
+struct amfi_bridge {
+    amfi_bridge_params p;
+    int n;          /* free DOFs */
+    int n_full;     /* 2·(n_elements + 1) */
+    int *free_of;   /* n_full: free index of a full DOF, or −1 */
+    double le;      /* element length, m */
+    double *M, *K, *C; /* n × n */
+    double *omega;  /* n, rad/s ascending */
+    double *zeta;   /* n */
+    double *Psi;    /* n × n, columns M-orthonormal */
+    double a0, a1;  /* Rayleigh */
+};
+
+/* Hermitian cubic shape functions of an element of length le at local
+ * coordinate xi in [0, 1]: N[4] for (w_i, θ_i, w_j, θ_j). */
+void amfi_hermite(double xi, double le, double N[4]);
+
+/* Element holding x (0 <= x <= L) and its local xi. */
+void amfi_bridge_locate(const amfi_bridge *b, double x, int *elem, double *xi);
+
+#endif

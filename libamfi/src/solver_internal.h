@@ -1,0 +1,80 @@
+/*
+ * solver_internal.h: the solver workspace shared by solver.c, the two sweeps
+ * and the L-curve search. Dimensions use: n bridge DOFs, m modes kept,
+ * na axles (≤ na_max), ns sensors, N steps (≤ cap).
+ */
+#ifndef AMFI_SOLVER_INTERNAL_H
+#define AMFI_SOLVER_INTERNAL_H
+
+#include "internal.h"
+
+struct amfi_solver {
+    const amfi_bridge *b;
+    amfi_solver_params p;
+    double h;     /* calculation step, s */
+    int n;        /* bridge DOFs */
+    int ns;       /* sensors */
+    int na_max;   /* axle capacity */
+    double w[AMFI_MAX_SENSORS]; /* W = diag(w) */
+    double *S;    /* ns × n: sensor shape rows */
+
+    /* modal path */
+    int m;          /* modes kept */
+    int *mode;      /* m: index into the bridge's modes */
+    double *Phi;    /* m × 4: Φ_k row-major 2 × 2 */
+    double *Gm;     /* m × 2 */
+    double *c;      /* ns × m: sensor modal coefficients ψ_k(x_s) */
+    double *Cx;     /* ns × 2m: constant output row (paper: (Φ − I)/h, velocity row) */
+    double *Hxx;    /* 2m × 2m: Cxᵀ W Cx */
+    double *pe;     /* n_elements × 4 × m: mode values at each element's 4 DOFs */
+
+    /* nodal path */
+    double *PhiN;   /* 2n × 2n */
+    double *GN;     /* 2n × n */
+
+    /* per passage (capacity cap steps, na_max axles) */
+    int cap;        /* steps */
+    int na;         /* axles of the current passage */
+    int N;          /* steps of the current passage */
+    double t0;      /* time of step 0 relative to entry, s */
+    double speed;   /* m/s */
+    double off[AMFI_MAX_AXLES]; /* axle a at x = speed·t − off[a] */
+    double *d;      /* (cap + 1) × ns: data at the steps */
+    double *force;  /* (cap + 1) × na_max */
+    double *y;      /* cap × ns: fitted outputs y_1..y_N */
+    double *gain;   /* cap × na_max × gstride: r_j = −(gain_j z_j + gofs_j) */
+    double *gofs;   /* cap × na_max */
+    int gstride;    /* state size of the widest path */
+    double *scratch; /* sweep scratch, sized at create */
+    size_t scratch_len;
+    size_t bytes;   /* workspace bytes */
+
+    /* L-curve (points sorted by λ) */
+    int lc_cap, lc_n;
+    double *lc_lam, *lc_res, *lc_smo, *lc_kap;
+};
+
+/* Position of axle a at step j. */
+static inline double axle_x(const struct amfi_solver *s, int a, int j)
+{
+    return s->speed * (s->t0 + j * s->h) - s->off[a];
+}
+
+/* One backward and forward sweep at per-step λ: fills s->force (N + 1 rows),
+ * s->y, and the two norms. */
+int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
+int amfi_sweep_nodal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
+size_t amfi_sweep_modal_scratch(int m, int na, int ns);
+size_t amfi_sweep_nodal_scratch(int n, int na, int ns);
+
+/* Run the sweep of the solver's coordinates. */
+int amfi_sweep(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
+
+/* L-curve search; returns the chosen per-step λ in *lam_h. */
+int amfi_lcurve(struct amfi_solver *s, const amfi_lambda *l, double *lam_h, int *n_solves);
+
+/* Solve a small SPD system in place (column-major, na ≤ 12): A ← A⁻¹.
+ * No allocation. Returns 0 or a LAPACK info. */
+int amfi_spd_inverse(int na, double *A);
+
+#endif
