@@ -60,14 +60,16 @@ int amfi_forward_newmark(const amfi_bridge *b, double speed_mps, int n_axles,
     for (size_t i = 0; i < nn; i++)
         Kh[i] = b->K[i] + c1 * b->C[i] + c0 * b->M[i];
     rc = AMFI_ENUM;
-    if (LAPACKE_dpotrf(LAPACK_ROW_MAJOR, 'U', n, Kh, n) != 0)
+    /* K̂ and M are symmetric: row-major 'U' is column-major 'L', and the
+     * column-major _work calls neither transpose nor allocate per step. */
+    if (LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n, Kh, n) != 0)
         goto out;
     /* At rest at t = 0: M a0 = f(0). */
     memcpy(Mf, b->M, sizeof(double) * nn);
-    if (LAPACKE_dpotrf(LAPACK_ROW_MAJOR, 'U', n, Mf, n) != 0)
+    if (LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n, Mf, n) != 0)
         goto out;
     load_at(b, 0.0, speed_mps, n_axles, offset_m, force, user, shape, a);
-    if (LAPACKE_dpotrs(LAPACK_ROW_MAJOR, 'U', n, 1, Mf, n, a, 1) != 0)
+    if (LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', n, 1, Mf, n, a, n) != 0)
         goto out;
     for (int s = 0; s < n_sensors; s++)
         accel_out[s] = cblas_ddot(n, S + (size_t)s * n, 1, a, 1);
@@ -75,7 +77,7 @@ int amfi_forward_newmark(const amfi_bridge *b, double speed_mps, int n_axles,
     for (long k = 1; k <= total; k++) {
         const double t = k * dt_s;
         load_at(b, t, speed_mps, n_axles, offset_m, force, user, shape, f);
-        /* rhs = f + M(c0 u + c1·2 v... ): average acceleration predictor */
+        /* rhs = f + M(4/dt² u + 4/dt v + a) + C(2/dt u + v) (β = 1/4, γ = 1/2) */
         for (int i = 0; i < n; i++)
             tmp[i] = c0 * u[i] + 2.0 * c1 * v[i] + a[i];
         memcpy(rhs, f, sizeof(double) * n);
@@ -84,7 +86,7 @@ int amfi_forward_newmark(const amfi_bridge *b, double speed_mps, int n_axles,
             tmp[i] = c1 * u[i] + v[i];
         cblas_dsymv(CblasRowMajor, CblasUpper, n, 1.0, b->C, n, tmp, 1, 1.0, rhs, 1);
         memcpy(un, rhs, sizeof(double) * n);
-        if (LAPACKE_dpotrs(LAPACK_ROW_MAJOR, 'U', n, 1, Kh, n, un, 1) != 0)
+        if (LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', n, 1, Kh, n, un, n) != 0)
             goto out;
         for (int i = 0; i < n; i++) {
             double an = c0 * (un[i] - u[i]) - 2.0 * c1 * v[i] - a[i];

@@ -191,7 +191,7 @@ typedef struct amfi_lambda {
     int lcurve_refine_points;
 } amfi_lambda;
 
-void amfi_lambda_default(amfi_lambda *l); /* fixed 7.94e-9 at 5000 Hz; grid 1e-14..1e-4, 1/decade, 8 refine */
+void amfi_lambda_default(amfi_lambda *l); /* fixed 7.94e-9 at 5000 Hz; grid 1e-13..1e-5, 2/decade, 4 refine */
 
 /* One passage as recorded: accelerations sampled uniformly at scan_rate_hz,
  * sample k at time t_first_s + k/scan_rate_hz, where t = 0 is the moment the
