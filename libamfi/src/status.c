@@ -1,9 +1,12 @@
 /*
  * status.c: status strings and the documented default parameter sets.
  */
+#include <cblas.h>
 #include <string.h>
 
 #include "amfi/amfi.h"
+
+void amfi_set_blas_threads(int n) { openblas_set_num_threads(n > 0 ? n : 1); }
 
 const char *amfi_strerror(int status)
 {
@@ -69,7 +72,7 @@ void amfi_lambda_default(amfi_lambda *l)
     l->lcurve_refine_points = 4;
 }
 
-static const char *const form_names[] = {"paper"};
+static const char *const form_names[] = {"paper", "endstep", "exact"};
 
 const char *amfi_formulation_name(amfi_formulation f)
 {

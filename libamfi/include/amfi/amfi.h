@@ -40,6 +40,11 @@ extern "C" {
 
 const char *amfi_strerror(int status); /* static string; never NULL */
 
+/* Threads OpenBLAS may use (process-wide). The solver's matrices are small:
+ * programs that parallelise across passages should set 1, which also stops
+ * OpenBLAS's idle threads spinning against the workers on a 2-core box. */
+void amfi_set_blas_threads(int n);
+
 /* ---- bridge: Euler-Bernoulli FE beam (MODEL.md §1) --------------------- */
 
 typedef struct amfi_support {
@@ -139,8 +144,14 @@ int amfi_forward_newmark(const amfi_bridge *b, double speed_mps, int n_axles,
 
 /* ---- the A-MFI solver -------------------------------------------------- */
 
+/* Output equations (MODEL.md §4). Only `paper` runs in nodal coordinates;
+ * the others are measured against it (docs/solver.md) and kept for that. */
 typedef enum amfi_formulation {
-    AMFI_FORM_PAPER = 0 /* eqs 13-20: backward-difference acceleration */
+    AMFI_FORM_PAPER = 0,   /* eqs 13-20: y_{j+1} = (u'_{j+1} − u'_j)/h, the
+                              step-averaged acceleration */
+    AMFI_FORM_ENDSTEP = 1, /* y_{j+1} = u''(t_{j+1}) from [X_j; g_j], the load
+                              still at its position of step j */
+    AMFI_FORM_EXACT = 2    /* y_j = S(−M⁻¹K u_j − M⁻¹C u'_j + M⁻¹L_j g_j) */
 } amfi_formulation;
 
 typedef enum amfi_coords {
