@@ -422,6 +422,7 @@ int main(int argc, char **argv)
     options o;
     if (parse_args(argc, argv, &o) != 0)
         return EXIT_USAGE;
+    amfi_set_blas_threads(1); /* small matrices: threads only spin */
 
     static amfi_site_config cfg; /* large; zeroed */
     if (load_config(&o, &cfg) != 0)

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Install the Debian packages amfi needs to build and test; a no-op when they
+# are all present. Run as root on Debian 12 (bookworm).
+set -euo pipefail
+pkgs=(
+  cmake make gcc pkg-config      # build
+  libopenblas-dev liblapacke-dev # dense linear algebra (BLAS, LAPACK, LAPACKE)
+  libyaml-dev                    # configuration files
+  zlib1g-dev                     # gzip-compressed passage CSVs
+  libgsl-dev                     # random numbers and statistics
+  libcmocka-dev                  # unit tests
+)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "install-deps: installing ${missing[*]}"
+  if [ "$(id -u)" -ne 0 ]; then
+    echo "install-deps: missing packages and not root; run: apt-get install -y ${missing[*]}" >&2
+    exit 1
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi

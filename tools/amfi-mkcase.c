@@ -1,0 +1,240 @@
+/*
+ * amfi-mkcase: write a synthetic passage CSV from known moving forces.
+ *
+ *   amfi-mkcase --out FILE.csv[.gz] [--config FILE.yaml] [--speed MPS]
+ *               [--axle-loads-kg W1,W2,...] [--axle-spacing S1,...]
+ *               [--scan-rate HZ] [--pre SEC] [--post SEC] [--noise FRACTION]
+ *               [--vary FRACTION] [--vary-hz HZ] [--damage FRACTION] [--seed N]
+ *
+ * The bridge (from the configuration, with --damage applied) carries point
+ * forces W_a·g·(1 + vary·sin(2π·vary_hz·t + 1.3a)) moving at --speed; its
+ * response at sensor 0 comes from the Newmark integrator of libamfi (the
+ * tests' independent reference, dt = 20 µs), sampled at --scan-rate, with
+ * --pre seconds of rest before the first axle enters (t = --pre in the file)
+ * and --post seconds after the last one leaves, plus Gaussian noise of
+ * --noise × the signal's RMS (GSL, Mersenne Twister, --seed).
+ * This is not vehicle-bridge interaction: the forces are prescribed. The
+ * simulator (sim_publisher) models vehicles.
+ *
+ * stdout: one JSON line with the truth: entry time, true mean force of each
+ * axle while on the span, true GVW.
+ */
+#include <errno.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <zlib.h>
+
+#include "amfi/amfi.h"
+#include "amfi_config.h"
+
+#define PROG "amfi-mkcase"
+
+typedef struct forces {
+    int n;
+    double W_N[AMFI_MAX_AXLES];
+    double vary, vary_hz;
+} forces;
+
+static double force(double t, int a, void *user)
+{
+    const forces *f = user;
+    return f->W_N[a] * (1.0 + f->vary * sin(2.0 * M_PI * f->vary_hz * t + 1.3 * a));
+}
+
+static void usage(void)
+{
+    fprintf(stderr, "usage: %s --out FILE.csv[.gz] [--config FILE.yaml] [--speed MPS]\n"
+                    "       [--axle-loads-kg W1,W2,...] [--axle-spacing S1,...] [--scan-rate HZ]\n"
+                    "       [--pre SEC] [--post SEC] [--noise FRACTION] [--vary FRACTION]\n"
+                    "       [--vary-hz HZ] [--damage FRACTION] [--seed N]\n",
+            PROG);
+}
+
+/* Parse a number in [lo, hi]; exits with status 2 naming the option. */
+static double num(const char *opt, const char *s, double lo, double hi)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
+        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, s, lo, hi);
+        exit(2);
+    }
+    return v;
+}
+
+static int list(const char *opt, const char *s, double *out, int max, double lo, double hi)
+{
+    char buf[512];
+    if (strlen(s) >= sizeof buf) {
+        fprintf(stderr, "%s: %s: list too long\n", PROG, opt);
+        exit(2);
+    }
+    strcpy(buf, s);
+    int n = 0;
+    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok;
+         tok = strtok_r(NULL, ",", &save)) {
+        if (n == max) {
+            fprintf(stderr, "%s: %s: at most %d values\n", PROG, opt, max);
+            exit(2);
+        }
+        out[n++] = num(opt, tok, lo, hi);
+    }
+    return n;
+}
+
+int main(int argc, char **argv)
+{
+    const char *out = NULL, *config = NULL;
+    double speed = 25.0, scan = 1000.0, pre = 0.5, post = 0.5, noise = 0.0, damage = -1;
+    double loads_kg[AMFI_MAX_AXLES] = {102000.0 / AMFI_GRAVITY, 74600.0 / AMFI_GRAVITY};
+    double spacing[AMFI_MAX_AXLES] = {5.0};
+    int n_loads = 2, n_spacing = 1;
+    unsigned long seed = 1;
+    forces f = {0};
+    f.vary_hz = 2.0;
+    for (int i = 1; i < argc; i++) {
+        const char *o = argv[i];
+        if (i + 1 >= argc) {
+            usage();
+            return 2;
+        }
+        const char *v = argv[++i];
+        if (!strcmp(o, "--out"))
+            out = v;
+        else if (!strcmp(o, "--config"))
+            config = v;
+        else if (!strcmp(o, "--speed"))
+            speed = num(o, v, 0.5, 60.0);
+        else if (!strcmp(o, "--scan-rate"))
+            scan = num(o, v, 10.0, 1e5);
+        else if (!strcmp(o, "--pre"))
+            pre = num(o, v, 0.0, 60.0);
+        else if (!strcmp(o, "--post"))
+            post = num(o, v, 0.0, 60.0);
+        else if (!strcmp(o, "--noise"))
+            noise = num(o, v, 0.0, 1.0);
+        else if (!strcmp(o, "--vary"))
+            f.vary = num(o, v, 0.0, 0.9);
+        else if (!strcmp(o, "--vary-hz"))
+            f.vary_hz = num(o, v, 0.0, 1000.0);
+        else if (!strcmp(o, "--damage"))
+            damage = num(o, v, 0.0, 0.99);
+        else if (!strcmp(o, "--seed"))
+            seed = (unsigned long)num(o, v, 0.0, 4294967295.0);
+        else if (!strcmp(o, "--axle-loads-kg"))
+            n_loads = list(o, v, loads_kg, AMFI_MAX_AXLES, 1.0, 1e5);
+        else if (!strcmp(o, "--axle-spacing"))
+            n_spacing = list(o, v, spacing, AMFI_MAX_AXLES - 1, 0.1, 30.0);
+        else {
+            fprintf(stderr, "%s: unknown option %s\n", PROG, o);
+            usage();
+            return 2;
+        }
+    }
+    if (!out) {
+        fprintf(stderr, "%s: --out is required\n", PROG);
+        usage();
+        return 2;
+    }
+    if (n_spacing != n_loads - 1) {
+        fprintf(stderr, "%s: %d axle loads need %d spacings, got %d\n", PROG, n_loads,
+                n_loads - 1, n_spacing);
+        return 2;
+    }
+    amfi_set_blas_threads(1);
+    amfi_site_config cfg;
+    char err[512];
+    amfi_config_defaults(&cfg);
+    if (config && amfi_config_load(config, &cfg, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    if (damage >= 0)
+        cfg.bridge.damage = damage;
+    amfi_bridge *b = NULL;
+    if (amfi_bridge_create(&cfg.bridge, &b, err, sizeof err)) {
+        fprintf(stderr, "%s: bridge: %s\n", PROG, err);
+        return 1;
+    }
+    f.n = n_loads;
+    double off[AMFI_MAX_AXLES] = {0.0};
+    for (int a = 0; a < n_loads; a++) {
+        f.W_N[a] = loads_kg[a] * AMFI_GRAVITY;
+        if (a > 0)
+            off[a] = off[a - 1] + spacing[a - 1];
+    }
+    const double L = cfg.bridge.span_m, T = (L + off[n_loads - 1]) / speed + post;
+    const int n_rest = (int)lround(pre * scan), n_move = (int)floor(T * scan) + 1;
+    const int n = n_rest + n_move;
+    double *acc = calloc(n, sizeof(double));
+    if (!acc) {
+        fprintf(stderr, "%s: out of memory\n", PROG);
+        return 1;
+    }
+    const double xs = cfg.solver.sensor_x_m[0];
+    /* dt = 20 µs, or the nearest step that divides the sample interval */
+    double dt = 1.0 / (scan * ceil(1.0 / (scan * 2e-5)));
+    if (amfi_forward_newmark(b, speed, n_loads, off, force, &f, 1, &xs, dt, scan, n_move,
+                             acc + n_rest, err, sizeof err)) {
+        fprintf(stderr, "%s: %s\n", PROG, err);
+        return 1;
+    }
+    if (noise > 0) {
+        double rms = 0.0;
+        for (int i = 0; i < n; i++)
+            rms += acc[i] * acc[i];
+        rms = sqrt(rms / n);
+        gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+        gsl_rng_set(rng, seed);
+        for (int i = 0; i < n; i++)
+            acc[i] += gsl_ran_gaussian(rng, noise * rms);
+        gsl_rng_free(rng);
+    }
+    size_t len = strlen(out);
+    int gz = len > 3 && !strcmp(out + len - 3, ".gz");
+    gzFile gzf = NULL;
+    FILE *fp = NULL;
+    if (gz)
+        gzf = gzopen(out, "wb9");
+    else
+        fp = fopen(out, "w");
+    if (!gzf && !fp) {
+        fprintf(stderr, "%s: %s: cannot create: %s\n", PROG, out, strerror(errno));
+        return 1;
+    }
+    int bad = 0;
+    char line[96];
+    for (int i = -1; i < n && !bad; i++) {
+        int k = i < 0 ? snprintf(line, sizeof line, "t,accel\n")
+                      : snprintf(line, sizeof line, "%.6f,%.9g\n", i / scan, acc[i]);
+        bad = gz ? gzwrite(gzf, line, (unsigned)k) != k : fwrite(line, 1, k, fp) != (size_t)k;
+    }
+    bad |= gz ? gzclose(gzf) != Z_OK : fclose(fp) != 0;
+    if (bad) {
+        fprintf(stderr, "%s: %s: write failed\n", PROG, out);
+        return 1;
+    }
+    /* Truth: mean of each axle's force over the time it is on the span,
+     * sampled at 5000 Hz. */
+    double gvw = 0.0;
+    printf("{\"file\":\"%s\",\"entry_time_s\":%.6f,\"speed_mps\":%.6g,\"mean_force_N\":[", out,
+           n_rest / scan, speed);
+    for (int a = 0; a < n_loads; a++) {
+        double sum = 0.0;
+        int cnt = 0;
+        for (double t = off[a] / speed; speed * t - off[a] <= L; t += 2e-4, cnt++)
+            sum += force(t, a, &f);
+        printf("%s%.6g", a ? "," : "", sum / cnt);
+        gvw += sum / cnt / AMFI_GRAVITY;
+    }
+    printf("],\"gvw_kg\":%.6g,\"damage\":%g,\"noise\":%g,\"seed\":%lu}\n", gvw,
+           cfg.bridge.damage, noise, seed);
+    free(acc);
+    amfi_bridge_destroy(b);
+    return 0;
+}
