@@ -36,7 +36,6 @@ void amfi_solver_destroy(amfi_solver *s)
     free(s->Gm);
     free(s->c);
     free(s->Cx);
-    free(s->beta);
     free(s->Hxx);
     free(s->pe);
     free(s->PhiN);
@@ -65,10 +64,7 @@ static int check_params(const amfi_bridge *b, const amfi_solver_params *p, char 
         if (!(cond))                                                      \
             return amfi_fail(err, errlen, AMFI_EINVAL, __VA_ARGS__);      \
     } while (0)
-    REQ(p->formulation >= AMFI_FORM_PAPER && p->formulation <= AMFI_FORM_EXACT,
-        "unknown formulation %d", (int)p->formulation);
-    REQ(p->formulation == AMFI_FORM_PAPER || p->coords == AMFI_COORDS_MODAL,
-        "formulation %s runs in modal coordinates only", amfi_formulation_name(p->formulation));
+    REQ(p->formulation == AMFI_FORM_PAPER, "unknown formulation %d", (int)p->formulation);
     REQ(p->coords == AMFI_COORDS_MODAL || p->coords == AMFI_COORDS_NODAL,
         "unknown coordinates %d", (int)p->coords);
     REQ(p->modes >= AMFI_MODES_ALL && p->modes <= AMFI_MODES_COUNT, "unknown modes policy");
@@ -162,10 +158,9 @@ static int setup_modal(struct amfi_solver *s, char *err, size_t errlen)
     s->Gm = malloc(sizeof(double) * 2 * m);
     s->c = malloc(sizeof(double) * ns * m);
     s->Cx = malloc(sizeof(double) * ns * 2 * m);
-    s->beta = malloc(sizeof(double) * m);
     s->Hxx = calloc((size_t)4 * m * m, sizeof(double));
     s->pe = calloc((size_t)b->p.n_elements * 4 * m, sizeof(double));
-    if (!s->mode || !s->Phi || !s->Gm || !s->c || !s->Cx || !s->beta || !s->Hxx || !s->pe) {
+    if (!s->mode || !s->Phi || !s->Gm || !s->c || !s->Cx || !s->Hxx || !s->pe) {
         free(call);
         free(keep);
         return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory");
@@ -174,37 +169,13 @@ static int setup_modal(struct amfi_solver *s, char *err, size_t errlen)
     for (int q = 0; q < m; q++) {
         int k = keep[q];
         s->mode[q] = k;
-        const double *F = s->Phi + 4 * q, *G = s->Gm + 2 * q;
         amfi_modal_block(b->omega[k], b->zeta[k], h, s->Phi + 4 * q, s->Gm + 2 * q);
-        /* Modal acceleration q'' = −ω²q − 2ζωq' + φ(x)·g, per output equation:
-         * cx0, cx1 multiply [q; q'] of step j, beta the load term φ(x_j)·g_j. */
-        const double w2 = b->omega[k] * b->omega[k], c2 = 2.0 * b->zeta[k] * b->omega[k];
-        double cx0, cx1;
-        switch (s->p.formulation) {
-        case AMFI_FORM_ENDSTEP: /* q''_{j+1} with [q; q']_{j+1} = Φ[q; q']_j + G φ g_j */
-            cx0 = -w2 * F[0] - c2 * F[2];
-            cx1 = -w2 * F[1] - c2 * F[3];
-            s->beta[q] = -w2 * G[0] - c2 * G[1] + 1.0;
-            s->doff = 1;
-            break;
-        case AMFI_FORM_EXACT: /* q''_j from [q; q']_j and the load of step j */
-            cx0 = -w2;
-            cx1 = -c2;
-            s->beta[q] = 1.0;
-            s->doff = 0;
-            break;
-        default: /* paper: (q'_{j+1} − q'_j)/h, the velocity row of (Φ − I)/h and P/h */
-            cx0 = F[2] / h;
-            cx1 = (F[3] - 1.0) / h;
-            s->beta[q] = G[1] / h;
-            s->doff = 1;
-            break;
-        }
         for (int si = 0; si < ns; si++) {
             double ck = call[si * n + k];
             s->c[si * m + q] = ck;
-            s->Cx[si * 2 * m + 2 * q] = ck * cx0;
-            s->Cx[si * 2 * m + 2 * q + 1] = ck * cx1;
+            /* paper: y_{j+1} = ψ(x_s)·(q'_{j+1} − q'_j)/h, velocity row of (Φ − I)/h */
+            s->Cx[si * 2 * m + 2 * q] = ck * s->Phi[4 * q + 2] / h;
+            s->Cx[si * 2 * m + 2 * q + 1] = ck * (s->Phi[4 * q + 3] - 1.0) / h;
         }
         for (int e = 0; e < b->p.n_elements; e++)
             for (int i = 0; i < 4; i++) {
@@ -217,7 +188,7 @@ static int setup_modal(struct amfi_solver *s, char *err, size_t errlen)
         for (int i = 0; i < m2; i++)
             for (int j = 0; j < m2; j++)
                 s->Hxx[i * m2 + j] += s->w[si] * s->Cx[si * m2 + i] * s->Cx[si * m2 + j];
-    s->bytes += sizeof(double) * ((size_t)8 * m + 3 * ns * m + 4 * (size_t)m * m +
+    s->bytes += sizeof(double) * ((size_t)7 * m + 3 * ns * m + 4 * (size_t)m * m +
                                   (size_t)b->p.n_elements * 4 * m);
     free(call);
     free(keep);

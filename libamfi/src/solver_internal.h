@@ -24,9 +24,7 @@ struct amfi_solver {
     double *Phi;    /* m × 4: Φ_k row-major 2 × 2 */
     double *Gm;     /* m × 2 */
     double *c;      /* ns × m: sensor modal coefficients ψ_k(x_s) */
-    double *Cx;     /* ns × 2m: constant part of the output row */
-    double *beta;   /* m: direct term Cg_j[s][a] = Σ_k c[s][k]·beta[k]·φ_k(x_a(t_j)) */
-    int doff;       /* stage j's output is compared with d_{j + doff} */
+    double *Cx;     /* ns × 2m: constant output row (paper: (Φ − I)/h, velocity row) */
     double *Hxx;    /* 2m × 2m: Cxᵀ W Cx */
     double *pe;     /* n_elements × 4 × m: mode values at each element's 4 DOFs */
 

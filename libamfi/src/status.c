@@ -72,7 +72,7 @@ void amfi_lambda_default(amfi_lambda *l)
     l->lcurve_refine_points = 4;
 }
 
-static const char *const form_names[] = {"paper", "endstep", "exact"};
+static const char *const form_names[] = {"paper"};
 
 const char *amfi_formulation_name(amfi_formulation f)
 {

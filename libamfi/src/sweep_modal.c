@@ -2,10 +2,6 @@
  * sweep_modal.c: the A-MFI backward/forward sweep in modal coordinates on
  * the reduced state z = [q₁, q₁', …, q_m, q_m', g₁ … g_na] (2m + na).
  *
- * The other output equations (endstep, exact) have the same shape, y = C_j z_j
- * with a constant Cx and a direct term Cg_j, compared with d_{j+1} (endstep)
- * or d_j (exact); solver.c sets Cx, beta and doff per formulation.
- *
  * Why reduced: in the paper formulation (MODEL.md §4) the X' block of the
  * augmented state never feeds forward, and y_{j+1} = Q x_{j+1} is a function
  * of [X_j; g_j] only:
@@ -64,12 +60,13 @@ static void step_rows(const struct amfi_solver *s, int j, double *phi, double *P
             P[(2 * k) * na + a] = s->Gm[2 * k] * phi[a * m + k];
             P[(2 * k + 1) * na + a] = s->Gm[2 * k + 1] * phi[a * m + k];
         }
+    const double ih = 1.0 / s->h;
     for (int si = 0; si < ns; si++)
         for (int a = 0; a < na; a++) {
             double v = 0.0;
             for (int k = 0; k < m; k++)
-                v += s->c[si * m + k] * s->beta[k] * phi[a * m + k];
-            Cg[si * na + a] = v;
+                v += s->c[si * m + k] * P[(2 * k + 1) * na + a];
+            Cg[si * na + a] = v * ih;
         }
 }
 
@@ -107,7 +104,7 @@ int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double
     memset(sg, 0, sizeof(double) * na);
 
     for (int j = N - 1; j >= 0; j--) {
-        const double *dj = s->d + (size_t)(j + s->doff) * ns;
+        const double *dj = s->d + (size_t)(j + 1) * ns;
         step_rows(s, j, phi, P, Cg);
         memcpy(Ux, Rxg, sizeof(double) * m2 * na);
         memcpy(Ugg, Rgg, sizeof(double) * na * na);
@@ -285,7 +282,7 @@ int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double
 
     double res2 = 0.0, smo2 = 0.0;
     for (int j = 0; j < N; j++) {
-        const double *dj = s->d + (size_t)(j + s->doff) * ns;
+        const double *dj = s->d + (size_t)(j + 1) * ns;
         step_rows(s, j, phi, P, Cg);
         const double *gj = s->gain + (size_t)j * na * nst;
         for (int a = 0; a < na; a++) {

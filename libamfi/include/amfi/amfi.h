@@ -144,14 +144,10 @@ int amfi_forward_newmark(const amfi_bridge *b, double speed_mps, int n_axles,
 
 /* ---- the A-MFI solver -------------------------------------------------- */
 
-/* Output equations (MODEL.md §4). Only `paper` runs in nodal coordinates;
- * the others are measured against it (docs/solver.md) and kept for that. */
+/* Output equation. Only the paper's is kept: the alternatives of MODEL.md §4
+ * were implemented and measured worse (docs/solver.md). */
 typedef enum amfi_formulation {
-    AMFI_FORM_PAPER = 0,   /* eqs 13-20: y_{j+1} = (u'_{j+1} − u'_j)/h, the
-                              step-averaged acceleration */
-    AMFI_FORM_ENDSTEP = 1, /* y_{j+1} = u''(t_{j+1}) from [X_j; g_j], the load
-                              still at its position of step j */
-    AMFI_FORM_EXACT = 2    /* y_j = S(−M⁻¹K u_j − M⁻¹C u'_j + M⁻¹L_j g_j) */
+    AMFI_FORM_PAPER = 0 /* eqs 13-20: backward-difference acceleration */
 } amfi_formulation;
 
 typedef enum amfi_coords {
