@@ -139,6 +139,21 @@ static void load_vector(void **state)
         assert_true(v[i] == 0.0);
     assert_int_equal(amfi_bridge_shape(bridge, 20.01, v), 1);
     assert_int_equal(amfi_bridge_shape(bridge, NAN, v), 1);
+    /* Mode values: ψ_k(x) = shape(x)·Ψ[:, k], to round-off. */
+    const double *P = amfi_bridge_modes(bridge);
+    double phi[64];
+    for (double x = 0.0; x <= 20.0; x += 0.37) {
+        amfi_bridge_shape(bridge, x, v);
+        assert_int_equal(amfi_bridge_mode_values(bridge, x, phi), 0);
+        for (int k = 0; k < n; k++) {
+            double ref = 0.0;
+            for (int i = 0; i < n; i++)
+                ref += v[i] * P[i * n + k];
+            assert_true(fabs(phi[k] - ref) < 1e-12);
+        }
+    }
+    assert_int_equal(amfi_bridge_mode_values(bridge, 20.5, phi), 1);
+    assert_true(phi[0] == 0.0);
     /* Restrained DOFs: the support node's w is not a free DOF. */
     assert_int_equal(amfi_bridge_dof(bridge, 0, 0), -1);
     assert_true(amfi_bridge_dof(bridge, 0, 1) >= 0);

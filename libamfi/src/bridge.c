@@ -88,6 +88,7 @@ void amfi_bridge_destroy(amfi_bridge *b)
     free(b->omega);
     free(b->zeta);
     free(b->Psi);
+    free(b->pe);
     free(b);
 }
 
@@ -213,6 +214,17 @@ int amfi_bridge_create(const amfi_bridge_params *p, amfi_bridge **out, char *err
     for (int k = 0; k < n; k++)
         b->zeta[k] = b->a0 / (2.0 * b->omega[k]) + b->a1 * b->omega[k] / 2.0;
 
+    b->pe = calloc((size_t)ne * 4 * n, sizeof(double));
+    if (!b->pe) {
+        rc = amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory");
+        goto fail;
+    }
+    for (int e = 0; e < ne; e++)
+        for (int i = 0; i < 4; i++) {
+            int d = b->free_of[2 * e + i];
+            if (d >= 0)
+                memcpy(b->pe + ((size_t)e * 4 + i) * n, b->Psi + (size_t)d * n, sizeof(double) * n);
+        }
     free(Mf);
     free(Kf);
     free(Mw);
@@ -246,6 +258,23 @@ int amfi_bridge_dof(const amfi_bridge *b, int node, int rot)
     if (node < 0 || node > b->p.n_elements || rot < 0 || rot > 1)
         return -1;
     return b->free_of[2 * node + rot];
+}
+
+int amfi_bridge_mode_values(const amfi_bridge *b, double x_m, double *phi)
+{
+    const int n = b->n;
+    if (!(x_m >= 0.0 && x_m <= b->p.span_m)) {
+        memset(phi, 0, sizeof(double) * n);
+        return 1;
+    }
+    int e;
+    double xi, N[4];
+    amfi_bridge_locate(b, x_m, &e, &xi);
+    amfi_hermite(xi, b->le, N);
+    const double *p0 = b->pe + (size_t)e * 4 * n;
+    for (int k = 0; k < n; k++)
+        phi[k] = N[0] * p0[k] + N[1] * p0[n + k] + N[2] * p0[2 * n + k] + N[3] * p0[3 * n + k];
+    return 0;
 }
 
 int amfi_bridge_shape(const amfi_bridge *b, double x_m, double *out)

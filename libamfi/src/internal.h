@@ -25,6 +25,7 @@ struct amfi_bridge {
     double *zeta;   /* n */
     double *Psi;    /* n × n, columns M-orthonormal */
     double a0, a1;  /* Rayleigh */
+    double *pe;     /* n_elements × 4 × n: mode values at each element's DOFs */
 };
 
 /* Hermitian cubic shape functions of an element of length le at local

@@ -99,6 +99,11 @@ void amfi_bridge_rayleigh(const amfi_bridge *b, double *a0, double *a1);
  * the beam (x < 0 or x > L), 0 otherwise. */
 int amfi_bridge_shape(const amfi_bridge *b, double x_m, double *out /* n */);
 
+/* Mode values at x: phi[k] = ψ_k(x) = shape(x)·Ψ[:, k], k = 0 .. n−1, from a
+ * table built at creation (O(n) per call, no allocation). Returns 1 and
+ * zeros off the beam, 0 otherwise. */
+int amfi_bridge_mode_values(const amfi_bridge *b, double x_m, double *phi /* n */);
+
 /* Free-DOF index of node `node` (0 .. n_elements), `rot` 0 for w, 1 for θ;
  * −1 when that DOF is restrained or out of range. */
 int amfi_bridge_dof(const amfi_bridge *b, int node, int rot);
