@@ -1,0 +1,521 @@
+/*
+ * test_config.c: unit tests of the YAML site loader (config/amfi_config.h).
+ *
+ * The shipped paper-20m.yaml must load to exactly amfi_config_defaults();
+ * a file changing every key must land every value in its field; and each bad
+ * input of the table below must fail with one line naming ":LINE: key.path"
+ * and the problem, leaving the caller's struct untouched. Files are written
+ * with mkstemp under /tmp and removed afterwards.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "amfi_config.h"
+
+#ifndef AMFI_CONFIG_DIR
+#error "AMFI_CONFIG_DIR (the config/ source folder) must be defined"
+#endif
+
+#define ERRLEN 512
+
+/* Write `text` (len bytes) to a fresh temporary file; its name into path. */
+static void write_temp(const char *text, size_t len, char path[64])
+{
+    int fd;
+
+    snprintf(path, 64, "/tmp/amfi_test_config_XXXXXX");
+    fd = mkstemp(path);
+    assert_true(fd >= 0);
+    assert_int_equal((ssize_t)len, write(fd, text, len));
+    assert_int_equal(0, close(fd));
+}
+
+/* Load `text` as a site file into *c; err gets the message. */
+static int load_text(const char *text, amfi_site_config *c, char *err)
+{
+    char path[64];
+    int rc;
+
+    write_temp(text, strlen(text), path);
+    rc = amfi_config_load(path, c, err, ERRLEN);
+    unlink(path);
+    return rc;
+}
+
+/* ---- good files ---------------------------------------------------------- */
+
+static void test_defaults(void **state)
+{
+    amfi_site_config c;
+    amfi_bridge_params b;
+    amfi_solver_params s;
+    amfi_lambda l;
+
+    (void)state;
+    amfi_config_defaults(&c);
+    amfi_bridge_params_paper20(&b);
+    amfi_solver_params_default(&s, 20.0);
+    amfi_lambda_default(&l);
+    assert_string_equal("paper-20m", c.name);
+    assert_memory_equal(&b, &c.bridge, sizeof b);
+    assert_memory_equal(&s, &c.solver, sizeof s);
+    assert_memory_equal(&l, &c.lambda, sizeof l);
+    assert_int_equal(0, c.sensor_id[0]);
+    for (int i = 1; i < AMFI_MAX_SENSORS; i++)
+        assert_int_equal(-1, c.sensor_id[i]);
+}
+
+static void test_shipped_file_is_the_defaults(void **state)
+{
+    amfi_site_config want, got;
+    char err[ERRLEN];
+    int rc;
+
+    (void)state;
+    amfi_config_defaults(&want);
+    memset(&got, 0xa5, sizeof got); /* every byte must be written */
+    rc = amfi_config_load(AMFI_CONFIG_DIR "/paper-20m.yaml", &got, err, sizeof err);
+    if (rc)
+        fail_msg("%s", err);
+    assert_string_equal(want.name, got.name);
+    assert_true(got.bridge.span_m == 20.0 && got.bridge.n_elements == 20);
+    assert_true(got.bridge.E_pa == 3.5e10 && got.bridge.A_m2 == 2.046);
+    assert_true(got.bridge.I_m4 == 0.2991 && got.bridge.density_kgm3 == 2400.0);
+    assert_true(got.lambda.lambda_ref == 7.94e-9 && !got.lambda.automatic);
+    assert_true(got.solver.sensor_x_m[0] == 10.0 && got.solver.n_sensors == 1);
+    assert_memory_equal(&want.bridge, &got.bridge, sizeof want.bridge);
+    assert_memory_equal(&want.solver, &got.solver, sizeof want.solver);
+    assert_memory_equal(&want.lambda, &got.lambda, sizeof want.lambda);
+    assert_memory_equal(&want, &got, sizeof want);
+}
+
+static const char every_key[] =
+    "# every key changed from its default\n"
+    "bridge:\n"
+    "  name: 'A9 Kühbach'\n"
+    "  span_m: 30.5\n"
+    "  elements: 61\n"
+    "  E_pa: 3.0e10\n"
+    "  A_m2: 3.5\n"
+    "  I_m4: 0.75\n"
+    "  density_kgm3: 2500\n"
+    "  damping: {ratio: 0.02, modes: [1, 3]}\n"
+    "  supports:\n"
+    "    - {at_m: 0, type: fixed}\n"
+    "    - {at_m: 15.25, type: roller}\n"
+    "    - at_m: 30.5\n"
+    "      type: pinned\n"
+    "  damage: 0.1\n"
+    "sensors:\n"
+    "  - {id: 7, at_m: 15.25}\n"
+    "  - {id: 3, at_m: 7.5, weight: 0.5}\n"
+    "  - {id: 255, at_m: 30.5, weight: 2}\n"
+    "solver:\n"
+    "  formulation: \"paper\"\n"
+    "  coordinates: nodal\n"
+    "  modes: 6\n"
+    "  calc_rate_hz: 2000\n"
+    "  initial_force: zero\n"
+    "  pre_roll_s: 0.2\n"
+    "  post_roll_s: 0.5\n"
+    "  max_axles: 5\n"
+    "  max_duration_s: 4.5\n"
+    "  lambda: auto\n"
+    "  lambda_ref_rate_hz: 1000\n"
+    "  lcurve: {lo: 1e-12, hi: 1e-6, per_decade: 4, refine: 0}\n";
+
+static void test_every_key(void **state)
+{
+    amfi_site_config c;
+    char err[ERRLEN];
+
+    (void)state;
+    if (load_text(every_key, &c, err))
+        fail_msg("%s", err);
+    assert_string_equal("A9 Kühbach", c.name);
+    assert_true(c.bridge.span_m == 30.5);
+    assert_int_equal(61, c.bridge.n_elements);
+    assert_true(c.bridge.E_pa == 3.0e10 && c.bridge.A_m2 == 3.5);
+    assert_true(c.bridge.I_m4 == 0.75 && c.bridge.density_kgm3 == 2500.0);
+    assert_true(c.bridge.damping_ratio == 0.02);
+    assert_int_equal(1, c.bridge.rayleigh_mode_a);
+    assert_int_equal(3, c.bridge.rayleigh_mode_b);
+    assert_int_equal(3, c.bridge.n_supports);
+    assert_true(c.bridge.supports[0].x_m == 0.0);
+    assert_int_equal(1, c.bridge.supports[0].restrain_w);
+    assert_int_equal(1, c.bridge.supports[0].restrain_theta);
+    assert_true(c.bridge.supports[1].x_m == 15.25);
+    assert_int_equal(1, c.bridge.supports[1].restrain_w);
+    assert_int_equal(0, c.bridge.supports[1].restrain_theta);
+    assert_true(c.bridge.supports[2].x_m == 30.5);
+    assert_int_equal(0, c.bridge.supports[2].restrain_theta);
+    assert_true(c.bridge.damage == 0.1);
+
+    assert_int_equal(3, c.solver.n_sensors);
+    assert_int_equal(7, c.sensor_id[0]);
+    assert_int_equal(3, c.sensor_id[1]);
+    assert_int_equal(255, c.sensor_id[2]);
+    assert_int_equal(-1, c.sensor_id[3]);
+    assert_true(c.solver.sensor_x_m[0] == 15.25 && c.solver.sensor_weight[0] == 1.0);
+    assert_true(c.solver.sensor_x_m[1] == 7.5 && c.solver.sensor_weight[1] == 0.5);
+    assert_true(c.solver.sensor_x_m[2] == 30.5 && c.solver.sensor_weight[2] == 2.0);
+
+    assert_int_equal(AMFI_FORM_PAPER, c.solver.formulation);
+    assert_int_equal(AMFI_COORDS_NODAL, c.solver.coords);
+    assert_int_equal(AMFI_MODES_COUNT, c.solver.modes);
+    assert_int_equal(6, c.solver.n_modes);
+    assert_true(c.solver.calc_rate_hz == 2000.0);
+    assert_int_equal(1, c.solver.fix_initial_force);
+    assert_true(c.solver.pre_roll_s == 0.2 && c.solver.post_roll_s == 0.5);
+    assert_int_equal(5, c.solver.max_axles);
+    assert_true(c.solver.max_duration_s == 4.5);
+
+    assert_int_equal(1, c.lambda.automatic);
+    assert_true(c.lambda.lambda_ref == 7.94e-9); /* auto keeps the fixed default */
+    assert_true(c.lambda.ref_rate_hz == 1000.0);
+    assert_true(c.lambda.lcurve_lo == 1e-12 && c.lambda.lcurve_hi == 1e-6);
+    assert_int_equal(4, c.lambda.lcurve_per_decade);
+    assert_int_equal(0, c.lambda.lcurve_refine_points);
+}
+
+/* Without supports and sensors, they follow span_m; everything else stays. */
+static void test_span_follows(void **state)
+{
+    amfi_site_config c, d;
+    char err[ERRLEN];
+
+    (void)state;
+    if (load_text("bridge: {span_m: 30}\nsolver: {modes: all, lambda: 1e-10}\n", &c, err))
+        fail_msg("%s", err);
+    amfi_config_defaults(&d);
+    assert_true(c.bridge.span_m == 30.0);
+    assert_int_equal(2, c.bridge.n_supports);
+    assert_true(c.bridge.supports[0].x_m == 0.0 && c.bridge.supports[1].x_m == 30.0);
+    assert_int_equal(1, c.solver.n_sensors);
+    assert_true(c.solver.sensor_x_m[0] == 15.0);
+    assert_int_equal(0, c.sensor_id[0]);
+    assert_int_equal(AMFI_MODES_ALL, c.solver.modes);
+    assert_int_equal(0, c.lambda.automatic);
+    assert_true(c.lambda.lambda_ref == 1e-10);
+    assert_int_equal(d.bridge.n_elements, c.bridge.n_elements);
+    assert_true(c.solver.calc_rate_hz == d.solver.calc_rate_hz);
+}
+
+/* A short list replaces the default list whole; unused slots are cleared. */
+static void test_list_replaces(void **state)
+{
+    amfi_site_config c;
+    char err[ERRLEN];
+
+    (void)state;
+    if (load_text("bridge:\n  supports: [{at_m: 0, type: fixed}]\n"
+                  "sensors: [{id: 4, at_m: 20}]\n",
+                  &c, err))
+        fail_msg("%s", err);
+    assert_int_equal(1, c.bridge.n_supports);
+    assert_true(c.bridge.supports[1].x_m == 0.0 && c.bridge.supports[1].restrain_w == 0);
+    assert_int_equal(1, c.solver.n_sensors);
+    assert_int_equal(4, c.sensor_id[0]);
+    assert_true(c.solver.sensor_x_m[0] == 20.0);
+}
+
+/* ---- bad inputs ---------------------------------------------------------- */
+
+typedef struct bad_case {
+    const char *name;
+    const char *yaml;
+    int line;            /* expected line, 0: the message has none */
+    const char *path;    /* expected key path right after "FILE:LINE: " */
+    const char *problem; /* a fragment of the problem */
+} bad_case;
+
+static const bad_case bad_cases[] = {
+    {"unknown_key", "solver:\n  calc_rate_hz: 5000\n  lamda: 1e-9\n", 3, "solver.lamda",
+     "unknown key"},
+    {"unknown_section", "bridge: {}\ndaemon:\n  bus: udpm://\n", 2, "daemon",
+     "unknown key (known: bridge, sensors, solver)"},
+    {"unknown_key_in_item", "sensors:\n  - {id: 0, at_m: 1}\n  - {id: 1, pos: 2}\n", 3,
+     "sensors[1].pos", "unknown key"},
+    {"map_for_scalar", "bridge:\n  span_m: {value: 20}\n", 2, "bridge.span_m",
+     "expected a number, got a mapping"},
+    {"list_for_scalar", "bridge:\n  E_pa: [1, 2]\n", 2, "bridge.E_pa",
+     "expected a number, got a list"},
+    {"not_a_number", "bridge:\n  A_m2: abc\n", 2, "bridge.A_m2", "'abc'"},
+    {"trailing_garbage", "bridge:\n  name: x\n  span_m: 20m\n", 3, "bridge.span_m",
+     "'20m'"},
+    {"nan", "bridge:\n  I_m4: .nan\n", 2, "bridge.I_m4", "finite number"},
+    {"inf", "bridge:\n  density_kgm3: inf\n", 2, "bridge.density_kgm3", "finite number"},
+    {"overflow", "bridge:\n  E_pa: 1e999\n", 2, "bridge.E_pa", "out of range"},
+    {"hex", "bridge:\n  span_m: 0x14\n", 2, "bridge.span_m", "'0x14'"},
+    {"quoted_number", "bridge:\n  span_m: \"20\"\n", 2, "bridge.span_m", "quoted string"},
+    {"null_value", "bridge:\n  span_m:\n  elements: 4\n", 2, "bridge.span_m", "no value"},
+    {"duplicate_key", "bridge:\n  span_m: 20\n  elements: 10\n  span_m: 30\n", 4,
+     "bridge.span_m", "duplicate key (first at line 2)"},
+    {"duplicate_section", "solver: {}\nbridge: {}\nsolver: {modes: all}\n", 3, "solver",
+     "duplicate key (first at line 1)"},
+    {"section_not_map", "bridge: 5\n", 1, "bridge", "expected a mapping"},
+    {"key_not_name", "bridge:\n  ? [a, b]\n  : 1\n", 2, "bridge", "key must be"},
+    {"nul_in_key", "bridge:\n  \"span_m\\0x\": 20\n", 2, "bridge.span_m?x",
+     "unknown key"},
+    {"span_zero", "bridge:\n  span_m: 0\n", 2, "bridge.span_m", "must be > 0, got 0"},
+    {"elements_zero", "bridge:\n  elements: 0\n", 2, "bridge.elements", "1 .. 1000"},
+    {"elements_big", "bridge:\n  elements: 1001\n", 2, "bridge.elements", "got 1001"},
+    {"elements_fraction", "bridge:\n  elements: 2.5\n", 2, "bridge.elements",
+     "expected an integer"},
+    {"E_negative", "bridge:\n  E_pa: -3.5e10\n", 2, "bridge.E_pa", "must be > 0"},
+    {"damping_ratio_one", "bridge:\n  damping:\n    ratio: 1\n", 3,
+     "bridge.damping.ratio", "[0, 1)"},
+    {"damping_unknown", "bridge:\n  damping: {ratio: 0.03, mode: [1, 2]}\n", 2,
+     "bridge.damping.mode", "unknown key"},
+    {"damping_same_modes", "bridge:\n  damping: {modes: [2, 2]}\n", 2,
+     "bridge.damping.modes", "must differ"},
+    {"damping_one_mode", "bridge:\n  damping: {modes: [1]}\n", 2, "bridge.damping.modes",
+     "two mode numbers"},
+    {"damping_mode_zero", "bridge:\n  damping:\n    modes:\n      - 1\n      - 0\n", 5,
+     "bridge.damping.modes[1]", "mode number"},
+    {"damping_mode_past_dofs", "bridge:\n  elements: 1\n  damping: {modes: [1, 9]}\n", 3,
+     "bridge.damping.modes", "only 2 modes"},
+    {"supports_empty", "bridge:\n  supports: []\n", 2, "bridge.supports",
+     "1 .. 16 supports, got 0"},
+    {"supports_17",
+     "bridge:\n  supports: [{at_m: 0, type: fixed}, {at_m: 1, type: roller},"
+     " {at_m: 2, type: roller}, {at_m: 3, type: roller}, {at_m: 4, type: roller},"
+     " {at_m: 5, type: roller}, {at_m: 6, type: roller}, {at_m: 7, type: roller},"
+     " {at_m: 8, type: roller}, {at_m: 9, type: roller}, {at_m: 10, type: roller},"
+     " {at_m: 11, type: roller}, {at_m: 12, type: roller}, {at_m: 13, type: roller},"
+     " {at_m: 14, type: roller}, {at_m: 15, type: roller}, {at_m: 16, type: roller}]\n",
+     2, "bridge.supports", "got 17"},
+    {"support_type", "bridge:\n  supports:\n    - {at_m: 0, type: pinned}\n"
+     "    - {at_m: 20, type: hinge}\n", 4, "bridge.supports[1].type",
+     "expected one of pinned, roller, fixed; got 'hinge'"},
+    {"support_no_type", "bridge:\n  supports:\n    - {at_m: 0, type: pinned}\n"
+     "    - at_m: 20\n", 4, "bridge.supports[1].type", "missing"},
+    {"support_off_span", "bridge:\n  supports:\n    - {at_m: 0, type: pinned}\n"
+     "    - {at_m: 25, type: roller}\n", 4, "bridge.supports[1].at_m", "beyond the span"},
+    {"support_same_node", "bridge:\n  supports:\n    - {at_m: 0, type: pinned}\n"
+     "    - {at_m: 0.3, type: roller}\n", 4, "bridge.supports[1].at_m", "node 0"},
+    {"support_mechanism", "bridge:\n  supports:\n    - {at_m: 10, type: pinned}\n", 2,
+     "bridge.supports", "free to rotate"},
+    {"damage_one", "bridge:\n  damage: 1\n", 2, "bridge.damage", "[0, 1)"},
+    {"name_empty", "bridge:\n  name: ''\n", 2, "bridge.name", "1 .. 63 bytes"},
+    {"name_long",
+     "bridge:\n  name: aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\n", 2,
+     "bridge.name", "got 64"},
+    {"name_control", "bridge:\n  name: \"a\\tb\"\n", 2, "bridge.name", "control"},
+    {"sensors_not_list", "sensors: {id: 0, at_m: 10}\n", 1, "sensors",
+     "expected a list of sensors, got a mapping"},
+    {"sensors_9",
+     "sensors:\n  - {id: 0, at_m: 1}\n  - {id: 1, at_m: 2}\n  - {id: 2, at_m: 3}\n"
+     "  - {id: 3, at_m: 4}\n  - {id: 4, at_m: 5}\n  - {id: 5, at_m: 6}\n"
+     "  - {id: 6, at_m: 7}\n  - {id: 7, at_m: 8}\n  - {id: 8, at_m: 9}\n", 2, "sensors",
+     "1 .. 8 sensors, got 9"},
+    {"sensor_item_scalar", "sensors:\n  - 10\n", 2, "sensors[0]", "expected a mapping"},
+    {"sensor_duplicate_id", "sensors:\n  - {id: 3, at_m: 5}\n  - {id: 4, at_m: 6}\n"
+     "  - {id: 3, at_m: 7}\n", 4, "sensors[2].id", "duplicate id 3 (also sensors[0])"},
+    {"sensor_id_256", "sensors:\n  - {id: 256, at_m: 5}\n", 2, "sensors[0].id",
+     "0 .. 255"},
+    {"sensor_no_position", "sensors:\n  - id: 0\n    weight: 1\n", 2, "sensors[0].at_m",
+     "missing"},
+    {"sensor_off_span", "bridge:\n  span_m: 20\nsensors:\n  - {id: 0, at_m: 20.5}\n", 4,
+     "sensors[0].at_m", "beyond the span"},
+    {"sensor_negative", "sensors:\n  - {id: 0, at_m: -1}\n", 2, "sensors[0].at_m",
+     "must be >= 0"},
+    {"sensor_weight_zero", "sensors:\n  - {id: 0, at_m: 10, weight: 0}\n", 2,
+     "sensors[0].weight", "must be > 0"},
+    {"formulation", "solver:\n  formulation: exact\n", 2, "solver.formulation",
+     "expected one of paper; got 'exact'"},
+    {"coordinates", "solver:\n  coordinates: Modal\n", 2, "solver.coordinates",
+     "modal, nodal"},
+    {"modes_zero", "solver:\n  modes: 0\n", 2, "solver.modes", "got 0"},
+    {"modes_word", "solver:\n  modes: some\n", 2, "solver.modes", "'some'"},
+    {"modes_fraction", "solver:\n  modes: 2.5\n", 2, "solver.modes", "'2.5'"},
+    {"modes_past_dofs", "solver:\n  modes: 41\n", 2, "solver.modes",
+     "the model has only 40"},
+    {"calc_rate_zero", "solver:\n  calc_rate_hz: 0\n", 2, "solver.calc_rate_hz",
+     "(0, 1e+06]"},
+    {"calc_rate_big", "solver:\n  calc_rate_hz: 2e6\n", 2, "solver.calc_rate_hz",
+     "got 2e+06"},
+    {"initial_force_word", "solver:\n  initial_force: none\n", 2, "solver.initial_force",
+     "free, zero"},
+    {"initial_zero_no_roll", "solver:\n  initial_force: zero\n  post_roll_s: 0.1\n", 2,
+     "solver.initial_force", "pre_roll_s > 0"},
+    {"pre_roll_60", "solver:\n  pre_roll_s: 60\n", 2, "solver.pre_roll_s", "[0, 60)"},
+    {"post_roll_negative", "solver:\n  post_roll_s: -0.1\n", 2, "solver.post_roll_s",
+     "got -0.1"},
+    {"max_axles", "solver:\n  max_axles: 13\n", 2, "solver.max_axles", "1 .. 12"},
+    {"max_duration_zero", "solver:\n  max_duration_s: 0\n", 2, "solver.max_duration_s",
+     "(0, 600]"},
+    {"lambda_negative", "solver:\n  lambda: -1e-9\n", 2, "solver.lambda",
+     "must be > 0 (or auto)"},
+    {"lambda_word", "solver:\n  lambda: automatic\n", 2, "solver.lambda",
+     "expected auto or a positive number, got 'automatic'"},
+    {"lambda_null", "solver:\n  lambda: ~\n", 2, "solver.lambda", "no value"},
+    {"lambda_rate_zero", "solver:\n  lambda_ref_rate_hz: 0\n", 2,
+     "solver.lambda_ref_rate_hz", "(0, 1e+06]"},
+    {"lcurve_lo_above_hi", "solver:\n  lcurve:\n    lo: 1e-3\n    hi: 1e-4\n", 4,
+     "solver.lcurve", "must be below hi"},
+    {"lcurve_lo_above_default_hi", "solver:\n  lcurve: {lo: 1e-3}\n", 2,
+     "solver.lcurve", "lo (0.001) must be below hi"},
+    {"lcurve_lo_zero", "solver:\n  lcurve: {lo: 0}\n", 2, "solver.lcurve.lo",
+     "must be > 0"},
+    {"lcurve_per_decade", "solver:\n  lcurve: {per_decade: 0}\n", 2,
+     "solver.lcurve.per_decade", "1 .. 100"},
+    {"lcurve_refine", "solver:\n  lcurve: {refine: 101}\n", 2, "solver.lcurve.refine",
+     "0 .. 100"},
+    {"self_alias", "bridge: &b\n  damping: *b\n", 2, "bridge.damping.damping",
+     "unknown key"},
+    {"top_list", "- bridge\n- solver\n", 1, NULL, "expected a mapping"},
+    {"top_scalar", "hello\n", 1, NULL, "expected a mapping"},
+    {"syntax_indent", "bridge:\n  span_m: 20\n   elements: 10\n", 3, NULL,
+     "YAML syntax error"},
+    {"syntax_flow", "bridge:\n  name: x\nsolver: {modes: all\n\n", 5, NULL,
+     "YAML syntax error"},
+    {"syntax_tab", "bridge:\n\tspan_m: 20\n", 2, NULL, "YAML syntax error"},
+    {"undefined_alias", "bridge:\n  span_m: *x\n", 2, NULL, "undefined alias"},
+    {"bad_utf8", "bridge:\n  name: \xff\xfe\n", 2, NULL, "UTF-8"},
+    {"two_documents", "bridge: {}\n---\nsolver: {}\n", 2, NULL, "second YAML document"},
+    {"too_deep", "bridge:\n  damping:\n    modes: [[[[[[[[[[[[[[[[[[1]]]]]]]]]]]]]]]]]]\n", 3, NULL,
+     "nested deeper than 16 levels"},
+    {"empty", "", 1, NULL, "empty file"},
+    {"comments_only", "# nothing\n\n", 1, NULL, "empty file"},
+};
+
+static void test_bad(void **state)
+{
+    const bad_case *bc = *state;
+    amfi_site_config c, before;
+    char err[ERRLEN], want[256], path[64];
+    int rc;
+
+    memset(&c, 0x5a, sizeof c);
+    memcpy(&before, &c, sizeof c);
+    write_temp(bc->yaml, strlen(bc->yaml), path);
+    rc = amfi_config_load(path, &c, err, sizeof err);
+    unlink(path);
+    print_message("    %s\n", err);
+    assert_int_equal(-1, rc);
+    assert_memory_equal(&before, &c, sizeof c); /* untouched on failure */
+    assert_null(strchr(err, '\n'));
+    assert_true(strncmp(err, path, strlen(path)) == 0);
+    if (bc->path)
+        snprintf(want, sizeof want, "%s:%d: %s: ", path, bc->line, bc->path);
+    else
+        snprintf(want, sizeof want, "%s:%d: ", path, bc->line);
+    if (strncmp(err, want, strlen(want)) != 0)
+        fail_msg("want prefix '%s', got '%s'", want, err);
+    if (!strstr(err, bc->problem))
+        fail_msg("want '%s' in '%s'", bc->problem, err);
+}
+
+/* ---- files and buffers ---------------------------------------------------- */
+
+static void test_missing_file(void **state)
+{
+    amfi_site_config c;
+    char err[ERRLEN];
+
+    (void)state;
+    assert_int_equal(-1, amfi_config_load("/nonexistent/site.yaml", &c, err, sizeof err));
+    assert_string_equal("/nonexistent/site.yaml: cannot open: No such file or directory",
+                        err);
+    assert_int_equal(-1, amfi_config_load("/tmp", &c, err, sizeof err));
+    assert_string_equal("/tmp: not a regular file", err);
+    assert_int_equal(-1, amfi_config_load(NULL, &c, err, sizeof err));
+    assert_non_null(strstr(err, "NULL"));
+    assert_int_equal(-1, amfi_config_load("/tmp/x.yaml", NULL, err, sizeof err));
+}
+
+static void test_too_large(void **state)
+{
+    amfi_site_config c;
+    char err[ERRLEN], path[64];
+    size_t n = (1u << 20) + 1;
+    char *big = malloc(n);
+
+    (void)state;
+    assert_non_null(big);
+    memset(big, '#', n); /* one long comment */
+    write_temp(big, n, path);
+    free(big);
+    assert_int_equal(-1, amfi_config_load(path, &c, err, sizeof err));
+    unlink(path);
+    assert_non_null(strstr(err, "too large"));
+}
+
+/* Deep flow nesting: a clear error at once (libyaml alone would take 30 s
+ * for this one: its scanner is quadratic in the nesting depth). */
+static void test_deep_nesting(void **state)
+{
+    amfi_site_config c;
+    char err[ERRLEN], path[64];
+    size_t depth = 100000, n = 2 * depth + 1;
+    char *deep = malloc(n);
+
+    (void)state;
+    assert_non_null(deep);
+    memset(deep, '[', depth);
+    memset(deep + depth, ']', depth);
+    deep[n - 1] = '\n';
+    write_temp(deep, n, path);
+    free(deep);
+    assert_int_equal(-1, amfi_config_load(path, &c, err, sizeof err));
+    unlink(path);
+    assert_non_null(strstr(err, ":1: nested deeper than 16 levels"));
+}
+
+/* Small, NULL and zero-length error buffers: truncated, never overrun. */
+static void test_error_buffer(void **state)
+{
+    amfi_site_config c;
+    char path[64], small[16];
+    const char *text = "solver:\n  lamda: 1\n";
+
+    (void)state;
+    write_temp(text, strlen(text), path);
+    assert_int_equal(-1, amfi_config_load(path, &c, NULL, 0));
+    memset(small, 'x', sizeof small);
+    assert_int_equal(-1, amfi_config_load(path, &c, small, 1));
+    assert_int_equal('\0', small[0]);
+    assert_int_equal('x', small[1]);
+    assert_int_equal(-1, amfi_config_load(path, &c, small, sizeof small));
+    assert_int_equal(sizeof small - 1, strlen(small));
+    assert_true(strncmp(small, path, sizeof small - 1) == 0);
+    unlink(path);
+}
+
+int main(void)
+{
+    static const struct CMUnitTest fixed[] = {
+        cmocka_unit_test(test_defaults),
+        cmocka_unit_test(test_shipped_file_is_the_defaults),
+        cmocka_unit_test(test_every_key),
+        cmocka_unit_test(test_span_follows),
+        cmocka_unit_test(test_list_replaces),
+        cmocka_unit_test(test_missing_file),
+        cmocka_unit_test(test_too_large),
+        cmocka_unit_test(test_deep_nesting),
+        cmocka_unit_test(test_error_buffer),
+    };
+    enum {
+        N_FIXED = sizeof fixed / sizeof fixed[0],
+        N_BAD = sizeof bad_cases / sizeof bad_cases[0]
+    };
+    struct CMUnitTest tests[N_FIXED + N_BAD];
+
+    memcpy(tests, fixed, sizeof fixed);
+    for (size_t i = 0; i < N_BAD; i++)
+        tests[N_FIXED + i] = (struct CMUnitTest){
+            .name = bad_cases[i].name,
+            .test_func = test_bad,
+            .initial_state = (void *)&bad_cases[i],
+        };
+    return cmocka_run_group_tests_name("config", tests, NULL, NULL);
+}
