@@ -5,9 +5,11 @@
  * The file (at most 1 MiB) is read into memory, checked once with libyaml's
  * event API (syntax, nesting depth, a single document), then loaded with the
  * document API (yaml_parser_load); every node keeps its start mark, so an
- * error names the line of the offending key or value. The schema is a set of tables (struct field), one per YAML
- * mapping: each row names a key, the function that parses its value and
- * where the value goes. walk_map() does what every mapping needs (type
+ * error names the line of the offending key or value.
+ *
+ * The schema is a set of tables (struct field), one per YAML mapping: each
+ * row names a key, the function that parses its value and where the value
+ * goes. walk_map() does what every mapping needs (type
  * check, unknown, duplicate and required keys); the row functions check the
  * value's type and range. Checks that involve several keys (a sensor within
  * the span, lo < hi, ...) run once the whole file is read, in check_site(),
@@ -459,7 +461,8 @@ static int p_rayleigh_modes(ctx *x, yaml_node_t *v, const char *path, const fiel
                         MAX_MODE_NO, m[i]);
     }
     if (m[0] == m[1])
-        return fail(x, line_of(v), path, "the two modes must differ, got %ld twice", m[0]);
+        return fail(x, line_of(v), path, "the two modes must differ, got %ld twice",
+                    m[0]);
     c->bridge.rayleigh_mode_a = (int)m[0];
     c->bridge.rayleigh_mode_b = (int)m[1];
     return 0;
@@ -1021,7 +1024,8 @@ int amfi_config_load(const char *path, amfi_site_config *c, char *err, size_t er
         err[0] = '\0';
     if (!path || !c) {
         if (err && errlen)
-            snprintf(err, errlen, "amfi_config_load: %s is NULL", path ? "config" : "path");
+            snprintf(err, errlen, "amfi_config_load: %s is NULL",
+                     path ? "config" : "path");
         return -1;
     }
     x = calloc(1, sizeof *x);
