@@ -1,0 +1,463 @@
+/*
+ * vbi.c: coupled vehicle-bridge time integration (see vbi.h).
+ *
+ * Newmark, average acceleration, on M a + C v + K u = f for every
+ * subsystem: with the predictors û = u + dt·v + dt²/4·a, v̂ = v + dt/2·a,
+ * the new acceleration solves S a' = f' − (C v̂ + K û), S = M + dt/2·C +
+ * dt²/4·K, and u' = û + β a', v' = v̂ + dt/2·a' (β = dt²/4).
+ *   bridge, per mode k: S_k = 1 + dt·ζω + β ω², f_k = Σ_J ψ_k(x_J)(W_J + P_J)
+ *   vehicle: S_v (4 × 4, inverted once with LAPACK), f_v = −[0, 0, P_1, P_2]
+ * Both new axle hops and new bridge deflections under the axles are affine
+ * in the dynamic tyre forces P, so P_I = kt_I (y_u,I' − w(x_I)' + r_I) is
+ *   (I + β·diag(kt)(A + B)) P = c,
+ * A_IJ = (S_v⁻¹) between the hop DOFs of one vehicle, B_IJ = Σ_k ψ_k(x_I)ψ_k(x_J)/S_k.
+ */
+#include <lapacke.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vbi.h"
+
+typedef struct active {
+    amfi_sim_vehicle v;
+    double u[4], vel[4], acc[4]; /* y_s, θ, y_u1, y_u2 */
+    double K[16], C[16];         /* suspension matrices, row-major */
+    double Sinv[16];             /* (M + dt/2 C + β K)⁻¹ */
+    double sumF[2];
+} active;
+
+struct amfi_sim {
+    const amfi_bridge *b;
+    const amfi_profile *prof;
+    amfi_sim_params p;
+    double L;
+    int n;          /* bridge modes (= DOFs) */
+    int sub;        /* integration steps per sample */
+    long step;      /* steps done; t = step·dt */
+    const double *omega, *zeta;
+    double *q, *qd, *qdd;   /* n: modal state */
+    double *Sk;             /* n: effective modal mass */
+    double *qh, *pred;      /* n: predictors */
+    double *cs;             /* n_sensors × n: ψ_k(x_s) */
+    double *phi;            /* AMFI_SIM_MAX_ACTIVE·2 × n: ψ_k at the axles */
+    active act[AMFI_SIM_MAX_ACTIVE];
+    int n_act;
+    amfi_sim_vehicle pend[AMFI_SIM_MAX_PENDING];
+    int n_pend;
+    amfi_sim_vehicle done[AMFI_SIM_MAX_PENDING];
+    int n_done;
+    amfi_sim_hook hook;
+    void *hook_user;
+};
+
+static int fail(char *err, size_t errlen, const char *fmt, double a, double b)
+{
+    if (err && errlen)
+        snprintf(err, errlen, fmt, a, b);
+    return -1;
+}
+
+void amfi_sim_params_default(amfi_sim_params *p, double span_m)
+{
+    memset(p, 0, sizeof *p);
+    p->dt_s = 1e-4;
+    p->scan_rate_hz = 1000.0;
+    p->approach_m = 100.0; /* MODEL.md §3, assumed */
+    p->exit_m = 5.0;
+    p->n_sensors = 1;
+    p->sensor_x_m[0] = 0.5 * span_m;
+}
+
+void amfi_sim_destroy(amfi_sim *s)
+{
+    if (!s)
+        return;
+    free(s->q);
+    free(s->qd);
+    free(s->qdd);
+    free(s->Sk);
+    free(s->qh);
+    free(s->pred);
+    free(s->cs);
+    free(s->phi);
+    free(s);
+}
+
+int amfi_sim_create(const amfi_bridge *b, const amfi_profile *prof, const amfi_sim_params *p,
+                    amfi_sim **out, char *err, size_t errlen)
+{
+    if (!b || !p || !out)
+        return fail(err, errlen, "sim: NULL argument%.0g%.0g", 0, 0);
+    if (!(p->dt_s > 0 && p->dt_s <= 1e-2) || !(p->scan_rate_hz > 0))
+        return fail(err, errlen, "sim: dt %g s and scan rate %g Hz must be > 0", p->dt_s,
+                    p->scan_rate_hz);
+    double ratio = 1.0 / (p->scan_rate_hz * p->dt_s);
+    long sub = lround(ratio);
+    if (sub < 1 || fabs(ratio - sub) > 1e-9 * ratio)
+        return fail(err, errlen, "sim: 1/(scan rate·dt) = %g is not an integer%.0g", ratio, 0);
+    if (!(p->approach_m >= 0) || !(p->exit_m >= 0))
+        return fail(err, errlen, "sim: approach %g m and exit %g m must be >= 0", p->approach_m,
+                    p->exit_m);
+    const double L = amfi_bridge_params_of(b)->span_m;
+    if (p->n_sensors < 1 || p->n_sensors > AMFI_MAX_SENSORS)
+        return fail(err, errlen, "sim: %g sensors (1..%g)", p->n_sensors, AMFI_MAX_SENSORS);
+    for (int i = 0; i < p->n_sensors; i++)
+        if (!(p->sensor_x_m[i] >= 0 && p->sensor_x_m[i] <= L))
+            return fail(err, errlen, "sim: sensor at %g m is off the span [0, %g]",
+                        p->sensor_x_m[i], L);
+    amfi_sim *s = calloc(1, sizeof *s);
+    if (!s)
+        return fail(err, errlen, "sim: out of memory%.0g%.0g", 0, 0);
+    s->b = b;
+    s->prof = prof;
+    s->p = *p;
+    s->L = L;
+    s->n = amfi_bridge_ndof(b);
+    s->sub = (int)sub;
+    s->omega = amfi_bridge_omega(b);
+    s->zeta = amfi_bridge_zeta(b);
+    const int n = s->n;
+    s->q = calloc(n, sizeof(double));
+    s->qd = calloc(n, sizeof(double));
+    s->qdd = calloc(n, sizeof(double));
+    s->Sk = malloc(sizeof(double) * n);
+    s->qh = malloc(sizeof(double) * n);
+    s->pred = malloc(sizeof(double) * n);
+    s->cs = malloc(sizeof(double) * n * p->n_sensors);
+    s->phi = malloc(sizeof(double) * n * 2 * AMFI_SIM_MAX_ACTIVE);
+    if (!s->q || !s->qd || !s->qdd || !s->Sk || !s->qh || !s->pred || !s->cs || !s->phi) {
+        amfi_sim_destroy(s);
+        return fail(err, errlen, "sim: out of memory%.0g%.0g", 0, 0);
+    }
+    const double dt = p->dt_s, beta = dt * dt / 4.0;
+    for (int k = 0; k < n; k++)
+        s->Sk[k] = 1.0 + dt * s->zeta[k] * s->omega[k] + beta * s->omega[k] * s->omega[k];
+    for (int i = 0; i < p->n_sensors; i++)
+        amfi_bridge_mode_values(b, p->sensor_x_m[i], s->cs + (size_t)i * n);
+    *out = s;
+    return 0;
+}
+
+void amfi_sim_set_hook(amfi_sim *s, amfi_sim_hook fn, void *user)
+{
+    s->hook = fn;
+    s->hook_user = user;
+}
+
+double amfi_sim_time(const amfi_sim *s) { return s->step * s->p.dt_s; }
+int amfi_sim_busy(const amfi_sim *s) { return s->n_pend + s->n_act; }
+
+static double t_start(const amfi_sim *s, const amfi_sim_vehicle *v)
+{
+    return v->t_entry_s - s->p.approach_m / v->speed_mps;
+}
+
+int amfi_sim_add(amfi_sim *s, const amfi_sim_vehicle *v, char *err, size_t errlen)
+{
+    if (!(v->speed_mps > 0 && v->speed_mps <= 100))
+        return fail(err, errlen, "sim: vehicle speed %g m/s out of (0, 100]%.0g", v->speed_mps,
+                    0);
+    if (s->prof && (v->track < 0 || v->track >= amfi_profile_tracks(s->prof)))
+        return fail(err, errlen, "sim: track %g out of range (%g tracks)", v->track,
+                    amfi_profile_tracks(s->prof));
+    amfi_halfcar c = v->car;
+    if (amfi_halfcar_finish(&c, err, errlen))
+        return -1;
+    if (t_start(s, v) < amfi_sim_time(s) - 0.5 * s->p.dt_s)
+        return fail(err, errlen, "sim: vehicle starts its approach at %g s, before now (%g s)",
+                    t_start(s, v), amfi_sim_time(s));
+    if (s->n_pend == AMFI_SIM_MAX_PENDING)
+        return fail(err, errlen, "sim: more than %g vehicles pending%.0g", AMFI_SIM_MAX_PENDING,
+                    0);
+    s->pend[s->n_pend] = *v;
+    s->pend[s->n_pend].car = c;
+    s->n_pend++;
+    return 0;
+}
+
+/* Build one vehicle's matrices and (M + dt/2 C + β K)⁻¹. */
+static int start(amfi_sim *s, const amfi_sim_vehicle *v)
+{
+    if (s->n_act == AMFI_SIM_MAX_ACTIVE)
+        return -1;
+    active *a = &s->act[s->n_act];
+    memset(a, 0, sizeof *a);
+    a->v = *v;
+    const amfi_halfcar *c = &v->car;
+    const double arm[2] = {-c->D1_m, c->D2_m};
+    for (int i = 0; i < 2; i++) {
+        /* e_i = g·u, g = [1, arm_i, −δ_i0, −δ_i1] */
+        const double g[4] = {1.0, arm[i], i == 0 ? -1.0 : 0.0, i == 1 ? -1.0 : 0.0};
+        for (int r = 0; r < 4; r++)
+            for (int q = 0; q < 4; q++) {
+                a->K[r * 4 + q] += c->ks_Nm[i] * g[r] * g[q];
+                a->C[r * 4 + q] += c->cs_Nsm[i] * g[r] * g[q];
+            }
+        a->v.min_force_N[i] = INFINITY;
+        a->v.max_force_N[i] = -INFINITY;
+    }
+    const double M[4] = {c->ms_kg, c->Is_kgm2, c->mu_kg[0], c->mu_kg[1]};
+    const double dt = s->p.dt_s, beta = dt * dt / 4.0;
+    for (int r = 0; r < 4; r++)
+        for (int q = 0; q < 4; q++) {
+            a->Sinv[r * 4 + q] = (r == q ? M[r] : 0.0) + 0.5 * dt * a->C[r * 4 + q] +
+                                 beta * a->K[r * 4 + q];
+        }
+    /* SPD: Cholesky inverse (column-major 'L' is row-major 'U' here). */
+    if (LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', 4, a->Sinv, 4) != 0 ||
+        LAPACKE_dpotri_work(LAPACK_COL_MAJOR, 'L', 4, a->Sinv, 4) != 0)
+        return -1;
+    /* dpotri filled column-major 'L', i.e. the row-major upper triangle. */
+    for (int r = 0; r < 4; r++)
+        for (int q = 0; q < r; q++)
+            a->Sinv[r * 4 + q] = a->Sinv[q * 4 + r];
+    s->n_act++;
+    return 0;
+}
+
+/* Road height under an axle (m, positive up). */
+static double road(const amfi_sim *s, int track, double x)
+{
+    if (!s->prof)
+        return 0.0;
+    return amfi_profile_height(s->prof, track, x + s->p.approach_m + AMFI_SIM_PROFILE_LEAD_M);
+}
+
+/* Retire vehicles whose rear axle is exit_m past the bridge. */
+static void retire(amfi_sim *s)
+{
+    const double t = amfi_sim_time(s);
+    for (int i = 0; i < s->n_act;) {
+        active *a = &s->act[i];
+        const double S = a->v.car.D1_m + a->v.car.D2_m;
+        double x2 = a->v.speed_mps * (t - a->v.t_entry_s) - S;
+        if (x2 <= s->L + s->p.exit_m) {
+            i++;
+            continue;
+        }
+        for (int k = 0; k < 2; k++)
+            a->v.mean_force_N[k] =
+                a->v.on_span_steps[k] ? a->sumF[k] / a->v.on_span_steps[k] : NAN;
+        if (s->n_done < AMFI_SIM_MAX_PENDING)
+            s->done[s->n_done++] = a->v;
+        s->act[i] = s->act[--s->n_act];
+    }
+}
+
+/* Start pending vehicles whose approach begins at or before time t. */
+static int admit(amfi_sim *s)
+{
+    const double t = amfi_sim_time(s);
+    for (int i = 0; i < s->n_pend;) {
+        if (t_start(s, &s->pend[i]) > t + 0.5 * s->p.dt_s) {
+            i++;
+            continue;
+        }
+        if (start(s, &s->pend[i]) != 0)
+            return -1;
+        s->pend[i] = s->pend[--s->n_pend];
+    }
+    return 0;
+}
+
+/* One Newmark step of the coupled system, to time (step + 1)·dt. */
+static int step(amfi_sim *s, char *err, size_t errlen)
+{
+    const int n = s->n, na = 2 * s->n_act;
+    const double dt = s->p.dt_s, beta = dt * dt / 4.0, hdt = 0.5 * dt;
+    const double t1 = (s->step + 1) * dt;
+    double x[2 * AMFI_SIM_MAX_ACTIVE], W[2 * AMFI_SIM_MAX_ACTIVE], kt[2 * AMFI_SIM_MAX_ACTIVE];
+    double c[2 * AMFI_SIM_MAX_ACTIVE], P[2 * AMFI_SIM_MAX_ACTIVE];
+    double Amat[4 * AMFI_SIM_MAX_ACTIVE * AMFI_SIM_MAX_ACTIVE]; /* na × na, column-major */
+    double wfree[2 * AMFI_SIM_MAX_ACTIVE];
+    int on[2 * AMFI_SIM_MAX_ACTIVE], fixed[2 * AMFI_SIM_MAX_ACTIVE];
+    lapack_int ipiv[2 * AMFI_SIM_MAX_ACTIVE];
+    double av0[AMFI_SIM_MAX_ACTIVE][4], vh[AMFI_SIM_MAX_ACTIVE][4], uh[AMFI_SIM_MAX_ACTIVE][4];
+
+    /* Bridge predictors and the acceleration without contact forces. */
+    for (int k = 0; k < n; k++) {
+        double vhk = s->qd[k] + hdt * s->qdd[k];
+        s->qh[k] = s->q[k] + dt * s->qd[k] + beta * s->qdd[k];
+        s->pred[k] = 2.0 * s->zeta[k] * s->omega[k] * vhk + s->omega[k] * s->omega[k] * s->qh[k];
+    }
+    /* Vehicles: predictors, force-free acceleration, axle data. */
+    for (int v = 0; v < s->n_act; v++) {
+        active *a = &s->act[v];
+        double f[4];
+        for (int r = 0; r < 4; r++) {
+            uh[v][r] = a->u[r] + dt * a->vel[r] + beta * a->acc[r];
+            vh[v][r] = a->vel[r] + hdt * a->acc[r];
+        }
+        for (int r = 0; r < 4; r++) {
+            double pr = 0.0;
+            for (int q = 0; q < 4; q++)
+                pr += a->C[r * 4 + q] * vh[v][q] + a->K[r * 4 + q] * uh[v][q];
+            f[r] = -pr;
+        }
+        for (int r = 0; r < 4; r++) {
+            double acc = 0.0;
+            for (int q = 0; q < 4; q++)
+                acc += a->Sinv[r * 4 + q] * f[q];
+            av0[v][r] = acc;
+        }
+        const double S = a->v.car.D1_m + a->v.car.D2_m;
+        for (int i = 0; i < 2; i++) {
+            int ia = 2 * v + i;
+            x[ia] = a->v.speed_mps * (t1 - a->v.t_entry_s) - (i ? S : 0.0);
+            W[ia] = a->v.car.W_N[i];
+            kt[ia] = a->v.car.kt_Nm[i];
+            on[ia] = amfi_bridge_mode_values(s->b, x[ia], s->phi + (size_t)ia * n) == 0;
+        }
+    }
+    /* c_I and the matrix (I + β diag(kt)(A + B)), column-major. */
+    for (int ia = 0; ia < na; ia++) {
+        const double *pI = s->phi + (size_t)ia * n;
+        double w0 = 0.0; /* bridge deflection at x_I without the axle loads' new share */
+        if (on[ia])
+            for (int k = 0; k < n; k++)
+                w0 += pI[k] * (s->qh[k] - beta * s->pred[k] / s->Sk[k]);
+        wfree[ia] = w0;
+        for (int ja = 0; ja < na; ja++) {
+            double bij = 0.0;
+            if (on[ia] && on[ja]) {
+                const double *pJ = s->phi + (size_t)ja * n;
+                for (int k = 0; k < n; k++)
+                    bij += pI[k] * pJ[k] / s->Sk[k];
+            }
+            double aij = 0.0;
+            if (ia / 2 == ja / 2) /* the same vehicle: hop DOFs 2 + i, 2 + j */
+                aij = s->act[ia / 2].Sinv[(2 + ia % 2) * 4 + 2 + ja % 2];
+            Amat[ia + ja * na] = (ia == ja ? 1.0 : 0.0) + beta * kt[ia] * (aij + bij);
+            wfree[ia] += beta * bij * W[ja];
+        }
+        const int v = ia / 2, i = ia % 2;
+        double yu = uh[v][2 + i] + beta * av0[v][2 + i];
+        c[ia] = kt[ia] * (yu - wfree[ia] + road(s, s->act[v].v.track, x[ia]));
+        fixed[ia] = 0;
+    }
+    /* Solve; a tyre with W + P < 0 leaves the road (P = −W), then re-solve. */
+    for (int pass = 0; pass <= na; pass++) {
+        double Ms[4 * AMFI_SIM_MAX_ACTIVE * AMFI_SIM_MAX_ACTIVE];
+        for (int ia = 0; ia < na; ia++) {
+            P[ia] = c[ia];
+            for (int ja = 0; ja < na; ja++)
+                Ms[ia + ja * na] = Amat[ia + ja * na];
+        }
+        for (int ja = 0; ja < na; ja++) {
+            if (!fixed[ja])
+                continue;
+            for (int ia = 0; ia < na; ia++) { /* move the known P_J = −W_J to the right */
+                P[ia] -= Ms[ia + ja * na] * (-W[ja]);
+                Ms[ia + ja * na] = 0.0;
+            }
+            for (int K = 0; K < na; K++)
+                Ms[ja + K * na] = 0.0;
+            Ms[ja + ja * na] = 1.0;
+            P[ja] = -W[ja];
+        }
+        if (na > 0 && LAPACKE_dgesv_work(LAPACK_COL_MAJOR, na, 1, Ms, na, ipiv, P, na) != 0)
+            return fail(err, errlen, "sim: coupled system singular at t = %g s%.0g", t1, 0);
+        int changed = 0;
+        for (int ia = 0; ia < na; ia++)
+            if (!fixed[ia] && W[ia] + P[ia] < 0.0) {
+                fixed[ia] = 1;
+                changed = 1;
+            }
+        if (!changed)
+            break;
+    }
+    /* Bridge update. */
+    for (int k = 0; k < n; k++) {
+        double f = 0.0;
+        for (int ia = 0; ia < na; ia++)
+            if (on[ia])
+                f += s->phi[(size_t)ia * n + k] * (W[ia] + P[ia]);
+        double ak = (f - s->pred[k]) / s->Sk[k];
+        double vhk = s->qd[k] + hdt * s->qdd[k];
+        s->q[k] = s->qh[k] + beta * ak;
+        s->qd[k] = vhk + hdt * ak;
+        s->qdd[k] = ak;
+    }
+    /* Vehicle update, truth, hook. */
+    for (int v = 0; v < s->n_act; v++) {
+        active *a = &s->act[v];
+        for (int r = 0; r < 4; r++) {
+            double acc = av0[v][r] - a->Sinv[r * 4 + 2] * P[2 * v] - a->Sinv[r * 4 + 3] * P[2 * v + 1];
+            a->u[r] = uh[v][r] + beta * acc;
+            a->vel[r] = vh[v][r] + hdt * acc;
+            a->acc[r] = acc;
+        }
+        double F[2], xx[2];
+        for (int i = 0; i < 2; i++) {
+            int ia = 2 * v + i;
+            F[i] = W[ia] + P[ia];
+            xx[i] = x[ia];
+            if (fixed[ia])
+                a->v.lost_contact_steps[i]++;
+            if (x[ia] >= 0.0 && x[ia] <= s->L) {
+                a->sumF[i] += F[i];
+                a->v.on_span_steps[i]++;
+                a->v.min_force_N[i] = fmin(a->v.min_force_N[i], F[i]);
+                a->v.max_force_N[i] = fmax(a->v.max_force_N[i], F[i]);
+            }
+        }
+        if (s->hook)
+            s->hook(s->hook_user, t1, &a->v, xx, F);
+    }
+    s->step++;
+    return 0;
+}
+
+int amfi_sim_advance(amfi_sim *s, int n_samples, double *accel, char *err, size_t errlen)
+{
+    const int n = s->n, ns = s->p.n_sensors;
+    for (int j = 0; j < n_samples; j++) {
+        for (int i = 0; i < ns; i++) {
+            double a = 0.0;
+            for (int k = 0; k < n; k++)
+                a += s->cs[(size_t)i * n + k] * s->qdd[k];
+            accel[(size_t)j * ns + i] = a;
+        }
+        for (int k = 0; k < s->sub; k++) {
+            if (admit(s) != 0)
+                return fail(err, errlen, "sim: more than %g vehicles at once at t = %g s",
+                            AMFI_SIM_MAX_ACTIVE, amfi_sim_time(s));
+            if (step(s, err, errlen) != 0)
+                return -1;
+            retire(s);
+        }
+    }
+    return 0;
+}
+
+int amfi_sim_pop_done(amfi_sim *s, amfi_sim_vehicle *out)
+{
+    if (s->n_done == 0)
+        return 0;
+    *out = s->done[0];
+    memmove(s->done, s->done + 1, sizeof *s->done * (size_t)(s->n_done - 1));
+    s->n_done--;
+    return 1;
+}
+
+int amfi_sim_vehicle_state(const amfi_sim *s, long id, double u[4])
+{
+    for (int v = 0; v < s->n_act; v++)
+        if (s->act[v].v.id == id) {
+            memcpy(u, s->act[v].u, sizeof(double) * 4);
+            return 0;
+        }
+    return -1;
+}
+
+double amfi_sim_deflection(amfi_sim *s, double x_m)
+{
+    double *phi = s->qh, w = 0.0; /* predictor scratch, free between steps */
+    if (amfi_bridge_mode_values(s->b, x_m, phi) != 0)
+        return 0.0;
+    for (int k = 0; k < s->n; k++)
+        w += phi[k] * s->q[k];
+    return w;
+}
