@@ -15,5 +15,6 @@ echo "== amfi-solve on $case_csv (true GVW 18 002 kg: axles 10 398 + 7 604 kg)"
 "$bin/amfi-solve" --accel "$case_csv" --speed 25 --axle-spacing 5 --entry-time 0.5 \
   --lambda auto --forces "$out/forces.csv" --lcurve "$out/lcurve.csv" | tee "$out/result.json"
 echo "== axle forces every 0.1 s (t from entry, N):"
-awk -F, 'NR == 1 || (NR - 2) % 500 == 0' "$out/forces.csv" | column -t -s,
+awk -F, 'NR == 1 { printf "%6s %7s %12s %12s\n", $1, $2, $3, $4 }
+          NR > 1 && (NR - 2) % 500 == 0 { printf "%6.2f %7.2f %12.0f %12.0f\n", $1, $2, $3, $4 }' "$out/forces.csv"
 echo "== written: $out/result.json, $out/forces.csv, $out/lcurve.csv"
