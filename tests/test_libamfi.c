@@ -620,9 +620,11 @@ static void solve_rejects_bad_passages(void **state)
 }
 
 /* g_0 = 0 with a pre-roll (MODEL.md §4): the window starts 0.2 s before
- * entry on a bridge at rest; the forced ramp happens before the vehicle
- * enters. The independent check saw −2.1 % on the baseline with vehicle
- * dynamics; on constant forces the weights stay within 1 %. */
+ * entry on a bridge at rest. The smoothing term spreads the ramp from 0 to
+ * the axle load into the first part of the span, so the weights come out
+ * low: −2.7 % here on constant forces (the independent check of MODEL.md saw
+ * −2.1 % with vehicle dynamics), where a free g_0 gives −0.2 %. That is why
+ * g_0 is free by default. */
 static void zero_initial_force_with_preroll(void **state)
 {
     (void)state;
@@ -648,8 +650,16 @@ static void zero_initial_force_with_preroll(void **state)
     assert_true(fabs(r.t0_s + 0.2) < 1e-12);
     assert_true(r.force_N[0] == 0.0 && r.force_N[1] == 0.0);
     double e = r.gvw_kg / (176600.0 / AMFI_GRAVITY) - 1;
-    print_message("g0 = 0 with 0.2 s pre-roll: GVW error %+.3f%%\n", 100 * e);
-    assert_true(fabs(e) < 0.01);
+    /* The same data, g_0 free, no pre-roll. */
+    amfi_solver *sf = make_solver(AMFI_COORDS_MODAL, AMFI_MODES_OBSERVABLE, 5000.0);
+    amfi_result rf;
+    assert_int_equal(amfi_solve(sf, &p, &lam, &rf, NULL, 0), 0);
+    double ef = rf.gvw_kg / (176600.0 / AMFI_GRAVITY) - 1;
+    amfi_solver_destroy(sf);
+    print_message("g0 = 0 with 0.2 s pre-roll: GVW error %+.3f%%; g0 free: %+.3f%%\n", 100 * e,
+                  100 * ef);
+    assert_true(e < 0.0 && e > -0.04); /* biased low, by a few per cent */
+    assert_true(fabs(ef) < 0.005 && fabs(ef) < fabs(e));
     /* Without a pre-roll a fixed g_0 is refused at creation. */
     amfi_solver *bad = NULL;
     sp.pre_roll_s = 0.0;
