@@ -1,0 +1,497 @@
+/*
+ * traffic.c: WIM-style vehicle list reader (format and messages in
+ * traffic.h).
+ *
+ * One pass: the header is mapped to column roles once, then every row is
+ * cut at commas, each field parsed and range-checked where it is read, and
+ * the record appended to an array that doubles when full. Lines are read
+ * byte by byte so that a NUL byte inside a line is seen (fgets would hide
+ * the rest of the line) and the length limit is exact.
+ */
+#include "traffic.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_COLS (4 + 2 * AMFI_MAX_AXLES - 1) /* fixed + axles + spacings */
+
+enum role { R_TIME, R_LANE, R_SPEED, R_GVW, R_AXLE, R_SPACING };
+
+static const char *const role_name[] = {"timestamp_s", "lane", "speed_mps", "gvw_kg"};
+
+typedef struct column {
+    enum role role;
+    int index;     /* axle or spacing number − 1 */
+    char name[24]; /* as in the header */
+} column;
+
+typedef struct reader {
+    FILE *f;
+    const char *path;
+    long lineno; /* of the line in `line`, 1-based */
+    char *err;
+    size_t errlen;
+    int n_cols, n_axles;
+    column col[MAX_COLS];
+    char line[AMFI_TRAFFIC_MAX_LINE + 2]; /* + a CR + NUL */
+} reader;
+
+static void fail(reader *r, long line, const char *colname, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+static void fail(reader *r, long line, const char *colname, const char *fmt, ...)
+{
+    if (!r->err || r->errlen == 0)
+        return;
+    int k = line > 0 ? snprintf(r->err, r->errlen, "%s:%ld: ", r->path, line)
+                     : snprintf(r->err, r->errlen, "%s: ", r->path);
+    if (k >= 0 && (size_t)k < r->errlen && colname)
+        k += snprintf(r->err + k, r->errlen - (size_t)k, "%s: ", colname);
+    if (k < 0 || (size_t)k >= r->errlen)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(r->err + k, r->errlen - (size_t)k, fmt, ap);
+    va_end(ap);
+}
+
+/* At most 24 characters of s[0 .. n), anything but printable ASCII (and the
+ * quote) replaced by '?', so that a message stays one readable line. */
+static const char *quote(const char *s, size_t n, char out[32])
+{
+    size_t k = 0;
+    for (; k < n && k < 24; k++) {
+        unsigned char c = (unsigned char)s[k];
+        out[k] = (c >= 0x20 && c < 0x7f && c != '\'') ? (char)c : '?';
+    }
+    if (k < n) {
+        memcpy(out + k, "...", 3);
+        k += 3;
+    }
+    out[k] = '\0';
+    return out;
+}
+
+/* Next line into r->line without CR/LF, NUL-terminated, length in *n.
+ * 1: a line, 0: end of file, −1: error (message written). */
+static int next_line(reader *r, size_t *n)
+{
+    const long line = r->lineno + 1;
+    size_t len = 0;
+    int c, any = 0;
+    while ((c = getc(r->f)) != EOF) {
+        any = 1;
+        if (c == '\n')
+            break;
+        if (len == AMFI_TRAFFIC_MAX_LINE + 1) { /* room for one CR before LF */
+            fail(r, line, NULL, "line longer than %d characters", AMFI_TRAFFIC_MAX_LINE);
+            return -1;
+        }
+        r->line[len++] = (char)c;
+    }
+    if (ferror(r->f)) {
+        fail(r, line, NULL, "read error: %s", strerror(errno));
+        return -1;
+    }
+    if (!any)
+        return 0;
+    r->lineno = line;
+    if (len > 0 && r->line[len - 1] == '\r')
+        len--;
+    if (len > AMFI_TRAFFIC_MAX_LINE) {
+        fail(r, line, NULL, "line longer than %d characters", AMFI_TRAFFIC_MAX_LINE);
+        return -1;
+    }
+    if (memchr(r->line, '\0', len)) {
+        fail(r, line, NULL, "NUL byte in line (binary data?)");
+        return -1;
+    }
+    r->line[len] = '\0';
+    *n = len;
+    return 1;
+}
+
+static int is_blank(int c) { return c == ' ' || c == '\t'; }
+
+/* Split s[0 .. n) at commas into trimmed fields; stores at most `max`,
+ * returns how many there are. */
+static int split(const char *s, size_t n, const char *start[], size_t flen[], int max)
+{
+    int count = 0;
+    size_t a = 0;
+    for (;;) {
+        size_t b = a;
+        while (b < n && s[b] != ',')
+            b++;
+        size_t x = a, y = b;
+        while (x < y && is_blank((unsigned char)s[x]))
+            x++;
+        while (y > x && is_blank((unsigned char)s[y - 1]))
+            y--;
+        if (count < max) {
+            start[count] = s + x;
+            flen[count] = y - x;
+        }
+        count++;
+        if (b == n)
+            return count;
+        a = b + 1;
+    }
+}
+
+/* "axle12_kg" → 12 with prefix "axle", suffix "_kg"; 0 if s is not of that
+ * form (digits without a leading zero, at most 4 of them). */
+static int numbered(const char *s, size_t n, const char *prefix, const char *suffix)
+{
+    size_t lp = strlen(prefix), ls = strlen(suffix);
+    if (n <= lp + ls || memcmp(s, prefix, lp) != 0 || memcmp(s + n - ls, suffix, ls) != 0)
+        return 0;
+    size_t nd = n - lp - ls;
+    if (nd > 4 || s[lp] == '0')
+        return 0;
+    int v = 0;
+    for (size_t i = lp; i < lp + nd; i++) {
+        if (s[i] < '0' || s[i] > '9')
+            return 0;
+        v = 10 * v + (s[i] - '0');
+    }
+    return v;
+}
+
+static int read_header(reader *r)
+{
+    size_t n = 0;
+    int rc = next_line(r, &n);
+    if (rc < 0)
+        return -1;
+    if (rc == 0) {
+        fail(r, 1, NULL, "empty file (expected a header: timestamp_s,lane,speed_mps,gvw_kg,"
+                         "axle1_kg,axle2_kg,...,spacing1_m,...)");
+        return -1;
+    }
+    const char *s = r->line;
+    if (n >= 3 && memcmp(s, "\xEF\xBB\xBF", 3) == 0) {
+        s += 3;
+        n -= 3;
+    }
+    const char *f[MAX_COLS];
+    size_t fl[MAX_COLS];
+    int count = split(s, n, f, fl, MAX_COLS);
+    int seen_fixed[4] = {0};
+    int axle_seen[AMFI_MAX_AXLES + 1] = {0}, spacing_seen[AMFI_MAX_AXLES + 1] = {0};
+    int max_axle = 0, max_spacing = 0;
+    char q[32];
+    if (count > MAX_COLS) {
+        fail(r, 1, NULL, "%d columns, more than the %d of a %d-axle vehicle", count, MAX_COLS,
+             AMFI_MAX_AXLES);
+        return -1;
+    }
+    for (int i = 0; i < count; i++) {
+        column *c = &r->col[i];
+        quote(f[i], fl[i], q);
+        if (fl[i] == 0) {
+            fail(r, 1, NULL, "column %d has an empty name", i + 1);
+            return -1;
+        }
+        if (fl[i] >= sizeof c->name) {
+            fail(r, 1, q, "unknown column");
+            return -1;
+        }
+        memcpy(c->name, f[i], fl[i]);
+        c->name[fl[i]] = '\0';
+        int k, found = 0;
+        for (k = 0; k < 4; k++)
+            if (!strcmp(c->name, role_name[k])) {
+                found = 1;
+                break;
+            }
+        if (found) {
+            if (seen_fixed[k]++) {
+                fail(r, 1, c->name, "duplicate column");
+                return -1;
+            }
+            c->role = (enum role)k;
+            c->index = 0;
+            continue;
+        }
+        int a = numbered(f[i], fl[i], "axle", "_kg");
+        int sp = numbered(f[i], fl[i], "spacing", "_m");
+        if (a > 0 || sp > 0) {
+            int num = a > 0 ? a : sp;
+            int lim = a > 0 ? AMFI_MAX_AXLES : AMFI_MAX_AXLES - 1;
+            if (num > lim) {
+                fail(r, 1, c->name, "at most %d axles (%d spacings)", AMFI_MAX_AXLES,
+                     AMFI_MAX_AXLES - 1);
+                return -1;
+            }
+            int *seen = a > 0 ? axle_seen : spacing_seen;
+            if (seen[num]++) {
+                fail(r, 1, c->name, "duplicate column");
+                return -1;
+            }
+            c->role = a > 0 ? R_AXLE : R_SPACING;
+            c->index = num - 1;
+            if (a > 0 && a > max_axle)
+                max_axle = a;
+            if (sp > 0 && sp > max_spacing)
+                max_spacing = sp;
+            continue;
+        }
+        fail(r, 1, q, "unknown column (expected timestamp_s, lane, speed_mps, gvw_kg, "
+                      "axle1_kg .. axleN_kg, spacing1_m .. spacingN-1_m)");
+        return -1;
+    }
+    for (int k = 0; k < 4; k++)
+        if (!seen_fixed[k]) {
+            fail(r, 1, role_name[k], "missing column");
+            return -1;
+        }
+    for (int a = 1; a <= max_axle; a++)
+        if (!axle_seen[a]) {
+            fail(r, 1, NULL, "axle%d_kg missing: axle columns must be axle1_kg .. axle%d_kg",
+                 a, max_axle);
+            return -1;
+        }
+    if (max_axle < 2) {
+        fail(r, 1, max_axle ? "axle1_kg" : NULL,
+             "at least two axle columns needed (axle1_kg, axle2_kg)");
+        return -1;
+    }
+    for (int s2 = 1; s2 <= max_spacing; s2++)
+        if (!spacing_seen[s2]) {
+            fail(r, 1, NULL,
+                 "spacing%d_m missing: spacing columns must be spacing1_m .. spacing%d_m", s2,
+                 max_spacing);
+            return -1;
+        }
+    if (max_spacing != max_axle - 1) {
+        if (max_spacing > max_axle - 1)
+            fail(r, 1, NULL, "spacing%d_m: %d axles have %d spacings (spacing1_m .. spacing%d_m)",
+                 max_spacing, max_axle, max_axle - 1, max_axle - 1);
+        else
+            fail(r, 1, NULL, "spacing%d_m missing: %d axles need %d spacings (spacing1_m .. "
+                             "spacing%d_m)",
+                 max_spacing + 1, max_axle, max_axle - 1, max_axle - 1);
+        return -1;
+    }
+    r->n_cols = count;
+    r->n_axles = max_axle;
+    return 0;
+}
+
+/* Parse field s[0 .. n) of column c as a finite number. */
+static int parse_number(reader *r, const column *c, const char *s, size_t n, double *v)
+{
+    char q[32], tmp[AMFI_TRAFFIC_MAX_LINE + 1];
+    if (n == 0) {
+        fail(r, r->lineno, c->name, "empty value");
+        return -1;
+    }
+    /* a NUL-terminated copy, so that strtod cannot run on into the next field */
+    memcpy(tmp, s, n);
+    tmp[n] = '\0';
+    char *end = NULL;
+    double x = strtod(tmp, &end);
+    if (end == tmp || *end != '\0') {
+        fail(r, r->lineno, c->name, "'%s' is not a number", quote(s, n, q));
+        return -1;
+    }
+    if (!isfinite(x)) {
+        fail(r, r->lineno, c->name, "'%s' is not a finite number", quote(s, n, q));
+        return -1;
+    }
+    *v = x;
+    return 0;
+}
+
+static int in_range(reader *r, const column *c, double v, double lo, double hi, const char *unit)
+{
+    if (v >= lo && v <= hi)
+        return 0;
+    fail(r, r->lineno, c->name, "%g is out of range [%g, %g] %s", v, lo, hi, unit);
+    return -1;
+}
+
+static int parse_row(reader *r, size_t len, amfi_vehicle_rec *v)
+{
+    const char *f[MAX_COLS];
+    size_t fl[MAX_COLS];
+    int count = split(r->line, len, f, fl, MAX_COLS);
+    if (count != r->n_cols) {
+        fail(r, r->lineno, NULL, "%d fields, the header has %d", count, r->n_cols);
+        return -1;
+    }
+    memset(v, 0, sizeof *v);
+    v->n_axles = r->n_axles;
+    for (int i = 0; i < count; i++) {
+        const column *c = &r->col[i];
+        double x;
+        if (c->role == R_LANE) {
+            char q[32], tmp[32];
+            long lane = 0;
+            int ok = fl[i] > 0 && fl[i] < sizeof tmp;
+            if (ok) {
+                memcpy(tmp, f[i], fl[i]);
+                tmp[fl[i]] = '\0';
+                char *end = NULL;
+                errno = 0;
+                lane = strtol(tmp, &end, 10);
+                ok = end != tmp && *end == '\0' && errno == 0;
+            }
+            if (!ok) {
+                fail(r, r->lineno, c->name, fl[i] ? "'%s' is not an integer" : "empty value%s",
+                     quote(f[i], fl[i], q));
+                return -1;
+            }
+            if (lane < 1 || lane > AMFI_TRAFFIC_MAX_LANE) {
+                fail(r, r->lineno, c->name, "%ld is out of range 1 .. %d", lane,
+                     AMFI_TRAFFIC_MAX_LANE);
+                return -1;
+            }
+            v->lane = (int)lane;
+            continue;
+        }
+        if (parse_number(r, c, f[i], fl[i], &x) != 0)
+            return -1;
+        switch (c->role) {
+        case R_TIME:
+            v->timestamp_s = x;
+            break;
+        case R_SPEED:
+            if (in_range(r, c, x, 1.0, 60.0, "m/s"))
+                return -1;
+            v->speed_mps = x;
+            break;
+        case R_GVW:
+            if (in_range(r, c, x, 500.0, 100000.0, "kg"))
+                return -1;
+            v->gvw_kg = x;
+            break;
+        case R_AXLE:
+            if (!(x > 0.0) || x > 100000.0) {
+                fail(r, r->lineno, c->name, "%g is out of range (0, 100000] kg", x);
+                return -1;
+            }
+            v->axle_kg[c->index] = x;
+            break;
+        case R_SPACING:
+            if (in_range(r, c, x, 0.5, 30.0, "m"))
+                return -1;
+            v->spacing_m[c->index] = x;
+            break;
+        case R_LANE:
+            break;
+        }
+    }
+    double sum = 0.0;
+    for (int a = 0; a < v->n_axles; a++)
+        sum += v->axle_kg[a];
+    if (fabs(v->gvw_kg - sum) > AMFI_TRAFFIC_GVW_TOL * sum) {
+        fail(r, r->lineno, "gvw_kg",
+             "%g kg differs by %.3g %% from the sum of the axle loads, %g kg (tolerance %g %%)",
+             v->gvw_kg, 100.0 * fabs(v->gvw_kg - sum) / sum, sum, 100.0 * AMFI_TRAFFIC_GVW_TOL);
+        return -1;
+    }
+    return 0;
+}
+
+static int read_rows(reader *r, amfi_vehicle_rec **recs, int *n_out)
+{
+    amfi_vehicle_rec *a = NULL;
+    long n = 0, cap = 0, blank_line = 0, prev_line = 0;
+    for (;;) {
+        size_t len = 0;
+        int got = next_line(r, &len);
+        if (got < 0)
+            goto fail;
+        if (got == 0)
+            break;
+        size_t k = 0;
+        while (k < len && is_blank((unsigned char)r->line[k]))
+            k++;
+        if (k == len) {
+            if (!blank_line)
+                blank_line = r->lineno;
+            continue;
+        }
+        if (blank_line) {
+            fail(r, blank_line, NULL, "blank line before the end of the data");
+            goto fail;
+        }
+        if (n == AMFI_TRAFFIC_MAX_ROWS) {
+            fail(r, r->lineno, NULL, "more than %ld vehicles", AMFI_TRAFFIC_MAX_ROWS);
+            goto fail;
+        }
+        if (n == cap) {
+            long ncap = cap ? 2 * cap : 1024;
+            if (ncap > AMFI_TRAFFIC_MAX_ROWS)
+                ncap = AMFI_TRAFFIC_MAX_ROWS;
+            amfi_vehicle_rec *na = realloc(a, (size_t)ncap * sizeof *a);
+            if (!na) {
+                fail(r, r->lineno, NULL, "out of memory");
+                free(a);
+                return AMFI_ENOMEM;
+            }
+            a = na;
+            cap = ncap;
+        }
+        if (parse_row(r, len, &a[n]) != 0)
+            goto fail;
+        if (n > 0 && a[n].timestamp_s < a[n - 1].timestamp_s) {
+            fail(r, r->lineno, "timestamp_s",
+                 "%.10g is earlier than %.10g on line %ld (timestamps must be non-decreasing)",
+                 a[n].timestamp_s, a[n - 1].timestamp_s, prev_line);
+            goto fail;
+        }
+        prev_line = r->lineno;
+        n++;
+    }
+    if (n == 0) {
+        fail(r, r->lineno, NULL, "no vehicles after the header");
+        goto fail;
+    }
+    *recs = a;
+    *n_out = (int)n;
+    return 0;
+fail:
+    free(a);
+    return AMFI_EINVAL;
+}
+
+int amfi_traffic_read(const char *path, amfi_vehicle_rec **recs, int *n, char *err,
+                      size_t errlen)
+{
+    *recs = NULL;
+    *n = 0;
+    if (err && errlen)
+        err[0] = '\0';
+    reader *r = calloc(1, sizeof *r);
+    if (!r) {
+        if (err && errlen)
+            snprintf(err, errlen, "%s: out of memory", path);
+        return AMFI_ENOMEM;
+    }
+    r->path = path;
+    r->err = err;
+    r->errlen = errlen;
+    int rc = AMFI_EINVAL;
+    r->f = fopen(path, "rb");
+    if (!r->f) {
+        fail(r, 0, NULL, "cannot open: %s", strerror(errno));
+        goto done;
+    }
+    if (read_header(r) != 0)
+        goto done;
+    rc = read_rows(r, recs, n);
+done:
+    if (r->f)
+        fclose(r->f);
+    free(r);
+    return rc;
+}
+
+void amfi_traffic_free(amfi_vehicle_rec *recs) { free(recs); }
