@@ -1,0 +1,349 @@
+/*
+ * sim_publisher: simulated vehicles crossing the bridge, written as the
+ * passages a site would record.
+ *
+ *   sim_publisher --out DIR [--config FILE.yaml] [--population FILE.csv]
+ *                 [--vehicles N] [--first K] [--damage FRACTION] [--seed S]
+ *                 [--profile A..H|smooth] [--track-std TRACKS] [--scan-rate HZ]
+ *                 [--noise FRACTION] [--speed-error MEAN,STD]
+ *                 [--preceding-gap LO[,HI]] [--pre SEC] [--post SEC] [--dt SEC]
+ *
+ * Vehicle i is the population's record first + i: its weights, spacing and
+ * speed; its Table 2 properties and its carpet track are drawn from a
+ * generator seeded by (seed, i), so any vehicle can be reproduced alone and
+ * the same seed gives the same bytes. The road is one ISO 8608 carpet per
+ * run (seeded by seed). Defaults are ideal: class A, no noise, exact speed,
+ * a healthy bridge, one vehicle at a time; every inaccuracy is switched on
+ * explicitly. With --preceding-gap, a population vehicle drawn at random
+ * crosses first, its rear axle leaving the bridge a gap (uniform in
+ * [LO, HI] s) before the target enters.
+ *
+ * Output: DIR/vNNNNN.csv per vehicle (header t,accel: s from the start of the
+ * record, m/s² positive downward at the configuration's first sensor; the
+ * format amfi-solve reads) and DIR/meta.csv, one row per vehicle: the speed
+ * given to a solver (measured) and the true one, spacing, the time in the
+ * file when the front axle enters, the true static weights, the true mean
+ * contact forces on the span, and the conditions.
+ *
+ * Exit status: 0; 1 bad input file or simulation failure; 2 bad command line.
+ */
+#include <errno.h>
+#include <gsl/gsl_rng.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "amfi_config.h"
+#include "passage.h"
+#include "profile.h"
+#include "traffic.h"
+#include "vbi.h"
+#include "vehicle.h"
+
+#define PROG "sim_publisher"
+
+#ifndef AMFI_DEFAULT_CONFIG
+#define AMFI_DEFAULT_CONFIG "config/paper-20m.yaml"
+#endif
+#ifndef AMFI_DEFAULT_POPULATION
+#define AMFI_DEFAULT_POPULATION "sim_publisher/data/population.csv"
+#endif
+
+typedef struct opts {
+    const char *out, *config, *population;
+    long vehicles, first;
+    double damage;
+    unsigned long seed;
+    char profile_class; /* 0: smooth */
+    double track_std, scan_rate, noise, speed_err_mean, speed_err_std;
+    int preceding;
+    double gap_lo, gap_hi, pre, post, dt;
+} opts;
+
+static void usage(void)
+{
+    fprintf(stderr,
+            "usage: %s --out DIR [--config FILE.yaml] [--population FILE.csv] [--vehicles N]\n"
+            "       [--first K] [--damage FRACTION] [--seed S] [--profile A..H|smooth]\n"
+            "       [--track-std TRACKS] [--scan-rate HZ] [--noise FRACTION]\n"
+            "       [--speed-error MEAN,STD] [--preceding-gap LO[,HI]] [--pre SEC] [--post SEC]\n"
+            "       [--dt SEC]\n",
+            PROG);
+}
+
+static double num(const char *opt, const char *s, double lo, double hi)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
+        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, s, lo, hi);
+        exit(2);
+    }
+    return v;
+}
+
+/* "A" or "A,B" */
+static void pair(const char *opt, const char *s, double lo, double hi, double *a, double *b,
+                 int need_two)
+{
+    char buf[128];
+    if (strlen(s) >= sizeof buf) {
+        fprintf(stderr, "%s: %s: too long\n", PROG, opt);
+        exit(2);
+    }
+    strcpy(buf, s);
+    char *comma = strchr(buf, ',');
+    if (!comma && need_two) {
+        fprintf(stderr, "%s: %s: expected two values 'A,B'\n", PROG, opt);
+        exit(2);
+    }
+    if (comma)
+        *comma = 0;
+    *a = num(opt, buf, lo, hi);
+    *b = comma ? num(opt, comma + 1, lo, hi) : *a;
+}
+
+static void parse(int argc, char **argv, opts *o)
+{
+    *o = (opts){0};
+    o->vehicles = 10;
+    o->seed = 1;
+    o->profile_class = 'A';
+    o->track_std = 2.0;
+    o->scan_rate = 1000.0;
+    o->pre = 0.5;
+    o->post = 0.5;
+    o->dt = 1e-4;
+    for (int i = 1; i < argc; i++) {
+        const char *k = argv[i];
+        if (!strcmp(k, "--help") || !strcmp(k, "-h")) {
+            usage();
+            exit(0);
+        }
+        if (i + 1 >= argc || strncmp(k, "--", 2)) {
+            fprintf(stderr, "%s: %s: %s\n", PROG, k,
+                    strncmp(k, "--", 2) ? "unexpected argument" : "missing value");
+            usage();
+            exit(2);
+        }
+        const char *v = argv[++i];
+        if (!strcmp(k, "--out"))
+            o->out = v;
+        else if (!strcmp(k, "--config"))
+            o->config = v;
+        else if (!strcmp(k, "--population"))
+            o->population = v;
+        else if (!strcmp(k, "--vehicles"))
+            o->vehicles = (long)num(k, v, 1, 1e7);
+        else if (!strcmp(k, "--first"))
+            o->first = (long)num(k, v, 0, 1e7);
+        else if (!strcmp(k, "--damage"))
+            o->damage = num(k, v, 0, 0.9);
+        else if (!strcmp(k, "--seed"))
+            o->seed = (unsigned long)num(k, v, 0, 4294967295.0);
+        else if (!strcmp(k, "--profile")) {
+            if (!strcmp(v, "smooth"))
+                o->profile_class = 0;
+            else if (strlen(v) == 1 && v[0] >= 'A' && v[0] <= 'H')
+                o->profile_class = v[0];
+            else {
+                fprintf(stderr, "%s: --profile: '%s' is not A..H or smooth\n", PROG, v);
+                exit(2);
+            }
+        } else if (!strcmp(k, "--track-std"))
+            o->track_std = num(k, v, 0, 100);
+        else if (!strcmp(k, "--scan-rate"))
+            o->scan_rate = num(k, v, 50, 20000);
+        else if (!strcmp(k, "--noise"))
+            o->noise = num(k, v, 0, 1);
+        else if (!strcmp(k, "--speed-error"))
+            pair(k, v, -0.5, 0.5, &o->speed_err_mean, &o->speed_err_std, 1);
+        else if (!strcmp(k, "--preceding-gap")) {
+            pair(k, v, -2, 30, &o->gap_lo, &o->gap_hi, 0);
+            o->preceding = 1;
+            if (o->gap_hi < o->gap_lo) {
+                fprintf(stderr, "%s: --preceding-gap: LO must not exceed HI\n", PROG);
+                exit(2);
+            }
+        } else if (!strcmp(k, "--pre"))
+            o->pre = num(k, v, 0, 30);
+        else if (!strcmp(k, "--post"))
+            o->post = num(k, v, 0, 30);
+        else if (!strcmp(k, "--dt"))
+            o->dt = num(k, v, 1e-6, 1e-3);
+        else {
+            fprintf(stderr, "%s: unknown option %s\n", PROG, k);
+            usage();
+            exit(2);
+        }
+    }
+    if (o->speed_err_std < 0) {
+        fprintf(stderr, "%s: --speed-error: STD must be >= 0\n", PROG);
+        exit(2);
+    }
+    if (!o->out) {
+        fprintf(stderr, "%s: --out DIR is required\n", PROG);
+        usage();
+        exit(2);
+    }
+}
+
+/* A generator for vehicle i of a run: the same (seed, i), the same draws. */
+static void seed_vehicle(gsl_rng *r, unsigned long seed, long i)
+{
+    unsigned long long h = (unsigned long long)seed * 0x9E3779B97F4A7C15ull + (unsigned long long)i;
+    h ^= h >> 31;
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 29;
+    gsl_rng_set(r, (unsigned long)(h & 0xffffffffu) | 1u);
+}
+
+int main(int argc, char **argv)
+{
+    opts o;
+    parse(argc, argv, &o);
+    amfi_set_blas_threads(1);
+    char err[512];
+    static amfi_site_config cfg;
+    amfi_config_defaults(&cfg);
+    const char *cpath = o.config ? o.config : AMFI_DEFAULT_CONFIG;
+    struct stat st;
+    if ((o.config || stat(cpath, &st) == 0) && amfi_config_load(cpath, &cfg, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    cfg.bridge.damage = o.damage;
+    const char *ppath = o.population ? o.population : AMFI_DEFAULT_POPULATION;
+    amfi_vehicle_rec *recs = NULL;
+    int n_recs = 0;
+    if (amfi_traffic_read(ppath, &recs, &n_recs, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    if (o.first + o.vehicles > n_recs) {
+        fprintf(stderr, "%s: %s has %d vehicles; --first %ld --vehicles %ld needs %ld\n", PROG,
+                ppath, n_recs, o.first, o.vehicles, o.first + o.vehicles);
+        amfi_traffic_free(recs);
+        return 2;
+    }
+    if (mkdir(o.out, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "%s: %s: cannot create: %s\n", PROG, o.out, strerror(errno));
+        amfi_traffic_free(recs);
+        return 1;
+    }
+    amfi_bridge *b = NULL;
+    amfi_profile *prof = NULL;
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    double *acc = NULL;
+    FILE *meta = NULL;
+    int rc = 1;
+    if (amfi_bridge_create(&cfg.bridge, &b, err, sizeof err)) {
+        fprintf(stderr, "%s: bridge: %s\n", PROG, err);
+        goto out;
+    }
+    amfi_sim_params sp;
+    amfi_sim_params_default(&sp, cfg.bridge.span_m);
+    sp.dt_s = o.dt;
+    sp.scan_rate_hz = o.scan_rate;
+    sp.n_sensors = cfg.solver.n_sensors;
+    memcpy(sp.sensor_x_m, cfg.solver.sensor_x_m, sizeof sp.sensor_x_m);
+    amfi_profile_params pp;
+    amfi_profile_params_default(&pp);
+    pp.iso_class = o.profile_class;
+    pp.seed = o.seed;
+    pp.length_m = sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + cfg.bridge.span_m + 100.0;
+    if (amfi_profile_create(&pp, &prof, err, sizeof err)) {
+        fprintf(stderr, "%s: profile: %s\n", PROG, err);
+        goto out;
+    }
+    amfi_halfcar_dist dist;
+    amfi_halfcar_dist_paper(&dist);
+    const int cap = (int)((o.pre + o.post + 60.0) * o.scan_rate);
+    acc = malloc(sizeof(double) * cap * sp.n_sensors);
+    char path[4096];
+    snprintf(path, sizeof path, "%s/meta.csv", o.out);
+    meta = fopen(path, "w");
+    if (!acc || !meta) {
+        fprintf(stderr, "%s: %s: %s\n", PROG, path, acc ? strerror(errno) : "out of memory");
+        goto out;
+    }
+    fprintf(meta, "name,speed_mps,speed_true_mps,axle_spacing_m,entry_time_s,gvw_kg,axle1_kg,"
+                  "axle2_kg,mean_force1_N,mean_force2_N,damage,noise,profile,track,"
+                  "preceding_gap_s,lost_contact_steps,scan_rate_hz,sensor_x_m\n");
+    for (long i = 0; i < o.vehicles; i++) {
+        const amfi_vehicle_rec *rec = &recs[o.first + i];
+        amfi_passage_spec spec;
+        seed_vehicle(rng, o.seed, o.first + i);
+        if (amfi_passage_spec_from_rec(rec, &dist, prof, o.track_std, rng, &spec, err,
+                                       sizeof err)) {
+            fprintf(stderr, "%s: %s: vehicle %ld: %s\n", PROG, ppath, o.first + i + 1, err);
+            goto out;
+        }
+        spec.pre_s = o.pre;
+        spec.post_s = o.post;
+        double gap = NAN;
+        if (o.preceding) {
+            const amfi_vehicle_rec *p = &recs[gsl_rng_uniform_int(rng, (unsigned long)n_recs)];
+            amfi_passage_spec ps;
+            if (amfi_passage_spec_from_rec(p, &dist, prof, o.track_std, rng, &ps, err,
+                                           sizeof err)) {
+                fprintf(stderr, "%s: %s: preceding vehicle: %s\n", PROG, ppath, err);
+                goto out;
+            }
+            gap = o.gap_lo + (o.gap_hi - o.gap_lo) * gsl_rng_uniform(rng);
+            spec.preceding = 1;
+            spec.prec_car = ps.car;
+            spec.prec_speed_mps = ps.speed_mps;
+            spec.prec_track = ps.track;
+            spec.gap_s = gap;
+        }
+        amfi_measure m = {o.noise, o.speed_err_mean, o.speed_err_std};
+        amfi_passage_rec pr;
+        if (amfi_passage_simulate(b, prof, &sp, &spec, &m, rng, acc, cap, &pr, err,
+                                  sizeof err)) {
+            fprintf(stderr, "%s: vehicle %ld: %s\n", PROG, o.first + i + 1, err);
+            goto out;
+        }
+        char name[32];
+        snprintf(name, sizeof name, "v%05ld", o.first + i + 1);
+        snprintf(path, sizeof path, "%s/%s.csv", o.out, name);
+        FILE *f = fopen(path, "w");
+        if (!f) {
+            fprintf(stderr, "%s: %s: cannot create: %s\n", PROG, path, strerror(errno));
+            goto out;
+        }
+        fprintf(f, "t,accel\n");
+        for (int k = 0; k < pr.n; k++)
+            fprintf(f, "%.6f,%.9g\n", k / o.scan_rate, acc[(size_t)k * pr.n_sensors]);
+        if (fclose(f) != 0) {
+            fprintf(stderr, "%s: %s: write failed\n", PROG, path);
+            goto out;
+        }
+        fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,%g\n",
+                name, pr.speed_measured_mps, spec.speed_mps, spec.car.D1_m + spec.car.D2_m,
+                -pr.t_first_s, rec->axle_kg[0] + rec->axle_kg[1], rec->axle_kg[0],
+                rec->axle_kg[1], pr.truth.mean_force_N[0], pr.truth.mean_force_N[1], o.damage,
+                o.noise, o.profile_class ? (char[]){o.profile_class, 0} : "smooth", spec.track,
+                gap, pr.truth.lost_contact_steps[0] + pr.truth.lost_contact_steps[1],
+                o.scan_rate, sp.sensor_x_m[0]);
+    }
+    if (fclose(meta) != 0) {
+        meta = NULL;
+        fprintf(stderr, "%s: %s/meta.csv: write failed\n", PROG, o.out);
+        goto out;
+    }
+    meta = NULL;
+    rc = 0;
+out:
+    if (meta)
+        fclose(meta);
+    free(acc);
+    gsl_rng_free(rng);
+    amfi_profile_destroy(prof);
+    amfi_bridge_destroy(b);
+    amfi_traffic_free(recs);
+    return rc;
+}

@@ -1,0 +1,40 @@
+#!/bin/sh
+# sim_publisher's offline output: the files amfi-solve reads, meta.csv with
+# the truth, the same seed giving the same bytes, and the weights amfi-solve
+# infers from them close to the truth on the ideal defaults.
+# Usage: sim_out.sh SIM_PUBLISHER AMFI_SOLVE
+set -u
+sim=$1
+solve=$2
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+"$sim" --out "$dir/a" --vehicles 4 --seed 5 || fail "sim_publisher exited $?"
+"$sim" --out "$dir/b" --vehicles 4 --seed 5 || fail "second run exited $?"
+"$sim" --out "$dir/c" --vehicles 4 --seed 6 || fail "third run exited $?"
+for f in meta.csv v00001.csv v00004.csv; do
+  cmp -s "$dir/a/$f" "$dir/b/$f" || fail "same seed, different $f"
+done
+cmp -s "$dir/a/v00001.csv" "$dir/c/v00001.csv" && fail "another seed gave the same v00001.csv"
+head -1 "$dir/a/meta.csv" | grep -q '^name,speed_mps,speed_true_mps,axle_spacing_m,entry_time_s,gvw_kg,axle1_kg,axle2_kg,mean_force1_N,mean_force2_N,damage,noise' ||
+  fail "meta.csv header: $(head -1 "$dir/a/meta.csv")"
+[ "$(wc -l < "$dir/a/meta.csv")" -eq 5 ] || fail "meta.csv rows"
+head -1 "$dir/a/v00001.csv" | grep -qx 't,accel' || fail "passage header"
+
+# Weigh every passage with amfi-solve; ideal data: within 5 % of the truth.
+tail -n +2 "$dir/a/meta.csv" | while IFS=, read -r name speed _ spacing entry gvw _; do
+  out=$("$solve" --accel "$dir/a/$name.csv" --speed "$speed" --axle-spacing "$spacing" \
+        --entry-time "$entry") || fail "amfi-solve on $name exited $?"
+  inferred=$(printf '%s' "$out" | sed 's/.*"gvw_kg":\([-0-9.e+]*\).*/\1/')
+  awk -v a="$inferred" -v b="$gvw" -v n="$name" 'BEGIN {
+    e = (a - b) / b; printf "%s: true %.0f kg, inferred %.0f kg (%+.2f %%)\n", n, b, a, 100 * e;
+    exit (e < -0.05 || e > 0.05) }' || fail "$name: GVW error over 5 %"
+done || exit 1
+
+# Bad command lines are refused with one line and status 2.
+"$sim" --vehicles 3 2>/dev/null; [ $? -eq 2 ] || fail "missing --out not refused"
+"$sim" --out "$dir/d" --damage 2 2>/dev/null; [ $? -eq 2 ] || fail "damage 2 not refused"
+"$sim" --out "$dir/d" --profile Z 2>/dev/null; [ $? -eq 2 ] || fail "profile Z not refused"
+"$sim" --out "$dir/d" --population /nonexistent.csv 2>/dev/null; [ $? -eq 1 ] || fail "missing population not refused"
+echo "sim_publisher output: ok"
