@@ -715,6 +715,9 @@ static const enum_name coords_names[] = {
 /* solver.initial_force -> fix_initial_force */
 static const enum_name initial_force_names[] = {{"free", 0}, {"zero", 1}, {NULL, 0}};
 
+/* solver.initial_state -> free_initial_state */
+static const enum_name initial_state_names[] = {{"rest", 0}, {"free", 1}, {NULL, 0}};
+
 static const field lcurve_fields[] = {
     {.key = "lo", .parse = p_double, .off = SC(lambda.lcurve_lo), .lo = 0,
      .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
@@ -735,6 +738,8 @@ static const field solver_fields[] = {
      .hi = MAX_RATE_HZ, .flags = F_LO_OPEN},
     {.key = "initial_force", .parse = p_enum, .off = SC(solver.fix_initial_force),
      .aux = initial_force_names},
+    {.key = "initial_state", .parse = p_enum, .off = SC(solver.free_initial_state),
+     .aux = initial_state_names},
     {.key = "pre_roll_s", .parse = p_double, .off = SC(solver.pre_roll_s), .lo = 0,
      .hi = MAX_ROLL_S, .flags = F_HI_OPEN},
     {.key = "post_roll_s", .parse = p_double, .off = SC(solver.post_roll_s), .lo = 0,
@@ -899,6 +904,12 @@ static int check_site(ctx *x, amfi_site_config *c)
     if (s->fix_initial_force && !(s->pre_roll_s > 0))
         return fail(x, first_noted(x, "solver.initial_force", "solver.pre_roll_s", NULL),
                     "solver.initial_force", "zero needs solver.pre_roll_s > 0");
+    if (s->free_initial_state && s->fix_initial_force)
+        return fail(x, first_noted(x, "solver.initial_state", "solver.initial_force", NULL),
+                    "solver.initial_state", "free needs solver.initial_force: free");
+    if (s->free_initial_state && s->coords != AMFI_COORDS_MODAL)
+        return fail(x, first_noted(x, "solver.initial_state", "solver.coordinates", NULL),
+                    "solver.initial_state", "free needs solver.coordinates: modal");
     return 0;
 }
 
@@ -910,6 +921,11 @@ void amfi_config_defaults(amfi_site_config *c)
     memcpy(c->name, "paper-20m", sizeof "paper-20m");
     amfi_bridge_params_paper20(&c->bridge);
     amfi_solver_params_default(&c->solver, c->bridge.span_m);
+    /* The site recommendation (docs/results/paper.md): the bridge may still
+     * vibrate from earlier traffic, so its state is estimated with the
+     * forces, from a window starting 0.3 s before the first axle enters. */
+    c->solver.free_initial_state = 1;
+    c->solver.pre_roll_s = 0.3;
     amfi_lambda_default(&c->lambda);
     for (int i = 0; i < AMFI_MAX_SENSORS; i++)
         c->sensor_id[i] = i < c->solver.n_sensors ? i : -1;

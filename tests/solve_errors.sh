@@ -131,7 +131,7 @@ run bad_formulation 2 "--formulation" $config --accel "$good" --speed 25 --axle-
 run lcurve_fixed 2 "--lcurve needs --lambda auto" $config --accel "$good" --speed 25 --axle-spacing 4 --lambda 1e-9 --lcurve "$tmp/l.csv"
 run bad_config 1 "^$tmp/nope.yaml" --config "$tmp/nope.yaml" --accel "$good" --speed 25 --axle-spacing 4
 # shellcheck disable=SC2086
-run forces_unwritable 1 "--forces" $config --accel "$good" --speed 25 --axle-spacing 4 --forces "$tmp/no/such/dir/f.csv"
+run forces_unwritable 1 "--forces" $config --accel "$good" --speed 25 --axle-spacing 4 --entry-time 0.5 --forces "$tmp/no/such/dir/f.csv"
 
 echo "solve_errors: $cases cases, $failures failed"
 [ "$failures" -eq 0 ]

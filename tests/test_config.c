@@ -63,6 +63,8 @@ static void test_defaults(void **state)
     amfi_config_defaults(&c);
     amfi_bridge_params_paper20(&b);
     amfi_solver_params_default(&s, 20.0);
+    s.free_initial_state = 1; /* the site recommendation over the library's minimum */
+    s.pre_roll_s = 0.3;
     amfi_lambda_default(&l);
     assert_string_equal("paper-20m", c.name);
     assert_memory_equal(&b, &c.bridge, sizeof b);
@@ -124,6 +126,7 @@ static const char every_key[] =
     "  modes: 6\n"
     "  calc_rate_hz: 2000\n"
     "  initial_force: zero\n"
+    "  initial_state: rest\n"
     "  pre_roll_s: 0.2\n"
     "  post_roll_s: 0.5\n"
     "  max_axles: 5\n"
@@ -345,8 +348,15 @@ static const bad_case bad_cases[] = {
      "got 2e+06"},
     {"initial_force_word", "solver:\n  initial_force: none\n", 2, "solver.initial_force",
      "free, zero"},
-    {"initial_zero_no_roll", "solver:\n  initial_force: zero\n  post_roll_s: 0.1\n", 2,
+    {"initial_zero_no_roll",
+     "solver:\n  initial_force: zero\n  initial_state: rest\n  pre_roll_s: 0\n", 2,
      "solver.initial_force", "pre_roll_s > 0"},
+    {"initial_state_word", "solver:\n  initial_state: moving\n", 2, "solver.initial_state",
+     "rest, free"},
+    {"free_state_zero_force", "solver:\n  initial_force: zero\n", 2, "solver.initial_state",
+     "initial_force: free"},
+    {"free_state_nodal", "solver:\n  coordinates: nodal\n", 2, "solver.initial_state",
+     "coordinates: modal"},
     {"pre_roll_60", "solver:\n  pre_roll_s: 60\n", 2, "solver.pre_roll_s", "[0, 60)"},
     {"post_roll_negative", "solver:\n  post_roll_s: -0.1\n", 2, "solver.post_roll_s",
      "got -0.1"},

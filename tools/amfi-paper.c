@@ -4,7 +4,8 @@
  * numbers (MODEL.md §5).
  *
  *   amfi-paper [--out DIR] [--quick] [--vehicles N] [--reps R] [--threads T]
- *              [--lambda-ref VALUE] [--batch-lcurve] [--config FILE.yaml]
+ *              [--lambda-ref VALUE] [--batch-lcurve] [--initial-state rest|free]
+ *              [--pre-roll SEC] [--config FILE.yaml]
  *              [--population FILE.csv] [--no-plots]
  *
  * Single-vehicle experiments use the baseline 18 t half-car at 25 m/s on an
@@ -65,6 +66,8 @@ static const double levels[N_LEVELS] = {0.0, 0.025, 0.05, 0.075, 0.10};
 typedef struct opts {
     const char *out, *config, *population;
     int quick, vehicles, reps, threads, batch_lcurve, plots;
+    int free_state;       /* -1: as configured; 0 rest; 1 free */
+    double pre_roll;      /* < 0: as configured */
     double lambda_ref;
 } opts;
 
@@ -111,7 +114,7 @@ static double num(const char *opt, const char *s, double lo, double hi)
 static void parse(int argc, char **argv, opts *o)
 {
     *o = (opts){.out = "docs/results", .vehicles = 500, .reps = 3, .threads = 2, .plots = 1,
-                .lambda_ref = 7.94e-9};
+                .lambda_ref = 7.94e-9, .free_state = -1, .pre_roll = -1};
     int vehicles_set = 0;
     for (int i = 1; i < argc; i++) {
         const char *k = argv[i];
@@ -147,6 +150,14 @@ static void parse(int argc, char **argv, opts *o)
             o->threads = (int)num(k, v, 1, 64);
         else if (!strcmp(k, "--lambda-ref"))
             o->lambda_ref = num(k, v, 1e-20, 1);
+        else if (!strcmp(k, "--initial-state")) {
+            if (strcmp(v, "rest") && strcmp(v, "free")) {
+                fprintf(stderr, "%s: --initial-state: rest or free\n", PROG);
+                exit(2);
+            }
+            o->free_state = !strcmp(v, "free");
+        } else if (!strcmp(k, "--pre-roll"))
+            o->pre_roll = num(k, v, 0, 0.5);
         else {
             fprintf(stderr, "%s: unknown option %s\n", PROG, k);
             exit(2);
@@ -385,8 +396,11 @@ static int batches(ctx *c)
             "leaving the bridge 0.5-2 s before, 3 %% noise (paper Table 5). Vehicles drawn at "
             "random from the synthetic population (`docs/simulator-inputs.md`), class A carpet "
             "(one per repetition), Table 2 properties drawn per vehicle. Solver: paper "
-            "formulation, modal, observable modes, %.0f Hz, fixed lambda_ref = %.3g%s.\n\n",
-            o->reps, o->vehicles, c->cfg.solver.calc_rate_hz, o->lambda_ref,
+            "formulation, modal, observable modes, %.0f Hz, initial bridge state %s, pre-roll "
+            "%.2f s, fixed lambda_ref = %.3g%s.\n\n",
+            o->reps, o->vehicles, c->cfg.solver.calc_rate_hz,
+            c->cfg.solver.free_initial_state ? "free" : "at rest", c->cfg.solver.pre_roll_s,
+            o->lambda_ref,
             o->batch_lcurve ? "; and a per-vehicle L-curve on the same data" : "");
     for (int cond = 0; cond < 2; cond++) {
         batch_job j;
@@ -871,6 +885,10 @@ int main(int argc, char **argv)
     if ((c.o.config || stat(cpath, &st) == 0) && amfi_config_load(cpath, &c.cfg, err, sizeof err))
         die("%s%s", err, "");
     c.cfg.solver.n_sensors = 1; /* one accelerometer, as in the paper */
+    if (c.o.free_state >= 0)
+        c.cfg.solver.free_initial_state = c.o.free_state;
+    if (c.o.pre_roll >= 0)
+        c.cfg.solver.pre_roll_s = c.o.pre_roll;
     c.cfg.bridge.damage = 0.0;
     if (amfi_bridge_create(&c.cfg.bridge, &c.healthy, err, sizeof err))
         die("bridge: %s%s", err, "");

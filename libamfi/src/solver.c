@@ -26,6 +26,25 @@ int amfi_spd_inverse(int na, double *A)
     return 0;
 }
 
+int amfi_spd_solve(int n, double *A, double *b)
+{
+    /* The entries span many orders of magnitude (a slow mode's displacement,
+     * a fast mode's velocity, a force not yet on the span), so any ridge is
+     * relative to each diagonal entry: it changes a well-posed answer by
+     * round-off only. A state the data cannot see at all (zero row) is
+     * pinned at zero. */
+    for (int i = 0; i < n; i++) {
+        double *d = &A[(size_t)i * n + i];
+        if (*d > 0.0) {
+            *d *= 1.0 + 1e-13;
+        } else {
+            *d = 1.0;
+            b[i] = 0.0;
+        }
+    }
+    return LAPACKE_dposv_work(LAPACK_COL_MAJOR, 'U', n, 1, A, n, b, n) == 0 ? 0 : -1;
+}
+
 void amfi_solver_destroy(amfi_solver *s)
 {
     if (!s)
@@ -87,6 +106,10 @@ static int check_params(const amfi_bridge *b, const amfi_solver_params *p, char 
         "pre_roll_s must be in [0, 60)");
     REQ(isfinite(p->post_roll_s) && p->post_roll_s >= 0 && p->post_roll_s < 60,
         "post_roll_s must be in [0, 60)");
+    REQ(!(p->free_initial_state && p->fix_initial_force),
+        "a free initial bridge state needs a free initial force");
+    REQ(!p->free_initial_state || p->coords == AMFI_COORDS_MODAL,
+        "a free initial bridge state is solved in modal coordinates only");
     REQ(!p->fix_initial_force || p->pre_roll_s > 0,
         "a zero initial force needs a pre-roll (pre_roll_s > 0)");
 #undef REQ
@@ -226,7 +249,9 @@ int amfi_solver_create(const amfi_bridge *b, const amfi_solver_params *p, amfi_s
         if ((rc = setup_modal(s, err, errlen)) != 0)
             goto fail;
         s->gstride = 2 * s->m + s->na_max;
-        s->scratch_len = amfi_sweep_modal_scratch(s->m, s->na_max, s->ns);
+        /* + the full R_0 and a right-hand side for a free initial state */
+        s->scratch_len = amfi_sweep_modal_scratch(s->m, s->na_max, s->ns) +
+                         (size_t)(s->gstride + 1) * s->gstride;
     } else {
         const int n = s->n;
         s->m = n;

@@ -77,4 +77,10 @@ int amfi_lcurve(struct amfi_solver *s, const amfi_lambda *l, double *lam_h, int 
  * No allocation. Returns 0 or a LAPACK info. */
 int amfi_spd_inverse(int na, double *A);
 
+/* Solve A x = b in place (b ← x) for a symmetric positive semi-definite A
+ * (n × n, overwritten): each diagonal entry raised by 1e-13 of itself (an
+ * empty row pinned at zero), then Cholesky (LAPACK dposv). Once per solve,
+ * not per step. */
+int amfi_spd_solve(int n, double *A, double *b);
+
 #endif

@@ -265,10 +265,36 @@ int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double
         }
     }
 
-    /* Start at rest; g_0 free: argmin over g of gᵀR_gg g + s_gᵀg. */
+    /* Start: at rest with g_0 free (argmin over g of gᵀR_gg g + s_gᵀg), or
+     * with the whole z_0 free (argmin of z_0ᵀR_0 z_0 + s_0ᵀz_0). */
     memset(x, 0, sizeof(double) * m2);
     memset(g, 0, sizeof(double) * na);
-    if (!s->p.fix_initial_force) {
+    if (s->p.free_initial_state) {
+        /* R_0 in full from its stored parts into the L-curve-free scratch
+         * at the end of the workspace (nst² doubles, sized at create). */
+        double *A = s->scratch + amfi_sweep_modal_scratch(s->m, s->na_max, s->ns);
+        double *rhs = A + (size_t)nst * nst;
+        for (int i = 0; i < m2; i++)
+            for (int k = i; k < m2; k++) {
+                /* only the upper block triangle of Rxx is valid */
+                double v = (k / 2 >= i / 2) ? Rxx[(size_t)i * m2 + k] : Rxx[(size_t)k * m2 + i];
+                A[(size_t)i * nst + k] = A[(size_t)k * nst + i] = v;
+            }
+        for (int i = 0; i < m2; i++)
+            for (int b = 0; b < na; b++)
+                A[(size_t)i * nst + m2 + b] = A[(size_t)(m2 + b) * nst + i] = Rxg[i * na + b];
+        for (int a = 0; a < na; a++)
+            for (int b = 0; b < na; b++)
+                A[(size_t)(m2 + a) * nst + m2 + b] = Rgg[a * na + b];
+        for (int i = 0; i < m2; i++)
+            rhs[i] = -0.5 * sx[i];
+        for (int a = 0; a < na; a++)
+            rhs[m2 + a] = -0.5 * sg[a];
+        if (amfi_spd_solve(nst, A, rhs) != 0)
+            return AMFI_ENUM;
+        memcpy(x, rhs, sizeof(double) * m2);
+        memcpy(g, rhs + m2, sizeof(double) * na);
+    } else if (!s->p.fix_initial_force) {
         memcpy(K, Rgg, sizeof(double) * na * na);
         if (amfi_spd_inverse(na, K) != 0)
             return AMFI_ENUM;

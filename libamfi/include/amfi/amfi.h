@@ -179,6 +179,11 @@ typedef struct amfi_solver_params {
     double max_duration_s;  /* workspace capacity in time (grown on demand) */
     int fix_initial_force;  /* 0 (default): g_0 free, from min x0ᵀR0x0 + x0ᵀs0;
                                1: g_0 = 0 (use with pre_roll_s > 0) */
+    int free_initial_state; /* 0 (default): the bridge is at rest when the window
+                               starts (X_0 = 0); 1: X_0 is free too, taken with
+                               g_0 from the minimum of the cost-to-go, for a
+                               bridge still vibrating from earlier traffic
+                               (use with a pre-roll, which shows that vibration) */
     double pre_roll_s;      /* window starts this long before entry, >= 0 */
     double post_roll_s;     /* window ends this long after the last exit, >= 0 */
 } amfi_solver_params;
