@@ -9,6 +9,7 @@ pkgs=(
   zlib1g-dev                     # gzip-compressed passage CSVs
   libgsl-dev                     # random numbers and statistics
   libcmocka-dev                  # unit tests
+  gnuplot-nox                    # plots of the experiments (amfi-paper)
 )
 missing=()
 for p in "${pkgs[@]}"; do

@@ -4,7 +4,8 @@
  * numbers (MODEL.md §5).
  *
  *   amfi-paper [--out DIR] [--quick] [--vehicles N] [--reps R] [--threads T]
- *              [--lambda-ref VALUE] [--batch-lcurve] [--initial-state rest|free]
+ *              [--lambda-ref VALUE] [--batch-lcurve] [--batches-only]
+ *              [--initial-state rest|free]
  *              [--pre-roll SEC] [--config FILE.yaml]
  *              [--population FILE.csv] [--no-plots]
  *
@@ -65,7 +66,7 @@ static const double levels[N_LEVELS] = {0.0, 0.025, 0.05, 0.075, 0.10};
 
 typedef struct opts {
     const char *out, *config, *population;
-    int quick, vehicles, reps, threads, batch_lcurve, plots;
+    int quick, vehicles, reps, threads, batch_lcurve, plots, batches_only;
     int free_state;       /* -1: as configured; 0 rest; 1 free */
     double pre_roll;      /* < 0: as configured */
     double lambda_ref;
@@ -124,6 +125,10 @@ static void parse(int argc, char **argv, opts *o)
         }
         if (!strcmp(k, "--batch-lcurve")) {
             o->batch_lcurve = 1;
+            continue;
+        }
+        if (!strcmp(k, "--batches-only")) {
+            o->batches_only = 1;
             continue;
         }
         if (!strcmp(k, "--no-plots")) {
@@ -242,7 +247,8 @@ static int run_passage(const ctx *c, worker *w, const amfi_bridge *b, const amfi
 
 typedef struct batch_job {
     const ctx *c;
-    int cond;           /* 0 ideal, 1 Table 5 inaccuracies */
+    int cond;           /* 0 ideal, 1 Table 5 inaccuracies, 2 the same with the
+                           same vehicles at every level */
     amfi_profile *prof[20];  /* per repetition */
     int *pick;          /* [cond][rep][level][i] record index */
     double *gvw_true;   /* same layout */
@@ -292,7 +298,7 @@ static void *batch_thread(void *arg)
         spec.pre_s = 0.5;
         spec.post_s = 0.3;
         amfi_measure m = {0};
-        if (j->cond == 1) {
+        if (j->cond >= 1) {
             /* Table 5: a vehicle left the bridge 0.5-2 s before; speed error
              * (0, 3 %); 3 % noise. */
             const amfi_vehicle_rec *pv = &c->recs[gsl_rng_uniform_int(w.rng, c->n_recs)];
@@ -387,13 +393,15 @@ static int batches(ctx *c)
         die("%s: %s", path, strerror(errno));
     fprintf(vcsv, "condition,repetition,damage,record,gvw_true_kg,gvw_fixed_kg%s\n",
             o->batch_lcurve ? ",gvw_lcurve_kg,lambda_lcurve" : "");
-    const char *cname[2] = {"ideal", "table5"};
+    const char *cname[3] = {"ideal", "table5", "table5_same"};
     fprintf(c->md, "## Table 4: inferred GVW over batches of %d vehicles\n\n", o->vehicles);
     fprintf(c->md,
             "Damage levels 0 / 2.5 / 5 / 7.5 / 10 %%, %d repetitions. *ideal*: the same %d "
             "vehicles at every level of a repetition, no noise, exact speed, one vehicle at a "
             "time. *table5*: a different batch per level, speed error N(0, 3 %%), a vehicle "
-            "leaving the bridge 0.5-2 s before, 3 %% noise (paper Table 5). Vehicles drawn at "
+            "leaving the bridge 0.5-2 s before, 3 %% noise (paper Table 5). *table5_same*: "
+            "the Table 5 inaccuracies on the same vehicles at every level (separates the "
+            "batch-to-batch variability of the traffic from the measurement errors). Vehicles drawn at "
             "random from the synthetic population (`docs/simulator-inputs.md`), class A carpet "
             "(one per repetition), Table 2 properties drawn per vehicle. Solver: paper "
             "formulation, modal, observable modes, %.0f Hz, initial bridge state %s, pre-roll "
@@ -402,7 +410,7 @@ static int batches(ctx *c)
             c->cfg.solver.free_initial_state ? "free" : "at rest", c->cfg.solver.pre_roll_s,
             o->lambda_ref,
             o->batch_lcurve ? "; and a per-vehicle L-curve on the same data" : "");
-    for (int cond = 0; cond < 2; cond++) {
+    for (int cond = 0; cond < 3; cond++) {
         batch_job j;
         memset(&j, 0, sizeof j);
         j.c = c;
@@ -432,7 +440,7 @@ static int batches(ctx *c)
             gsl_ran_shuffle(r, perm, c->n_recs, sizeof(int));
             for (int lev = 0; lev < N_LEVELS; lev++)
                 for (int i = 0; i < o->vehicles; i++) {
-                    int k = cond == 0 ? i : (lev * o->vehicles + i) % c->n_recs;
+                    int k = cond != 1 ? i : (lev * o->vehicles + i) % c->n_recs;
                     j.pick[idx(c, rep, lev, i)] = perm[k];
                 }
             free(perm);
@@ -453,9 +461,11 @@ static int batches(ctx *c)
                        "paper STD t | paper mean t |\n",
                 o->batch_lcurve ? " L-curve mean t | L-curve STD t |" : "");
         fprintf(c->md, "|---|---|---|---|---|%s---|---|\n", o->batch_lcurve ? "---|---|" : "");
-        static const double pstd[2][N_LEVELS] = {{2.07, 2.18, 2.71, 3.45, 4.14},
+        static const double pstd[3][N_LEVELS] = {{2.07, 2.18, 2.71, 3.45, 4.14},
+                                                 {2.27, 2.55, 2.89, 3.34, 3.88},
                                                  {2.27, 2.55, 2.89, 3.34, 3.88}};
-        static const double pmean[2][N_LEVELS] = {{8.68, 8.71, 8.49, 8.17, 7.92},
+        static const double pmean[3][N_LEVELS] = {{8.68, 8.71, 8.49, 8.17, 7.92},
+                                                  {8.12, 8.04, 7.71, 7.42, 7.28},
                                                   {8.12, 8.04, 7.71, 7.42, 7.28}};
         double xs[20 * N_LEVELS], ys[20 * N_LEVELS], ym[20 * N_LEVELS], ysl[20 * N_LEVELS];
         double std0[20], std10[20];
@@ -518,6 +528,29 @@ static int batches(ctx *c)
                        "monotonic STD | STD(10 %%) > STD(0 %%) |%s\n",
                 o->batch_lcurve ? " R² STD, L-curve |" : "");
         fprintf(c->md, "|---|---|---|---|---|---|%s\n", o->batch_lcurve ? "---|" : "");
+        {
+            double ax[N_LEVELS], as[N_LEVELS], am[N_LEVELS], al[N_LEVELS];
+            for (int l = 0; l < N_LEVELS; l++) {
+                ax[l] = 100 * levels[l];
+                as[l] = am[l] = al[l] = 0.0;
+                for (int rep = 0; rep < o->reps; rep++) {
+                    as[l] += ys[rep * N_LEVELS + l] / o->reps;
+                    am[l] += ym[rep * N_LEVELS + l] / o->reps;
+                    al[l] += ysl[rep * N_LEVELS + l] / o->reps;
+                }
+            }
+            double slope;
+            double rs = r2(ax, as, N_LEVELS, &slope);
+            int mono = 1;
+            for (int l = 1; l < N_LEVELS; l++)
+                mono &= as[l] > as[l - 1];
+            fprintf(c->md, "| mean of the %d repetitions | %.3f | %+.3f | %.3f | %s | %s |",
+                    o->reps, rs, slope, r2(ax, am, N_LEVELS, NULL), mono ? "yes" : "no",
+                    as[N_LEVELS - 1] > as[0] ? "yes" : "no");
+            if (o->batch_lcurve)
+                fprintf(c->md, " %.3f |", r2(ax, al, N_LEVELS, NULL));
+            fprintf(c->md, "\n");
+        }
         for (int rep = 0; rep <= o->reps; rep++) {
             const double *X = rep < o->reps ? xs + rep * N_LEVELS : xs;
             const double *Y = rep < o->reps ? ys + rep * N_LEVELS : ys;
@@ -624,12 +657,14 @@ static void plot(const ctx *c, const char *name, const char *script)
     FILE *f = fopen(path, "w");
     if (!f)
         die("%s: %s", path, strerror(errno));
-    fprintf(f, "set terminal pngcairo size 900,560 font 'sans,10'\nset output '%s/%s.png'\n"
+    /* Run inside the output directory: the scripts name their CSVs and PNGs
+     * relative to it, so they can be re-run there by hand. */
+    fprintf(f, "set terminal pngcairo size 900,560 font 'sans,10'\nset output '%s.png'\n"
                "set datafile separator ','\nset key autotitle columnhead\nset grid\n%s",
-            c->o.out, name, script);
+            name, script);
     fclose(f);
-    char cmd[8300];
-    snprintf(cmd, sizeof cmd, "gnuplot '%s'", path);
+    char cmd[8400];
+    snprintf(cmd, sizeof cmd, "cd '%s' && gnuplot '%s.gp'", c->o.out, name);
     if (system(cmd) != 0)
         fprintf(stderr, "%s: gnuplot failed on %s (is gnuplot-nox installed?)\n", PROG, path);
 }
@@ -865,10 +900,12 @@ static void batch_plots(const ctx *c)
     plot(c, "fig10_trends",
          "set multiplot layout 1,2\nset xlabel 'damage (%)'\nset ylabel 'STD of inferred GVW (t)'\n"
          "plot 'table4_batches.csv' u ($3*100):(strcol(1) eq 'ideal' ? $8 : 1/0) w p pt 7 t 'ideal',"
-         " '' u ($3*100):(strcol(1) eq 'table5' ? $8 : 1/0) w p pt 5 t 'Table 5 inaccuracies'\n"
+         " '' u ($3*100):(strcol(1) eq 'table5' ? $8 : 1/0) w p pt 5 t 'Table 5 inaccuracies',"
+         " '' u ($3*100+0.3):(strcol(1) eq 'table5_same' ? $8 : 1/0) w p pt 9 t 'Table 5, same vehicles'\n"
          "set ylabel 'mean of inferred GVW (t)'\n"
          "plot 'table4_batches.csv' u ($3*100):(strcol(1) eq 'ideal' ? $7 : 1/0) w p pt 7 t 'ideal',"
-         " '' u ($3*100):(strcol(1) eq 'table5' ? $7 : 1/0) w p pt 5 t 'Table 5 inaccuracies'\n"
+         " '' u ($3*100):(strcol(1) eq 'table5' ? $7 : 1/0) w p pt 5 t 'Table 5 inaccuracies',"
+         " '' u ($3*100+0.3):(strcol(1) eq 'table5_same' ? $7 : 1/0) w p pt 9 t 'Table 5, same vehicles'\n"
          "unset multiplot\n");
 }
 
@@ -910,7 +947,8 @@ int main(int argc, char **argv)
     if (mkdir(c.o.out, 0777) != 0 && errno != EEXIST)
         die("%s: %s", c.o.out, strerror(errno));
     char path[4096];
-    snprintf(path, sizeof path, "%s/%s", c.o.out, c.o.quick ? "paper-quick.md" : "paper.md");
+    snprintf(path, sizeof path, "%s/%s", c.o.out,
+             c.o.quick ? "paper-quick.md" : c.o.batches_only ? "batches.md" : "paper.md");
     c.md = fopen(path, "w");
     if (!c.md)
         die("%s: %s", path, strerror(errno));
@@ -924,7 +962,7 @@ int main(int argc, char **argv)
             c.o.quick ? " --quick" : "", c.cfg.name, c.cfg.bridge.span_m,
             c.cfg.bridge.n_elements, c.sp.sensor_x_m[0], c.sp.scan_rate_hz,
             c.cfg.solver.calc_rate_hz);
-    if (!c.o.quick)
+    if (!c.o.quick && !c.o.batches_only)
         single_vehicle(&c);
     int trend = batches(&c);
     if (!c.o.quick)
