@@ -754,12 +754,89 @@ static const field solver_fields[] = {
     {.key = "lcurve", .parse = p_map, .aux = lcurve_fields},
     {.key = NULL}};
 
-/* The top level of a site file. The daemon's section goes here as one more
- * row, e.g. {.key = "daemon", .parse = p_map, .aux = daemon_fields}. */
+/* A string of printable characters, stored in char[f->hi] at f->off; lo is
+ * the minimum length. */
+static int p_string(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    const char *s = scalar(x, v, path, "a string", 1);
+    size_t n, cap = (size_t)f->hi;
+
+    if (!s)
+        return -1;
+    n = strlen(s);
+    if ((double)n < f->lo || n >= cap)
+        return fail(x, line_of(v), path, "must be %.0f .. %zu characters long, got %zu",
+                    f->lo, cap - 1, n);
+    for (size_t i = 0; i < n; i++)
+        if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
+            return fail(x, line_of(v), path, "must not contain control characters");
+    memset((char *)base + f->off, 0, cap);
+    memcpy((char *)base + f->off, s, n);
+    return 0;
+}
+
+#define DC(m) offsetof(amfi_site_config, daemon.m)
+#define STR(k, m, minlen) \
+    {.key = k, .parse = p_string, .off = DC(m), .lo = minlen, \
+     .hi = sizeof(((amfi_daemon_config *)0)->m)}
+
+static const field channel_fields[] = {
+    STR("accel", ch_accel, 1),     STR("vehicle", ch_vehicle, 1),
+    STR("truth", ch_truth, 1),     STR("passage", ch_passage, 1),
+    STR("indicator", ch_indicator, 1), STR("alert", ch_alert, 1),
+    STR("status", ch_status, 1),   {.key = NULL}};
+
+static const enum_name sync_names[] = {{"normal", 0}, {"full", 1}, {NULL, 0}};
+
+static const field store_fields[] = {
+    STR("path", db_path, 1),
+    {.key = "sync", .parse = p_enum, .off = DC(sync_full), .aux = sync_names},
+    {.key = NULL}};
+
+static const enum_name onoff_names[] = {{"off", 0}, {"on", 1}, {NULL, 0}};
+
+static const field indicator_fields[] = {
+    {.key = "window", .parse = p_int, .off = DC(ind_window), .lo = 10, .hi = 1000000},
+    {.key = "every", .parse = p_int, .off = DC(ind_every), .lo = 1, .hi = 1000000},
+    {.key = "baseline_n", .parse = p_int, .off = DC(ind_baseline_n), .lo = 10, .hi = 1000000},
+    {.key = "std_alert_ratio", .parse = p_double, .off = DC(ind_std_alert_ratio), .lo = 1,
+     .hi = 10},
+    {.key = "std_alert_p", .parse = p_double, .off = DC(ind_std_alert_p), .lo = 0, .hi = 1,
+     .flags = F_LO_OPEN},
+    {.key = "std_clear_ratio", .parse = p_double, .off = DC(ind_std_clear_ratio), .lo = 0.5,
+     .hi = 10},
+    {.key = "raise_after", .parse = p_int, .off = DC(ind_raise_after), .lo = 1, .hi = 1000},
+    {.key = "clear_after", .parse = p_int, .off = DC(ind_clear_after), .lo = 1, .hi = 1000},
+    {.key = "mean_shift", .parse = p_enum, .off = DC(ind_mean_shift), .aux = onoff_names},
+    {.key = "mean_alert_ratio", .parse = p_double, .off = DC(ind_mean_alert_ratio), .lo = 1,
+     .hi = 10},
+    {.key = "mean_alert_p", .parse = p_double, .off = DC(ind_mean_alert_p), .lo = 0, .hi = 1,
+     .flags = F_LO_OPEN},
+    {.key = "mean_clear_ratio", .parse = p_double, .off = DC(ind_mean_clear_ratio), .lo = 0.5,
+     .hi = 10},
+    {.key = NULL}};
+
+static const field daemon_fields[] = {
+    STR("lcm_url", lcm_url, 0),
+    {.key = "channels", .parse = p_map, .aux = channel_fields},
+    {.key = "store", .parse = p_map, .aux = store_fields},
+    {.key = "workers", .parse = p_int, .off = DC(workers), .lo = 1, .hi = 64},
+    {.key = "queue_size", .parse = p_int, .off = DC(queue_size), .lo = 1, .hi = 100000},
+    {.key = "ring_s", .parse = p_double, .off = DC(ring_s), .lo = 5, .hi = 3600},
+    {.key = "window_margin_s", .parse = p_double, .off = DC(margin_s), .lo = 0, .hi = 5},
+    {.key = "max_wait_s", .parse = p_double, .off = DC(max_wait_s), .lo = 0, .hi = 3600,
+     .flags = F_LO_OPEN},
+    {.key = "status_period_s", .parse = p_double, .off = DC(status_period_s), .lo = 0.1,
+     .hi = 3600},
+    {.key = "indicators", .parse = p_map, .aux = indicator_fields},
+    {.key = NULL}};
+
+/* The top level of a site file. */
 static const field top_fields[] = {
     {.key = "bridge", .parse = p_map, .aux = bridge_fields},
     {.key = "sensors", .parse = p_sensors},
     {.key = "solver", .parse = p_map, .aux = solver_fields},
+    {.key = "daemon", .parse = p_map, .aux = daemon_fields},
     {.key = NULL}};
 
 /* ---- the walk ----------------------------------------------------------- */
@@ -910,6 +987,14 @@ static int check_site(ctx *x, amfi_site_config *c)
     if (s->free_initial_state && s->coords != AMFI_COORDS_MODAL)
         return fail(x, first_noted(x, "solver.initial_state", "solver.coordinates", NULL),
                     "solver.initial_state", "free needs solver.coordinates: modal");
+    if (c->daemon.ind_std_clear_ratio > c->daemon.ind_std_alert_ratio)
+        return fail(x, first_noted(x, "daemon.indicators.std_clear_ratio",
+                                   "daemon.indicators.std_alert_ratio", NULL),
+                    "daemon.indicators.std_clear_ratio", "must not exceed std_alert_ratio");
+    if (c->daemon.ind_mean_clear_ratio > c->daemon.ind_mean_alert_ratio)
+        return fail(x, first_noted(x, "daemon.indicators.mean_clear_ratio",
+                                   "daemon.indicators.mean_alert_ratio", NULL),
+                    "daemon.indicators.mean_clear_ratio", "must not exceed mean_alert_ratio");
     return 0;
 }
 
@@ -929,6 +1014,35 @@ void amfi_config_defaults(amfi_site_config *c)
     amfi_lambda_default(&c->lambda);
     for (int i = 0; i < AMFI_MAX_SENSORS; i++)
         c->sensor_id[i] = i < c->solver.n_sensors ? i : -1;
+    amfi_daemon_config *d = &c->daemon;
+    strcpy(d->ch_accel, "AMFI_ACCEL");
+    strcpy(d->ch_vehicle, "AMFI_VEHICLE");
+    strcpy(d->ch_truth, "AMFI_TRUTH");
+    strcpy(d->ch_passage, "AMFI_PASSAGE");
+    strcpy(d->ch_indicator, "AMFI_INDICATOR");
+    strcpy(d->ch_alert, "AMFI_ALERT");
+    strcpy(d->ch_status, "AMFI_STATUS");
+    strcpy(d->db_path, "amfi.db");
+    d->sync_full = 1;
+    d->workers = 2;
+    d->queue_size = 256;
+    d->ring_s = 60.0;
+    d->margin_s = 0.05;
+    d->max_wait_s = 10.0;
+    d->status_period_s = 1.0;
+    /* docs/indicators.md */
+    d->ind_window = 500;
+    d->ind_every = 50;
+    d->ind_baseline_n = 500;
+    d->ind_std_alert_ratio = 1.06;
+    d->ind_std_alert_p = 0.01;
+    d->ind_std_clear_ratio = 1.03;
+    d->ind_raise_after = 3;
+    d->ind_clear_after = 3;
+    d->ind_mean_shift = 1;
+    d->ind_mean_alert_ratio = 1.04;
+    d->ind_mean_alert_p = 0.001;
+    d->ind_mean_clear_ratio = 1.02;
 }
 
 /* Line (1-based) holding byte `offset` of buf[len]. */

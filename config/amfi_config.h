@@ -25,6 +25,26 @@
 extern "C" {
 #endif
 
+/* The monitoring daemon's section (daemon: in the site file). */
+typedef struct amfi_daemon_config {
+    char lcm_url[256];        /* daemon.lcm_url; "" = LCM's default */
+    char ch_accel[64], ch_vehicle[64], ch_truth[64]; /* daemon.channels.* (inputs) */
+    char ch_passage[64], ch_indicator[64], ch_alert[64], ch_status[64]; /* outputs */
+    char db_path[512];        /* daemon.store.path */
+    int sync_full;            /* daemon.store.sync: full (1) | normal (0) */
+    int workers;              /* daemon.workers: solver threads, 1 .. 64 */
+    int queue_size;           /* daemon.queue_size: passages waiting, 1 .. 100000 */
+    double ring_s;            /* daemon.ring_s: seconds of samples kept per sensor */
+    double margin_s;          /* daemon.window_margin_s: data around the solver window */
+    double max_wait_s;        /* daemon.max_wait_s: data time to wait for a window */
+    double status_period_s;   /* daemon.status_period_s: heartbeat, wall time */
+    /* daemon.indicators.* (docs/indicators.md) */
+    int ind_window, ind_every, ind_baseline_n, ind_raise_after, ind_clear_after;
+    double ind_std_alert_ratio, ind_std_alert_p, ind_std_clear_ratio;
+    int ind_mean_shift;
+    double ind_mean_alert_ratio, ind_mean_alert_p, ind_mean_clear_ratio;
+} amfi_daemon_config;
+
 typedef struct amfi_site_config {
     char name[64];             /* bridge.name: 1 .. 63 bytes, NUL-terminated */
     amfi_bridge_params bridge; /* bridge.* */
@@ -34,6 +54,7 @@ typedef struct amfi_site_config {
     int sensor_id[AMFI_MAX_SENSORS]; /* sensors[i].id, 0 .. 255, unique;
                                         entry i belongs to solver.sensor_x_m[i];
                                         −1 past solver.n_sensors */
+    amfi_daemon_config daemon;       /* daemon.* */
 } amfi_site_config;
 
 /* Fill `c` (not NULL) with the paper-20m defaults: amfi_bridge_params_paper20,

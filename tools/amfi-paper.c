@@ -775,7 +775,7 @@ static void single_vehicle(ctx *c)
     plot(c, "fig2_lcurve",
          "set multiplot layout 1,2\nset logscale xy\nset xlabel 'residual norm (m/s^2)'\n"
          "set ylabel 'smoothing norm (N)'\nplot '" "fig2_lcurve.csv' u 2:3 w lp t 'L-curve'\n"
-         "unset logscale y\nset logscale x\nset xlabel 'lambda_ref'\nset ylabel 'curvature'\n"
+         "unset logscale y\nset logscale x\nset xlabel 'lambda_ref' noenhanced\nset ylabel 'curvature'\n"
          "plot 'fig2_lcurve.csv' u 1:4 w lp t 'curvature'\nunset multiplot\n");
     plot(c, "fig3_forces",
          "set xlabel 'position of axle 1 (m)'\nset ylabel 'axle force (kN)'\nset xrange [-2:27]\n"

@@ -1,0 +1,56 @@
+/*
+ * ring.h: one sensor's recent samples, indexed by absolute sample number.
+ *
+ * Sample k is at utime origin + k·1e6/rate µs; the first block fixes origin
+ * and rate. Blocks normally arrive in order; a block that starts after the
+ * newest sample leaves a gap (its samples are missing, NaN, and counted); a
+ * block that starts earlier fills missing samples (out-of-order arrival) or
+ * is a duplicate (counted, ignored); a block older than the ring holds is
+ * late (counted, dropped). Capacity is fixed at creation: nothing is
+ * allocated per block. Not thread-safe: the bus thread owns it.
+ */
+#ifndef AMFI_RING_H
+#define AMFI_RING_H
+
+#include <stdint.h>
+
+typedef struct amfi_ring_stats {
+    int64_t blocks;          /* accepted */
+    int64_t duplicates;      /* every sample already present */
+    int64_t late;            /* older than the ring */
+    int64_t filled;          /* samples that filled an earlier gap */
+    int64_t missing;         /* samples skipped by gaps (net of later fills) */
+    int64_t rejected;        /* inconsistent rate or time */
+} amfi_ring_stats;
+
+typedef struct amfi_ring amfi_ring;
+
+/* rate_hz > 0; capacity in seconds of samples. Free with amfi_ring_destroy. */
+amfi_ring *amfi_ring_create(double rate_hz, double seconds);
+void amfi_ring_destroy(amfi_ring *r); /* NULL-safe */
+
+enum { AMFI_RING_OK = 0, AMFI_RING_DUP = 1, AMFI_RING_LATE = 2, AMFI_RING_REJECT = -1 };
+
+/* Put n samples (m/s²) starting at utime (µs) with sample rate rate_hz.
+ * Returns AMFI_RING_OK (stored, possibly filling a gap), _DUP, _LATE, or
+ * _REJECT (rate differs from the ring's by more than 1e-6, a start that is
+ * not on the sample grid within a quarter sample, or a jump of more than
+ * an hour ahead); `why` then says which. */
+int amfi_ring_put(amfi_ring *r, int64_t utime, double rate_hz, int n, const double *x,
+                  const char **why);
+
+double amfi_ring_rate(const amfi_ring *r);
+int amfi_ring_started(const amfi_ring *r);      /* 1 once a block was stored */
+int64_t amfi_ring_newest(const amfi_ring *r);   /* newest sample index, −1 if none */
+int64_t amfi_ring_oldest(const amfi_ring *r);   /* oldest index still held */
+int64_t amfi_ring_index(const amfi_ring *r, int64_t utime); /* nearest sample index */
+double amfi_ring_utime(const amfi_ring *r, int64_t k);      /* µs of sample k */
+
+/* Copy samples k0 .. k0 + n − 1 into out. Returns the number of missing
+ * (NaN) samples among them, or −1 when part of the range is not held
+ * (older than the ring or newer than the newest sample). */
+int amfi_ring_get(const amfi_ring *r, int64_t k0, int n, double *out);
+
+const amfi_ring_stats *amfi_ring_stats_of(const amfi_ring *r);
+
+#endif

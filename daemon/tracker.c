@@ -1,0 +1,167 @@
+/*
+ * tracker.c: passage windows from vehicle events and sample rings.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tracker.h"
+
+#define RECENT 64
+
+typedef struct span {
+    int64_t id;
+    double t_in, t_out; /* µs: first axle on, last axle off */
+} span;
+
+struct amfi_tracker {
+    amfi_tracker_params p;
+    amfi_vehicle_ev pend[AMFI_TRACKER_MAX_PENDING]; /* sorted by utime */
+    int n_pend;
+    span recent[RECENT]; /* released vehicles, for multiple presence */
+    int n_recent, recent_head;
+    int64_t seq;
+};
+
+amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p)
+{
+    if (!(p->span_m > 0) || !(p->pre_s >= 0) || !(p->post_s >= 0) || !(p->max_wait_s > 0) ||
+        p->n_sensors < 1 || p->n_sensors > AMFI_MAX_SENSORS)
+        return NULL;
+    amfi_tracker *t = calloc(1, sizeof *t);
+    if (t)
+        t->p = *p;
+    return t;
+}
+
+void amfi_tracker_destroy(amfi_tracker *t) { free(t); }
+int amfi_tracker_pending(const amfi_tracker *t) { return t->n_pend; }
+
+static double on_span_s(const amfi_tracker *t, const amfi_vehicle_ev *v)
+{
+    double s = 0.0;
+    for (int a = 0; a + 1 < v->n_axles; a++)
+        s += v->spacing_m[a];
+    return (t->p.span_m + s) / v->speed_mps;
+}
+
+static span span_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
+{
+    span s = {v->vehicle_id, (double)v->utime, (double)v->utime + 1e6 * on_span_s(t, v)};
+    return s;
+}
+
+int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, const char **why)
+{
+    const char *dummy;
+    if (!why)
+        why = &dummy;
+    for (int i = 0; i < t->n_pend; i++)
+        if (t->pend[i].vehicle_id == v->vehicle_id) {
+            *why = "vehicle id already pending";
+            return -1;
+        }
+    if (t->n_pend == AMFI_TRACKER_MAX_PENDING) {
+        *why = "too many vehicles waiting for their data";
+        return -1;
+    }
+    int i = t->n_pend;
+    while (i > 0 && t->pend[i - 1].utime > v->utime) {
+        t->pend[i] = t->pend[i - 1];
+        i--;
+    }
+    t->pend[i] = *v;
+    t->n_pend++;
+    return 0;
+}
+
+/* Another vehicle (pending or recently released) on the span at the same time. */
+static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, int64_t *other)
+{
+    span me = span_of(t, v);
+    for (int i = 0; i < t->n_pend; i++) {
+        if (t->pend[i].vehicle_id == v->vehicle_id)
+            continue;
+        span o = span_of(t, &t->pend[i]);
+        if (o.t_in < me.t_out && me.t_in < o.t_out) {
+            *other = o.id;
+            return 1;
+        }
+    }
+    for (int i = 0; i < t->n_recent; i++) {
+        const span *o = &t->recent[i];
+        if (o->id != v->vehicle_id && o->t_in < me.t_out && me.t_in < o->t_out) {
+            *other = o->id;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_window *out)
+{
+    if (t->n_pend == 0)
+        return 0;
+    const amfi_vehicle_ev *v = &t->pend[0];
+    const int ns = t->p.n_sensors;
+    const double t0 = (double)v->utime - 1e6 * t->p.pre_s;
+    const double t1 = (double)v->utime + 1e6 * (on_span_s(t, v) + t->p.post_s);
+    memset(out, 0, sizeof *out);
+    out->v = *v;
+    out->status = "ok";
+    /* Decide: all data present, data gone, or waited long enough. */
+    int complete = 1, gone = 0;
+    double newest_us = -INFINITY;
+    int n = -1;
+    for (int s = 0; s < ns; s++) {
+        const amfi_ring *r = rings[s];
+        if (!r || !amfi_ring_started(r)) {
+            complete = 0;
+            continue;
+        }
+        int64_t k0 = (int64_t)ceil((t0 - amfi_ring_utime(r, 0)) * amfi_ring_rate(r) * 1e-6 - 1e-6);
+        int64_t k1 = (int64_t)floor((t1 - amfi_ring_utime(r, 0)) * amfi_ring_rate(r) * 1e-6 + 1e-6);
+        out->k0[s] = k0;
+        if (n < 0 || k1 - k0 + 1 < n)
+            n = (int)(k1 - k0 + 1);
+        newest_us = fmax(newest_us, amfi_ring_utime(r, amfi_ring_newest(r)));
+        if (amfi_ring_newest(r) < k1)
+            complete = 0;
+        if (k0 < amfi_ring_oldest(r))
+            gone = 1;
+    }
+    out->n = n > 0 ? n : 0;
+    if (!complete && !gone && !flush && !(newest_us > t1 + 1e6 * t->p.max_wait_s))
+        return 0; /* keep waiting */
+    if (gone) {
+        out->status = "late";
+        snprintf(out->reason, sizeof out->reason,
+                 "the data for this passage had left the ring (window starts %.3f s before "
+                 "the oldest sample held)",
+                 1e-6 * (amfi_ring_utime(rings[0], amfi_ring_oldest(rings[0])) - t0));
+    } else if (!complete) {
+        out->status = "gap";
+        snprintf(out->reason, sizeof out->reason, "%s",
+                 flush ? "shut down before the passage's data arrived"
+                       : "the data stream stopped before the passage's end (max_wait exceeded)");
+    } else {
+        int64_t other;
+        if (overlapping(t, v, &other)) {
+            out->status = "multiple";
+            snprintf(out->reason, sizeof out->reason,
+                     "vehicle %lld on the span at the same time", (long long)other);
+        }
+    }
+    if (rings[0] && amfi_ring_started(rings[0]))
+        out->t_first_s = (amfi_ring_utime(rings[0], out->k0[0]) - (double)v->utime) * 1e-6;
+    out->seq = ++t->seq;
+    /* remember its span, release */
+    t->recent[t->recent_head] = span_of(t, v);
+    t->recent_head = (t->recent_head + 1) % RECENT;
+    if (t->n_recent < RECENT)
+        t->n_recent++;
+    memmove(t->pend, t->pend + 1, sizeof *t->pend * (size_t)(t->n_pend - 1));
+    t->n_pend--;
+    return 1;
+}

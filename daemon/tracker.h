@@ -1,0 +1,68 @@
+/*
+ * tracker.h: cuts the sample stream into vehicle passages.
+ *
+ * Each vehicle event gives a window, entry − pre .. entry + (L + Σ spacing)/v
+ * + post, in data time (message utimes, never the wall clock, so a replay at
+ * any speed cuts the same windows). Windows are released in order of entry
+ * time once every sensor's ring holds their last sample, or, when a sensor
+ * falls silent, once the newest data is max_wait past the window's end. A
+ * released window says how it is to be stored: "ok" (to be solved), "gap"
+ * (samples missing), "late" (the data left the ring before the vehicle
+ * event arrived), or "multiple" (another vehicle on the span at the same
+ * time: the single-vehicle solve would be wrong). Not thread-safe: the bus
+ * thread owns it. Capacity fixed at creation.
+ */
+#ifndef AMFI_TRACKER_H
+#define AMFI_TRACKER_H
+
+#include <stdint.h>
+
+#include "amfi/amfi.h"
+#include "ring.h"
+
+#define AMFI_TRACKER_MAX_PENDING 256
+
+typedef struct amfi_vehicle_ev {
+    int64_t vehicle_id;
+    int64_t utime;       /* first axle at the bridge entry, µs */
+    int lane;
+    double speed_mps;
+    int n_axles;
+    double spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1 */
+} amfi_vehicle_ev;
+
+typedef struct amfi_tracker_params {
+    double span_m;
+    double pre_s;        /* window before entry (solver pre-roll + margin) */
+    double post_s;       /* window after the last exit (solver post-roll + margin) */
+    double max_wait_s;   /* data time past a window's end before it is given up */
+    int n_sensors;
+} amfi_tracker_params;
+
+typedef struct amfi_window {
+    amfi_vehicle_ev v;
+    int64_t seq;          /* release order, from 1 */
+    int64_t k0[AMFI_MAX_SENSORS]; /* first sample index per sensor */
+    int n;                /* samples per sensor */
+    double t_first_s;     /* time of the first sample relative to entry, per sensor 0 */
+    const char *status;   /* "ok", "gap", "late", "multiple" */
+    char reason[200];
+} amfi_window;
+
+typedef struct amfi_tracker amfi_tracker;
+
+amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p);
+void amfi_tracker_destroy(amfi_tracker *t);
+
+/* Queue a validated vehicle event. Returns 0, or −1 when the queue is full
+ * or the id is already pending (then `why` says which). */
+int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, const char **why);
+
+/* Release the next window if it is decided (1), or none (0). rings: one per
+ * sensor (NULL while a sensor has sent nothing). `flush` releases every
+ * pending window now, as "gap" when its data is incomplete (shutdown). */
+int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_window *out);
+
+int amfi_tracker_pending(const amfi_tracker *t);
+
+#endif
