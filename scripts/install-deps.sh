@@ -10,6 +10,16 @@ pkgs=(
   libgsl-dev                     # random numbers and statistics
   libcmocka-dev                  # unit tests
   gnuplot-nox                    # plots of the experiments (amfi-paper)
+  liblcm-dev                     # LCM C library: the amfi bus (messages/)
+  libglib2.0-dev                 # lcm.pc requires glib-2.0; liblcm-dev does not pull it in
+  liblcm-bin                     # lcm-gen, lcm-logger, lcm-logplayer
+  liblcm-java                    # lcm.jar: lcm-spy (tools/amfi-spy)
+  default-jdk-headless           # javac, jar: amfi_types.jar for lcm-spy
+  default-jre                    # AWT/X11 runtime that lcm-spy's window needs
+  libjchart2d-java               # lcm-spy's chart library
+  xvfb                           # headless X server for the amfi_spy test
+  x11-apps                       # xwd: the amfi_spy test's screenshot
+  iproute2                       # ip: the amfi_spy test's private network namespace
 )
 missing=()
 for p in "${pkgs[@]}"; do
