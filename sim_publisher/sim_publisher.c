@@ -25,9 +25,28 @@
  * file when the front axle enters, the true static weights, the true mean
  * contact forces on the span, and the conditions.
  *
- * Exit status: 0; 1 bad input file or simulation failure; 2 bad command line.
+ * Streaming (without --out): continuous traffic on the LCM bus, as a site
+ * would publish it: accelerometer blocks (--block samples each, the bridge's
+ * free vibration between vehicles included), a vehicle_t for each vehicle
+ * --detector-lead seconds before it enters (utime = its entry), and its
+ * truth_t after it has left. Time is the data's time, starting at
+ * --start-utime; pacing is real time divided by --speedup (or none with
+ * max). --log FILE writes the same events to an LCM log (timestamps = data
+ * time), replayable with lcm-logplayer and readable by amfid through LCM's
+ * file:// provider; --lcm-url none publishes nothing. Vehicles follow each
+ * other --headway seconds apart (default: the population's timestamps);
+ * --damage-step-at K switches the bridge to --damage from vehicle K on.
+ *
+ *   sim_publisher [--lcm-url URL|none] [--log FILE] [--speedup X|max]
+ *                 [--vehicles N] [--headway SEC] [--damage FRACTION]
+ *                 [--damage-step-at K] [--noise-ms2 STD] [--block N]
+ *                 [--start-utime US] [--detector-lead SEC] ... (as above)
+ *
+ * Exit status: 0; 1 bad input file, bus or simulation failure; 2 bad command
+ * line.
  */
 #include <errno.h>
+#include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 #include <math.h>
 #include <stdio.h>
@@ -35,7 +54,14 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include <lcm/eventlog.h>
+#include <lcm/lcm.h>
+#include <signal.h>
+#include <time.h>
+#include <unistd.h>
+
 #include "amfi_config.h"
+#include "amfi_messages.h"
 #include "passage.h"
 #include "profile.h"
 #include "traffic.h"
@@ -60,12 +86,24 @@ typedef struct opts {
     double track_std, scan_rate, noise, speed_err_mean, speed_err_std;
     int preceding;
     double gap_lo, gap_hi, pre, post, dt;
+    /* streaming */
+    const char *lcm_url, *log;
+    double speedup;       /* <= 0: as fast as possible */
+    double headway;       /* <= 0: the population's timestamps */
+    long damage_step_at;  /* < 0: --damage from the start */
+    double noise_ms2;
+    int block;
+    long long start_utime;
+    double detector_lead;
 } opts;
 
 static void usage(void)
 {
     fprintf(stderr,
-            "usage: %s --out DIR [--config FILE.yaml] [--population FILE.csv] [--vehicles N]\n"
+            "usage: %s [--out DIR | --lcm-url URL|none] [--log FILE] [--speedup X|max]\n"
+            "       [--headway SEC] [--damage-step-at K] [--noise-ms2 STD] [--block N]\n"
+            "       [--start-utime US] [--detector-lead SEC]\n"
+            "       [--config FILE.yaml] [--population FILE.csv] [--vehicles N]\n"
             "       [--first K] [--damage FRACTION] [--seed S] [--profile A..H|smooth]\n"
             "       [--track-std TRACKS] [--scan-rate HZ] [--noise FRACTION]\n"
             "       [--speed-error MEAN,STD] [--preceding-gap LO[,HI]] [--pre SEC] [--post SEC]\n"
@@ -117,6 +155,11 @@ static void parse(int argc, char **argv, opts *o)
     o->pre = 0.5;
     o->post = 0.5;
     o->dt = 1e-4;
+    o->speedup = 1.0;
+    o->damage_step_at = -1;
+    o->block = 100;
+    o->start_utime = 1767225600000000LL; /* 2026-01-01T00:00:00Z */
+    o->detector_lead = 1.0;
     for (int i = 1; i < argc; i++) {
         const char *k = argv[i];
         if (!strcmp(k, "--help") || !strcmp(k, "-h")) {
@@ -174,6 +217,24 @@ static void parse(int argc, char **argv, opts *o)
             o->post = num(k, v, 0, 30);
         else if (!strcmp(k, "--dt"))
             o->dt = num(k, v, 1e-6, 1e-3);
+        else if (!strcmp(k, "--lcm-url"))
+            o->lcm_url = v;
+        else if (!strcmp(k, "--log"))
+            o->log = v;
+        else if (!strcmp(k, "--speedup"))
+            o->speedup = !strcmp(v, "max") ? 0.0 : num(k, v, 0.01, 1e6);
+        else if (!strcmp(k, "--headway"))
+            o->headway = num(k, v, 0.1, 3600);
+        else if (!strcmp(k, "--damage-step-at"))
+            o->damage_step_at = (long)num(k, v, 0, 1e7);
+        else if (!strcmp(k, "--noise-ms2"))
+            o->noise_ms2 = num(k, v, 0, 10);
+        else if (!strcmp(k, "--block"))
+            o->block = (int)num(k, v, 1, 160);
+        else if (!strcmp(k, "--start-utime"))
+            o->start_utime = (long long)num(k, v, 1, 4e15);
+        else if (!strcmp(k, "--detector-lead"))
+            o->detector_lead = num(k, v, 0, 60);
         else {
             fprintf(stderr, "%s: unknown option %s\n", PROG, k);
             usage();
@@ -184,9 +245,8 @@ static void parse(int argc, char **argv, opts *o)
         fprintf(stderr, "%s: --speed-error: STD must be >= 0\n", PROG);
         exit(2);
     }
-    if (!o->out) {
-        fprintf(stderr, "%s: --out DIR is required\n", PROG);
-        usage();
+    if (!o->out && o->lcm_url && !strcmp(o->lcm_url, "none") && !o->log) {
+        fprintf(stderr, "%s: --lcm-url none without --log would produce nothing\n", PROG);
         exit(2);
     }
 }
@@ -199,6 +259,278 @@ static void seed_vehicle(gsl_rng *r, unsigned long seed, long i)
     h *= 0xBF58476D1CE4E5B9ull;
     h ^= h >> 29;
     gsl_rng_set(r, (unsigned long)(h & 0xffffffffu) | 1u);
+}
+
+/* ---- streaming ----------------------------------------------------------- */
+
+static volatile sig_atomic_t stream_stop;
+static void on_signal(int sig)
+{
+    (void)sig;
+    stream_stop = 1;
+}
+
+typedef struct bus {
+    lcm_t *lcm;          /* NULL: not publishing */
+    lcm_eventlog_t *log; /* NULL: no log */
+    int64_t eventnum;
+    unsigned char *buf;
+    int cap;
+} bus;
+
+/* Send one encoded message to the bus and/or the log (timestamp = data time). */
+static int emit(bus *b, const char *channel, int64_t utime, const void *data, int len)
+{
+    if (b->lcm && lcm_publish(b->lcm, channel, data, (unsigned)len) != 0)
+        return -1;
+    if (b->log) {
+        lcm_eventlog_event_t ev = {b->eventnum++, utime, (int32_t)strlen(channel), len,
+                                   (char *)channel, (void *)data};
+        if (lcm_eventlog_write_event(b->log, &ev) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+#define EMIT(b, T, channel, msg)                                                      \
+    ({                                                                                \
+        int len_ = T##_encoded_size(msg), rc_ = -1;                                   \
+        if (len_ > (b)->cap) {                                                        \
+            unsigned char *n_ = realloc((b)->buf, (size_t)len_);                      \
+            if (n_) {                                                                 \
+                (b)->buf = n_;                                                        \
+                (b)->cap = len_;                                                      \
+            }                                                                         \
+        }                                                                             \
+        if (len_ <= (b)->cap && T##_encode((b)->buf, 0, len_, msg) == len_)           \
+            rc_ = emit(b, channel, (msg)->utime, (b)->buf, len_);                     \
+        rc_;                                                                          \
+    })
+
+static double wall_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+typedef struct planned {
+    amfi_sim_vehicle v;  /* id = population record + 1 */
+    double entry_s;      /* sim time */
+    int added, announced;
+    double spacing;
+} planned;
+
+static int stream(const opts *o, amfi_site_config *cfg, const amfi_vehicle_rec *recs,
+                  const char *ppath)
+{
+    char err[512];
+    int rc = 1;
+    bus b = {0};
+    amfi_bridge *healthy = NULL, *damaged = NULL;
+    amfi_profile *prof = NULL;
+    amfi_sim *sim = NULL;
+    planned *plan = calloc((size_t)o->vehicles, sizeof *plan);
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    double *acc = NULL;
+    if (!plan || !rng)
+        goto out;
+    if (!o->lcm_url || strcmp(o->lcm_url, "none")) {
+        b.lcm = lcm_create(o->lcm_url);
+        if (!b.lcm) {
+            fprintf(stderr, "%s: cannot open the LCM bus '%s'\n", PROG,
+                    o->lcm_url ? o->lcm_url : "(default)");
+            goto out;
+        }
+    }
+    if (o->log) {
+        b.log = lcm_eventlog_create(o->log, "w");
+        if (!b.log) {
+            fprintf(stderr, "%s: %s: cannot create the log: %s\n", PROG, o->log, strerror(errno));
+            goto out;
+        }
+    }
+    amfi_bridge_params bp = cfg->bridge;
+    bp.damage = o->damage_step_at >= 0 ? 0.0 : o->damage;
+    if (amfi_bridge_create(&bp, &healthy, err, sizeof err)) {
+        fprintf(stderr, "%s: bridge: %s\n", PROG, err);
+        goto out;
+    }
+    if (o->damage_step_at >= 0) {
+        bp.damage = o->damage;
+        if (amfi_bridge_create(&bp, &damaged, err, sizeof err)) {
+            fprintf(stderr, "%s: bridge: %s\n", PROG, err);
+            goto out;
+        }
+    }
+    amfi_sim_params sp;
+    amfi_sim_params_default(&sp, cfg->bridge.span_m);
+    sp.dt_s = o->dt;
+    sp.scan_rate_hz = o->scan_rate;
+    sp.n_sensors = cfg->solver.n_sensors;
+    memcpy(sp.sensor_x_m, cfg->solver.sensor_x_m, sizeof sp.sensor_x_m);
+    amfi_profile_params pp;
+    amfi_profile_params_default(&pp);
+    pp.iso_class = o->profile_class;
+    pp.seed = o->seed;
+    pp.length_m = sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + cfg->bridge.span_m + 100.0;
+    if (amfi_profile_create(&pp, &prof, err, sizeof err) ||
+        amfi_sim_create(healthy, prof, &sp, &sim, err, sizeof err)) {
+        fprintf(stderr, "%s: %s\n", PROG, err);
+        goto out;
+    }
+    /* The plan: entries spaced by the headway (or the population's clock),
+     * the first after its full approach. */
+    amfi_halfcar_dist dist;
+    amfi_halfcar_dist_paper(&dist);
+    double t = 0.0;
+    for (long i = 0; i < o->vehicles; i++) {
+        const amfi_vehicle_rec *rec = &recs[o->first + i];
+        amfi_passage_spec spec;
+        seed_vehicle(rng, o->seed, o->first + i);
+        if (amfi_passage_spec_from_rec(rec, &dist, prof, o->track_std, rng, &spec, err,
+                                       sizeof err)) {
+            fprintf(stderr, "%s: %s: vehicle %ld: %s\n", PROG, ppath, o->first + i + 1, err);
+            goto out;
+        }
+        double gap = o->headway > 0 ? o->headway
+                                    : (i ? rec->timestamp_s - recs[o->first + i - 1].timestamp_s
+                                         : 0.0);
+        t = i ? t + gap : sp.approach_m / spec.speed_mps + 1.0;
+        /* a vehicle cannot start its approach before the previous one: keep order */
+        plan[i].entry_s = t;
+        plan[i].v.id = o->first + i + 1;
+        plan[i].v.car = spec.car;
+        plan[i].v.speed_mps = spec.speed_mps;
+        plan[i].v.t_entry_s = t;
+        plan[i].v.track = spec.track;
+        plan[i].spacing = spec.car.D1_m + spec.car.D2_m;
+    }
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    const int ns = sp.n_sensors, blk = o->block;
+    acc = malloc(sizeof(double) * (size_t)blk * ns);
+    int64_t seq[AMFI_MAX_SENSORS] = {0};
+    long next_add = 0, next_announce = 0, left = 0;
+    const double t_end_extra = 3.0;
+    double t_last_left = -1.0;
+    const double w0 = wall_s();
+    gsl_rng *noise = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(noise, o->seed ^ 0x5eedu);
+    int stepped = 0; /* the damage step has happened */
+    if (!acc || !noise)
+        goto out;
+    while (!stream_stop) {
+        const double now = amfi_sim_time(sim);
+        /* add vehicles before their approach starts */
+        while (next_add < o->vehicles &&
+               plan[next_add].entry_s - sp.approach_m / plan[next_add].v.speed_mps <=
+                   now + (double)blk / o->scan_rate + 1e-9) {
+            if (damaged && !stepped && next_add == o->damage_step_at)
+                break; /* switch the bridge first (next loop turn) */
+            if (amfi_sim_add(sim, &plan[next_add].v, err, sizeof err)) {
+                fprintf(stderr, "%s: vehicle %ld: %s\n", PROG, plan[next_add].v.id, err);
+                goto out;
+            }
+            plan[next_add].added = 1;
+            next_add++;
+        }
+        if (damaged && !stepped && next_add == o->damage_step_at && next_add < o->vehicles) {
+            plan[next_add].added = 1; /* marks the step; added after the switch */
+            if (amfi_sim_set_bridge(sim, damaged, err, sizeof err)) {
+                fprintf(stderr, "%s: %s\n", PROG, err);
+                goto out;
+            }
+            stepped = 1;
+            fprintf(stderr, "%s: damage %.3g from vehicle %ld on (t = %.1f s)\n", PROG, o->damage,
+                    plan[next_add].v.id, now);
+            if (amfi_sim_add(sim, &plan[next_add].v, err, sizeof err)) {
+                fprintf(stderr, "%s: vehicle %ld: %s\n", PROG, plan[next_add].v.id, err);
+                goto out;
+            }
+            next_add++;
+        }
+        /* announce vehicles the detector has seen */
+        while (next_announce < next_add &&
+               plan[next_announce].entry_s - o->detector_lead <= now + 1e-9) {
+            const planned *p = &plan[next_announce];
+            double speed = p->v.speed_mps;
+            if (o->speed_err_mean != 0 || o->speed_err_std > 0)
+                speed *= 1.0 + o->speed_err_mean +
+                         (o->speed_err_std > 0 ? gsl_ran_gaussian(noise, o->speed_err_std) : 0.0);
+            double spacing = p->spacing;
+            amfi_vehicle_t m = {o->start_utime + (int64_t)llround(p->entry_s * 1e6), p->v.id, 1,
+                                speed, 2, 1, &spacing, PROG};
+            if (EMIT(&b, amfi_vehicle_t, AMFI_CHANNEL_VEHICLE, &m)) {
+                fprintf(stderr, "%s: publishing failed\n", PROG);
+                goto out;
+            }
+            next_announce++;
+        }
+        /* one block of samples */
+        if (amfi_sim_advance(sim, blk, acc, err, sizeof err)) {
+            fprintf(stderr, "%s: %s\n", PROG, err);
+            goto out;
+        }
+        const int64_t u0 = o->start_utime + (int64_t)llround(now * 1e6);
+        for (int si = 0; si < ns; si++) {
+            double x[160];
+            for (int k = 0; k < blk; k++)
+                x[k] = acc[(size_t)k * ns + si] +
+                       (o->noise_ms2 > 0 ? gsl_ran_gaussian(noise, o->noise_ms2) : 0.0);
+            amfi_accel_block_t m = {u0, cfg->sensor_id[si], seq[si]++, o->scan_rate,
+                                    (int16_t)blk, x};
+            if (EMIT(&b, amfi_accel_block_t, AMFI_CHANNEL_ACCEL, &m)) {
+                fprintf(stderr, "%s: publishing failed\n", PROG);
+                goto out;
+            }
+        }
+        /* the truth of the vehicles that have left */
+        amfi_sim_vehicle d;
+        while (amfi_sim_pop_done(sim, &d)) {
+            const amfi_vehicle_rec *rec = &recs[d.id - 1];
+            double axle[2] = {rec->axle_kg[0], rec->axle_kg[1]};
+            amfi_truth_t m = {o->start_utime + (int64_t)llround(d.t_entry_s * 1e6), d.id,
+                              axle[0] + axle[1], 2, axle, d.mean_force_N, d.speed_mps};
+            if (EMIT(&b, amfi_truth_t, AMFI_CHANNEL_TRUTH, &m)) {
+                fprintf(stderr, "%s: publishing failed\n", PROG);
+                goto out;
+            }
+            left++;
+            t_last_left = amfi_sim_time(sim);
+        }
+        if (left == o->vehicles && amfi_sim_time(sim) > t_last_left + t_end_extra)
+            break;
+        /* pacing */
+        if (o->speedup > 0) {
+            double due = w0 + amfi_sim_time(sim) / o->speedup - wall_s();
+            if (due > 0) {
+                struct timespec ts = {(time_t)due, (long)((due - floor(due)) * 1e9)};
+                nanosleep(&ts, NULL);
+            }
+        }
+    }
+    fprintf(stderr, "%s: %ld vehicles streamed over %.1f s of data%s\n", PROG, left,
+            amfi_sim_time(sim), stream_stop ? " (stopped by a signal)" : "");
+    rc = 0;
+    gsl_rng_free(noise);
+out:
+    free(acc);
+    amfi_sim_destroy(sim);
+    amfi_profile_destroy(prof);
+    amfi_bridge_destroy(damaged);
+    amfi_bridge_destroy(healthy);
+    if (b.log)
+        lcm_eventlog_destroy(b.log);
+    if (b.lcm)
+        lcm_destroy(b.lcm);
+    free(b.buf);
+    free(plan);
+    gsl_rng_free(rng);
+    return rc;
 }
 
 int main(int argc, char **argv)
@@ -228,6 +560,11 @@ int main(int argc, char **argv)
                 ppath, n_recs, o.first, o.vehicles, o.first + o.vehicles);
         amfi_traffic_free(recs);
         return 2;
+    }
+    if (!o.out) {
+        int src = stream(&o, &cfg, recs, ppath);
+        amfi_traffic_free(recs);
+        return src;
     }
     if (mkdir(o.out, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "%s: %s: cannot create: %s\n", PROG, o.out, strerror(errno));

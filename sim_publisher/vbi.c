@@ -461,3 +461,52 @@ double amfi_sim_deflection(amfi_sim *s, double x_m)
         w += phi[k] * s->q[k];
     return w;
 }
+
+int amfi_sim_set_bridge(amfi_sim *s, const amfi_bridge *b, char *err, size_t errlen)
+{
+    const int n = s->n;
+    if (amfi_bridge_ndof(b) != n ||
+        amfi_bridge_params_of(b)->span_m != amfi_bridge_params_of(s->b)->span_m)
+        return fail(err, errlen, "sim: the new bridge has %g DOFs or another span (%g)",
+                    amfi_bridge_ndof(b), amfi_bridge_params_of(b)->span_m);
+    const double *P0 = amfi_bridge_modes(s->b), *P1 = amfi_bridge_modes(b);
+    const double *M = amfi_bridge_mass(b);
+    double *u = malloc(sizeof(double) * n * 3), *Mu = malloc(sizeof(double) * n * 3);
+    if (!u || !Mu) {
+        free(u);
+        free(Mu);
+        return fail(err, errlen, "sim: out of memory%.0g%.0g", 0, 0);
+    }
+    double *state[3] = {s->q, s->qd, s->qdd};
+    for (int c = 0; c < 3; c++) {
+        for (int i = 0; i < n; i++) { /* u = Ψ0 q */
+            double v = 0.0;
+            for (int k = 0; k < n; k++)
+                v += P0[(size_t)i * n + k] * state[c][k];
+            u[(size_t)c * n + i] = v;
+        }
+        for (int i = 0; i < n; i++) { /* M u */
+            double v = 0.0;
+            for (int k = 0; k < n; k++)
+                v += M[(size_t)i * n + k] * u[(size_t)c * n + k];
+            Mu[(size_t)c * n + i] = v;
+        }
+        for (int k = 0; k < n; k++) { /* q' = Ψ1ᵀ M u */
+            double v = 0.0;
+            for (int i = 0; i < n; i++)
+                v += P1[(size_t)i * n + k] * Mu[(size_t)c * n + i];
+            state[c][k] = v;
+        }
+    }
+    free(u);
+    free(Mu);
+    s->b = b;
+    s->omega = amfi_bridge_omega(b);
+    s->zeta = amfi_bridge_zeta(b);
+    const double dt = s->p.dt_s, beta = dt * dt / 4.0;
+    for (int k = 0; k < n; k++)
+        s->Sk[k] = 1.0 + dt * s->zeta[k] * s->omega[k] + beta * s->omega[k] * s->omega[k];
+    for (int i = 0; i < s->p.n_sensors; i++)
+        amfi_bridge_mode_values(b, s->p.sensor_x_m[i], s->cs + (size_t)i * n);
+    return 0;
+}

@@ -90,6 +90,12 @@ typedef void (*amfi_sim_hook)(void *user, double t_s, const amfi_sim_vehicle *v,
                               const double x_m[2], const double F_N[2]);
 void amfi_sim_set_hook(amfi_sim *s, amfi_sim_hook fn, void *user);
 
+/* Replace the simulated bridge (a damage step) while traffic runs: the
+ * deflections and velocities are carried over through the nodal DOFs
+ * (u = Ψ q, then q' = Ψ'ᵀ M u, the mass being unchanged by damage). `b`
+ * must have the same mesh and supports, and outlive the simulation. */
+int amfi_sim_set_bridge(amfi_sim *s, const amfi_bridge *b, char *err, size_t errlen);
+
 /* Bridge deflection at x (m, positive downward) at the current time. */
 double amfi_sim_deflection(amfi_sim *s, double x_m);
 
