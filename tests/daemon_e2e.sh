@@ -1,0 +1,68 @@
+#!/bin/sh
+# amfid end to end: the real sim_publisher and amfid on LCM's UDP multicast
+# inside a private network namespace (nothing leaves it), then the stored
+# rows: every vehicle a passage row, GVW against the truth, a clean
+# shutdown on SIGTERM (integrity_check ok), and a log replayed twice at two
+# speeds through LCM's file:// provider giving identical rows.
+# Usage: daemon_e2e.sh AMFID SIM_PUBLISHER AMFI_REPORT CONFIG
+set -u
+if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
+  # Re-run inside a new network namespace with multicast routed on loopback.
+  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
+    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
+fi
+amfid=$1 sim=$2 report=$3 config=$4
+dir=$(mktemp -d)
+pids=""
+cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
+trap cleanup EXIT
+fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
+N=12
+
+# Indicators small enough to evaluate in a short test.
+sed -e 's/^    window: 500/    window: 8/' -e 's/^    every: 50/    every: 4/' \
+    -e 's/^    baseline_n: 500/    baseline_n: 8/' "$config" > "$dir/amfid.yaml"
+"$amfid" --config "$dir/amfid.yaml" --check-config >/dev/null || fail "check-config"
+
+# 1. Live: amfid listening, sim_publisher publishing at 20x real time.
+"$amfid" --config "$dir/amfid.yaml" --db "$dir/live.db" 2> "$dir/amfid.log" &
+apid=$!; pids="$pids $apid"
+i=0; until grep -q "running" "$dir/amfid.log"; do
+  i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+timeout 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 3 2> "$dir/sim.log" ||
+  fail "sim_publisher exited $?"
+sleep 1
+kill -TERM $apid
+i=0; while kill -0 $apid 2>/dev/null; do
+  i=$((i + 1)); [ $i -lt 600 ] || fail "amfid did not stop on SIGTERM"; sleep 0.1; done
+wait $apid; rc=$?
+[ $rc -eq 0 ] || fail "amfid exit status $rc"
+rows=$(sqlite3 "$dir/live.db" "SELECT count(*) FROM passages")
+ok=$(sqlite3 "$dir/live.db" "SELECT count(*) FROM passages WHERE status = 'ok'")
+truth=$(sqlite3 "$dir/live.db" "SELECT count(*) FROM truth")
+echo "live: $rows passage rows ($ok ok), $truth truth rows for $N vehicles"
+[ "$rows" -eq $N ] || fail "expected $N passage rows, got $rows"
+[ "$truth" -eq $N ] || fail "expected $N truth rows, got $truth"
+[ "$ok" -ge $((N - 1)) ] || fail "only $ok of $N passages ok"
+sqlite3 "$dir/live.db" "PRAGMA integrity_check" | grep -qx ok || fail "integrity_check"
+err=$(sqlite3 "$dir/live.db" "SELECT max(abs(p.gvw_kg - t.gvw_kg) / t.gvw_kg) FROM passages p
+      JOIN truth t USING (vehicle_id) WHERE p.status = 'ok'")
+echo "live: largest GVW error $(awk -v e="$err" 'BEGIN { printf "%.2f %%", 100 * e }')"
+awk -v e="$err" 'BEGIN { exit !(e < 0.08) }' || fail "GVW error $err over 8 %"
+"$report" --db "$dir/live.db" > "$dir/report.txt" || fail "amfi-report"
+
+# 2. Replay: one log, read twice through file:// at two speeds: same rows.
+"$sim" --lcm-url none --log "$dir/traffic.log" --vehicles $N --headway 3 --speedup max --seed 4 \
+  2> "$dir/simlog.log" || fail "sim_publisher --log"
+for speed in 0 8; do
+  "$amfid" --config "$dir/amfid.yaml" --db "$dir/replay$speed.db" \
+    --lcm-url "file://$dir/traffic.log?speed=$speed" 2> "$dir/replay$speed.log" ||
+    fail "amfid on the log (speed $speed)"
+done
+q="SELECT vehicle_id, utime, status, printf('%.6f', gvw_kg), printf('%.6g', lambda) FROM passages ORDER BY id"
+sqlite3 "$dir/replay0.db" "$q" > "$dir/a.txt"
+sqlite3 "$dir/replay8.db" "$q" > "$dir/b.txt"
+[ "$(wc -l < "$dir/a.txt")" -eq $N ] || fail "replay: $(wc -l < "$dir/a.txt") rows"
+cmp -s "$dir/a.txt" "$dir/b.txt" || fail "replays at two speeds differ"
+echo "replay: $N identical rows at speed 0 (as fast as possible) and 8"
+echo "daemon end to end: ok"

@@ -1,0 +1,220 @@
+/*
+ * test_daemon_core.c: the sample ring (gaps, duplicates, out-of-order and
+ * late blocks) and the passage tracker (windows in data time, release
+ * order, gaps, late vehicle events, multiple presence).
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "ring.h"
+#include "tracker.h"
+
+#define RATE 1000.0
+#define T0 1767225600000000LL /* µs */
+
+static void block(double *x, int n, double v)
+{
+    for (int i = 0; i < n; i++)
+        x[i] = v + i;
+}
+
+static void ring_in_order_and_gaps(void **state)
+{
+    (void)state;
+    amfi_ring *r = amfi_ring_create(RATE, 10.0);
+    double x[100], out[300];
+    block(x, 100, 0);
+    assert_int_equal(amfi_ring_put(r, T0, RATE, 100, x, NULL), AMFI_RING_OK);
+    block(x, 100, 100);
+    assert_int_equal(amfi_ring_put(r, T0 + 100000, RATE, 100, x, NULL), AMFI_RING_OK);
+    assert_int_equal(amfi_ring_newest(r), 199);
+    assert_int_equal(amfi_ring_get(r, 0, 200, out), 0);
+    assert_true(out[150] == 150.0);
+    /* skip one block: 100 samples missing */
+    block(x, 100, 300);
+    assert_int_equal(amfi_ring_put(r, T0 + 300000, RATE, 100, x, NULL), AMFI_RING_OK);
+    assert_int_equal(amfi_ring_get(r, 150, 200, out), 100);
+    assert_int_equal(amfi_ring_stats_of(r)->missing, 100);
+    /* the missing block arrives late (out of order): the gap fills */
+    block(x, 100, 200);
+    assert_int_equal(amfi_ring_put(r, T0 + 200000, RATE, 100, x, NULL), AMFI_RING_OK);
+    assert_int_equal(amfi_ring_get(r, 150, 200, out), 0);
+    assert_true(out[100] == 250.0);
+    assert_int_equal(amfi_ring_stats_of(r)->missing, 0);
+    /* a duplicate */
+    assert_int_equal(amfi_ring_put(r, T0 + 200000, RATE, 100, x, NULL), AMFI_RING_DUP);
+    assert_int_equal(amfi_ring_stats_of(r)->duplicates, 1);
+    /* not held: beyond the newest */
+    assert_int_equal(amfi_ring_get(r, 350, 100, out), -1);
+    amfi_ring_destroy(r);
+}
+
+static void ring_rejects_and_late(void **state)
+{
+    (void)state;
+    amfi_ring *r = amfi_ring_create(RATE, 5.0);
+    double x[100];
+    const char *why = NULL;
+    block(x, 100, 0);
+    assert_int_equal(amfi_ring_put(r, T0, RATE, 100, x, NULL), AMFI_RING_OK);
+    assert_int_equal(amfi_ring_put(r, T0 + 100000, 999.0, 100, x, &why), AMFI_RING_REJECT);
+    assert_non_null(strstr(why, "rate"));
+    assert_int_equal(amfi_ring_put(r, T0 + 100400, RATE, 100, x, &why), AMFI_RING_REJECT);
+    assert_non_null(strstr(why, "grid"));
+    assert_int_equal(amfi_ring_put(r, T0 + 7200000000LL, RATE, 100, x, &why),
+                     AMFI_RING_REJECT);
+    /* run 10 s ahead; the first block is now older than the ring */
+    for (int k = 1; k <= 100; k++)
+        assert_int_equal(amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL),
+                         AMFI_RING_OK);
+    assert_int_equal(amfi_ring_put(r, T0, RATE, 100, x, NULL), AMFI_RING_LATE);
+    assert_int_equal(amfi_ring_stats_of(r)->late, 1);
+    amfi_ring_destroy(r);
+}
+
+static amfi_ring *filled(double seconds_of_data)
+{
+    amfi_ring *r = amfi_ring_create(RATE, 60.0);
+    double x[100];
+    block(x, 100, 0);
+    for (int k = 0; k < (int)(seconds_of_data * 10); k++)
+        amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL);
+    return r;
+}
+
+static amfi_vehicle_ev vehicle(int64_t id, double entry_s)
+{
+    amfi_vehicle_ev v;
+    memset(&v, 0, sizeof v);
+    v.vehicle_id = id;
+    v.utime = T0 + (int64_t)(entry_s * 1e6);
+    v.speed_mps = 25.0;
+    v.n_axles = 2;
+    v.spacing_m[0] = 5.0;
+    return v;
+}
+
+static void tracker_windows(void **state)
+{
+    (void)state;
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1};
+    amfi_tracker *t = amfi_tracker_create(&p);
+    amfi_ring *r = filled(3.0); /* samples 0 .. 2999 */
+    amfi_ring *rings[1] = {r};
+    amfi_window w;
+    /* two vehicles far apart, added out of order: released by entry time */
+    amfi_vehicle_ev b = vehicle(2, 1.9), a = vehicle(1, 0.5);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL), -1); /* duplicate id */
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_int_equal(w.v.vehicle_id, 1);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.seq, 1);
+    /* window: entry 0.5 s − 0.35 s .. entry + 1.0 s + 0.05 s */
+    assert_int_equal(w.k0[0], 150);
+    assert_int_equal(w.n, 1401);
+    assert_true(fabs(w.t_first_s + 0.35) < 1e-9);
+    /* vehicle 2's window ends at 1.9 + 1.05 = 2.95 s: held */
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_int_equal(w.v.vehicle_id, 2);
+    assert_string_equal(w.status, "ok");
+    /* a third, whose data has not all arrived: waits */
+    amfi_vehicle_ev c = vehicle(3, 2.5);
+    assert_int_equal(amfi_tracker_add(t, &c, NULL), 0);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0);
+    /* on shutdown it is released as a gap */
+    assert_int_equal(amfi_tracker_next(t, rings, 1, &w), 1);
+    assert_string_equal(w.status, "gap");
+    assert_int_equal(amfi_tracker_pending(t), 0);
+    amfi_ring_destroy(r);
+    amfi_tracker_destroy(t);
+}
+
+static void tracker_multiple_and_late(void **state)
+{
+    (void)state;
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1};
+    amfi_tracker *t = amfi_tracker_create(&p);
+    amfi_ring *r = filled(4.0);
+    amfi_ring *rings[1] = {r};
+    amfi_window w;
+    /* two vehicles 0.4 s apart: both on the span at once */
+    amfi_vehicle_ev a = vehicle(1, 1.0), b = vehicle(2, 1.4);
+    amfi_tracker_add(t, &a, NULL);
+    amfi_tracker_add(t, &b, NULL);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "multiple");
+    assert_non_null(strstr(w.reason, "vehicle 2"));
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "multiple"); /* against the released vehicle 1 */
+    amfi_tracker_destroy(t);
+    /* a vehicle event whose data has left a short ring */
+    amfi_ring *s = amfi_ring_create(RATE, 5.0);
+    double x[100];
+    block(x, 100, 0);
+    for (int k = 0; k < 100; k++)
+        amfi_ring_put(s, T0 + k * 100000LL, RATE, 100, x, NULL);
+    amfi_ring *srings[1] = {s};
+    t = amfi_tracker_create(&p);
+    amfi_vehicle_ev old = vehicle(9, 1.0);
+    amfi_tracker_add(t, &old, NULL);
+    assert_int_equal(amfi_tracker_next(t, srings, 0, &w), 1);
+    assert_string_equal(w.status, "late");
+    /* data arriving block by block, the tracker asked after each (as the
+     * daemon does): released as soon as its window is covered */
+    amfi_vehicle_ev next = vehicle(10, 9.0); /* window to 10.05 s */
+    amfi_tracker_add(t, &next, NULL);
+    assert_int_equal(amfi_tracker_next(t, srings, 0, &w), 0);
+    int released_at = -1;
+    for (int k = 100; k < 120 && released_at < 0; k++) {
+        amfi_ring_put(s, T0 + k * 100000LL, RATE, 100, x, NULL);
+        if (amfi_tracker_next(t, srings, 0, &w) == 1)
+            released_at = k;
+    }
+    assert_int_equal(released_at, 100); /* the block 10.0 .. 10.099 s */
+    assert_string_equal(w.status, "ok");
+    amfi_tracker_destroy(t);
+    /* two sensors, the second falls silent: given up max_wait (5 s) after
+     * the window's end, as a gap */
+    amfi_tracker_params p2 = {20.0, 0.35, 0.05, 5.0, 2};
+    t = amfi_tracker_create(&p2);
+    amfi_ring *a1 = amfi_ring_create(RATE, 60.0), *a2 = amfi_ring_create(RATE, 60.0);
+    amfi_ring *two[2] = {a1, a2};
+    for (int k = 0; k < 20; k++) { /* 2 s on both */
+        amfi_ring_put(a1, T0 + k * 100000LL, RATE, 100, x, NULL);
+        amfi_ring_put(a2, T0 + k * 100000LL, RATE, 100, x, NULL);
+    }
+    amfi_vehicle_ev v2 = vehicle(11, 1.5); /* window to 2.55 s */
+    amfi_tracker_add(t, &v2, NULL);
+    int k = 20;
+    for (; k < 120; k++) {
+        amfi_ring_put(a1, T0 + k * 100000LL, RATE, 100, x, NULL);
+        if (amfi_tracker_next(t, two, 0, &w) == 1)
+            break;
+    }
+    assert_string_equal(w.status, "gap");
+    assert_int_equal(k, 75); /* block 75 ends at 7.599 s > 2.55 + 5 s */
+    amfi_ring_destroy(a1);
+    amfi_ring_destroy(a2);
+    amfi_ring_destroy(s);
+    amfi_ring_destroy(r);
+    amfi_tracker_destroy(t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(ring_in_order_and_gaps),
+        cmocka_unit_test(ring_rejects_and_late),
+        cmocka_unit_test(tracker_windows),
+        cmocka_unit_test(tracker_multiple_and_late),
+    };
+    return cmocka_run_group_tests_name("daemon core", tests, NULL, NULL);
+}
