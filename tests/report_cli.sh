@@ -1,0 +1,271 @@
+#!/bin/sh
+# report_cli.sh: amfi-report on a fixture store. The fixture is built with
+# the sqlite3 program from the DDL in docs/schema.md (the same DDL the store
+# creates: test_store checks that), then filled with known rows; every mode
+# must print what the rows say (figures cross-checked with sqlite3 itself),
+# exit 0, leave the file unchanged unless it sets a baseline, and every bad
+# database or command line must fail cleanly: status 1 (data) or 2 (usage),
+# never a crash, one line on stderr, nothing on stdout.
+#
+# usage: report_cli.sh PATH/TO/amfi-report PATH/TO/docs/schema.md
+# Exit 77 (skipped) without the sqlite3 program.
+set -u
+
+bin=${1:?usage: report_cli.sh AMFI_REPORT SCHEMA_MD}
+doc=${2:?usage: report_cli.sh AMFI_REPORT SCHEMA_MD}
+[ -x "$bin" ] || { echo "report_cli.sh: $bin: not executable" >&2; exit 1; }
+[ -r "$doc" ] || { echo "report_cli.sh: $doc: not readable" >&2; exit 1; }
+command -v sqlite3 > /dev/null || { echo "report_cli.sh: no sqlite3 program: skipped"; exit 77; }
+
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/report_cli.XXXXXX") || exit 1
+trap 'rm -rf "$tmp"' EXIT INT TERM
+
+failures=0
+cases=0
+problem() { echo "FAIL $name: $*"; failures=$((failures + 1)); }
+
+# ---- the fixture ----------------------------------------------------------
+# 40 passages an hour apart from 2025-11-22 00:00 UTC (1763769600 s): every
+# tenth a gap (no GVW), the others ok, GVW 15 000 + 1000·(i mod 7) kg; a truth
+# row per vehicle 2 % lighter than inferred; 25 indicators; alerts: a
+# mean_shift raised then cleared, a std_increase raised and still open; one
+# automatic baseline.
+db=$tmp/fixture.db
+awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
+     on && !/^```/' "$doc" > "$tmp/ddl.sql"
+[ -s "$tmp/ddl.sql" ] || { echo "report_cli.sh: no DDL block in $doc" >&2; exit 1; }
+{
+    cat "$tmp/ddl.sql"
+    cat <<'EOF'
+PRAGMA journal_mode = WAL;
+PRAGMA user_version = 1;
+INSERT INTO schema_migrations (version, description) VALUES (1, 'report_cli fixture');
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 40)
+INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status,
+                      reason, lambda, residual_rms, formulation, solve_ms)
+SELECT i, 1763769600000000 + i * 3600000000, 1, 25.0, 2,
+       CASE WHEN i % 10 = 0 THEN NULL ELSE 15000.0 + 1000 * (i % 7) END,
+       CASE WHEN i % 10 = 0 THEN 'gap' ELSE 'ok' END,
+       CASE WHEN i % 10 = 0 THEN '12 samples missing in the window' ELSE '' END,
+       CASE WHEN i % 10 = 0 THEN NULL ELSE 7.94e-9 END,
+       CASE WHEN i % 10 = 0 THEN NULL ELSE 0.001 END,
+       CASE WHEN i % 10 = 0 THEN NULL ELSE 'paper' END, 15.0
+FROM k;
+INSERT INTO axles (passage_id, idx, spacing_m, load_kg)
+SELECT id, 1, NULL, 0.4 * gvw_kg FROM passages;
+INSERT INTO axles (passage_id, idx, spacing_m, load_kg)
+SELECT id, 2, 4.5, 0.6 * gvw_kg FROM passages;
+INSERT INTO truth (vehicle_id, utime, gvw_kg, n_axles, speed_true_mps)
+SELECT vehicle_id, utime, coalesce(gvw_kg, 15000.0) / 1.02, 2, 25.0 FROM passages;
+INSERT INTO truth_axles (truth_id, idx, load_kg, mean_force_N)
+SELECT id, 1, 0.4 * gvw_kg, NULL FROM truth;
+INSERT INTO truth_axles (truth_id, idx, load_kg, mean_force_N)
+SELECT id, 2, 0.6 * gvw_kg, NULL FROM truth;
+INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note)
+VALUES (1763769600000000, 30, 17800, 1900, 'auto', '');
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 25)
+INSERT INTO indicators (utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg,
+                        std_ratio, p_value, state)
+SELECT 1763769600000000 + i * 5400000000, 20, 17800 + i, 1900 + 20 * i, 17800, 1900,
+       (1900 + 20 * i) / 1900.0, 0.5 / i, CASE WHEN i >= 22 THEN 'alert' ELSE 'normal' END
+FROM k;
+INSERT INTO alerts (utime, level, kind, message, indicator_id, raised) VALUES
+  (1763769600000000 + 10 * 5400000000, 'info', 'mean_shift', 'mean GVW +6 % over the baseline', 10, 1),
+  (1763769600000000 + 12 * 5400000000, 'info', 'mean_shift', 'mean GVW back within 3 %', 12, 0),
+  (1763769600000000 + 22 * 5400000000, 'warning', 'std_increase', 'STD of GVW 1.23 x baseline (p = 0.023)', 22, 1);
+EOF
+} > "$tmp/fixture.sql"
+if ! sqlite3 "$db" < "$tmp/fixture.sql" > "$tmp/fixture.log" 2>&1; then
+    echo "report_cli.sh: building the fixture failed:" >&2
+    cat "$tmp/fixture.log" >&2
+    exit 1
+fi
+q() { sqlite3 "$1" "$2"; }
+cp "$db" "$tmp/pristine.db" # the fixture before the baseline tests add rows
+
+# ---- good runs ---------------------------------------------------------------
+
+# ok NAME ARGS...: exit 0, nothing on stderr; output in $tmp/out
+ok() {
+    name=$1
+    shift
+    cases=$((cases + 1))
+    "$bin" "$@" > "$tmp/out" 2> "$tmp/err"
+    rc=$?
+    if [ "$rc" -ne 0 ]; then
+        problem "status $rc, expected 0 ($(head -c 300 "$tmp/err"))"
+        return 1
+    fi
+    [ -s "$tmp/err" ] && problem "wrote to stderr: $(head -c 300 "$tmp/err")"
+    return 0
+}
+# has PATTERN: the output of the last run matches the grep -E pattern
+has() { grep -Eq -- "$1" "$tmp/out" || problem "output lacks /$1/"; }
+hasnt() { ! grep -Eq -- "$1" "$tmp/out" || problem "output has /$1/"; }
+
+sum0=$(md5sum < "$db")
+
+if ok default --db "$db"; then
+    has '^== passages$'
+    has '^== indicators \(last 20 of 25\)$'
+    has '^== alerts \(last 3 of 3\)$'
+    hasnt '^== errors'
+    has '^Next, with sqlite3'
+    has "^  sqlite3 -header -column $db \"SELECT \\* FROM daily_trend\"$"
+fi
+
+if ok summary --db "$db" --summary; then
+    has '^passages +40$'
+    has '^  ok +36 +90\.0 %$'
+    has '^  gap +4 +10\.0 %$'
+    has '^  late +0 '
+    mean=$(q "$db" "SELECT printf('%.0f', avg(gvw_kg)) FROM passages WHERE status = 'ok'")
+    std=$(q "$db" "SELECT printf('%.0f', sqrt(sum((gvw_kg - m) * (gvw_kg - m)) / (count(*) - 1)))
+                   FROM passages, (SELECT avg(gvw_kg) AS m FROM passages WHERE status = 'ok')
+                   WHERE status = 'ok'")
+    has "^GVW, ok +n 36, mean $mean kg, STD $std kg, min 15000, median [0-9]+, max 21000 kg$"
+    has '^time span +2025-11-22 01:00:00 \.\. 2025-11-23 16:00:00 UTC \(39\.0 h\)$'
+    has '^baseline +mean 17800 kg, STD 1900 kg, n 30, auto, from 2025-11-22 00:00:00 UTC$'
+    hasnt '^== indicators'
+fi
+
+if ok trend --db "$db" --trend; then
+    has '^time \(UTC\) +n +mean kg +STD kg +ratio +p +state$'
+    rows=$(grep -Ec '^20[0-9]{2}-[0-9]{2}-[0-9]{2} ' "$tmp/out")
+    [ "$rows" -eq 20 ] || problem "$rows indicator rows, expected 20"
+    # oldest first: the 6th indicator (2025-11-22 09:00) to the 25th
+    has '^2025-11-22 09:00:00 +20 +17806 +2020 +1\.063 +8\.33e-02 +normal$'
+    last=$(grep -E '^20[0-9]{2}-' "$tmp/out" | tail -n 1)
+    case $last in
+    "2025-11-23 13:30:00"*alert) ;;
+    *) problem "last trend row is '$last'" ;;
+    esac
+    has 'window_trend'
+fi
+
+if ok alerts --db "$db" --alerts; then
+    has '^OPEN NOW +warning std_increase since 2025-11-23 09:00:00 UTC$'
+    hasnt 'OPEN NOW +info mean_shift'
+    has 'mean_shift +cleared +12 +mean GVW back within 3 %$'
+    has '^2025-11-23 09:00:00 +warning +std_increase +raised +22 +STD of GVW 1\.23 x baseline \(p = 0\.023\)$'
+fi
+
+if ok errors --db "$db" --errors; then
+    has '^== errors against the truth$'
+    has '^truth rows +40; ok passages matched 36; other passages matched 4$'
+    e=$(q "$db" "SELECT printf('%+.2f', avg(gvw_error_pct)) FROM passage_errors WHERE status = 'ok'" |
+        sed 's/[+.]/\\&/g')
+    has "^GVW error +mean $e %, STD 0\\.00 %\$"
+    has '^\|GVW error\| +median 2\.00 %, 90 % 2\.00 %, 95 % 2\.00 %, 99 % 2\.00 %, max 2\.00 %$'
+    has 'passage_errors ORDER BY abs\(gvw_error_pct\)'
+fi
+
+if ok check --db "$db" --check; then
+    has '^integrity +ok$'
+fi
+
+sum1=$(md5sum < "$db")
+name="read-only modes"
+cases=$((cases + 1))
+[ "$sum0" = "$sum1" ] || problem "the printing modes changed the file"
+
+if ok baseline-last --db "$db" --set-baseline-last 10 --note "after the bearing repair"; then
+    has '^baseline set: mean [0-9]+ kg, STD [0-9]+ kg, n 10, manual, from 2025-11-23 16:00:00 UTC$'
+    got=$(q "$db" "SELECT n, source, note, utime_set FROM baseline ORDER BY id DESC LIMIT 1")
+    [ "$got" = "10|manual|after the bearing repair|1763913600000000" ] || problem "newest baseline row '$got'"
+    want=$(q "$db" "SELECT printf('%.6f', avg(gvw_kg)) FROM (SELECT gvw_kg FROM passages
+                    WHERE status = 'ok' ORDER BY utime DESC LIMIT 10)")
+    got=$(q "$db" "SELECT printf('%.6f', mean_kg) FROM baseline ORDER BY id DESC LIMIT 1")
+    [ "$got" = "$want" ] || problem "baseline mean $got, expected $want"
+    has 'SELECT \* FROM baseline'
+fi
+
+if ok baseline-explicit --db "$db" --set-baseline 18000,2000.5,500 --summary; then
+    got=$(q "$db" "SELECT mean_kg, std_kg, n, source, note FROM baseline ORDER BY id DESC LIMIT 1")
+    [ "$got" = "18000.0|2000.5|500|manual|" ] || problem "newest baseline row '$got'"
+    has '^baseline +mean 18000 kg, STD 2000 kg, n 500, manual, from 2025-11-23 16:00:00 UTC$'
+fi
+
+if ok help --help; then
+    has '^usage: amfi-report --db PATH'
+fi
+
+# ---- failures -------------------------------------------------------------
+
+# bad NAME WANT_STATUS PATTERN ARGS...: one stderr line matching PATTERN
+bad() {
+    name=$1 want=$2 pattern=$3
+    shift 3
+    cases=$((cases + 1))
+    "$bin" "$@" > "$tmp/out" 2> "$tmp/err"
+    rc=$?
+    lines=$(wc -l < "$tmp/err")
+    if [ "$rc" -ge 128 ]; then
+        problem "crashed (status $rc)"
+    elif [ "$rc" -ne "$want" ]; then
+        problem "status $rc, expected $want"
+    elif [ "$lines" -ne 1 ]; then
+        problem "stderr has $lines lines, expected 1: $(head -c 300 "$tmp/err")"
+    elif ! grep -Eq -- "$pattern" "$tmp/err"; then
+        problem "stderr '$(cat "$tmp/err")' does not match /$pattern/"
+    elif [ -s "$tmp/out" ]; then
+        problem "wrote to stdout: $(head -c 200 "$tmp/out")"
+    fi
+}
+
+bad no-db 2 '^amfi-report: --db: missing' --summary
+bad empty-db 2 '^amfi-report: --db: empty value' --db ''
+bad unknown 2 '^amfi-report: --bogus: unknown option' --db "$db" --bogus
+bad stray 2 '^amfi-report: stray: unexpected argument' --db "$db" stray
+bad last-1 2 '^amfi-report: --set-baseline-last: .1. is not an integer in \[2,' --db "$db" --set-baseline-last 1
+bad both 2 'not both' --db "$db" --set-baseline-last 5 --set-baseline 1,2,3
+bad two-fields 2 '^amfi-report: --set-baseline: .18000,2000.: expected MEAN_KG,STD_KG,N' --db "$db" --set-baseline 18000,2000
+bad neg-std 2 '^amfi-report: --set-baseline: STD .-1. is not in' --db "$db" --set-baseline 18000,-1,10
+bad note-alone 2 '^amfi-report: --note: only with' --db "$db" --note hello
+
+bad missing 1 "^amfi-report: $tmp/missing\\.db: No such file or directory\$" --db "$tmp/missing.db"
+name=missing-not-created
+cases=$((cases + 1))
+[ ! -e "$tmp/missing.db" ] || problem "amfi-report created $tmp/missing.db"
+bad missing-set 1 'No such file or directory$' --db "$tmp/missing.db" --set-baseline 1,2,3
+[ ! -e "$tmp/missing.db" ] || problem "--set-baseline created $tmp/missing.db"
+
+i=0
+while [ $i -lt 100 ]; do echo "t,accel"; i=$((i + 1)); done > "$tmp/text.db"
+bad not-sqlite 1 "^amfi-report: $tmp/text\\.db: not an SQLite database" --db "$tmp/text.db"
+bad not-sqlite-check 1 'not an SQLite database' --db "$tmp/text.db" --check
+: > "$tmp/empty.db"
+bad empty-file 1 'empty database, not an amfi store' --db "$tmp/empty.db"
+bad directory 1 'not a regular file' --db "$tmp"
+
+sqlite3 "$tmp/recipes.db" "CREATE TABLE recipes (name TEXT)"
+bad foreign 1 'not an amfi store' --db "$tmp/recipes.db"
+
+cp "$tmp/pristine.db" "$tmp/newer.db"
+sqlite3 "$tmp/newer.db" "PRAGMA user_version = 7"
+bad newer 1 'schema version 7 is newer than this program.s 1' --db "$tmp/newer.db"
+
+cp "$tmp/pristine.db" "$tmp/damaged.db"
+sqlite3 "$tmp/damaged.db" "PRAGMA ignore_check_constraints = ON; UPDATE passages SET gvw_kg = -1 WHERE id = 3"
+bad damaged-row 1 "^amfi-report: $tmp/damaged\\.db: passages row 3: gvw_kg is out of range" --db "$tmp/damaged.db" --summary
+cp "$tmp/pristine.db" "$tmp/damaged2.db"
+sqlite3 "$tmp/damaged2.db" "PRAGMA ignore_check_constraints = ON; UPDATE baseline SET std_kg = -5 WHERE id = 1"
+bad damaged-baseline 1 'baseline row 1: std_kg: -5 kg is out of range \(0, 1e\+06\] kg$' --db "$tmp/damaged2.db" --summary
+# the damaged row is not read to set a new baseline, which then is in force
+ok baseline-over-damaged --db "$tmp/damaged2.db" --set-baseline 18000,2000,100 --summary
+cp "$tmp/pristine.db" "$tmp/damaged3.db"
+sqlite3 "$tmp/damaged3.db" "PRAGMA ignore_check_constraints = ON; UPDATE indicators SET state = 'panic' WHERE id = 24"
+bad damaged-indicator 1 'indicators row 24: state is not a known state' --db "$tmp/damaged3.db" --trend
+
+cp "$tmp/pristine.db" "$tmp/orphan.db"
+sqlite3 "$tmp/orphan.db" "INSERT INTO axles (passage_id, idx, spacing_m, load_kg) VALUES (999, 1, NULL, 1)"
+name=orphan
+cases=$((cases + 1))
+"$bin" --db "$tmp/orphan.db" --check > "$tmp/out" 2> "$tmp/err"
+rc=$?
+[ "$rc" -eq 1 ] || problem "status $rc, expected 1"
+grep -q 'foreign key: a axles row refers to a missing passages row' "$tmp/out" || problem "stdout: $(cat "$tmp/out")"
+[ "$(wc -l < "$tmp/err")" -eq 1 ] || problem "stderr: $(cat "$tmp/err")"
+
+echo "report_cli.sh: $cases cases, $failures failed"
+[ "$failures" -eq 0 ]

@@ -1,0 +1,1047 @@
+/*
+ * test_store.c: unit tests of amfid's SQLite store (daemon/store.h).
+ *
+ * Each test works in a fresh directory under /tmp (removed afterwards) and
+ * looks at the file with a second, raw sqlite3 connection: the schema
+ * version and identity, what the rows hold (NULL for unknown numbers), that
+ * a bad argument or a failure half-way stores nothing, that damaged rows
+ * written behind the store's back (CHECK constraints switched off) are
+ * reported by table and rowid, and that the views agree with naive C
+ * computations of the same figures. docs/schema.md must hold exactly the
+ * DDL the store creates. The bulk test stores 10 000 passages and prints
+ * the insert rate.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <sqlite3.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "store.h"
+
+#ifndef AMFI_SCHEMA_DOC
+#error "AMFI_SCHEMA_DOC (path of docs/schema.md) must be defined"
+#endif
+
+#define ERRLEN 512
+#define DAY_US INT64_C(86400000000)
+
+/* ---- fixtures ------------------------------------------------------------ */
+
+typedef struct fixture {
+    char dir[64];
+    char path[96];
+    amfi_store *s;
+} fixture;
+
+static int setup(void **state)
+{
+    fixture *f = calloc(1, sizeof *f);
+    char err[ERRLEN];
+    if (!f)
+        return -1;
+    snprintf(f->dir, sizeof f->dir, "/tmp/amfi_test_store_XXXXXX");
+    if (!mkdtemp(f->dir))
+        return -1;
+    snprintf(f->path, sizeof f->path, "%s/amfi.db", f->dir);
+    if (amfi_store_open(f->path, 0, &f->s, err, sizeof err) != 0) {
+        fprintf(stderr, "setup: %s\n", err);
+        return -1;
+    }
+    *state = f;
+    return 0;
+}
+
+static void remove_db(const char *path)
+{
+    char p[256];
+    unlink(path);
+    snprintf(p, sizeof p, "%s-wal", path);
+    unlink(p);
+    snprintf(p, sizeof p, "%s-shm", path);
+    unlink(p);
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    char p[128];
+    amfi_store_close(f->s);
+    remove_db(f->path);
+    snprintf(p, sizeof p, "%s/other.db", f->dir);
+    remove_db(p);
+    snprintf(p, sizeof p, "%s/doc.db", f->dir);
+    remove_db(p);
+    snprintf(p, sizeof p, "%s/not-sqlite.db", f->dir);
+    unlink(p);
+    rmdir(f->dir);
+    free(f);
+    return 0;
+}
+
+/* A raw connection to the fixture's file, as a user's sqlite3 would be. */
+static sqlite3 *raw_open(const char *path)
+{
+    sqlite3 *db = NULL;
+    assert_int_equal(SQLITE_OK, sqlite3_open_v2(path, &db,
+                                                SQLITE_OPEN_READWRITE, NULL));
+    sqlite3_busy_timeout(db, 5000);
+    return db;
+}
+
+static void raw_exec(sqlite3 *db, const char *sql)
+{
+    char *msg = NULL;
+    int rc = sqlite3_exec(db, sql, NULL, NULL, &msg);
+    if (rc != SQLITE_OK)
+        fail_msg("%s: %s", sql, msg ? msg : "?");
+    sqlite3_free(msg);
+}
+
+/* First column of the first row as integer (0 when NULL / no row). */
+static int64_t raw_int(sqlite3 *db, const char *sql)
+{
+    sqlite3_stmt *st = NULL;
+    int64_t v = 0;
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK)
+        fail_msg("%s: %s", sql, sqlite3_errmsg(db));
+    if (sqlite3_step(st) == SQLITE_ROW)
+        v = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    return v;
+}
+
+static double raw_real(sqlite3 *db, const char *sql)
+{
+    sqlite3_stmt *st = NULL;
+    double v = NAN;
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK)
+        fail_msg("%s: %s", sql, sqlite3_errmsg(db));
+    if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_type(st, 0) != SQLITE_NULL)
+        v = sqlite3_column_double(st, 0);
+    sqlite3_finalize(st);
+    return v;
+}
+
+/* First column of the first row as text into buf ("" when none). */
+static const char *raw_text(sqlite3 *db, const char *sql, char *buf, size_t len)
+{
+    sqlite3_stmt *st = NULL;
+    buf[0] = '\0';
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK)
+        fail_msg("%s: %s", sql, sqlite3_errmsg(db));
+    if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0))
+        snprintf(buf, len, "%s", (const char *)sqlite3_column_text(st, 0));
+    sqlite3_finalize(st);
+    return buf;
+}
+
+/* An ok two-axle passage: 40 / 60 % of gvw, 4.5 m apart, 25 m/s. */
+static void ok_row(amfi_passage_row *r, int64_t vehicle_id, int64_t utime,
+                   double gvw_kg)
+{
+    memset(r, 0, sizeof *r);
+    r->vehicle_id = vehicle_id;
+    r->utime = utime;
+    r->lane = 1;
+    r->speed_mps = 25.0;
+    r->n_axles = 2;
+    r->spacing_m[0] = 4.5;
+    r->axle_kg[0] = 0.4 * gvw_kg;
+    r->axle_kg[1] = 0.6 * gvw_kg;
+    r->gvw_kg = gvw_kg;
+    r->status = "ok";
+    r->reason = "";
+    r->lambda = 7.94e-9;
+    r->residual_rms = 1e-3;
+    r->formulation = "paper";
+    r->solve_ms = 15.0;
+}
+
+static void add_ok(amfi_store *s, int64_t vehicle_id, int64_t utime,
+                   double gvw_kg, int64_t *id)
+{
+    amfi_passage_row r;
+    char err[ERRLEN];
+    ok_row(&r, vehicle_id, utime, gvw_kg);
+    if (amfi_store_add_passage(s, &r, id, err, sizeof err) != 0)
+        fail_msg("add_passage: %s", err);
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- open, schema, identity -------------------------------------------- */
+
+static void test_create_and_reopen(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN], buf[64];
+    sqlite3 *db = raw_open(f->path);
+
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(AMFI_STORE_APPLICATION_ID, raw_int(db, "PRAGMA application_id"));
+    assert_string_equal("wal", raw_text(db, "PRAGMA journal_mode", buf, sizeof buf));
+    static const char *const objects[] = {
+        "passages", "axles", "truth", "truth_axles", "indicators", "alerts",
+        "baseline", "meta", "schema_migrations", "daily_trend", "window_trend",
+        "passage_errors", "passages_utime", "passages_status_utime"};
+    for (size_t k = 0; k < sizeof objects / sizeof objects[0]; k++) {
+        sqlite3_stmt *st = NULL;
+        assert_int_equal(SQLITE_OK, sqlite3_prepare_v2(db,
+            "SELECT count(*) FROM sqlite_schema WHERE name = ?1", -1, &st, NULL));
+        sqlite3_bind_text(st, 1, objects[k], -1, SQLITE_STATIC);
+        assert_int_equal(SQLITE_ROW, sqlite3_step(st));
+        if (sqlite3_column_int(st, 0) != 1)
+            fail_msg("schema object %s missing", objects[k]);
+        sqlite3_finalize(st);
+    }
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    sqlite3_close(db);
+
+    /* reopen: nothing migrates again, data stays */
+    add_ok(f->s, 1, DAY_US, 18000.0, NULL);
+    amfi_store_close(f->s);
+    f->s = NULL;
+    char wal[128];
+    snprintf(wal, sizeof wal, "%s-wal", f->path);
+    assert_int_not_equal(0, access(wal, F_OK)); /* checkpointed and removed */
+    assert_int_equal(0, amfi_store_open(f->path, 1, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
+    assert_int_equal(1, raw_int(db, "PRAGMA user_version"));
+    sqlite3_close(db);
+}
+
+static void test_refuse_newer_version(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    amfi_store *s2 = NULL;
+    sqlite3 *db;
+
+    amfi_store_close(f->s);
+    f->s = NULL;
+    db = raw_open(f->path);
+    raw_exec(db, "PRAGMA user_version = 99");
+    sqlite3_close(db);
+
+    err[0] = '\0';
+    assert_int_equal(AMFI_STORE_ESCHEMA,
+                     amfi_store_open(f->path, 0, &s2, err, sizeof err));
+    assert_null(s2);
+    assert_non_null(strstr(err, "schema version 99 is newer"));
+    assert_non_null(strstr(err, f->path));
+    assert_int_equal(AMFI_STORE_ESCHEMA,
+                     amfi_store_open_readonly(f->path, &s2, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(99, raw_int(db, "PRAGMA user_version")); /* untouched */
+    sqlite3_close(db);
+}
+
+static void test_refuse_foreign_files(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN], path[128];
+    amfi_store *s2 = NULL;
+    sqlite3 *db;
+    FILE *fp;
+
+    /* an SQLite database of something else */
+    snprintf(path, sizeof path, "%s/other.db", f->dir);
+    assert_int_equal(SQLITE_OK, sqlite3_open(path, &db));
+    raw_exec(db, "CREATE TABLE recipes (name TEXT)");
+    sqlite3_close(db);
+    assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open(path, 0, &s2, err, sizeof err));
+    assert_non_null(strstr(err, "not an amfi store"));
+    assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(path, &s2, err, sizeof err));
+    db = raw_open(path);
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM sqlite_schema")); /* untouched */
+    sqlite3_close(db);
+
+    /* not SQLite at all */
+    snprintf(path, sizeof path, "%s/not-sqlite.db", f->dir);
+    fp = fopen(path, "w");
+    assert_non_null(fp);
+    for (int k = 0; k < 200; k++)
+        fputs("this is a text file, not a database\n", fp);
+    fclose(fp);
+    assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_open(path, 0, &s2, err, sizeof err));
+    assert_non_null(strstr(err, "not an SQLite database"));
+    assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_open_readonly(path, &s2, err, sizeof err));
+    assert_null(s2);
+
+    /* missing file (read-only) and missing directory */
+    snprintf(path, sizeof path, "%s/missing.db", f->dir);
+    assert_int_equal(AMFI_STORE_EDB, amfi_store_open_readonly(path, &s2, err, sizeof err));
+    assert_non_null(strstr(err, "No such file"));
+    assert_int_not_equal(0, access(path, F_OK));
+    snprintf(path, sizeof path, "%s/no/such/dir.db", f->dir);
+    assert_int_equal(AMFI_STORE_EDB, amfi_store_open(path, 0, &s2, err, sizeof err));
+    assert_non_null(strstr(err, "cannot open"));
+
+    /* bad arguments */
+    assert_int_equal(AMFI_EINVAL, amfi_store_open("", 0, &s2, err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_open(NULL, 0, &s2, err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_open(f->path, 0, NULL, err, sizeof err));
+    amfi_store_close(NULL); /* NULL-safe */
+    assert_string_equal("damaged database or row",
+                        amfi_store_strerror(AMFI_STORE_ECORRUPT));
+    assert_string_equal("invalid argument", amfi_store_strerror(AMFI_EINVAL));
+}
+
+/* ---- passages --------------------------------------------------------------- */
+
+static void test_passage_with_axles(void **state)
+{
+    fixture *f = *state;
+    amfi_passage_row r;
+    char err[ERRLEN], buf[64];
+    int64_t id = 0;
+    sqlite3 *db;
+
+    ok_row(&r, 42, 3 * DAY_US + 123, 25000.0);
+    r.n_axles = 3;
+    r.spacing_m[0] = 3.8;
+    r.spacing_m[1] = 1.3;
+    r.axle_kg[0] = 7000.0;
+    r.axle_kg[1] = 9000.0;
+    r.axle_kg[2] = 9000.0;
+    r.lane = 2;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, &id, err, sizeof err));
+    assert_true(id > 0);
+
+    db = raw_open(f->path);
+    assert_int_equal(42, raw_int(db, "SELECT vehicle_id FROM passages"));
+    assert_int_equal(3 * DAY_US + 123, raw_int(db, "SELECT utime FROM passages"));
+    assert_int_equal(2, raw_int(db, "SELECT lane FROM passages"));
+    assert_int_equal(3, raw_int(db, "SELECT n_axles FROM passages"));
+    assert_true(raw_real(db, "SELECT gvw_kg FROM passages") == 25000.0);
+    assert_true(raw_real(db, "SELECT lambda FROM passages") == 7.94e-9);
+    assert_string_equal("ok", raw_text(db, "SELECT status FROM passages", buf, sizeof buf));
+    assert_string_equal("paper", raw_text(db, "SELECT formulation FROM passages", buf, sizeof buf));
+    raw_text(db, "SELECT stored_at FROM passages", buf, sizeof buf);
+    assert_int_equal(24, (int)strlen(buf)); /* 2026-11-22T05:06:07.123Z */
+    assert_int_equal('Z', buf[23]);
+    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM axles"));
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM axles WHERE idx = 1 AND spacing_m IS NULL"));
+    assert_true(raw_real(db, "SELECT spacing_m FROM axles WHERE idx = 2") == 3.8);
+    assert_true(raw_real(db, "SELECT spacing_m FROM axles WHERE idx = 3") == 1.3);
+    assert_true(raw_real(db, "SELECT load_kg FROM axles WHERE idx = 1") == 7000.0);
+    assert_true(raw_real(db, "SELECT sum(load_kg) FROM axles") == 25000.0);
+    /* the cascade */
+    raw_exec(db, "PRAGMA foreign_keys = ON; DELETE FROM passages");
+    assert_int_equal(0, raw_int(db, "SELECT count(*) FROM axles"));
+    sqlite3_close(db);
+}
+
+static void test_unsolved_is_null(void **state)
+{
+    fixture *f = *state;
+    amfi_passage_row r;
+    char err[ERRLEN], buf[128];
+    sqlite3 *db;
+
+    ok_row(&r, 7, DAY_US, NAN);
+    r.status = "gap";
+    r.reason = "accelerometer gap of 12 samples in the window";
+    r.axle_kg[0] = r.axle_kg[1] = NAN;
+    r.lambda = r.residual_rms = r.solve_ms = NAN;
+    r.formulation = NULL;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    /* an invalid event without known speed or axles */
+    ok_row(&r, 8, DAY_US + 1, NAN);
+    r.status = "invalid";
+    r.reason = "speed -3 m/s";
+    r.speed_mps = NAN;
+    r.n_axles = 0;
+    r.reason = NULL;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+
+    db = raw_open(f->path);
+    assert_string_equal("null", raw_text(db, "SELECT typeof(gvw_kg) FROM passages WHERE vehicle_id = 7", buf, sizeof buf));
+    assert_string_equal("null", raw_text(db, "SELECT typeof(lambda) FROM passages WHERE vehicle_id = 7", buf, sizeof buf));
+    assert_string_equal("null", raw_text(db, "SELECT typeof(formulation) FROM passages WHERE vehicle_id = 7", buf, sizeof buf));
+    assert_string_equal("accelerometer gap of 12 samples in the window",
+                        raw_text(db, "SELECT reason FROM passages WHERE vehicle_id = 7", buf, sizeof buf));
+    assert_int_equal(2, raw_int(db, "SELECT count(*) FROM axles WHERE load_kg IS NULL"));
+    assert_string_equal("null", raw_text(db, "SELECT typeof(speed_mps) FROM passages WHERE vehicle_id = 8", buf, sizeof buf));
+    assert_string_equal("", raw_text(db, "SELECT reason FROM passages WHERE vehicle_id = 8", buf, sizeof buf));
+    assert_int_equal(2, raw_int(db, "SELECT count(*) FROM axles"));
+    sqlite3_close(db);
+}
+
+typedef struct bad_case {
+    const char *what;       /* the field changed */
+    void (*spoil)(amfi_passage_row *r);
+    const char *expect;     /* substring of the message */
+} bad_case;
+
+static void spoil_status(amfi_passage_row *r) { r->status = "maybe"; }
+static void spoil_status_null(amfi_passage_row *r) { r->status = NULL; }
+static void spoil_utime(amfi_passage_row *r) { r->utime = -1; }
+static void spoil_lane(amfi_passage_row *r) { r->lane = 40000; }
+static void spoil_axles(amfi_passage_row *r) { r->n_axles = AMFI_MAX_AXLES + 1; }
+static void spoil_speed_inf(amfi_passage_row *r) { r->speed_mps = INFINITY; }
+static void spoil_speed_high(amfi_passage_row *r) { r->speed_mps = 400.0; }
+static void spoil_gvw_ok_nan(amfi_passage_row *r) { r->gvw_kg = NAN; }
+static void spoil_gvw_ok_neg(amfi_passage_row *r) { r->gvw_kg = -5.0; }
+static void spoil_spacing(amfi_passage_row *r) { r->spacing_m[0] = -1.0; }
+static void spoil_axle_nan(amfi_passage_row *r) { r->axle_kg[1] = NAN; }
+static void spoil_axle_inf(amfi_passage_row *r) { r->status = "error"; r->axle_kg[1] = -INFINITY; }
+static void spoil_lambda(amfi_passage_row *r) { r->lambda = 0.0; }
+static void spoil_residual(amfi_passage_row *r) { r->residual_rms = -1e-3; }
+static void spoil_reason(amfi_passage_row *r) { r->reason = "two\nlines"; }
+static void spoil_utf8(amfi_passage_row *r) { r->reason = "bad \xc3\x28 byte"; }
+static void spoil_formulation(amfi_passage_row *r) { r->formulation = ""; }
+static void spoil_ok_no_axles(amfi_passage_row *r) { r->n_axles = 0; }
+static void spoil_ok_no_speed(amfi_passage_row *r) { r->speed_mps = NAN; }
+
+static void test_invalid_rows_store_nothing(void **state)
+{
+    fixture *f = *state;
+    static const bad_case cases[] = {
+        {"status", spoil_status, "passages.status: 'maybe' is not one of ok, gap"},
+        {"status NULL", spoil_status_null, "passages.status: NULL"},
+        {"utime", spoil_utime, "passages.utime: -1 us is out of range"},
+        {"lane", spoil_lane, "passages.lane: 40000"},
+        {"n_axles", spoil_axles, "passages.n_axles: 13 is out of range [0, 12]"},
+        {"speed inf", spoil_speed_inf, "passages.speed_mps: inf is not a finite"},
+        {"speed 400", spoil_speed_high, "passages.speed_mps: 400 m/s is out of range [0, 150] m/s"},
+        {"ok gvw NaN", spoil_gvw_ok_nan, "status ok: gvw_kg: NaN"},
+        {"ok gvw < 0", spoil_gvw_ok_neg, "status ok: gvw_kg: -5 kg is out of range (0"},
+        {"spacing", spoil_spacing, "spacing_m[0]: -1 m is out of range (0, 50] m"},
+        {"ok axle NaN", spoil_axle_nan, "status ok: axle_kg[1]: NaN"},
+        {"axle inf", spoil_axle_inf, "axle_kg[1]: -inf is not a finite"},
+        {"lambda", spoil_lambda, "passages.lambda: 0 must be > 0"},
+        {"residual", spoil_residual, "passages.residual_rms: -0.001 must be >= 0"},
+        {"reason newline", spoil_reason, "passages.reason: control character"},
+        {"reason UTF-8", spoil_utf8, "invalid UTF-8 at byte 4"},
+        {"formulation", spoil_formulation, "passages.formulation: empty"},
+        {"ok no axles", spoil_ok_no_axles, "status ok needs n_axles >= 1"},
+        {"ok no speed", spoil_ok_no_speed, "status ok: speed_mps: NaN"},
+    };
+    amfi_passage_row r;
+    char err[ERRLEN];
+    sqlite3 *db = raw_open(f->path);
+
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        ok_row(&r, 1, DAY_US, 18000.0);
+        cases[k].spoil(&r);
+        err[0] = '\0';
+        int rc = amfi_store_add_passage(f->s, &r, NULL, err, sizeof err);
+        if (rc != AMFI_EINVAL || !strstr(err, cases[k].expect))
+            fail_msg("%s: rc %d, message '%s', expected '%s'", cases[k].what,
+                     rc, err, cases[k].expect);
+    }
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, NULL, NULL, err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(NULL, &r, NULL, err, sizeof err));
+    assert_int_equal(0, raw_int(db, "SELECT count(*) FROM passages"));
+    assert_int_equal(0, raw_int(db, "SELECT count(*) FROM axles"));
+
+    /* a failure half-way (the third axle row) undoes the passage row too */
+    raw_exec(db, "CREATE TRIGGER fail_third_axle BEFORE INSERT ON axles "
+                 "WHEN NEW.idx = 3 BEGIN SELECT RAISE(ABORT, 'injected'); END");
+    ok_row(&r, 1, DAY_US, 18000.0);
+    r.n_axles = 3;
+    r.spacing_m[1] = 1.3;
+    r.axle_kg[2] = 1000.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "axles: insert: injected"));
+    assert_int_equal(0, raw_int(db, "SELECT count(*) FROM passages"));
+    assert_int_equal(0, raw_int(db, "SELECT count(*) FROM axles"));
+    raw_exec(db, "DROP TRIGGER fail_third_axle");
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
+    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM axles"));
+    sqlite3_close(db);
+}
+
+/* WAL: a reader in the middle of a read transaction does not block. */
+static void test_reader_does_not_block(void **state)
+{
+    fixture *f = *state;
+    sqlite3 *db = raw_open(f->path);
+    char err[ERRLEN];
+    amfi_passage_row r;
+    add_ok(f->s, 1, DAY_US, 18000.0, NULL);
+    raw_exec(db, "BEGIN");
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
+    ok_row(&r, 2, DAY_US + 1, 19000.0);
+    double t0 = now_s();
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_true(now_s() - t0 < 1.0);
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages")); /* snapshot */
+    raw_exec(db, "COMMIT");
+    assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages"));
+    sqlite3_close(db);
+}
+
+/* ---- truth and passage_errors ---------------------------------------------- */
+
+static void test_truth_and_errors_view(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    double axle[2], force[2];
+    int64_t id[5];
+    sqlite3 *db;
+    static const double inferred[5] = {18000, 20500, 9800, 31000, NAN};
+    static const double truth[5] = {18200, 20000, 10000, 30000, 15000};
+
+    for (int k = 0; k < 5; k++) {
+        amfi_passage_row r;
+        ok_row(&r, 100 + k, DAY_US + k * 1000000, isnan(inferred[k]) ? 1 : inferred[k]);
+        if (isnan(inferred[k])) {
+            r.status = "multiple";
+            r.gvw_kg = r.axle_kg[0] = r.axle_kg[1] = NAN;
+        }
+        assert_int_equal(0, amfi_store_add_passage(f->s, &r, &id[k], err, sizeof err));
+        axle[0] = 0.4 * truth[k];
+        axle[1] = 0.6 * truth[k];
+        force[0] = axle[0] * AMFI_GRAVITY;
+        force[1] = NAN;
+        assert_int_equal(0, amfi_store_add_truth(f->s, 100 + k, DAY_US + k * 1000000,
+                                                 truth[k], 2, axle, force, 25.2,
+                                                 err, sizeof err));
+    }
+    /* the same vehicle_id in an earlier simulation run: not the nearest */
+    axle[0] = axle[1] = 500;
+    assert_int_equal(0, amfi_store_add_truth(f->s, 100, 5, 1000.0, 2, axle, NULL,
+                                             NAN, err, sizeof err));
+
+    db = raw_open(f->path);
+    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM truth"));
+    assert_int_equal(12, raw_int(db, "SELECT count(*) FROM truth_axles"));
+    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM truth_axles WHERE mean_force_N IS NULL"));
+    assert_int_equal(5, raw_int(db, "SELECT count(*) FROM passage_errors"));
+    for (int k = 0; k < 5; k++) {
+        char sql[160];
+        snprintf(sql, sizeof sql,
+                 "SELECT gvw_error_pct FROM passage_errors WHERE passage_id = %lld",
+                 (long long)id[k]);
+        double e = raw_real(db, sql);
+        if (isnan(inferred[k])) {
+            assert_true(isnan(e));
+        } else {
+            double want = 100.0 * (inferred[k] - truth[k]) / truth[k];
+            assert_true(fabs(e - want) < 1e-12 * fabs(want) + 1e-12);
+        }
+    }
+    sqlite3_close(db);
+
+    /* bad truth */
+    axle[0] = axle[1] = 1000;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_truth(f->s, 1, 0, 0.0, 2, axle, NULL, NAN, err, sizeof err));
+    assert_non_null(strstr(err, "truth.gvw_kg"));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_truth(f->s, 1, 0, 2000, 0, axle, NULL, NAN, err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_truth(f->s, 1, 0, 2000, 2, NULL, NULL, NAN, err, sizeof err));
+    axle[1] = NAN;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_truth(f->s, 1, 0, 2000, 2, axle, NULL, NAN, err, sizeof err));
+    assert_non_null(strstr(err, "truth: axle_kg[1]: NaN"));
+}
+
+/* ---- indicators, alerts, window_trend -------------------------------------- */
+
+static void test_indicators_alerts(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN], buf[64];
+    int64_t i1 = 0, i2 = 0, i3 = 0, a1 = 0;
+    amfi_indicator_row r = {DAY_US, 0, NAN, NAN, NAN, NAN, NAN, NAN, "baseline"};
+    sqlite3 *db;
+
+    assert_int_equal(0, amfi_store_add_indicator(f->s, &r, &i1, err, sizeof err));
+    r = (amfi_indicator_row){DAY_US + 1000, 200, 18100, 2400, 18000, 2000, 1.2, 0.004, "watch"};
+    assert_int_equal(0, amfi_store_add_indicator(f->s, &r, &i2, err, sizeof err));
+    r = (amfi_indicator_row){DAY_US + 2000, 200, 18200, 2600, 18000, 2000, 1.3, 1e-5, "alert"};
+    assert_int_equal(0, amfi_store_add_indicator(f->s, &r, &i3, err, sizeof err));
+    assert_true(i1 < i2 && i2 < i3);
+    assert_int_equal(0, amfi_store_add_alert(f->s, DAY_US + 2000, "warning", "std_increase",
+                                             "STD of GVW 1.30 x baseline (p = 1e-05)",
+                                             i3, 1, &a1, err, sizeof err));
+    assert_int_equal(0, amfi_store_add_alert(f->s, DAY_US + 2000, "info", "mean_shift",
+                                             "mean GVW +1.1 %", i3, 1, NULL, err, sizeof err));
+    assert_int_equal(0, amfi_store_add_alert(f->s, DAY_US + 3000, "info", "store",
+                                             "no indicator behind this one", 0, 0, NULL,
+                                             err, sizeof err));
+    db = raw_open(f->path);
+    /* i1, i2 without alerts: one row each; i3 with two alerts: two rows */
+    assert_int_equal(4, raw_int(db, "SELECT count(*) FROM window_trend"));
+    assert_int_equal(2, raw_int(db, "SELECT count(*) FROM window_trend WHERE alert_id IS NULL"));
+    assert_int_equal(2, raw_int(db, "SELECT count(*) FROM window_trend WHERE indicator_id = (SELECT max(id) FROM indicators)"));
+    assert_string_equal("1970-01-02 00:00:00", raw_text(db, "SELECT time_utc FROM window_trend LIMIT 1", buf, sizeof buf));
+    assert_string_equal("null", raw_text(db, "SELECT typeof(baseline_std_kg) FROM indicators ORDER BY id LIMIT 1", buf, sizeof buf));
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM alerts WHERE indicator_id IS NULL"));
+    sqlite3_close(db);
+
+    /* bad ones */
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_alert(f->s, 0, "warning", "std_increase", "x",
+                                                       999, 1, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "refers to a row that does not exist"));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_alert(f->s, 0, "fatal", "k", "x", 0, 1, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "alerts.level: 'fatal' is not one of info, warning"));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_alert(f->s, 0, "info", "Bad Kind", "x", 0, 1, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "alerts.kind"));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_alert(f->s, 0, "info", "k", "", 0, 1, NULL, err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_alert(f->s, 0, "info", "k", "x", 0, 2, NULL, err, sizeof err));
+    r = (amfi_indicator_row){0, 10, 1, 1, 1, 1, 1, 1.5, "normal"};
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_indicator(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "indicators.p_value: 1.5 is out of range [0, 1]"));
+    r.p_value = 0.5;
+    r.state = "panic";
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_indicator(f->s, &r, NULL, err, sizeof err));
+    r.state = "normal";
+    r.n = -1;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_indicator(f->s, &r, NULL, err, sizeof err));
+}
+
+/* ---- baseline, recent GVW, meta --------------------------------------------- */
+
+static void test_baseline(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    amfi_baseline b, got;
+    int found = -1;
+
+    memset(&got, 0x5a, sizeof got);
+    assert_int_equal(0, amfi_store_get_baseline(f->s, &got, &found, err, sizeof err));
+    assert_int_equal(0, found);
+    memset(&b, 0, sizeof b);
+    b = (amfi_baseline){DAY_US, 500, 18000.0, 2070.0, "auto", ""};
+    assert_int_equal(0, amfi_store_set_baseline(f->s, &b, err, sizeof err));
+    b = (amfi_baseline){2 * DAY_US, 300, 18100.5, 2100.25, "manual", "after bearing repair"};
+    assert_int_equal(0, amfi_store_set_baseline(f->s, &b, err, sizeof err));
+    assert_int_equal(0, amfi_store_get_baseline(f->s, &got, &found, err, sizeof err));
+    assert_int_equal(1, found);
+    assert_int_equal(2 * DAY_US, got.utime_set);
+    assert_int_equal(300, got.n);
+    assert_true(got.mean_kg == 18100.5 && got.std_kg == 2100.25);
+    assert_string_equal("manual", got.source);
+    assert_string_equal("after bearing repair", got.note);
+
+    b.n = 1;
+    assert_int_equal(AMFI_EINVAL, amfi_store_set_baseline(f->s, &b, err, sizeof err));
+    assert_non_null(strstr(err, "baseline.n: 1"));
+    b.n = 10;
+    b.std_kg = 0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_set_baseline(f->s, &b, err, sizeof err));
+    b.std_kg = 1;
+    snprintf(b.source, sizeof b.source, "guess");
+    assert_int_equal(AMFI_EINVAL, amfi_store_set_baseline(f->s, &b, err, sizeof err));
+    snprintf(b.source, sizeof b.source, "auto");
+    memset(b.note, 'x', sizeof b.note); /* not terminated */
+    assert_int_equal(AMFI_EINVAL, amfi_store_set_baseline(f->s, &b, err, sizeof err));
+    assert_non_null(strstr(err, "baseline.note: not terminated"));
+}
+
+static void test_recent_ok_gvw(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    double g[16];
+    int n = -1;
+    amfi_passage_row r;
+    /* utimes out of insertion order; every third not ok */
+    static const int64_t t[9] = {50, 10, 40, 20, 90, 30, 70, 60, 80};
+
+    assert_int_equal(0, amfi_store_recent_ok_gvw(f->s, 4, g, &n, err, sizeof err));
+    assert_int_equal(0, n);
+    for (int k = 0; k < 9; k++) {
+        ok_row(&r, k, DAY_US + t[k], 10000.0 + (double)t[k]);
+        if (k % 3 == 2) {
+            r.status = "late";
+            r.reason = "arrived after the window closed";
+        }
+        assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    }
+    /* ok: t = 50 10 20 90 70 60 → newest 4 oldest first: 50 60 70 90 */
+    assert_int_equal(0, amfi_store_recent_ok_gvw(f->s, 4, g, &n, err, sizeof err));
+    assert_int_equal(4, n);
+    assert_true(g[0] == 10050 && g[1] == 10060 && g[2] == 10070 && g[3] == 10090);
+    assert_int_equal(0, amfi_store_recent_ok_gvw(f->s, 16, g, &n, err, sizeof err));
+    assert_int_equal(6, n);
+    for (int k = 1; k < n; k++)
+        assert_true(g[k - 1] < g[k]);
+    assert_int_equal(AMFI_EINVAL, amfi_store_recent_ok_gvw(f->s, 0, g, &n, err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_recent_ok_gvw(f->s, 4, NULL, &n, err, sizeof err));
+}
+
+static void test_meta(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN], val[64], big[AMFI_STORE_META_VALUE_MAX + 2];
+    int found = -1;
+
+    assert_int_equal(0, amfi_store_meta_get(f->s, "last_vehicle_id", val, sizeof val, &found, err, sizeof err));
+    assert_int_equal(0, found);
+    assert_string_equal("", val);
+    assert_int_equal(0, amfi_store_meta_set(f->s, "last_vehicle_id", "41", err, sizeof err));
+    assert_int_equal(0, amfi_store_meta_set(f->s, "last_vehicle_id", "42", err, sizeof err));
+    assert_int_equal(0, amfi_store_meta_set(f->s, "empty", "", err, sizeof err));
+    assert_int_equal(0, amfi_store_meta_get(f->s, "last_vehicle_id", val, sizeof val, &found, err, sizeof err));
+    assert_int_equal(1, found);
+    assert_string_equal("42", val);
+    assert_int_equal(0, amfi_store_meta_get(f->s, "empty", val, sizeof val, &found, err, sizeof err));
+    assert_int_equal(1, found);
+    assert_string_equal("", val);
+    /* too long for the caller's buffer: an error, never a truncated value */
+    assert_int_equal(AMFI_EINVAL, amfi_store_meta_get(f->s, "last_vehicle_id", val, 2, &found, err, sizeof err));
+    assert_non_null(strstr(err, "value is 2 bytes, the buffer holds 1"));
+    assert_int_equal(0, found);
+    memset(big, 'v', sizeof big - 1);
+    big[sizeof big - 1] = '\0';
+    assert_int_equal(AMFI_EINVAL, amfi_store_meta_set(f->s, "k", big, err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_meta_set(f->s, "bad key", "v", err, sizeof err));
+    assert_non_null(strstr(err, "meta.key"));
+    assert_int_equal(AMFI_EINVAL, amfi_store_meta_set(f->s, "", "v", err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_meta_get(f->s, "k'; DROP TABLE meta; --", val, sizeof val, &found, err, sizeof err));
+}
+
+/* ---- damage ----------------------------------------------------------------- */
+
+static void test_integrity_check(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN], result[256];
+    sqlite3 *db;
+
+    add_ok(f->s, 1, DAY_US, 18000.0, NULL);
+    assert_int_equal(0, amfi_store_integrity_check(f->s, result, sizeof result, err, sizeof err));
+    assert_string_equal("ok", result);
+    /* an axle row whose passage is gone, written with foreign keys off */
+    db = raw_open(f->path);
+    raw_exec(db, "PRAGMA foreign_keys = OFF; "
+                 "INSERT INTO axles (passage_id, idx, spacing_m, load_kg) VALUES (999, 1, NULL, 10)");
+    sqlite3_close(db);
+    assert_int_equal(0, amfi_store_integrity_check(f->s, result, sizeof result, err, sizeof err));
+    assert_non_null(strstr(result, "foreign key: a axles row refers to a missing passages row"));
+    assert_int_equal(AMFI_EINVAL, amfi_store_integrity_check(f->s, NULL, 0, err, sizeof err));
+}
+
+/* Rows damaged behind the store's back: CHECK constraints switched off in a
+ * raw connection, and a table whose STRICT was edited away so that a text
+ * could go into a REAL column. Each read reports table and rowid. */
+static void test_corrupt_rows_reported(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN], val[64];
+    double g[8];
+    int n = 0, found = 0;
+    int64_t id = 0;
+    amfi_baseline b = {DAY_US, 100, 18000.0, 2000.0, "auto", ""};
+    sqlite3 *db;
+    char sql[160], expect[96];
+
+    add_ok(f->s, 1, DAY_US, 18000.0, NULL);
+    add_ok(f->s, 2, DAY_US + 1, 19000.0, &id);
+    assert_int_equal(0, amfi_store_set_baseline(f->s, &b, err, sizeof err));
+    assert_int_equal(0, amfi_store_meta_set(f->s, "state", "running", err, sizeof err));
+
+    db = raw_open(f->path);
+    raw_exec(db, "PRAGMA ignore_check_constraints = ON");
+    snprintf(sql, sizeof sql, "UPDATE passages SET gvw_kg = -5 WHERE id = %lld", (long long)id);
+    raw_exec(db, sql);
+    raw_exec(db, "UPDATE baseline SET std_kg = 0");
+    raw_exec(db, "UPDATE meta SET value = 'two' || char(10) || 'lines'");
+
+    assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_recent_ok_gvw(f->s, 8, g, &n, err, sizeof err));
+    snprintf(expect, sizeof expect, "passages row %lld: gvw_kg: -5 kg is out of range", (long long)id);
+    if (!strstr(err, expect))
+        fail_msg("got '%s', expected '%s'", err, expect);
+    assert_int_equal(0, n);
+    assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_get_baseline(f->s, &b, &found, err, sizeof err));
+    assert_non_null(strstr(err, "baseline row 1: std_kg: 0 kg is out of range (0, 1e+06] kg"));
+    assert_int_equal(0, found);
+    assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_meta_get(f->s, "state", val, sizeof val, &found, err, sizeof err));
+    assert_non_null(strstr(err, "meta row 1: value holds a control character"));
+    assert_int_equal(0, found);
+
+    /* an ok passage with no GVW at all */
+    snprintf(sql, sizeof sql, "UPDATE passages SET gvw_kg = NULL WHERE id = %lld", (long long)id);
+    raw_exec(db, sql);
+    assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_recent_ok_gvw(f->s, 8, g, &n, err, sizeof err));
+    assert_non_null(strstr(err, "gvw_kg is NULL, expected a number"));
+
+    /* a text in a REAL column: only possible once STRICT is edited away */
+    raw_exec(db, "PRAGMA writable_schema = ON; "
+                 "UPDATE sqlite_schema SET sql = replace(sql, ') STRICT', ')') "
+                 "WHERE name = 'baseline'; PRAGMA writable_schema = OFF");
+    sqlite3_close(db);
+    db = raw_open(f->path);
+    raw_exec(db, "PRAGMA ignore_check_constraints = ON; "
+                 "UPDATE baseline SET std_kg = 2000, mean_kg = 'lots'");
+    sqlite3_close(db);
+    amfi_store_close(f->s); /* the new schema is seen by a new connection */
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_get_baseline(f->s, &b, &found, err, sizeof err));
+    assert_non_null(strstr(err, "baseline row 1: mean_kg is text, expected a number"));
+}
+
+static void test_readonly(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    amfi_store *ro = NULL;
+    amfi_passage_row r;
+    amfi_baseline b;
+    double g[4];
+    int n = 0, found = 0;
+
+    add_ok(f->s, 1, DAY_US, 18000.0, NULL);
+    assert_int_equal(0, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
+    ok_row(&r, 2, DAY_US + 1, 18000.0);
+    assert_int_equal(AMFI_STORE_EDB, amfi_store_add_passage(ro, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "read-only"));
+    assert_int_equal(AMFI_STORE_EDB, amfi_store_meta_set(ro, "k", "v", err, sizeof err));
+    assert_int_equal(0, amfi_store_recent_ok_gvw(ro, 4, g, &n, err, sizeof err));
+    assert_int_equal(1, n);
+    assert_int_equal(0, amfi_store_get_baseline(ro, &b, &found, err, sizeof err));
+    assert_non_null(amfi_store_db(ro));
+    amfi_store_close(ro);
+}
+
+/* ---- the DDL in docs/schema.md -------------------------------------------- */
+
+/* The SQL between "<!-- ddl:begin -->" and "<!-- ddl:end -->" lines of the
+ * document, fence lines dropped; malloc'd. */
+static char *doc_ddl(void)
+{
+    FILE *fp = fopen(AMFI_SCHEMA_DOC, "r");
+    char line[1024];
+    size_t cap = 1 << 16, len = 0;
+    char *out = malloc(cap);
+    int in = 0, blocks = 0;
+    assert_non_null(fp);
+    assert_non_null(out);
+    out[0] = '\0';
+    while (fgets(line, sizeof line, fp)) {
+        if (strncmp(line, "<!-- ddl:begin -->", 18) == 0) {
+            in = 1;
+            blocks++;
+            continue;
+        }
+        if (strncmp(line, "<!-- ddl:end -->", 16) == 0) {
+            in = 0;
+            continue;
+        }
+        if (!in || strncmp(line, "```", 3) == 0)
+            continue;
+        size_t n = strlen(line);
+        assert_true(len + n + 1 < cap);
+        memcpy(out + len, line, n + 1);
+        len += n;
+    }
+    fclose(fp);
+    assert_true(blocks >= 1);
+    return out;
+}
+
+/* Whitespace runs collapsed to one space, ends trimmed, in place. */
+static void squeeze(char *s)
+{
+    char *w = s;
+    int space = 1;
+    for (char *p = s; *p; p++) {
+        if (*p == ' ' || *p == '\n' || *p == '\t' || *p == '\r') {
+            if (!space)
+                *w++ = ' ';
+            space = 1;
+        } else {
+            *w++ = *p;
+            space = 0;
+        }
+    }
+    if (w > s && w[-1] == ' ')
+        w--;
+    *w = '\0';
+}
+
+/* "type name tbl_name sql" of every schema object, sorted, one per line. */
+static char *schema_dump(sqlite3 *db)
+{
+    sqlite3_stmt *st = NULL;
+    size_t cap = 1 << 17, len = 0;
+    char *out = malloc(cap);
+    assert_non_null(out);
+    out[0] = '\0';
+    assert_int_equal(SQLITE_OK, sqlite3_prepare_v2(db,
+        "SELECT type, name, tbl_name, coalesce(sql, '') FROM sqlite_schema "
+        "ORDER BY type, name", -1, &st, NULL));
+    while (sqlite3_step(st) == SQLITE_ROW) {
+        char item[16384];
+        snprintf(item, sizeof item, "%s %s %s %s", sqlite3_column_text(st, 0),
+                 sqlite3_column_text(st, 1), sqlite3_column_text(st, 2),
+                 sqlite3_column_text(st, 3));
+        squeeze(item);
+        size_t n = strlen(item);
+        assert_true(len + n + 2 < cap);
+        memcpy(out + len, item, n);
+        len += n;
+        out[len++] = '\n';
+        out[len] = '\0';
+    }
+    sqlite3_finalize(st);
+    return out;
+}
+
+static void test_schema_doc_matches(void **state)
+{
+    fixture *f = *state;
+    char path[128], *ddl = doc_ddl(), *msg = NULL;
+    sqlite3 *doc = NULL, *db = raw_open(f->path);
+
+    snprintf(path, sizeof path, "%s/doc.db", f->dir);
+    assert_int_equal(SQLITE_OK, sqlite3_open(path, &doc));
+    if (sqlite3_exec(doc, ddl, NULL, NULL, &msg) != SQLITE_OK)
+        fail_msg("docs/schema.md DDL: %s", msg);
+    char *a = schema_dump(db), *b = schema_dump(doc);
+    if (strcmp(a, b) != 0) {
+        /* show the first differing line */
+        const char *p = a, *q = b;
+        while (*p && *p == *q) {
+            p++;
+            q++;
+        }
+        while (p > a && p[-1] != '\n') {
+            p--;
+            q--;
+        }
+        fail_msg("docs/schema.md differs from the store's schema:\n store: %.300s\n doc:   %.300s", p, q);
+    }
+    assert_int_equal(AMFI_STORE_APPLICATION_ID, raw_int(doc, "PRAGMA application_id"));
+    free(a);
+    free(b);
+    free(ddl);
+    sqlite3_close(doc);
+    sqlite3_close(db);
+}
+
+/* ---- volume: 10 000 passages and the daily_trend view ---------------------- */
+
+static void test_many_passages(void **state)
+{
+    fixture *f = *state;
+    enum { N = 10000, DAYS = 4 };
+    char err[ERRLEN];
+    amfi_passage_row r;
+    static double gvw[N];
+    double sum[DAYS] = {0}, mean[DAYS], ss[DAYS] = {0};
+    int cnt[DAYS] = {0}, bad[DAYS] = {0};
+    sqlite3 *db;
+    uint64_t x = 88172645463325252ULL; /* xorshift64 */
+
+    double t0 = now_s();
+    for (int k = 0; k < N; k++) {
+        int64_t utime = DAY_US * 20000 + (int64_t)k * (DAYS * DAY_US / N);
+        int day = (int)((int64_t)k * DAYS / N);
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        gvw[k] = 3000.0 + (double)(x % 4000000) / 100.0; /* 3 .. 43 t */
+        ok_row(&r, k, utime, gvw[k]);
+        if (k % 50 == 7) {
+            r.status = "gap";
+            r.gvw_kg = NAN;
+            bad[day]++;
+        } else {
+            sum[day] += gvw[k];
+            cnt[day]++;
+        }
+        if (amfi_store_add_passage(f->s, &r, NULL, err, sizeof err) != 0)
+            fail_msg("passage %d: %s", k, err);
+    }
+    double dt = now_s() - t0;
+    printf("store: %d passages (2 axles each, one transaction each, synchronous "
+           "NORMAL) in %.2f s: %.0f passages/s\n", N, dt, N / dt);
+    assert_true(dt < 120.0); /* sanitizers on a busy box; amfid needs ~10/s */
+
+    /* synchronous FULL: an fsync per commit */
+    amfi_store_close(f->s); /* checkpointed: the main file holds everything */
+    struct stat sb;
+    assert_int_equal(0, stat(f->path, &sb));
+    printf("store: file of %d passages: %.2f MB, %.0f bytes a passage\n", N,
+           (double)sb.st_size / 1e6, (double)sb.st_size / N);
+    assert_int_equal(0, amfi_store_open(f->path, 1, &f->s, err, sizeof err));
+    t0 = now_s();
+    for (int k = 0; k < 200; k++) {
+        ok_row(&r, N + k, DAY_US * 30000 + k, 18000.0);
+        assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    }
+    dt = now_s() - t0;
+    printf("store: 200 passages with synchronous FULL in %.2f s: %.0f passages/s\n",
+           dt, 200 / dt);
+
+    double g[1000];
+    int n = 0;
+    t0 = now_s();
+    assert_int_equal(0, amfi_store_recent_ok_gvw(f->s, 1000, g, &n, err, sizeof err));
+    printf("store: recent_ok_gvw(1000) in %.1f ms\n", 1e3 * (now_s() - t0));
+    assert_int_equal(1000, n);
+
+    /* daily_trend against a naive two-pass computation */
+    for (int d = 0; d < DAYS; d++)
+        mean[d] = sum[d] / cnt[d];
+    for (int k = 0; k < N; k++) {
+        int day = (int)((int64_t)k * DAYS / N);
+        if (k % 50 != 7)
+            ss[day] += (gvw[k] - mean[day]) * (gvw[k] - mean[day]);
+    }
+    db = raw_open(f->path);
+    for (int d = 0; d < DAYS; d++) {
+        char sql[200];
+        int64_t utime = DAY_US * (20000 + d);
+        snprintf(sql, sizeof sql, "SELECT %%s FROM daily_trend WHERE day = date(%lld, 'unixepoch')",
+                 (long long)(utime / 1000000));
+        char q[256];
+        snprintf(q, sizeof q, sql, "n_ok");
+        assert_int_equal(cnt[d], raw_int(db, q));
+        snprintf(q, sizeof q, sql, "n_not_ok");
+        assert_int_equal(bad[d], raw_int(db, q));
+        snprintf(q, sizeof q, sql, "mean_kg");
+        assert_true(fabs(raw_real(db, q) - mean[d]) < 1e-9 * mean[d]);
+        snprintf(q, sizeof q, sql, "std_kg");
+        double sd = sqrt(ss[d] / (cnt[d] - 1));
+        assert_true(fabs(raw_real(db, q) - sd) < 1e-9 * sd);
+    }
+    sqlite3_close(db);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_create_and_reopen, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_refuse_newer_version, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_refuse_foreign_files, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_passage_with_axles, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_unsolved_is_null, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_invalid_rows_store_nothing, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_reader_does_not_block, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_truth_and_errors_view, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_indicators_alerts, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_baseline, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_recent_ok_gvw, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_meta, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_integrity_check, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_corrupt_rows_reported, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_readonly, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_many_passages, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

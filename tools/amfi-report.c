@@ -1,0 +1,923 @@
+/*
+ * amfi-report: what amfid's store holds, for people.
+ *
+ *   amfi-report --db PATH [--summary] [--trend] [--alerts] [--errors]
+ *               [--set-baseline-last N | --set-baseline MEAN_KG,STD_KG,N]
+ *               [--note TEXT] [--check]
+ *
+ * Prints the passage summary (counts by status, GVW statistics of the ok
+ * passages, time span, baseline in force), the indicator trend (the last
+ * indicators as a compact table), the alerts, and the errors of the
+ * inferred GVW against the truth (simulations); sets a manual baseline from
+ * the last N ok passages or from explicit values; checks the file's
+ * integrity. With no option: summary, trend and alerts. It ends with the
+ * sqlite3 queries one would type next. Schema: docs/schema.md.
+ *
+ * The database is opened read-only (amfid may be writing it: WAL readers
+ * never block the writer); only --set-baseline* opens it read-write, for
+ * one INSERT. The file must exist and be an amfi store of this version:
+ * amfi-report never creates or migrates one.
+ *
+ * Exit status: 0 ok; 1 the database cannot be read, a row is damaged, or
+ * --check found a problem; 2 bad command line. Every error is one line on
+ * stderr: "amfi-report: PATH: problem" or "amfi-report: --option: problem".
+ *
+ * Workload: one run reads the ok GVWs once (8 bytes each: a million
+ * passages take 8 MB and well under a second) plus a few indexed queries.
+ */
+#include <math.h>
+#include <sqlite3.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "store.h"
+
+#define PROG "amfi-report"
+#define EXIT_DATA 1
+#define EXIT_USAGE 2
+#define TREND_ROWS 20  /* indicators shown by --trend */
+#define ALERT_ROWS 20  /* alerts shown by --alerts */
+#define MAX_BASELINE_N 10000000
+
+typedef struct options {
+    const char *db;
+    int summary, trend, alerts, errors, check;
+    int baseline_last;   /* N of --set-baseline-last, 0: not given */
+    int baseline_given;  /* --set-baseline MEAN,STD,N given */
+    double mean_kg, std_kg;
+    int n;
+    const char *note;    /* NULL: empty */
+} options;
+
+static const char *g_db = "?"; /* for messages */
+static FILE *g_out;             /* where a section is rendered */
+
+static void out(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+static void out(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(g_out, fmt, ap);
+    va_end(ap);
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: " PROG " --db PATH [--summary] [--trend] [--alerts] "
+            "[--errors]\n"
+            "       [--set-baseline-last N | --set-baseline MEAN_KG,STD_KG,N] "
+            "[--note TEXT] [--check]\n"
+            "\n"
+            "Reports on amfid's SQLite store (schema: docs/schema.md).\n"
+            "  --db PATH             the store (must exist)\n"
+            "  --summary             passages by status, GVW of the ok ones, "
+            "time span, baseline\n"
+            "  --trend               the last %d indicators\n"
+            "  --alerts              the last %d alerts and those open now\n"
+            "  --errors              inferred GVW against the truth "
+            "(simulations)\n"
+            "  --set-baseline-last N baseline (source manual) from the last N "
+            "ok passages, N >= 2\n"
+            "  --set-baseline M,S,N  baseline mean M kg, STD S kg, from N "
+            "passages\n"
+            "  --note TEXT           note stored with the baseline (<= 127 "
+            "bytes)\n"
+            "  --check               PRAGMA integrity_check and "
+            "foreign_key_check\n"
+            "With no option: --summary --trend --alerts.\n"
+            "Exit status: 0 ok, 1 database error or check failed, 2 usage "
+            "error.\n",
+            TREND_ROWS, ALERT_ROWS);
+}
+
+static int usage_error(const char *opt, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+/* "amfi-report: OPT: problem" on stderr; returns −1 */
+static int usage_error(const char *opt, const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, PROG ": %s: ", opt);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    return -1;
+}
+
+static int data_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+/* "amfi-report: PATH: problem" on stderr; returns −1 */
+static int data_error(const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, PROG ": %s: ", g_db);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    return -1;
+}
+
+/* s for a message: at most 40 characters, control characters as '?'. */
+static const char *shown(const char *s)
+{
+    static char buf[2][48];
+    static int which;
+    char *out = buf[which];
+    which ^= 1;
+    size_t k = 0;
+    for (; s[k] && k < 40; k++)
+        out[k] = ((unsigned char)s[k] < 0x20 || s[k] == 0x7f) ? '?' : s[k];
+    if (s[k]) {
+        memcpy(out + k, "...", 3);
+        k += 3;
+    }
+    out[k] = '\0';
+    return out;
+}
+
+static int parse_double(const char *s, double *v)
+{
+    char *end = NULL;
+    double x = strtod(s, &end);
+    if (end == s || *end != '\0' || !isfinite(x))
+        return -1;
+    *v = x;
+    return 0;
+}
+
+static int parse_int(const char *s, long lo, long hi, int *v)
+{
+    char *end = NULL;
+    long x = strtol(s, &end, 10);
+    if (end == s || *end != '\0' || x < lo || x > hi)
+        return -1;
+    *v = (int)x;
+    return 0;
+}
+
+/* "MEAN_KG,STD_KG,N" */
+static int parse_baseline(const char *arg, options *o)
+{
+    const char *opt = "--set-baseline";
+    char buf[96], *f[3], *save = NULL;
+    int k = 0;
+    if (strlen(arg) >= sizeof buf)
+        return usage_error(opt, "'%s' is too long", shown(arg));
+    snprintf(buf, sizeof buf, "%s", arg);
+    for (char *p = buf;; p = NULL) {
+        char *t = strtok_r(p, ",", &save);
+        if (!t)
+            break;
+        if (k == 3)
+            return usage_error(opt, "'%s': expected MEAN_KG,STD_KG,N",
+                               shown(arg));
+        f[k++] = t;
+    }
+    if (k != 3)
+        return usage_error(opt, "'%s': expected MEAN_KG,STD_KG,N", shown(arg));
+    if (parse_double(f[0], &o->mean_kg) != 0 || !(o->mean_kg > 0)
+        || o->mean_kg > AMFI_STORE_MAX_KG)
+        return usage_error(opt, "mean '%s' is not a mass in (0, %g] kg",
+                           shown(f[0]), AMFI_STORE_MAX_KG);
+    if (parse_double(f[1], &o->std_kg) != 0 || !(o->std_kg > 0)
+        || o->std_kg > AMFI_STORE_MAX_KG)
+        return usage_error(opt, "STD '%s' is not in (0, %g] kg", shown(f[1]),
+                           AMFI_STORE_MAX_KG);
+    if (parse_int(f[2], 2, MAX_BASELINE_N, &o->n) != 0)
+        return usage_error(opt, "N '%s' is not an integer in [2, %d]",
+                           shown(f[2]), MAX_BASELINE_N);
+    o->baseline_given = 1;
+    return 0;
+}
+
+static int parse_args(int argc, char **argv, options *o)
+{
+    static const char *const flags[] = {"--summary", "--trend", "--alerts",
+                                        "--errors", "--check"};
+    static const char *const valued[] = {"--db", "--set-baseline-last",
+                                         "--set-baseline", "--note"};
+    memset(o, 0, sizeof *o);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int which = -1;
+        const char *val = NULL;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            exit(0);
+        }
+        for (int k = 0; k < 5; k++)
+            if (strcmp(a, flags[k]) == 0)
+                which = k;
+        if (which >= 0) {
+            int *f[] = {&o->summary, &o->trend, &o->alerts, &o->errors,
+                        &o->check};
+            *f[which] = 1;
+            continue;
+        }
+        for (int k = 0; k < 4; k++) {
+            size_t n = strlen(valued[k]);
+            if (strncmp(a, valued[k], n) == 0 && (a[n] == '\0' || a[n] == '=')) {
+                which = k;
+                val = a[n] == '=' ? a + n + 1 : NULL;
+            }
+        }
+        if (which < 0)
+            return usage_error(shown(a), a[0] == '-'
+                                             ? "unknown option (see --help)"
+                                             : "unexpected argument (see --help)");
+        const char *opt = valued[which];
+        if (!val) {
+            if (i + 1 >= argc)
+                return usage_error(opt, "needs a value");
+            val = argv[++i];
+        }
+        switch (which) {
+        case 0:
+            if (!*val)
+                return usage_error(opt, "empty value");
+            o->db = val;
+            break;
+        case 1:
+            if (parse_int(val, 2, MAX_BASELINE_N, &o->baseline_last) != 0)
+                return usage_error(opt, "'%s' is not an integer in [2, %d]",
+                                   shown(val), MAX_BASELINE_N);
+            break;
+        case 2:
+            if (parse_baseline(val, o) != 0)
+                return -1;
+            break;
+        case 3:
+            if (strlen(val) > 127)
+                return usage_error(opt, "%zu bytes, at most 127", strlen(val));
+            o->note = val;
+            break;
+        }
+    }
+    if (!o->db)
+        return usage_error("--db", "missing (see --help)");
+    if (o->baseline_last && o->baseline_given)
+        return usage_error("--set-baseline", "give --set-baseline-last or "
+                           "--set-baseline, not both");
+    if (o->note && !o->baseline_last && !o->baseline_given)
+        return usage_error("--note", "only with --set-baseline-last or "
+                           "--set-baseline");
+    if (!o->summary && !o->trend && !o->alerts && !o->errors && !o->check
+        && !o->baseline_last && !o->baseline_given)
+        o->summary = o->trend = o->alerts = 1;
+    return 0;
+}
+
+/* ---- reading rows, every value checked --------------------------------- */
+
+static const char *const statuses[] = {"ok", "gap", "late", "overload",
+                                       "multiple", "invalid", "error"};
+#define N_STATUS 7
+static const char *const states[] = {"baseline", "normal", "watch", "alert"};
+
+static int prepare(sqlite3 *db, const char *sql, sqlite3_stmt **st)
+{
+    if (sqlite3_prepare_v2(db, sql, -1, st, NULL) != SQLITE_OK)
+        return data_error("%s", sqlite3_errmsg(db));
+    return 0;
+}
+
+/* Step st: 1 row, 0 done, −1 error (reported). */
+static int step(sqlite3 *db, sqlite3_stmt *st)
+{
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW)
+        return 1;
+    if (rc == SQLITE_DONE)
+        return 0;
+    return data_error("%s", sqlite3_errmsg(db));
+}
+
+static int bad_value(const char *table, long long rowid, sqlite3_stmt *st,
+                     int col, const char *problem)
+{
+    if (rowid >= 0)
+        return data_error("%s row %lld: %s %s", table, rowid,
+                          sqlite3_column_name(st, col), problem);
+    return data_error("%s: %s %s", table, sqlite3_column_name(st, col), problem);
+}
+
+/* A finite number; NULL gives NaN when nullable, else an error. */
+static int col_real(sqlite3_stmt *st, int col, int nullable, const char *table,
+                    long long rowid, double *out)
+{
+    int t = sqlite3_column_type(st, col);
+    if (t == SQLITE_NULL && nullable) {
+        *out = NAN;
+        return 0;
+    }
+    if (t != SQLITE_FLOAT && t != SQLITE_INTEGER)
+        return bad_value(table, rowid, st, col,
+                         t == SQLITE_NULL ? "is NULL, expected a number"
+                                          : "is not a number");
+    *out = sqlite3_column_double(st, col);
+    if (!isfinite(*out))
+        return bad_value(table, rowid, st, col, "is not finite");
+    return 0;
+}
+
+/* An integer in lo .. hi. */
+static int col_int(sqlite3_stmt *st, int col, long long lo, long long hi,
+                   const char *table, long long rowid, long long *out)
+{
+    if (sqlite3_column_type(st, col) != SQLITE_INTEGER)
+        return bad_value(table, rowid, st, col, "is not an integer");
+    *out = sqlite3_column_int64(st, col);
+    if (*out < lo || *out > hi)
+        return bad_value(table, rowid, st, col, "is out of range");
+    return 0;
+}
+
+/* Text, NUL-free; *out points into the statement's row. */
+static int col_text(sqlite3_stmt *st, int col, const char *table,
+                    long long rowid, const char **out)
+{
+    if (sqlite3_column_type(st, col) != SQLITE_TEXT)
+        return bad_value(table, rowid, st, col, "is not text");
+    const char *t = (const char *)sqlite3_column_text(st, col);
+    if (!t || strlen(t) != (size_t)sqlite3_column_bytes(st, col))
+        return bad_value(table, rowid, st, col, "holds a NUL byte");
+    *out = t;
+    return 0;
+}
+
+static int in_list(const char *s, const char *const *list, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (strcmp(s, list[k]) == 0)
+            return k;
+    return -1;
+}
+
+/* µs since 1970 → "YYYY-MM-DD HH:MM:SS" (UTC). */
+static const char *utc(long long utime, char buf[32])
+{
+    time_t t = (time_t)(utime / 1000000);
+    struct tm tm;
+    if (!gmtime_r(&t, &tm) || strftime(buf, 32, "%Y-%m-%d %H:%M:%S", &tm) == 0)
+        snprintf(buf, 32, "%lld us", utime);
+    return buf;
+}
+
+static const char *duration(double s, char buf[32])
+{
+    if (s < 120)
+        snprintf(buf, 32, "%.0f s", s);
+    else if (s < 7200)
+        snprintf(buf, 32, "%.1f min", s / 60);
+    else if (s < 172800)
+        snprintf(buf, 32, "%.1f h", s / 3600);
+    else
+        snprintf(buf, 32, "%.1f days", s / 86400);
+    return buf;
+}
+
+/* "-" for NaN, else printf of fmt into buf. */
+static const char *num(double x, const char *fmt, char buf[32])
+{
+    if (isnan(x))
+        return "-";
+    snprintf(buf, 32, fmt, x);
+    return buf;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Nearest-rank percentile of sorted v[0 .. n−1], 0 < p <= 100. */
+static double percentile(const double *v, size_t n, double p)
+{
+    size_t k = (size_t)ceil(p / 100.0 * (double)n);
+    return v[k > 0 ? k - 1 : 0];
+}
+
+/* Mean and sample STD (two passes; NaN STD when n < 2). */
+static void mean_std(const double *v, size_t n, double *mean, double *std)
+{
+    double s = 0, q = 0;
+    for (size_t k = 0; k < n; k++)
+        s += v[k];
+    *mean = n ? s / (double)n : NAN;
+    for (size_t k = 0; k < n; k++)
+        q += (v[k] - *mean) * (v[k] - *mean);
+    *std = n > 1 ? sqrt(q / (double)(n - 1)) : NAN;
+}
+
+/* A growing array of doubles. */
+typedef struct vec {
+    double *v;
+    size_t n, cap;
+} vec;
+
+static int vec_push(vec *a, double x)
+{
+    if (a->n == a->cap) {
+        size_t cap = a->cap ? 2 * a->cap : 1024;
+        double *v = realloc(a->v, cap * sizeof *v);
+        if (!v)
+            return data_error("out of memory");
+        a->v = v;
+        a->cap = cap;
+    }
+    a->v[a->n++] = x;
+    return 0;
+}
+
+/* ---- sections ------------------------------------------------------------ */
+
+static int print_baseline(amfi_store *s)
+{
+    amfi_baseline b;
+    int found = 0;
+    char err[256], t[32];
+    if (amfi_store_get_baseline(s, &b, &found, err, sizeof err) != 0)
+        return data_error("%s", err);
+    if (!found) {
+        out("baseline     none yet (amfid sets it from the first ok "
+               "passages, or --set-baseline*)\n");
+        return 0;
+    }
+    out("baseline     mean %.0f kg, STD %.0f kg, n %d, %s, from %s UTC%s%s%s\n",
+           b.mean_kg, b.std_kg, b.n, b.source, utc(b.utime_set, t),
+           b.note[0] ? " \"" : "", b.note, b.note[0] ? "\"" : "");
+    return 0;
+}
+
+static int section_summary(amfi_store *s)
+{
+    sqlite3 *db = amfi_store_db(s);
+    sqlite3_stmt *st = NULL;
+    long long total = 0, t0 = 0, t1 = 0, counts[N_STATUS] = {0};
+    vec g = {0};
+    char a[32], b[32], c[32];
+    int rc = prepare(db, "SELECT count(*), min(utime), max(utime) FROM passages",
+                     &st);
+    if (rc == 0 && (rc = step(db, st)) == 1) {
+        rc = col_int(st, 0, 0, INT64_MAX, "passages", -1, &total);
+        if (rc == 0 && total > 0)
+            rc = col_int(st, 1, 0, AMFI_STORE_MAX_UTIME, "passages", -1, &t0);
+        if (rc == 0 && total > 0)
+            rc = col_int(st, 2, 0, AMFI_STORE_MAX_UTIME, "passages", -1, &t1);
+    }
+    sqlite3_finalize(st);
+    st = NULL;
+    if (rc < 0)
+        return -1;
+    out("== passages\n");
+    if (total == 0)
+        out("time span    (no passages yet)\n");
+    else
+        out("time span    %s .. %s UTC (%s)\n", utc(t0, a), utc(t1, b),
+               duration((double)(t1 - t0) / 1e6, c));
+    rc = prepare(db, "SELECT status, count(*) FROM passages GROUP BY status",
+                 &st);
+    while (rc == 0 && (rc = step(db, st)) == 1) {
+        const char *name;
+        long long n;
+        rc = col_text(st, 0, "passages", -1, &name);
+        if (rc == 0)
+            rc = col_int(st, 1, 0, INT64_MAX, "passages", -1, &n);
+        if (rc == 0 && in_list(name, statuses, N_STATUS) < 0)
+            rc = data_error("passages: %lld rows have the unknown status '%s'",
+                            n, shown(name));
+        if (rc == 0)
+            counts[in_list(name, statuses, N_STATUS)] = n;
+    }
+    sqlite3_finalize(st);
+    st = NULL;
+    if (rc < 0)
+        return -1;
+    out("passages     %lld\n", total);
+    for (int k = 0; k < N_STATUS; k++)
+        out("  %-10s %8lld  %5.1f %%\n", statuses[k], counts[k],
+               total ? 100.0 * (double)counts[k] / (double)total : 0.0);
+    rc = prepare(db, "SELECT id, gvw_kg FROM passages WHERE status = 'ok'", &st);
+    while (rc == 0 && (rc = step(db, st)) == 1) {
+        long long id = sqlite3_column_int64(st, 0);
+        double x;
+        rc = col_real(st, 1, 0, "passages", id, &x);
+        if (rc == 0 && !(x > 0 && x <= AMFI_STORE_MAX_KG))
+            rc = bad_value("passages", id, st, 1, "is out of range for an ok "
+                           "passage");
+        if (rc == 0)
+            rc = vec_push(&g, x);
+    }
+    sqlite3_finalize(st);
+    if (rc == 0) {
+        double mean, std;
+        if (g.n == 0) {
+            out("GVW, ok      (no ok passages)\n");
+        } else {
+            qsort(g.v, g.n, sizeof *g.v, cmp_double);
+            mean_std(g.v, g.n, &mean, &std);
+            out("GVW, ok      n %zu, mean %.0f kg, STD %s kg, min %.0f, "
+                   "median %.0f, max %.0f kg\n",
+                   g.n, mean, num(std, "%.0f", a), g.v[0],
+                   percentile(g.v, g.n, 50), g.v[g.n - 1]);
+        }
+        rc = print_baseline(s);
+    }
+    free(g.v);
+    return rc < 0 ? -1 : 0;
+}
+
+static int section_trend(amfi_store *s)
+{
+    sqlite3 *db = amfi_store_db(s);
+    sqlite3_stmt *st = NULL;
+    long long total = 0;
+    char lines[TREND_ROWS][256];
+    int nl = 0;
+    int rc = prepare(db, "SELECT count(*) FROM indicators", &st);
+    if (rc == 0 && (rc = step(db, st)) == 1)
+        rc = col_int(st, 0, 0, INT64_MAX, "indicators", -1, &total);
+    sqlite3_finalize(st);
+    st = NULL;
+    if (rc < 0)
+        return -1;
+    out("== indicators (last %lld of %lld)\n",
+           total < TREND_ROWS ? total : (long long)TREND_ROWS, total);
+    if (total == 0) {
+        out("(none yet: amfid writes one every few ok passages once its "
+               "window is full)\n");
+        return 0;
+    }
+    rc = prepare(db, "SELECT id, utime, n, mean_kg, std_kg, std_ratio, p_value, "
+                     "state FROM indicators ORDER BY utime DESC, id DESC "
+                     "LIMIT ?1", &st);
+    if (rc == 0)
+        sqlite3_bind_int(st, 1, TREND_ROWS);
+    while (rc == 0 && nl < TREND_ROWS && (rc = step(db, st)) == 1) {
+        long long id = sqlite3_column_int64(st, 0), ut = 0, n = 0;
+        double mean = 0, std = 0, ratio = 0, p = 0;
+        const char *state = NULL;
+        char t[32], b1[32], b2[32], b3[32], b4[32];
+        rc = col_int(st, 1, 0, AMFI_STORE_MAX_UTIME, "indicators", id, &ut);
+        if (rc == 0) rc = col_int(st, 2, 0, INT32_MAX, "indicators", id, &n);
+        if (rc == 0) rc = col_real(st, 3, 1, "indicators", id, &mean);
+        if (rc == 0) rc = col_real(st, 4, 1, "indicators", id, &std);
+        if (rc == 0) rc = col_real(st, 5, 1, "indicators", id, &ratio);
+        if (rc == 0) rc = col_real(st, 6, 1, "indicators", id, &p);
+        if (rc == 0) rc = col_text(st, 7, "indicators", id, &state);
+        if (rc == 0 && in_list(state, states, 4) < 0)
+            rc = bad_value("indicators", id, st, 7, "is not a known state");
+        if (rc == 0)
+            snprintf(lines[nl++], sizeof lines[0],
+                     "%-19.19s  %6lld  %9.31s  %8.31s  %6.31s  %8.31s  %.8s", utc(ut, t), n,
+                     num(mean, "%.0f", b1), num(std, "%.0f", b2),
+                     num(ratio, "%.3f", b3), num(p, "%.2e", b4), state);
+    }
+    sqlite3_finalize(st);
+    if (rc < 0)
+        return -1;
+    out("%-19s  %6s  %9s  %8s  %6s  %8s  %s\n", "time (UTC)", "n",
+           "mean kg", "STD kg", "ratio", "p", "state");
+    for (int k = nl - 1; k >= 0; k--) /* oldest first */
+        out("%s\n", lines[k]);
+    return 0;
+}
+
+static int section_alerts(amfi_store *s)
+{
+    sqlite3 *db = amfi_store_db(s);
+    sqlite3_stmt *st = NULL;
+    long long total = 0;
+    char lines[ALERT_ROWS][512];
+    int nl = 0, open = 0;
+    int rc = prepare(db, "SELECT count(*) FROM alerts", &st);
+    if (rc == 0 && (rc = step(db, st)) == 1)
+        rc = col_int(st, 0, 0, INT64_MAX, "alerts", -1, &total);
+    sqlite3_finalize(st);
+    st = NULL;
+    if (rc < 0)
+        return -1;
+    out("== alerts (last %lld of %lld)\n",
+           total < ALERT_ROWS ? total : (long long)ALERT_ROWS, total);
+    if (total == 0) {
+        out("(none)\n");
+        return 0;
+    }
+    /* open now: the newest event of each kind is a raise */
+    rc = prepare(db, "SELECT a.id, a.kind, a.level, a.utime FROM alerts AS a "
+                     "WHERE a.raised = 1 AND a.id = (SELECT b.id FROM alerts "
+                     "AS b WHERE b.kind = a.kind ORDER BY b.utime DESC, b.id "
+                     "DESC LIMIT 1) ORDER BY a.utime", &st);
+    while (rc == 0 && (rc = step(db, st)) == 1) {
+        long long id = sqlite3_column_int64(st, 0), ut = 0;
+        const char *kind = NULL, *level = NULL;
+        char t[32];
+        rc = col_text(st, 1, "alerts", id, &kind);
+        if (rc == 0) rc = col_text(st, 2, "alerts", id, &level);
+        if (rc == 0) rc = col_int(st, 3, 0, AMFI_STORE_MAX_UTIME, "alerts", id, &ut);
+        if (rc == 0)
+            out("OPEN NOW     %s %s since %s UTC\n", shown(level),
+                   shown(kind), utc(ut, t));
+        open++;
+    }
+    sqlite3_finalize(st);
+    st = NULL;
+    if (rc < 0)
+        return -1;
+    if (open == 0)
+        out("open now     none\n");
+    rc = prepare(db, "SELECT id, utime, level, kind, raised, indicator_id, "
+                     "message FROM alerts ORDER BY utime DESC, id DESC "
+                     "LIMIT ?1", &st);
+    if (rc == 0)
+        sqlite3_bind_int(st, 1, ALERT_ROWS);
+    while (rc == 0 && nl < ALERT_ROWS && (rc = step(db, st)) == 1) {
+        long long id = sqlite3_column_int64(st, 0), ut = 0, raised = 0, ind = 0;
+        const char *level = NULL, *kind = NULL, *msg = NULL;
+        char t[32], is[32], m[301];
+        rc = col_int(st, 1, 0, AMFI_STORE_MAX_UTIME, "alerts", id, &ut);
+        if (rc == 0) rc = col_text(st, 2, "alerts", id, &level);
+        if (rc == 0) rc = col_text(st, 3, "alerts", id, &kind);
+        if (rc == 0) rc = col_int(st, 4, 0, 1, "alerts", id, &raised);
+        if (rc == 0 && sqlite3_column_type(st, 5) != SQLITE_NULL)
+            rc = col_int(st, 5, 1, INT64_MAX, "alerts", id, &ind);
+        if (rc == 0) rc = col_text(st, 6, "alerts", id, &msg);
+        if (rc == 0) {
+            if (ind > 0)
+                snprintf(is, sizeof is, "%lld", ind);
+            else
+                snprintf(is, sizeof is, "-");
+            /* one line per alert whatever the row holds */
+            size_t k = 0;
+            for (; msg[k] && k < sizeof m - 1; k++)
+                m[k] = ((unsigned char)msg[k] < 0x20 || msg[k] == 0x7f)
+                           ? '?' : msg[k];
+            m[k] = '\0';
+            snprintf(lines[nl++], sizeof lines[0],
+                     "%-19.19s  %-7.7s  %-14.40s  %-7s  %9.20s  %.300s",
+                     utc(ut, t), shown(level), shown(kind),
+                     raised ? "raised" : "cleared", is, m);
+        }
+    }
+    sqlite3_finalize(st);
+    if (rc < 0)
+        return -1;
+    out("%-19s  %-7s  %-14s  %-7s  %9s  %s\n", "time (UTC)", "level",
+           "kind", "event", "indicator", "message");
+    for (int k = nl - 1; k >= 0; k--)
+        out("%s\n", lines[k]);
+    return 0;
+}
+
+static int section_errors(amfi_store *s)
+{
+    sqlite3 *db = amfi_store_db(s);
+    sqlite3_stmt *st = NULL;
+    long long n_truth = 0, not_ok = 0;
+    vec e = {0};
+    char b[4][32];
+    int rc = prepare(db, "SELECT count(*) FROM truth", &st);
+    if (rc == 0 && (rc = step(db, st)) == 1)
+        rc = col_int(st, 0, 0, INT64_MAX, "truth", -1, &n_truth);
+    sqlite3_finalize(st);
+    st = NULL;
+    if (rc < 0)
+        return -1;
+    out("== errors against the truth\n");
+    if (n_truth == 0) {
+        out("(no truth rows: the truth is recorded in simulations only)\n");
+        return 0;
+    }
+    rc = prepare(db, "SELECT passage_id, status, gvw_error_pct "
+                     "FROM passage_errors", &st);
+    while (rc == 0 && (rc = step(db, st)) == 1) {
+        long long id = sqlite3_column_int64(st, 0);
+        const char *status = NULL;
+        double x;
+        rc = col_text(st, 1, "passages", id, &status);
+        if (rc == 0 && strcmp(status, "ok") != 0) {
+            not_ok++;
+            continue;
+        }
+        if (rc == 0)
+            rc = col_real(st, 2, 0, "passages", id, &x);
+        if (rc == 0)
+            rc = vec_push(&e, x);
+    }
+    sqlite3_finalize(st);
+    if (rc < 0) {
+        free(e.v);
+        return -1;
+    }
+    out("truth rows   %lld; ok passages matched %zu; other passages "
+           "matched %lld\n", n_truth, e.n, not_ok);
+    if (e.n > 0) {
+        double mean, std;
+        mean_std(e.v, e.n, &mean, &std);
+        out("GVW error    mean %+.2f %%, STD %s %%\n", mean,
+               num(std, "%.2f", b[0]));
+        for (size_t k = 0; k < e.n; k++)
+            e.v[k] = fabs(e.v[k]);
+        qsort(e.v, e.n, sizeof *e.v, cmp_double);
+        out("|GVW error|  median %.2f %%, 90 %% %.2f %%, 95 %% %.2f %%, "
+               "99 %% %.2f %%, max %.2f %%\n",
+               percentile(e.v, e.n, 50), percentile(e.v, e.n, 90),
+               percentile(e.v, e.n, 95), percentile(e.v, e.n, 99),
+               e.v[e.n - 1]);
+    }
+    free(e.v);
+    return 0;
+}
+
+static int set_baseline(const options *o)
+{
+    amfi_store *s = NULL;
+    amfi_baseline b;
+    double *g = NULL;
+    char err[512];
+    int rc = 0, n = 0;
+    memset(&b, 0, sizeof b);
+    if (amfi_store_open(o->db, 1, &s, err, sizeof err) != 0) {
+        fprintf(stderr, PROG ": %s\n", err); /* starts with the path */
+        return -1;
+    }
+    if (o->baseline_last) {
+        g = malloc((size_t)o->baseline_last * sizeof *g);
+        if (!g)
+            rc = data_error("out of memory");
+        if (rc == 0
+            && amfi_store_recent_ok_gvw(s, o->baseline_last, g, &n, err,
+                                        sizeof err) != 0)
+            rc = data_error("%s", err);
+        if (rc == 0 && n < o->baseline_last)
+            rc = data_error("only %d ok passages stored, --set-baseline-last "
+                            "asked for %d", n, o->baseline_last);
+        if (rc == 0) {
+            mean_std(g, (size_t)n, &b.mean_kg, &b.std_kg);
+            b.n = n;
+        }
+    } else {
+        b.mean_kg = o->mean_kg;
+        b.std_kg = o->std_kg;
+        b.n = o->n;
+    }
+    /* it applies from the newest passage stored (data time) */
+    if (rc == 0) {
+        sqlite3_stmt *st = NULL;
+        long long t = 0;
+        rc = prepare(amfi_store_db(s), "SELECT max(utime) FROM passages", &st);
+        if (rc == 0 && (rc = step(amfi_store_db(s), st)) == 1
+            && sqlite3_column_type(st, 0) != SQLITE_NULL)
+            rc = col_int(st, 0, 0, AMFI_STORE_MAX_UTIME, "passages", -1, &t);
+        sqlite3_finalize(st);
+        b.utime_set = t;
+        rc = rc < 0 ? -1 : 0;
+    }
+    if (rc == 0) {
+        snprintf(b.source, sizeof b.source, "manual");
+        snprintf(b.note, sizeof b.note, "%s", o->note ? o->note : "");
+        if (amfi_store_set_baseline(s, &b, err, sizeof err) != 0)
+            rc = data_error("%s", err);
+    }
+    if (rc == 0) {
+        char t[32];
+        printf("baseline set: mean %.0f kg, STD %.0f kg, n %d, manual, from "
+               "%s UTC\n", b.mean_kg, b.std_kg, b.n, utc(b.utime_set, t));
+        printf("(amfid reads the newest baseline row when it starts: restart "
+               "it to use this one)\n");
+    }
+    free(g);
+    amfi_store_close(s);
+    return rc;
+}
+
+/* PATH as one shell word, for the suggested commands. */
+static void shell_word(const char *s, char *out, size_t len)
+{
+    int plain = *s != '\0';
+    for (const char *p = s; *p; p++)
+        if (!strchr("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                    "0123456789_./-+,:@%=", *p))
+            plain = 0;
+    if (plain) {
+        snprintf(out, len, "%s", s);
+        return;
+    }
+    size_t k = 0;
+    if (len < 8) {
+        snprintf(out, len, "''");
+        return;
+    }
+    out[k++] = '\'';
+    for (const char *p = s; *p && k + 6 < len; p++) {
+        if (*p == '\'') {
+            memcpy(out + k, "'\\''", 4);
+            k += 4;
+        } else {
+            out[k++] = *p;
+        }
+    }
+    out[k++] = '\'';
+    out[k] = '\0';
+}
+
+static void print_next(const options *o)
+{
+    char w[1100];
+    shell_word(o->db, w, sizeof w);
+    printf("\nNext, with sqlite3 (docs/schema.md lists every table and view):\n");
+    printf("  sqlite3 -header -column %s \"SELECT * FROM daily_trend\"\n", w);
+    if (o->trend || o->alerts)
+        printf("  sqlite3 -header -column %s \"SELECT * FROM window_trend "
+               "ORDER BY utime DESC LIMIT 50\"\n", w);
+    if (o->summary)
+        printf("  sqlite3 -header -column %s \"SELECT status, reason, "
+               "count(*) FROM passages WHERE status <> 'ok' GROUP BY 1, 2\"\n",
+               w);
+    if (o->errors)
+        printf("  sqlite3 -header -column %s \"SELECT * FROM passage_errors "
+               "ORDER BY abs(gvw_error_pct) DESC LIMIT 20\"\n", w);
+    if (o->baseline_last || o->baseline_given)
+        printf("  sqlite3 -header -column %s \"SELECT * FROM baseline ORDER BY "
+               "id DESC LIMIT 5\"\n", w);
+}
+
+/* Render one section in memory and print it only when it is complete: a
+ * damaged row gives its error line, not half a table. Sections are
+ * separated by a blank line. */
+static int run_section(int (*fn)(amfi_store *), amfi_store *s, int *printed)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    g_out = open_memstream(&buf, &len);
+    if (!g_out)
+        return data_error("out of memory");
+    int rc = fn(s);
+    fclose(g_out);
+    g_out = stdout;
+    if (rc == 0) {
+        if (*printed)
+            putchar('\n');
+        fwrite(buf, 1, len, stdout);
+        *printed = 1;
+    }
+    free(buf);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    amfi_store *s = NULL;
+    char err[512];
+    int rc = 0, printed = 0;
+
+    if (parse_args(argc, argv, &o) != 0)
+        return EXIT_USAGE;
+    g_db = o.db;
+    /* read-only first: refuses a missing file, a non-SQLite file, a foreign
+     * or newer database, before anything could write to it */
+    if (amfi_store_open_readonly(o.db, &s, err, sizeof err) != 0) {
+        /* the store's message starts with the path already */
+        fprintf(stderr, PROG ": %s\n", err);
+        return EXIT_DATA;
+    }
+    g_out = stdout;
+    if (o.baseline_last || o.baseline_given) {
+        rc = set_baseline(&o);
+        printed = rc == 0;
+    }
+    if (rc == 0 && o.summary)
+        rc = run_section(section_summary, s, &printed);
+    if (rc == 0 && o.trend)
+        rc = run_section(section_trend, s, &printed);
+    if (rc == 0 && o.alerts)
+        rc = run_section(section_alerts, s, &printed);
+    if (rc == 0 && o.errors)
+        rc = run_section(section_errors, s, &printed);
+    if (rc == 0 && o.check) {
+        char result[1024];
+        int st = amfi_store_integrity_check(s, result, sizeof result, err,
+                                            sizeof err);
+        if (printed)
+            printf("\n");
+        printf("integrity    %s\n", result);
+        if (st != 0 || strcmp(result, "ok") != 0)
+            rc = data_error("integrity check failed: %s", result);
+    }
+    if (rc == 0 && (o.summary || o.trend || o.alerts || o.errors
+                    || o.baseline_last || o.baseline_given))
+        print_next(&o);
+    amfi_store_close(s);
+    fflush(stdout);
+    return rc == 0 ? 0 : EXIT_DATA;
+}
