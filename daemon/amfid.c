@@ -536,13 +536,13 @@ static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
     j->w.v.vehicle_id = m->vehicle_id;
     j->w.v.utime = (m->utime > 0 && m->utime < 253402300800000000LL) ? m->utime
                                                                        : d->newest_utime;
-    j->w.v.lane = (m->lane >= -32768 && m->lane <= 32767) ? m->lane : 0;
+    j->w.v.lane = m->lane; /* int16_t on the bus */
     j->w.v.speed_mps = NAN;
     j->w.v.n_axles = 0;
     j->gvw_kg = NAN;
     snprintf(j->status, sizeof j->status, "invalid");
-    snprintf(j->reason, sizeof j->reason, "%.150s (speed_mps %g, n_axles %d, utime %lld)", why,
-             m->speed_mps, m->n_axles, (long long)m->utime);
+    snprintf(j->reason, sizeof j->reason, "%.120s (speed_mps %.6g, n_axles %d, utime %lld)",
+             why, m->speed_mps, m->n_axles, (long long)m->utime);
     /* outside the entry order: stored now */
     store_job(d, j);
     job_free(j);

@@ -33,7 +33,7 @@ tail -n +2 "$dir/a/meta.csv" | while IFS=, read -r name speed _ spacing entry gv
 done || exit 1
 
 # Bad command lines are refused with one line and status 2.
-"$sim" --vehicles 3 2>/dev/null; [ $? -eq 2 ] || fail "missing --out not refused"
+"$sim" --lcm-url none --vehicles 3 2>/dev/null; [ $? -eq 2 ] || fail "streaming to nothing not refused"
 "$sim" --out "$dir/d" --damage 2 2>/dev/null; [ $? -eq 2 ] || fail "damage 2 not refused"
 "$sim" --out "$dir/d" --profile Z 2>/dev/null; [ $? -eq 2 ] || fail "profile Z not refused"
 "$sim" --out "$dir/d" --population /nonexistent.csv 2>/dev/null; [ $? -eq 1 ] || fail "missing population not refused"
