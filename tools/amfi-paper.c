@@ -26,10 +26,10 @@
  * per-vehicle L-curve on the same data.
  *
  * Output in DIR (default docs/results): paper.md (the report), CSV files,
- * PNG plots made with gnuplot. --quick (a few dozen vehicles per level, no
- * single-vehicle plots) is what the test suite runs: it exits 3 unless the
- * inferred-GVW STD at 10 % damage exceeds that at 0 % in every repetition
- * of both conditions.
+ * PNG plots made with gnuplot. --quick (30 vehicles per level, the ideal
+ * and Table 5 conditions, no single-vehicle experiments) is what the test
+ * suite runs: it exits 3 unless the inferred-GVW STD at 10 % damage exceeds
+ * that at 0 % in every repetition of both conditions.
  */
 #include <errno.h>
 #include <gsl/gsl_fit.h>
@@ -169,7 +169,7 @@ static void parse(int argc, char **argv, opts *o)
         }
     }
     if (o->quick && !vehicles_set)
-        o->vehicles = 40;
+        o->vehicles = 30;
 }
 
 /* ---- one passage: simulate, measure, solve ----------------------------- */
@@ -410,7 +410,10 @@ static int batches(ctx *c)
             c->cfg.solver.free_initial_state ? "free" : "at rest", c->cfg.solver.pre_roll_s,
             o->lambda_ref,
             o->batch_lcurve ? "; and a per-vehicle L-curve on the same data" : "");
-    for (int cond = 0; cond < 3; cond++) {
+    /* --quick (the test suite, under sanitizers): the two conditions the
+     * trend check needs; table5_same explains a result, it checks nothing. */
+    const int n_cond = o->quick ? 2 : 3;
+    for (int cond = 0; cond < n_cond; cond++) {
         batch_job j;
         memset(&j, 0, sizeof j);
         j.c = c;
