@@ -1030,19 +1030,20 @@ void amfi_config_defaults(amfi_site_config *c)
     d->margin_s = 0.05;
     d->max_wait_s = 10.0;
     d->status_period_s = 1.0;
-    /* docs/indicators.md */
+    /* amfi_indicator_params_default() (daemon/indicators.c) and the
+     * simulation behind each value in docs/indicators.md */
     d->ind_window = 500;
-    d->ind_every = 50;
-    d->ind_baseline_n = 500;
-    d->ind_std_alert_ratio = 1.06;
+    d->ind_every = 100;
+    d->ind_baseline_n = 10000;
+    d->ind_std_alert_ratio = 1.08;
     d->ind_std_alert_p = 0.01;
-    d->ind_std_clear_ratio = 1.03;
-    d->ind_raise_after = 3;
-    d->ind_clear_after = 3;
+    d->ind_std_clear_ratio = 1.00;
+    d->ind_raise_after = 6;
+    d->ind_clear_after = 6;
     d->ind_mean_shift = 1;
-    d->ind_mean_alert_ratio = 1.04;
-    d->ind_mean_alert_p = 0.001;
-    d->ind_mean_clear_ratio = 1.02;
+    d->ind_mean_alert_ratio = 1.05;
+    d->ind_mean_alert_p = 0.01;
+    d->ind_mean_clear_ratio = 1.03;
 }
 
 /* Line (1-based) holding byte `offset` of buf[len]. */

@@ -20,8 +20,9 @@ fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"
 N=12
 
 # Indicators small enough to evaluate in a short test.
-sed -e "s/^    window: 500/    window: 10/" -e "s/^    every: 50/    every: 5/" \
-    -e "s/^    baseline_n: 500/    baseline_n: 10/" "$config" > "$dir/amfid.yaml"
+sed -e "s/^    window: 500/    window: 10/" -e "s/^    every: 100/    every: 5/" \
+    -e "s/^    baseline_n: 10000/    baseline_n: 10/" "$config" > "$dir/amfid.yaml"
+grep -q "^    baseline_n: 10 " "$dir/amfid.yaml" || fail "the test's indicator settings did not apply"
 "$amfid" --config "$dir/amfid.yaml" --check-config >/dev/null || fail "check-config"
 
 # 1. Live: amfid listening, sim_publisher publishing at 20x real time.
