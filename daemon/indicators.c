@@ -77,7 +77,7 @@ void amfi_indicator_params_default(amfi_indicator_params *p)
     p->baseline_n = 10000;
     p->std_alert_ratio = 1.08;
     p->std_alert_p = 0.01;
-    p->std_clear_ratio = 1.02;
+    p->std_clear_ratio = 1.00;
     p->raise_after = 6;
     p->clear_after = 6;
     p->mean_shift = 1;
