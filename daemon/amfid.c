@@ -51,6 +51,7 @@
 #include "amfi_truth_t.h"
 #include "amfi_vehicle_t.h"
 #include "indicators.h"
+#include <sqlite3.h>
 #include "ring.h"
 #include "store.h"
 #include "tracker.h"
@@ -317,8 +318,11 @@ static void feed_indicators(daemon_s *d, const job *j)
     amfi_alert_event al[2];
     int n_al = 0;
     int bits = amfi_indicators_push(d->ind, j->gvw_kg, &ev, al, &n_al);
-    if (bits < 0)
+    if (bits < 0) {
+        set_error(d, "indicators: GVW %.1f kg of vehicle %lld refused", j->gvw_kg,
+                  (long long)j->w.v.vehicle_id);
         return;
+    }
     char err[256];
     if (bits & AMFI_IND_BASELINE) {
         amfi_baseline b;
@@ -686,6 +690,21 @@ static void indicator_params(const amfi_daemon_config *dc, amfi_indicator_params
     p->mean_clear_ratio = dc->ind_mean_clear_ratio;
 }
 
+/* 1 when the newest alert of `kind` in the store was a raise (still open). */
+static int last_alert_raised(amfi_store *st, const char *kind)
+{
+    sqlite3_stmt *q = NULL;
+    int raised = 0;
+    if (sqlite3_prepare_v2(amfi_store_db(st),
+                           "SELECT raised FROM alerts WHERE kind = ?1 ORDER BY id DESC LIMIT 1",
+                           -1, &q, NULL) == SQLITE_OK &&
+        sqlite3_bind_text(q, 1, kind, -1, SQLITE_STATIC) == SQLITE_OK &&
+        sqlite3_step(q) == SQLITE_ROW && sqlite3_column_type(q, 0) == SQLITE_INTEGER)
+        raised = sqlite3_column_int(q, 0) == 1;
+    sqlite3_finalize(q);
+    return raised;
+}
+
 /* SIGHUP: apply what can change while running, report the rest. */
 static void reload(daemon_s *d)
 {
@@ -804,6 +823,13 @@ int main(int argc, char **argv)
             if (g && amfi_store_recent_ok_gvw(d.store, ip.window, g, &n, err, sizeof err) == 0)
                 amfi_indicators_prefill(d.ind, g, n);
             free(g);
+            /* An alert open before a restart stays open, not raised twice. */
+            int open_std = last_alert_raised(d.store, "std_increase");
+            int open_mean = last_alert_raised(d.store, "mean_shift");
+            amfi_indicators_set_alerted(d.ind, open_std, open_mean);
+            if (open_std || open_mean)
+                LOG_INFO("open alerts restored from the store:%s%s", open_std ? " std_increase" : "",
+                         open_mean ? " mean_shift" : "");
         }
     }
     amfi_tracker_params tp = {d.cfg.bridge.span_m, d.cfg.solver.pre_roll_s + d.cfg.daemon.margin_s,
