@@ -400,15 +400,30 @@ static int store_job(daemon_s *d, job *j)
     return 0;
 }
 
-/* Park a finished job by seq; store every consecutive one from next_seq. */
+/* Park a finished job by seq; store every consecutive one from next_seq.
+ * The parking ring grows when the solvers fall far behind (windows that
+ * bypass them keep arriving): a passage is never dropped for lack of room. */
 static int complete(daemon_s *d, job *j)
 {
     int64_t seq = j->w.seq;
     if (seq - d->next_seq >= d->pend_cap) {
-        set_error(d, "internal: reorder window exceeded (seq %lld, next %lld)", (long long)seq,
-                  (long long)d->next_seq);
-        job_free(j);
-        return -1;
+        int cap = d->pend_cap;
+        while (seq - d->next_seq >= cap)
+            cap *= 2;
+        job **np = calloc((size_t)cap, sizeof *np);
+        if (!np) { /* out of memory: store it now, out of order, rather than lose it */
+            set_error(d, "out of memory for the reorder buffer: passage %lld stored out of order",
+                      (long long)seq);
+            int rc = store_job(d, j);
+            job_free(j);
+            return rc;
+        }
+        for (int i = 0; i < d->pend_cap; i++)
+            if (d->pending[i])
+                np[d->pending[i]->w.seq % cap] = d->pending[i];
+        free(d->pending);
+        d->pending = np;
+        d->pend_cap = cap;
     }
     d->pending[seq % d->pend_cap] = j;
     int rc = 0;
@@ -892,9 +907,13 @@ int main(int argc, char **argv)
         int wd = sd_watchdog_enabled(0, &wd_usec) > 0;
         double last_beat = 0.0, last_wd = 0.0;
         int lfd = lcm_get_fileno(d.lcm);
+        const int replay = strncmp(d.cfg.daemon.lcm_url, "file://", 7) == 0;
         rc = 0;
         while (!stop_flag) {
-            struct pollfd pf[2] = {{lfd, POLLIN, 0}, {d.efd, POLLIN, 0}};
+            /* Replaying a log, the bus waits for the solvers (no overload,
+             * the same rows at any speed); a live bus is always read. */
+            const int hold = replay && queue_depth(&d.jobs) >= d.cfg.daemon.queue_size;
+            struct pollfd pf[2] = {{hold ? -1 : lfd, POLLIN, 0}, {d.efd, POLLIN, 0}};
             int pr = poll(pf, 2, 100);
             if (pr < 0 && errno != EINTR) {
                 LOG_ERR("poll: %s", strerror(errno));
@@ -902,9 +921,13 @@ int main(int argc, char **argv)
                 break;
             }
             if (pr > 0 && (pf[0].revents & POLLIN) && lcm_handle(d.lcm) != 0) {
-                /* file:// provider: end of the log */
-                LOG_INFO("the bus has no more data (end of log)");
-                break;
+                if (replay) { /* file:// provider: the end of the log */
+                    LOG_INFO("the bus has no more data (end of log)");
+                    break;
+                }
+                /* a live bus: a receive error is logged and counted, not fatal */
+                d.messages_malformed++;
+                set_error(&d, "LCM receive error on '%s'", d.cfg.daemon.lcm_url);
             }
             if (pr > 0 && (pf[0].revents & (POLLHUP | POLLERR | POLLNVAL))) {
                 LOG_INFO("the bus closed");

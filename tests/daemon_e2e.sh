@@ -20,8 +20,12 @@ fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"
 N=12
 
 # Indicators small enough to evaluate in a short test.
+# A solver queue of 4: replaying a log must hold the bus, not overflow
+# (every row ok, none lost or "overload").
 sed -e "s/^    window: 500/    window: 10/" -e "s/^    every: 100/    every: 5/" \
-    -e "s/^    baseline_n: 10000/    baseline_n: 10/" "$config" > "$dir/amfid.yaml"
+    -e "s/^    baseline_n: 10000/    baseline_n: 10/" -e "s/^  queue_size: 256/  queue_size: 4/" \
+    "$config" > "$dir/amfid.yaml"
+grep -q "^  queue_size: 4 " "$dir/amfid.yaml" || fail "the test's queue size did not apply"
 grep -q "^    baseline_n: 10 " "$dir/amfid.yaml" || fail "the test's indicator settings did not apply"
 "$amfid" --config "$dir/amfid.yaml" --check-config >/dev/null || fail "check-config"
 
@@ -64,6 +68,7 @@ q="SELECT vehicle_id, utime, status, printf('%.6f', gvw_kg), printf('%.6g', lamb
 sqlite3 "$dir/replay0.db" "$q" > "$dir/a.txt"
 sqlite3 "$dir/replay8.db" "$q" > "$dir/b.txt"
 [ "$(wc -l < "$dir/a.txt")" -eq $N ] || fail "replay: $(wc -l < "$dir/a.txt") rows"
+[ "$(grep -c '|ok|' "$dir/a.txt")" -eq $N ] || fail "replay: not every passage ok: $(cut -d'|' -f3 "$dir/a.txt" | sort | uniq -c)"
 cmp -s "$dir/a.txt" "$dir/b.txt" || fail "replays at two speeds differ"
 echo "replay: $N identical rows at speed 0 (as fast as possible) and 8"
 echo "daemon end to end: ok"
