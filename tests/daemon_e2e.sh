@@ -1,9 +1,10 @@
 #!/bin/sh
 # amfid end to end: the real sim_publisher and amfid on LCM's UDP multicast
 # inside a private network namespace (nothing leaves it), then the stored
-# rows: every vehicle a passage row, GVW against the truth, a clean
-# shutdown on SIGTERM (integrity_check ok), and a log replayed twice at two
-# speeds through LCM's file:// provider giving identical rows.
+# rows: every vehicle a passage row, GVW against the truth, a SIGHUP reload
+# while traffic streams, a clean shutdown on SIGTERM (integrity_check ok),
+# SIGTERM mid-stream losing no received vehicle, and a log replayed twice
+# at two speeds through LCM's file:// provider giving identical rows.
 # Usage: daemon_e2e.sh AMFID SIM_PUBLISHER AMFI_REPORT CONFIG
 set -u
 if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
@@ -34,8 +35,13 @@ grep -q "^    baseline_n: 10 " "$dir/amfid.yaml" || fail "the test's indicator s
 apid=$!; pids="$pids $apid"
 i=0; until grep -q "running" "$dir/amfid.log"; do
   i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
-timeout 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 3 2> "$dir/sim.log" ||
-  fail "sim_publisher exited $?"
+timeout 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 3 2> "$dir/sim.log" &
+spid=$!; pids="$pids $spid"
+sleep 0.5
+kill -HUP $apid  # reload while the traffic streams
+wait $spid || fail "sim_publisher exited $?"
+grep -q "reload: configuration .* applied" "$dir/amfid.log" || fail "SIGHUP: no reload in the log"
+kill -0 $apid 2>/dev/null || fail "amfid died on SIGHUP"
 sleep 1
 kill -TERM $apid
 i=0; while kill -0 $apid 2>/dev/null; do
@@ -56,7 +62,28 @@ echo "live: largest GVW error $(awk -v e="$err" 'BEGIN { printf "%.2f %%", 100 *
 awk -v e="$err" 'BEGIN { exit !(e < 0.08) }' || fail "GVW error $err over 8 %"
 "$report" --db "$dir/live.db" > "$dir/report.txt" || fail "amfi-report"
 
-# 2. Replay: one log, read twice through file:// at two speeds: same rows.
+# 2. SIGTERM mid-stream: every vehicle amfid received is a row (the ones
+#    whose data never came as gap), the database is intact.
+"$amfid" --config "$dir/amfid.yaml" --db "$dir/term.db" 2> "$dir/term.log" &
+apid=$!; pids="$pids $apid"
+i=0; until grep -q "running" "$dir/term.log"; do
+  i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+timeout 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 5 2> "$dir/simterm.log" &
+spid=$!; pids="$pids $spid"
+sleep 1.2  # about half the traffic
+kill -TERM $apid
+wait $apid; rc=$?
+[ $rc -eq 0 ] || fail "amfid exit status $rc after SIGTERM mid-stream"
+kill $spid 2>/dev/null; wait $spid 2>/dev/null
+received=$(sed -n 's/.*stopped: .* blocks, \([0-9]*\) vehicles.*/\1/p' "$dir/term.log")
+rows=$(sqlite3 "$dir/term.db" "SELECT count(*) FROM passages")
+echo "SIGTERM mid-stream: $received vehicles received, $rows rows ($(sqlite3 "$dir/term.db" \
+  "SELECT group_concat(status || ' ' || n, ', ') FROM (SELECT status, count(*) n FROM passages GROUP BY 1)"))"
+[ -n "$received" ] && [ "$received" -gt 0 ] || fail "no vehicle received before SIGTERM"
+[ "$rows" -eq "$received" ] || fail "$received vehicles received but $rows rows stored"
+sqlite3 "$dir/term.db" "PRAGMA integrity_check" | grep -qx ok || fail "integrity_check after SIGTERM"
+
+# 3. Replay: one log, read twice through file:// at two speeds: same rows.
 "$sim" --lcm-url none --log "$dir/traffic.log" --vehicles $N --headway 3 --speedup max --seed 4 \
   2> "$dir/simlog.log" || fail "sim_publisher --log"
 for speed in 0 8; do
