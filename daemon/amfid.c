@@ -265,6 +265,14 @@ static void solve_job(const daemon_s *d, amfi_solver *s, job *j)
         j->gvw_kg = NAN;
         return;
     }
+    if (!(r.gvw_kg > 0.0) || !isfinite(r.gvw_kg)) {
+        /* e.g. a silent sensor: stored as an error with the number, not lost */
+        snprintf(j->status, sizeof j->status, "error");
+        snprintf(j->reason, sizeof j->reason,
+                 "inferred GVW %.0f kg is not positive: no response from the bridge?", r.gvw_kg);
+        j->gvw_kg = NAN;
+        return;
+    }
     j->solved = 1;
     snprintf(j->status, sizeof j->status, "ok");
     j->gvw_kg = r.gvw_kg;

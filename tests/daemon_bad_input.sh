@@ -1,0 +1,28 @@
+#!/bin/sh
+# amfid on bad input from the bus (no network: an LCM log read through
+# file://): a duplicate, a truncated and an unknown-sensor accel block,
+# random bytes on each input channel, an invalid vehicle, two blocks out of
+# order. amfid must count them, store the invalid vehicle with its reason,
+# weigh the real vehicles, and exit cleanly.
+# Usage: daemon_bad_input.sh AMFID SIM_PUBLISHER LCM_INJECT CONFIG
+set -u
+amfid=$1 sim=$2 inject=$3 config=$4
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+fail() { echo "FAIL: $*"; tail -30 "$dir/amfid.log"; exit 1; }
+"$sim" --lcm-url none --log "$dir/clean.log" --vehicles 3 --headway 4 --speedup max --seed 2 \
+  2> "$dir/sim.log" || fail "sim_publisher"
+"$inject" "$dir/clean.log" "$dir/bad.log" || fail "lcm_inject"
+"$amfid" --config "$config" --db "$dir/a.db" --lcm-url "file://$dir/bad.log?speed=0" \
+  2> "$dir/amfid.log"; rc=$?
+[ $rc -eq 0 ] || fail "amfid exit status $rc"
+for what in "malformed accel_block_t" "malformed vehicle_t" "malformed truth_t" \
+            "vehicle_t 424242 rejected: speed_mps" "sensor 99 .* rejected: sensor_id not in the configuration"; do
+  grep -q "$what" "$dir/amfid.log" || fail "no log line for: $what"
+done
+grep -q "stopped: 4 passages stored (3 ok)" "$dir/amfid.log" || fail "counts: $(grep stopped "$dir/amfid.log")"
+sqlite3 "$dir/a.db" "SELECT status FROM passages WHERE vehicle_id = 424242" | grep -qx invalid ||
+  fail "the invalid vehicle was not stored as invalid"
+[ "$(sqlite3 "$dir/a.db" "SELECT count(*) FROM passages WHERE status = 'ok'")" -eq 3 ] ||
+  fail "the three real vehicles are not all ok"
+echo "bad input: $(grep -c 'rejected' "$dir/amfid.log") rejections logged, 3 vehicles ok, 1 invalid stored"

@@ -1,0 +1,87 @@
+/*
+ * lcm_inject: copy an LCM log, splicing in the bad input a site's bus can
+ * carry, for amfid's bad-input test (tests/daemon_bad_input.sh):
+ *   after the 50th AMFI_ACCEL event: the same event again (duplicate), its
+ *   first half (truncated), 40 random bytes on AMFI_ACCEL, AMFI_VEHICLE and
+ *   AMFI_TRUTH, a well-formed vehicle_t with speed −3 m/s, an accel block
+ *   from sensor 99; the 60th and 61st accel events swapped (out of order).
+ *
+ *   lcm_inject IN.log OUT.log
+ */
+#include <lcm/eventlog.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amfi_messages.h"
+
+static int put(lcm_eventlog_t *out, int64_t *num, int64_t ts, const char *ch, void *data, int len)
+{
+    lcm_eventlog_event_t e = {(*num)++, ts, (int32_t)strlen(ch), len, (char *)ch, data};
+    return lcm_eventlog_write_event(out, &e);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 3) {
+        fprintf(stderr, "usage: lcm_inject IN.log OUT.log\n");
+        return 2;
+    }
+    lcm_eventlog_t *in = lcm_eventlog_create(argv[1], "r");
+    lcm_eventlog_t *out = lcm_eventlog_create(argv[2], "w");
+    if (!in || !out) {
+        fprintf(stderr, "lcm_inject: cannot open the logs\n");
+        return 1;
+    }
+    lcm_eventlog_event_t *e, *held = NULL;
+    int64_t num = 0;
+    int accel = 0, rc = 0;
+    unsigned char junk[40];
+    srand(7);
+    for (size_t i = 0; i < sizeof junk; i++)
+        junk[i] = (unsigned char)(rand() & 0xff);
+    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
+        int is_accel = strcmp(e->channel, AMFI_CHANNEL_ACCEL) == 0;
+        if (is_accel)
+            accel++;
+        if (is_accel && accel == 60) { /* hold it: written after the 61st */
+            held = e;
+            continue;
+        }
+        rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
+        if (is_accel && accel == 61 && held) {
+            rc |= put(out, &num, held->timestamp, held->channel, held->data, held->datalen);
+            lcm_eventlog_free_event(held);
+            held = NULL;
+        }
+        if (is_accel && accel == 50) {
+            rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen); /* duplicate */
+            rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen / 2); /* truncated */
+            rc |= put(out, &num, e->timestamp, AMFI_CHANNEL_ACCEL, junk, sizeof junk);
+            rc |= put(out, &num, e->timestamp, AMFI_CHANNEL_VEHICLE, junk, sizeof junk);
+            rc |= put(out, &num, e->timestamp, AMFI_CHANNEL_TRUTH, junk, sizeof junk);
+            double spacing = 5.0;
+            amfi_vehicle_t v = {e->timestamp + 500000, 424242, 1, -3.0, 2, 1, &spacing, "inject"};
+            unsigned char buf[256];
+            int n = amfi_vehicle_t_encode(buf, 0, sizeof buf, &v);
+            rc |= n < 0 || put(out, &num, e->timestamp, AMFI_CHANNEL_VEHICLE, buf, n);
+            amfi_accel_block_t m;
+            memset(&m, 0, sizeof m);
+            if (amfi_accel_block_t_decode(e->data, 0, e->datalen, &m) >= 0) {
+                m.sensor_id = 99;
+                unsigned char b2[2048];
+                n = amfi_accel_block_t_encode(b2, 0, sizeof b2, &m);
+                rc |= n < 0 || put(out, &num, e->timestamp, AMFI_CHANNEL_ACCEL, b2, n);
+            }
+            amfi_accel_block_t_decode_cleanup(&m);
+        }
+        lcm_eventlog_free_event(e);
+    }
+    lcm_eventlog_destroy(in);
+    lcm_eventlog_destroy(out);
+    if (rc || accel < 61) {
+        fprintf(stderr, "lcm_inject: %s\n", rc ? "write failed" : "the log is too short");
+        return 1;
+    }
+    return 0;
+}
