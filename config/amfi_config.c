@@ -15,9 +15,10 @@
  * the span, lo < hi, ...) run once the whole file is read, in check_site(),
  * and find the line they blame in a record of where each key path was seen.
  *
- * Adding a section (the daemon's `daemon:`): its fields in amfi_site_config
- * with their defaults in amfi_config_defaults(), a field table, one row in
- * top_fields[] and, if needed, its cross-checks in check_site().
+ * Adding a section (the daemon's `daemon:`, sim_publisher's `simulation:`):
+ * its fields in amfi_site_config with their defaults in
+ * amfi_config_defaults(), a field table, one row in top_fields[] and, if
+ * needed, its cross-checks in check_site().
  *
  * The walk is bounded by the schema, not by the document: it descends only
  * where the schema has a mapping or a list, and lists have bounded length, so
@@ -251,6 +252,27 @@ static int to_double(const char *s, double *out)
 }
 
 /* Strict decimal integer: optional sign, digits. 0 ok, −1 not, −2 range. */
+static int to_llong(const char *s, long long *out)
+{
+    const char *p = s;
+    char *end;
+    long long l;
+
+    if (*p == '+' || *p == '-')
+        p++;
+    if (!*p)
+        return -1;
+    for (; *p; p++)
+        if (*p < '0' || *p > '9')
+            return -1;
+    errno = 0;
+    l = strtoll(s, &end, 10);
+    if (errno == ERANGE)
+        return -2;
+    *out = l;
+    return 0;
+}
+
 static int to_long(const char *s, long *out)
 {
     const char *p = s;
@@ -320,6 +342,7 @@ typedef int (*parse_fn)(ctx *x, yaml_node_t *v, const char *path, const field *f
 #define F_LO_OPEN 1u  /* lo itself is not allowed */
 #define F_HI_OPEN 2u  /* hi itself is not allowed */
 #define F_REQUIRED 4u /* the key must be present (list items) */
+#define F_FILE_DIR 8u /* p_path: a relative path is joined to the file's folder */
 
 struct field {
     const char *key;   /* NULL ends a table */
@@ -344,6 +367,18 @@ static int out_of_range(double d, const field *f)
            ((f->flags & F_HI_OPEN) && d == f->hi);
 }
 
+/* The message for d outside row f's range; returns −1. */
+static int range_fail(ctx *x, const yaml_node_t *v, const char *path, const field *f,
+                      double d)
+{
+    if (isinf(f->hi))
+        return fail(x, line_of(v), path, "must be %s %g, got %g",
+                    (f->flags & F_LO_OPEN) ? ">" : ">=", f->lo, d);
+    return fail(x, line_of(v), path, "must be in %c%g, %g%c, got %g",
+                (f->flags & F_LO_OPEN) ? '(' : '[', f->lo, f->hi,
+                (f->flags & F_HI_OPEN) ? ')' : ']', d);
+}
+
 static int p_double(ctx *x, yaml_node_t *v, const char *path, const field *f,
                     void *base)
 {
@@ -351,14 +386,8 @@ static int p_double(ctx *x, yaml_node_t *v, const char *path, const field *f,
 
     if (get_double(x, v, path, &d))
         return -1;
-    if (out_of_range(d, f)) {
-        if (isinf(f->hi))
-            return fail(x, line_of(v), path, "must be %s %g, got %g",
-                        (f->flags & F_LO_OPEN) ? ">" : ">=", f->lo, d);
-        return fail(x, line_of(v), path, "must be in %c%g, %g%c, got %g",
-                    (f->flags & F_LO_OPEN) ? '(' : '[', f->lo, f->hi,
-                    (f->flags & F_HI_OPEN) ? ')' : ']', d);
-    }
+    if (out_of_range(d, f))
+        return range_fail(x, v, path, f, d);
     memcpy((char *)base + f->off, &d, sizeof d);
     return 0;
 }
@@ -375,6 +404,27 @@ static int p_int(ctx *x, yaml_node_t *v, const char *path, const field *f, void 
                     l);
     i = (int)l;
     memcpy((char *)base + f->off, &i, sizeof i);
+    return 0;
+}
+
+/* An integer stored as a long long (seeds, µs timestamps). */
+static int p_llong(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    char buf[SHOW_LEN];
+    const char *s = scalar(x, v, path, "an integer", 0);
+    long long l = 0;
+    int rc;
+
+    if (!s)
+        return -1;
+    rc = to_llong(s, &l);
+    if (rc == -1)
+        return fail(x, line_of(v), path, "expected an integer, got '%s'",
+                    show(buf, sizeof buf, v));
+    if (rc == -2 || (double)l < f->lo || (double)l > f->hi)
+        return fail(x, line_of(v), path, "must be %.0f .. %.0f, got '%s'", f->lo, f->hi,
+                    show(buf, sizeof buf, v));
+    memcpy((char *)base + f->off, &l, sizeof l);
     return 0;
 }
 
@@ -831,12 +881,228 @@ static const field daemon_fields[] = {
     {.key = "indicators", .parse = p_map, .aux = indicator_fields},
     {.key = NULL}};
 
+/* ---- simulation: sim_publisher's settings --------------------------------- */
+
+/* A plain null (`key:`, `~`, `null`): "no value" for the keys that allow it. */
+static int is_null_node(const yaml_node_t *v)
+{
+    return v->type == YAML_SCALAR_NODE && is_plain(v) &&
+           strlen((const char *)v->data.scalar.value) == v->data.scalar.length &&
+           is_null((const char *)v->data.scalar.value);
+}
+
+/* A file path stored in char[f->hi] at f->off; "" or null: none. With
+ * F_FILE_DIR a relative path is joined to the folder of the file being read
+ * (a site file names its neighbours wherever the program runs). */
+static int p_path(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    char *dst = (char *)base + f->off;
+    size_t cap = (size_t)f->hi, n, dir = 0;
+    const char *s, *slash;
+
+    if (is_null_node(v)) {
+        memset(dst, 0, cap);
+        return 0;
+    }
+    s = scalar(x, v, path, "a file path", 1);
+    if (!s)
+        return -1;
+    n = strlen(s);
+    for (size_t i = 0; i < n; i++)
+        if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
+            return fail(x, line_of(v), path, "must not contain control characters");
+    if (n && s[0] != '/' && (f->flags & F_FILE_DIR) && (slash = strrchr(x->file, '/')))
+        dir = (size_t)(slash - x->file) + 1;
+    if (dir + n >= cap)
+        return fail(x, line_of(v), path, "too long: %zu characters%s, at most %zu",
+                    dir + n, dir ? " with the file's folder" : "", cap - 1);
+    memset(dst, 0, cap);
+    memcpy(dst, x->file, dir);
+    memcpy(dst + dir, s, n);
+    return 0;
+}
+
+/* simulation.stream.speedup: max (stored as 0: no pacing) or a factor in
+ * the row's range. */
+static int p_speedup(ctx *x, yaml_node_t *v, const char *path, const field *f,
+                     void *base)
+{
+    const char *want = "max or a number";
+    char buf[SHOW_LEN];
+    const char *s = scalar(x, v, path, want, 1);
+    double d = 0.0;
+    int rc;
+
+    if (!s)
+        return -1;
+    if (strcmp(s, "max") != 0) {
+        rc = is_plain(v) ? to_double(s, &d) : -1;
+        if (rc == -1)
+            return fail(x, line_of(v), path, "expected %s, got '%s'", want,
+                        show(buf, sizeof buf, v));
+        if (rc == -2)
+            return fail(x, line_of(v), path, "number out of range: '%s'",
+                        show(buf, sizeof buf, v));
+        if (out_of_range(d, f))
+            return fail(x, line_of(v), path, "must be max or in [%g, %g], got %g", f->lo,
+                        f->hi, d);
+    }
+    memcpy((char *)base + f->off, &d, sizeof d);
+    return 0;
+}
+
+/* simulation.stream.headway_s: 0 or null (stored as 0: the population's
+ * timestamps) or seconds in the row's range. */
+static int p_headway(ctx *x, yaml_node_t *v, const char *path, const field *f,
+                     void *base)
+{
+    double d = 0.0;
+
+    if (!is_null_node(v)) {
+        if (get_double(x, v, path, &d))
+            return -1;
+        if (d != 0.0 && out_of_range(d, f))
+            return fail(x, line_of(v), path, "must be 0 or null (the population's "
+                        "timestamps) or in [%g, %g], got %g", f->lo, f->hi, d);
+    }
+    memcpy((char *)base + f->off, &d, sizeof d);
+    return 0;
+}
+
+/* simulation.damage_step_at: none or null (stored as −1) or a 0-based vehicle
+ * index in the row's range, stored as an int. */
+static int p_step(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    const char *want = "none or a vehicle index";
+    char buf[SHOW_LEN];
+    const char *s;
+    long l = -1;
+    int i;
+
+    if (!is_null_node(v)) {
+        s = scalar(x, v, path, want, 1);
+        if (!s)
+            return -1;
+        if (strcmp(s, "none") != 0) {
+            if (!is_plain(v) || to_long(s, &l) != 0)
+                return fail(x, line_of(v), path, "expected %s, got '%s'", want,
+                            show(buf, sizeof buf, v));
+            if ((double)l < f->lo || (double)l > f->hi)
+                return fail(x, line_of(v), path, "must be none or %.0f .. %.0f, got %ld",
+                            f->lo, f->hi, l);
+        }
+    }
+    i = (int)l;
+    memcpy((char *)base + f->off, &i, sizeof i);
+    return 0;
+}
+
+/* simulation.preceding_gap: null or none (no preceding vehicle), a number
+ * (lo = hi) or [lo, hi]; seconds, each in the row's range, lo <= hi. */
+static int p_gap(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    amfi_sim_config *m = &((amfi_site_config *)base)->sim;
+    double g[2] = {0.0, 0.0};
+    char ip[PATH_LEN];
+    int n = 1;
+
+    if (is_null_node(v) || (v->type == YAML_SCALAR_NODE &&
+                            v->data.scalar.length == 4 &&
+                            memcmp(v->data.scalar.value, "none", 4) == 0)) {
+        m->preceding = 0;
+        m->gap_lo_s = m->gap_hi_s = 0.0;
+        return 0;
+    }
+    if (v->type == YAML_SEQUENCE_NODE) {
+        n = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
+        if (n != 2)
+            return fail(x, line_of(v), path, "expected [lo, hi] (two numbers), got %d", n);
+        for (int i = 0; i < 2; i++) {
+            yaml_node_t *it =
+                yaml_document_get_node(x->doc, v->data.sequence.items.start[i]);
+            join_index(ip, path, (size_t)i);
+            if (!it)
+                return fail(x, line_of(v), ip, "malformed list");
+            if (get_double(x, it, ip, &g[i]))
+                return -1;
+            if (out_of_range(g[i], f))
+                return range_fail(x, it, ip, f, g[i]);
+        }
+    } else if (v->type == YAML_SCALAR_NODE) {
+        if (get_double(x, v, path, &g[0]))
+            return -1;
+        if (out_of_range(g[0], f))
+            return range_fail(x, v, path, f, g[0]);
+        g[1] = g[0];
+    } else {
+        return fail(x, line_of(v), path, "expected null, a number or [lo, hi], got %s",
+                    what(v));
+    }
+    if (g[0] > g[1])
+        return fail(x, line_of(v), path, "lo (%g) must not exceed hi (%g)", g[0], g[1]);
+    m->preceding = 1;
+    m->gap_lo_s = g[0];
+    m->gap_hi_s = g[1];
+    return 0;
+}
+
+#define SIM(m) offsetof(amfi_site_config, sim.m)
+#define SIM_CAP(m) sizeof(((amfi_sim_config *)0)->m)
+
+/* simulation.profile -> profile_class ('A' .. 'H', 0 smooth) */
+static const enum_name profile_names[] = {
+    {"A", 'A'}, {"B", 'B'}, {"C", 'C'}, {"D", 'D'}, {"E", 'E'},
+    {"F", 'F'}, {"G", 'G'}, {"H", 'H'}, {"smooth", 0}, {NULL, 0}};
+
+static const field speed_error_fields[] = {
+    {.key = "mean", .parse = p_double, .off = SIM(speed_err_mean), .lo = -0.5, .hi = 0.5},
+    {.key = "std", .parse = p_double, .off = SIM(speed_err_std), .lo = 0, .hi = 0.5},
+    {.key = NULL}};
+
+static const field stream_fields[] = {
+    {.key = "lcm_url", .parse = p_string, .off = SIM(lcm_url), .lo = 0,
+     .hi = SIM_CAP(lcm_url)},
+    {.key = "log", .parse = p_path, .off = SIM(log), .hi = SIM_CAP(log)},
+    {.key = "speedup", .parse = p_speedup, .off = SIM(speedup), .lo = 0.01, .hi = 1e6},
+    {.key = "headway_s", .parse = p_headway, .off = SIM(headway_s), .lo = 0.1,
+     .hi = 3600},
+    {.key = "noise_ms2", .parse = p_double, .off = SIM(noise_ms2), .lo = 0, .hi = 10},
+    {.key = "block", .parse = p_int, .off = SIM(block), .lo = 1, .hi = 160},
+    {.key = "start_utime", .parse = p_llong, .off = SIM(start_utime), .lo = 1,
+     .hi = 4e15},
+    {.key = "detector_lead_s", .parse = p_double, .off = SIM(detector_lead_s), .lo = 0,
+     .hi = 60},
+    {.key = NULL}};
+
+static const field sim_fields[] = {
+    {.key = "population", .parse = p_path, .off = SIM(population),
+     .hi = SIM_CAP(population), .flags = F_FILE_DIR},
+    {.key = "vehicles", .parse = p_int, .off = SIM(vehicles), .lo = 1, .hi = 1e7},
+    {.key = "first", .parse = p_int, .off = SIM(first), .lo = 0, .hi = 1e7},
+    {.key = "seed", .parse = p_llong, .off = SIM(seed), .lo = 0, .hi = 4294967295.0},
+    {.key = "damage", .parse = p_double, .off = SIM(damage), .lo = 0, .hi = 0.9},
+    {.key = "damage_step_at", .parse = p_step, .off = SIM(damage_step_at), .lo = 0,
+     .hi = 1e7},
+    {.key = "profile", .parse = p_enum, .off = SIM(profile_class), .aux = profile_names},
+    {.key = "track_std", .parse = p_double, .off = SIM(track_std), .lo = 0, .hi = 100},
+    {.key = "scan_rate_hz", .parse = p_double, .off = SIM(scan_rate_hz), .lo = 50,
+     .hi = 20000},
+    {.key = "noise", .parse = p_double, .off = SIM(noise), .lo = 0, .hi = 1},
+    {.key = "speed_error", .parse = p_map, .aux = speed_error_fields},
+    {.key = "preceding_gap", .parse = p_gap, .lo = -2, .hi = 30},
+    {.key = "pre_s", .parse = p_double, .off = SIM(pre_s), .lo = 0, .hi = 30},
+    {.key = "post_s", .parse = p_double, .off = SIM(post_s), .lo = 0, .hi = 30},
+    {.key = "dt_s", .parse = p_double, .off = SIM(dt_s), .lo = 1e-6, .hi = 1e-3},
+    {.key = "stream", .parse = p_map, .aux = stream_fields},
+    {.key = NULL}};
+
 /* The top level of a site file. */
 static const field top_fields[] = {
     {.key = "bridge", .parse = p_map, .aux = bridge_fields},
     {.key = "sensors", .parse = p_sensors},
     {.key = "solver", .parse = p_map, .aux = solver_fields},
     {.key = "daemon", .parse = p_map, .aux = daemon_fields},
+    {.key = "simulation", .parse = p_map, .aux = sim_fields},
     {.key = NULL}};
 
 /* ---- the walk ----------------------------------------------------------- */
@@ -995,6 +1261,16 @@ static int check_site(ctx *x, amfi_site_config *c)
         return fail(x, first_noted(x, "daemon.indicators.mean_clear_ratio",
                                    "daemon.indicators.mean_alert_ratio", NULL),
                     "daemon.indicators.mean_clear_ratio", "must not exceed mean_alert_ratio");
+
+    /* The simulator steps an integer number of times per sample (vbi.c);
+     * blame dt_s, or scan_rate_hz when only the rate was given. */
+    double sub = 1.0 / (c->sim.scan_rate_hz * c->sim.dt_s);
+    if (fabs(sub - round(sub)) > 1e-9 * sub) {
+        const char *k = !noted(x, "simulation.dt_s") && noted(x, "simulation.scan_rate_hz")
+                            ? "simulation.scan_rate_hz" : "simulation.dt_s";
+        return fail(x, noted(x, k), k, "1/(scan_rate_hz*dt_s) = %g steps per sample is "
+                    "not an integer", sub);
+    }
     return 0;
 }
 
@@ -1044,6 +1320,31 @@ void amfi_config_defaults(amfi_site_config *c)
     d->ind_mean_alert_ratio = 1.05;
     d->ind_mean_alert_p = 0.01;
     d->ind_mean_clear_ratio = 1.03;
+    /* sim_publisher's ideal simulation (docs/simulator.md): every inaccuracy
+     * is switched on explicitly. */
+    amfi_sim_config *m = &c->sim;
+    m->vehicles = 10;
+    m->first = 0;
+    m->seed = 1;
+    m->damage = 0.0;
+    m->damage_step_at = -1;
+    m->profile_class = 'A';
+    m->track_std = 2.0;
+    m->scan_rate_hz = 1000.0;
+    m->noise = 0.0;
+    m->speed_err_mean = 0.0;
+    m->speed_err_std = 0.0;
+    m->preceding = 0;
+    m->gap_lo_s = m->gap_hi_s = 0.0;
+    m->pre_s = 0.5;
+    m->post_s = 0.5;
+    m->dt_s = 1e-4;
+    m->speedup = 1.0;
+    m->headway_s = 0.0;
+    m->noise_ms2 = 0.0;
+    m->block = 100;
+    m->start_utime = 1767225600000000LL; /* 2026-01-01T00:00:00Z */
+    m->detector_lead_s = 1.0;
 }
 
 /* Line (1-based) holding byte `offset` of buf[len]. */

@@ -2,9 +2,10 @@
  * amfi_config.h: a bridge site's configuration, loaded from YAML.
  *
  * One file describes one site: the bridge model (MODEL.md §1), the sensors
- * and the solver with its λ policy (MODEL.md §4). The shipped file
- * config/paper-20m.yaml documents every key and reproduces
- * amfi_config_defaults() exactly.
+ * and the solver with its λ policy (MODEL.md §4), the daemon's settings and
+ * the simulator's. The shipped files document every key and reproduce
+ * amfi_config_defaults() exactly: config/paper-20m.yaml (bridge, sensors,
+ * solver), config/sim_publisher.yaml (bridge, sensors, simulation).
  *
  * Workload: read once at start-up (and on reload) by the daemon, the
  * simulator and the tools. Every value is validated here, at the boundary;
@@ -45,6 +46,54 @@ typedef struct amfi_daemon_config {
     double ind_mean_alert_ratio, ind_mean_alert_p, ind_mean_clear_ratio;
 } amfi_daemon_config;
 
+/* The simulator's section (simulation: in the site file). Only
+ * sim_publisher reads it; the daemon and the tools accept and ignore it. The
+ * ranges are those of sim_publisher's command-line flags, which override
+ * these values (docs/simulator.md). Defaults: the ideal conditions listed in
+ * amfi_config_defaults(). */
+typedef struct amfi_sim_config {
+    char population[512];   /* simulation.population: WIM-style CSV; "" = the
+                               shipped synthetic population; a relative path in
+                               the file is stored joined to the file's folder */
+    int vehicles;           /* simulation.vehicles: vehicles simulated, 1 .. 10^7 */
+    int first;              /* simulation.first: first population record
+                               (0-based), 0 .. 10^7 */
+    long long seed;         /* simulation.seed: 0 .. 2^32 − 1 */
+    double damage;          /* simulation.damage: stiffness loss δ, [0, 0.9] */
+    int damage_step_at;     /* simulation.damage_step_at: streaming: healthy
+                               before vehicle K (0-based), damaged from K on,
+                               0 .. 10^7; −1 (null|none): damaged from the start */
+    int profile_class;      /* simulation.profile: ISO 8608 class 'A' .. 'H';
+                               0 = smooth (no roughness) */
+    double track_std;       /* simulation.track_std: lateral track spread,
+                               in tracks, [0, 100] */
+    double scan_rate_hz;    /* simulation.scan_rate_hz: sampling rate, [50, 20000] */
+    double noise;           /* simulation.noise: accelerometer noise, fraction
+                               of the record's RMS, [0, 1] */
+    double speed_err_mean;  /* simulation.speed_error.mean: relative, [−0.5, 0.5] */
+    double speed_err_std;   /* simulation.speed_error.std: relative, [0, 0.5] */
+    int preceding;          /* simulation.preceding_gap given: 1, null: 0 */
+    double gap_lo_s, gap_hi_s; /* simulation.preceding_gap: [lo, hi], s, each
+                               in [−2, 30], lo <= hi (0, 0 without) */
+    double pre_s, post_s;   /* simulation.pre_s, post_s: record before entry /
+                               after exit (--out), s, [0, 30] */
+    double dt_s;            /* simulation.dt_s: integration step, s, [1e-6, 1e-3] */
+    /* simulation.stream.* (streaming, without --out) */
+    char lcm_url[256];      /* lcm_url: "" = LCM's default; "none" = publish nothing */
+    char log[512];          /* log: LCM log file to write; "" = none (relative
+                               to the working directory, like an output) */
+    double speedup;         /* speedup: data time / wall time, [0.01, 1e6];
+                               0 = as fast as possible ("max") */
+    double headway_s;       /* headway_s: entry to entry, s, [0.1, 3600];
+                               0 = the population's timestamps */
+    double noise_ms2;       /* noise_ms2: extra Gaussian noise, m/s², [0, 10] */
+    int block;              /* block: samples per accel message, 1 .. 160 */
+    long long start_utime;  /* start_utime: data time of the first sample,
+                               µs since 1970, 1 .. 4e15 */
+    double detector_lead_s; /* detector_lead_s: vehicle event before entry,
+                               s, [0, 60] */
+} amfi_sim_config;
+
 typedef struct amfi_site_config {
     char name[64];             /* bridge.name: 1 .. 63 bytes, NUL-terminated */
     amfi_bridge_params bridge; /* bridge.* */
@@ -55,11 +104,17 @@ typedef struct amfi_site_config {
                                         entry i belongs to solver.sensor_x_m[i];
                                         −1 past solver.n_sensors */
     amfi_daemon_config daemon;       /* daemon.* */
+    amfi_sim_config sim;             /* simulation.* */
 } amfi_site_config;
 
 /* Fill `c` (not NULL) with the paper-20m defaults: amfi_bridge_params_paper20,
  * amfi_solver_params_default(20 m), amfi_lambda_default, name "paper-20m",
- * one sensor with id 0. Every byte is set (the struct may be memcmp'd). */
+ * one sensor with id 0; the daemon's defaults; and sim_publisher's ideal
+ * simulation: 10 vehicles from record 0, seed 1, healthy, class A, track
+ * std 2, 1000 Hz, no noise, exact speed, no preceding vehicle, 0.5 s before
+ * and after, dt 1e-4 s; streaming in real time on LCM's default URL, no log,
+ * the population's headways, blocks of 100 samples from 2026-01-01T00:00Z,
+ * the detector 1 s ahead. Every byte is set (the struct may be memcmp'd). */
 void amfi_config_defaults(amfi_site_config *c);
 
 /* Load the YAML file `path` over the defaults of amfi_config_defaults().

@@ -1,8 +1,9 @@
 /*
  * test_config.c: unit tests of the YAML site loader (config/amfi_config.h).
  *
- * The shipped paper-20m.yaml must load to exactly amfi_config_defaults();
- * a file changing every key must land every value in its field; and each bad
+ * The shipped paper-20m.yaml and sim_publisher.yaml must load to exactly
+ * amfi_config_defaults(), the other shipped files must load; a file changing
+ * every key must land every value in its field; and each bad
  * input of the table below must fail with one line naming ":LINE: key.path"
  * and the problem, leaving the caller's struct untouched. Files are written
  * with mkstemp under /tmp and removed afterwards.
@@ -73,6 +74,27 @@ static void test_defaults(void **state)
     assert_int_equal(0, c.sensor_id[0]);
     for (int i = 1; i < AMFI_MAX_SENSORS; i++)
         assert_int_equal(-1, c.sensor_id[i]);
+
+    /* simulation: sim_publisher's built-in values before the section existed */
+    assert_string_equal("", c.sim.population);
+    assert_int_equal(10, c.sim.vehicles);
+    assert_int_equal(0, c.sim.first);
+    assert_true(c.sim.seed == 1);
+    assert_true(c.sim.damage == 0.0);
+    assert_int_equal(-1, c.sim.damage_step_at);
+    assert_int_equal('A', c.sim.profile_class);
+    assert_true(c.sim.track_std == 2.0 && c.sim.scan_rate_hz == 1000.0);
+    assert_true(c.sim.noise == 0.0);
+    assert_true(c.sim.speed_err_mean == 0.0 && c.sim.speed_err_std == 0.0);
+    assert_int_equal(0, c.sim.preceding);
+    assert_true(c.sim.pre_s == 0.5 && c.sim.post_s == 0.5 && c.sim.dt_s == 1e-4);
+    assert_string_equal("", c.sim.lcm_url);
+    assert_string_equal("", c.sim.log);
+    assert_true(c.sim.speedup == 1.0 && c.sim.headway_s == 0.0);
+    assert_true(c.sim.noise_ms2 == 0.0);
+    assert_int_equal(100, c.sim.block);
+    assert_true(c.sim.start_utime == 1767225600000000LL);
+    assert_true(c.sim.detector_lead_s == 1.0);
 }
 
 static void test_shipped_file_is_the_defaults(void **state)
@@ -97,6 +119,39 @@ static void test_shipped_file_is_the_defaults(void **state)
     assert_memory_equal(&want.solver, &got.solver, sizeof want.solver);
     assert_memory_equal(&want.lambda, &got.lambda, sizeof want.lambda);
     assert_memory_equal(&want, &got, sizeof want);
+}
+
+/* sim_publisher's shipped file: the same bridge and sensors, the channels
+ * and the simulation section all at their defaults. */
+static void test_shipped_sim_file_is_the_defaults(void **state)
+{
+    amfi_site_config want, got;
+    char err[ERRLEN];
+    int rc;
+
+    (void)state;
+    amfi_config_defaults(&want);
+    memset(&got, 0xa5, sizeof got);
+    rc = amfi_config_load(AMFI_CONFIG_DIR "/sim_publisher.yaml", &got, err, sizeof err);
+    if (rc)
+        fail_msg("%s", err);
+    assert_memory_equal(&want.sim, &got.sim, sizeof want.sim);
+    assert_memory_equal(&want.bridge, &got.bridge, sizeof want.bridge);
+    assert_memory_equal(&want, &got, sizeof want);
+}
+
+/* The daemon's files load (their simulation: sections, if any, accepted). */
+static void test_other_shipped_files_load(void **state)
+{
+    static const char *const files[] = {AMFI_CONFIG_DIR "/amfid.yaml",
+                                        AMFI_CONFIG_DIR "/demo.yaml"};
+    amfi_site_config c;
+    char err[ERRLEN];
+
+    (void)state;
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
+        if (amfi_config_load(files[i], &c, err, sizeof err))
+            fail_msg("%s", err);
 }
 
 static const char every_key[] =
@@ -189,6 +244,139 @@ static void test_every_key(void **state)
     assert_int_equal(0, c.lambda.lcurve_refine_points);
 }
 
+/* Every key of simulation: changed from its default. The file is written
+ * under /tmp, so the relative population lands there. */
+static const char every_sim_key[] =
+    "simulation:\n"
+    "  population: traffic/wim.csv\n"
+    "  vehicles: 500\n"
+    "  first: 7\n"
+    "  seed: 4294967295\n"
+    "  damage: 0.2\n"
+    "  damage_step_at: 200\n"
+    "  profile: smooth\n"
+    "  track_std: 0.5\n"
+    "  scan_rate_hz: 2000\n"
+    "  noise: 0.05\n"
+    "  speed_error: {mean: -0.01, std: 0.02}\n"
+    "  preceding_gap: [-1.5, 2]\n"
+    "  pre_s: 0.25\n"
+    "  post_s: 1.5\n"
+    "  dt_s: 5e-5\n"
+    "  stream:\n"
+    "    lcm_url: udpm://239.255.76.99:7667?ttl=0\n"
+    "    log: out/traffic.lcmlog\n"
+    "    speedup: 25\n"
+    "    headway_s: 2\n"
+    "    noise_ms2: 0.003\n"
+    "    block: 160\n"
+    "    start_utime: 4000000000000000\n"
+    "    detector_lead_s: 0.5\n";
+
+static void test_every_sim_key(void **state)
+{
+    amfi_site_config c, d;
+    char err[ERRLEN];
+
+    (void)state;
+    if (load_text(every_sim_key, &c, err))
+        fail_msg("%s", err);
+    assert_string_equal("/tmp/traffic/wim.csv", c.sim.population);
+    assert_int_equal(500, c.sim.vehicles);
+    assert_int_equal(7, c.sim.first);
+    assert_true(c.sim.seed == 4294967295LL);
+    assert_true(c.sim.damage == 0.2);
+    assert_int_equal(200, c.sim.damage_step_at);
+    assert_int_equal(0, c.sim.profile_class);
+    assert_true(c.sim.track_std == 0.5 && c.sim.scan_rate_hz == 2000.0);
+    assert_true(c.sim.noise == 0.05);
+    assert_true(c.sim.speed_err_mean == -0.01 && c.sim.speed_err_std == 0.02);
+    assert_int_equal(1, c.sim.preceding);
+    assert_true(c.sim.gap_lo_s == -1.5 && c.sim.gap_hi_s == 2.0);
+    assert_true(c.sim.pre_s == 0.25 && c.sim.post_s == 1.5 && c.sim.dt_s == 5e-5);
+    assert_string_equal("udpm://239.255.76.99:7667?ttl=0", c.sim.lcm_url);
+    assert_string_equal("out/traffic.lcmlog", c.sim.log); /* not the file's folder */
+    assert_true(c.sim.speedup == 25.0 && c.sim.headway_s == 2.0);
+    assert_true(c.sim.noise_ms2 == 0.003);
+    assert_int_equal(160, c.sim.block);
+    assert_true(c.sim.start_utime == 4000000000000000LL);
+    assert_true(c.sim.detector_lead_s == 0.5);
+
+    /* the rest of the site untouched */
+    amfi_config_defaults(&d);
+    assert_memory_equal(&d.bridge, &c.bridge, sizeof d.bridge);
+    assert_memory_equal(&d.daemon, &c.daemon, sizeof d.daemon);
+}
+
+/* The words and nulls of simulation: (max, none, null, a single gap). */
+static void test_sim_words(void **state)
+{
+    amfi_site_config c;
+    char err[ERRLEN];
+
+    (void)state;
+    if (load_text("simulation:\n  damage_step_at: none\n  preceding_gap: 1.5\n"
+                  "  population: /data/wim.csv\n  profile: H\n"
+                  "  stream: {speedup: max, headway_s: null, log: ~, lcm_url: none}\n",
+                  &c, err))
+        fail_msg("%s", err);
+    assert_int_equal(-1, c.sim.damage_step_at);
+    assert_int_equal(1, c.sim.preceding);
+    assert_true(c.sim.gap_lo_s == 1.5 && c.sim.gap_hi_s == 1.5);
+    assert_string_equal("/data/wim.csv", c.sim.population); /* absolute: as given */
+    assert_int_equal('H', c.sim.profile_class);
+    assert_true(c.sim.speedup == 0.0); /* max: no pacing */
+    assert_true(c.sim.headway_s == 0.0);
+    assert_string_equal("", c.sim.log);
+    assert_string_equal("none", c.sim.lcm_url);
+
+    if (load_text("simulation:\n  damage_step_at:\n  preceding_gap: ~\n  population: ''\n"
+                  "  stream: {speedup: 0.01, headway_s: 0}\n",
+                  &c, err))
+        fail_msg("%s", err);
+    assert_int_equal(-1, c.sim.damage_step_at);
+    assert_int_equal(0, c.sim.preceding);
+    assert_true(c.sim.gap_lo_s == 0.0 && c.sim.gap_hi_s == 0.0);
+    assert_string_equal("", c.sim.population);
+    assert_true(c.sim.speedup == 0.01 && c.sim.headway_s == 0.0);
+
+    if (load_text("simulation: {damage_step_at: 0, preceding_gap: none, "
+                  "scan_rate_hz: 20000, dt_s: 1e-6, seed: 0}\n", &c, err))
+        fail_msg("%s", err);
+    assert_int_equal(0, c.sim.damage_step_at);
+    assert_int_equal(0, c.sim.preceding);
+    assert_true(c.sim.seed == 0);
+}
+
+/* A relative population follows the file's folder; a bare file name, read
+ * from the working directory, stays as it is. */
+static void test_sim_population_folder(void **state)
+{
+    static const char text[] = "simulation: {population: wim.csv}\n";
+    amfi_site_config c;
+    char err[ERRLEN], cwd[4096], *dir;
+    FILE *f;
+
+    (void)state;
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    dir = mkdtemp((char[]){"/tmp/amfi_test_config_XXXXXX"});
+    assert_non_null(dir);
+    assert_int_equal(0, chdir(dir));
+    f = fopen("site.yaml", "w");
+    assert_non_null(f);
+    assert_int_equal(1, fwrite(text, sizeof text - 1, 1, f));
+    assert_int_equal(0, fclose(f));
+    if (amfi_config_load("site.yaml", &c, err, sizeof err))
+        fail_msg("%s", err);
+    assert_string_equal("wim.csv", c.sim.population);
+    if (amfi_config_load("./site.yaml", &c, err, sizeof err))
+        fail_msg("%s", err);
+    assert_string_equal("./wim.csv", c.sim.population);
+    assert_int_equal(0, unlink("site.yaml"));
+    assert_int_equal(0, chdir(cwd));
+    assert_int_equal(0, rmdir(dir));
+}
+
 /* Without supports and sensors, they follow span_m; everything else stays. */
 static void test_span_follows(void **state)
 {
@@ -244,7 +432,105 @@ static const bad_case bad_cases[] = {
     {"unknown_key", "solver:\n  calc_rate_hz: 5000\n  lamda: 1e-9\n", 3, "solver.lamda",
      "unknown key"},
     {"unknown_section", "bridge: {}\nmonitor:\n  bus: udpm://\n", 2, "monitor",
-     "unknown key (known: bridge, sensors, solver, daemon)"},
+     "unknown key (known: bridge, sensors, solver, daemon, simulation)"},
+    {"sim_not_map", "simulation: 10\n", 1, "simulation", "expected a mapping"},
+    {"sim_unknown_key", "simulation:\n  vehicles: 5\n  vehicle: 5\n", 3,
+     "simulation.vehicle", "unknown key (known: population, vehicles, first"},
+    {"sim_stream_unknown_key", "simulation:\n  stream:\n    url: udpm://\n", 3,
+     "simulation.stream.url", "unknown key (known: lcm_url, log, speedup"},
+    {"sim_duplicate", "simulation:\n  seed: 1\n  seed: 2\n", 3, "simulation.seed",
+     "duplicate key (first at line 2)"},
+    {"sim_vehicles_zero", "simulation:\n  vehicles: 0\n", 2, "simulation.vehicles",
+     "must be 1 .. 10000000, got 0"},
+    {"sim_vehicles_fraction", "simulation:\n  vehicles: 2.5\n", 2, "simulation.vehicles",
+     "expected an integer"},
+    {"sim_first_negative", "simulation:\n  first: -1\n", 2, "simulation.first",
+     "0 .. 10000000"},
+    {"sim_seed_big", "simulation:\n  seed: 4294967296\n", 2, "simulation.seed",
+     "must be 0 .. 4294967295, got '4294967296'"},
+    {"sim_seed_huge", "simulation:\n  seed: 99999999999999999999999\n", 2,
+     "simulation.seed", "must be 0 .. 4294967295"},
+    {"sim_seed_word", "simulation:\n  seed: random\n", 2, "simulation.seed",
+     "expected an integer, got 'random'"},
+    {"sim_damage", "simulation:\n  damage: 0.95\n", 2, "simulation.damage",
+     "must be in [0, 0.9], got 0.95"},
+    {"sim_step_word", "simulation:\n  damage_step_at: later\n", 2,
+     "simulation.damage_step_at", "expected none or a vehicle index, got 'later'"},
+    {"sim_step_negative", "simulation:\n  damage_step_at: -1\n", 2,
+     "simulation.damage_step_at", "must be none or 0 .. 10000000, got -1"},
+    {"sim_step_list", "simulation:\n  damage_step_at: [1]\n", 2,
+     "simulation.damage_step_at", "got a list"},
+    {"sim_profile", "simulation:\n  profile: Z\n", 2, "simulation.profile",
+     "expected one of A, B, C, D, E, F, G, H, smooth; got 'Z'"},
+    {"sim_profile_lower", "simulation:\n  profile: a\n", 2, "simulation.profile",
+     "got 'a'"},
+    {"sim_track_std", "simulation:\n  track_std: 101\n", 2, "simulation.track_std",
+     "[0, 100]"},
+    {"sim_scan_rate", "simulation:\n  scan_rate_hz: 30\n", 2, "simulation.scan_rate_hz",
+     "[50, 20000]"},
+    {"sim_noise", "simulation:\n  noise: -0.1\n", 2, "simulation.noise", "[0, 1]"},
+    {"sim_speed_error_scalar", "simulation:\n  speed_error: 0.01\n", 2,
+     "simulation.speed_error", "expected a mapping"},
+    {"sim_speed_error_std", "simulation:\n  speed_error:\n    mean: 0\n    std: -0.1\n",
+     4, "simulation.speed_error.std", "must be in [0, 0.5], got -0.1"},
+    {"sim_speed_error_mean", "simulation:\n  speed_error: {mean: 0.6}\n", 2,
+     "simulation.speed_error.mean", "[-0.5, 0.5]"},
+    {"sim_speed_error_unknown", "simulation:\n  speed_error: {sd: 0.1}\n", 2,
+     "simulation.speed_error.sd", "unknown key (known: mean, std)"},
+    {"sim_gap_lo_above_hi", "simulation:\n  preceding_gap: [3, 1]\n", 2,
+     "simulation.preceding_gap", "lo (3) must not exceed hi (1)"},
+    {"sim_gap_three", "simulation:\n  preceding_gap: [1, 2, 3]\n", 2,
+     "simulation.preceding_gap", "expected [lo, hi] (two numbers), got 3"},
+    {"sim_gap_item_range", "simulation:\n  preceding_gap:\n    - -3\n    - 1\n", 3,
+     "simulation.preceding_gap[0]", "must be in [-2, 30], got -3"},
+    {"sim_gap_single_range", "simulation:\n  preceding_gap: 31\n", 2,
+     "simulation.preceding_gap", "[-2, 30]"},
+    {"sim_gap_word", "simulation:\n  preceding_gap: some\n", 2, "simulation.preceding_gap",
+     "'some'"},
+    {"sim_gap_map", "simulation:\n  preceding_gap: {lo: 1}\n", 2,
+     "simulation.preceding_gap", "expected null, a number or [lo, hi], got a mapping"},
+    {"sim_pre", "simulation:\n  pre_s: 31\n", 2, "simulation.pre_s", "[0, 30]"},
+    {"sim_post", "simulation:\n  post_s: -1\n", 2, "simulation.post_s", "[0, 30]"},
+    {"sim_dt", "simulation:\n  dt_s: 1e-2\n", 2, "simulation.dt_s", "[1e-06, 0.001]"},
+    {"sim_dt_not_sub_sample", "simulation:\n  scan_rate_hz: 3000\n", 2,
+     "simulation.scan_rate_hz", "1/(scan_rate_hz*dt_s) = 3.33333 steps per sample is not"},
+    {"sim_dt_not_sub_sample_dt", "simulation:\n  scan_rate_hz: 1000\n  dt_s: 3e-4\n", 3,
+     "simulation.dt_s", "not an integer"},
+    {"sim_population_control", "simulation:\n  population: \"a\\nb.csv\"\n", 2,
+     "simulation.population", "control characters"},
+    {"sim_population_list", "simulation:\n  population: [a.csv]\n", 2,
+     "simulation.population", "expected a file path, got a list"},
+    {"sim_speedup_zero", "simulation:\n  stream:\n    speedup: 0\n", 3,
+     "simulation.stream.speedup", "must be max or in [0.01, 1e+06], got 0"},
+    {"sim_speedup_word", "simulation:\n  stream: {speedup: fast}\n", 2,
+     "simulation.stream.speedup", "expected max or a number, got 'fast'"},
+    {"sim_speedup_quoted", "simulation:\n  stream: {speedup: \"25\"}\n", 2,
+     "simulation.stream.speedup", "got '25'"},
+    {"sim_speedup_null", "simulation:\n  stream: {speedup: ~}\n", 2,
+     "simulation.stream.speedup", "no value"},
+    {"sim_headway", "simulation:\n  stream: {headway_s: 0.05}\n", 2,
+     "simulation.stream.headway_s",
+     "must be 0 or null (the population's timestamps) or in [0.1, 3600], got 0.05"},
+    {"sim_headway_word", "simulation:\n  stream: {headway_s: population}\n", 2,
+     "simulation.stream.headway_s", "'population'"},
+    {"sim_noise_ms2", "simulation:\n  stream: {noise_ms2: 11}\n", 2,
+     "simulation.stream.noise_ms2", "[0, 10]"},
+    {"sim_block", "simulation:\n  stream: {block: 161}\n", 2, "simulation.stream.block",
+     "1 .. 160"},
+    {"sim_start_utime_zero", "simulation:\n  stream: {start_utime: 0}\n", 2,
+     "simulation.stream.start_utime", "must be 1 .. 4000000000000000, got '0'"},
+    {"sim_start_utime_float", "simulation:\n  stream: {start_utime: 1.7e15}\n", 2,
+     "simulation.stream.start_utime", "expected an integer"},
+    {"sim_detector_lead", "simulation:\n  stream: {detector_lead_s: 61}\n", 2,
+     "simulation.stream.detector_lead_s", "[0, 60]"},
+    {"sim_lcm_url_long",
+     "simulation:\n  stream:\n    lcm_url: udpm://"
+     "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+     "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+     "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\n",
+     3, "simulation.stream.lcm_url", "must be 0 .. 255 characters long, got 264"},
+    {"sim_log_quoted_control", "simulation:\n  stream: {log: \"a\\tb\"}\n", 2,
+     "simulation.stream.log", "control characters"},
     {"unknown_daemon_key", "daemon:\n  bus: udpm://\n", 2, "daemon.bus",
      "unknown key (known: lcm_url, channels"},
     {"daemon_workers_zero", "daemon:\n  workers: 0\n", 2, "daemon.workers", "1 .. 64"},
@@ -514,7 +800,12 @@ int main(void)
     static const struct CMUnitTest fixed[] = {
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_shipped_file_is_the_defaults),
+        cmocka_unit_test(test_shipped_sim_file_is_the_defaults),
+        cmocka_unit_test(test_other_shipped_files_load),
         cmocka_unit_test(test_every_key),
+        cmocka_unit_test(test_every_sim_key),
+        cmocka_unit_test(test_sim_words),
+        cmocka_unit_test(test_sim_population_folder),
         cmocka_unit_test(test_span_follows),
         cmocka_unit_test(test_list_replaces),
         cmocka_unit_test(test_missing_file),
