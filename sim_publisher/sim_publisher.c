@@ -6,7 +6,16 @@
  *                 [--vehicles N] [--first K] [--damage FRACTION] [--seed S]
  *                 [--profile A..H|smooth] [--track-std TRACKS] [--scan-rate HZ]
  *                 [--noise FRACTION] [--speed-error MEAN,STD]
- *                 [--preceding-gap LO[,HI]] [--pre SEC] [--post SEC] [--dt SEC]
+ *                 [--preceding-gap LO[,HI]|none] [--pre SEC] [--post SEC] [--dt SEC]
+ *
+ * Configuration: every setting has a built-in default (amfi_config_defaults(),
+ * an ideal simulation), which the configuration file's `simulation:` section
+ * overrides, which a flag overrides. The file is --config FILE, else the
+ * shipped config/sim_publisher.yaml (source tree, then the installed
+ * share/amfi copy) if present; it holds the values built in and documents
+ * each key with its flag. The same file gives the bridge, the sensors and
+ * the channels the stream is published on (daemon.channels.accel, vehicle,
+ * truth), so any site file amfid reads also drives its simulator.
  *
  * Vehicle i is the population's record first + i: its weights, spacing and
  * speed; its Table 2 properties and its carpet track are drawn from a
@@ -26,10 +35,10 @@
  * contact forces on the span, and the conditions.
  *
  * Streaming (without --out): continuous traffic on the LCM bus, as a site
- * would publish it: accelerometer blocks (--block samples each, the bridge's
- * free vibration between vehicles included), a vehicle_t for each vehicle
- * --detector-lead seconds before it enters (utime = its entry), and its
- * truth_t after it has left. Time is the data's time, starting at
+ * would publish it, on the configured channels: accelerometer blocks
+ * (--block samples each, the bridge's free vibration between vehicles
+ * included), a vehicle_t for each vehicle --detector-lead seconds before it
+ * enters (utime = its entry), and its truth_t after it has left. Time is the data's time, starting at
  * --start-utime; pacing is real time divided by --speedup (or none with
  * max). --log FILE writes the same events to an LCM log (timestamps = data
  * time), replayable with lcm-logplayer and readable by amfid through LCM's
@@ -39,7 +48,7 @@
  *
  *   sim_publisher [--lcm-url URL|none] [--log FILE] [--speedup X|max]
  *                 [--vehicles N] [--headway SEC] [--damage FRACTION]
- *                 [--damage-step-at K] [--noise-ms2 STD] [--block N]
+ *                 [--damage-step-at K|none] [--noise-ms2 STD] [--block N]
  *                 [--start-utime US] [--detector-lead SEC] ... (as above)
  *
  * Exit status: 0; 1 bad input file, bus or simulation failure; 2 bad command
@@ -71,14 +80,20 @@
 #define PROG "sim_publisher"
 
 #ifndef AMFI_DEFAULT_CONFIG
-#define AMFI_DEFAULT_CONFIG "config/paper-20m.yaml"
+#define AMFI_DEFAULT_CONFIG "config/sim_publisher.yaml"
+#endif
+#ifndef AMFI_INSTALLED_CONFIG
+#define AMFI_INSTALLED_CONFIG "/usr/local/share/amfi/sim_publisher.yaml"
 #endif
 #ifndef AMFI_DEFAULT_POPULATION
 #define AMFI_DEFAULT_POPULATION "sim_publisher/data/population.csv"
 #endif
 
+/* The effective settings: the built-in defaults (amfi_config_defaults()),
+ * then the configuration file's simulation: section, then the flags. The
+ * strings point into argv or into main's static configuration. */
 typedef struct opts {
-    const char *out, *config, *population;
+    const char *out, *config, *population; /* NULL: none / the shipped population */
     long vehicles, first;
     double damage;
     unsigned long seed;
@@ -87,7 +102,8 @@ typedef struct opts {
     int preceding;
     double gap_lo, gap_hi, pre, post, dt;
     /* streaming */
-    const char *lcm_url, *log;
+    const char *lcm_url, *log; /* NULL: LCM's default URL / no log */
+    int lcm_url_flag;     /* lcm_url came from --lcm-url (for messages) */
     double speedup;       /* <= 0: as fast as possible */
     double headway;       /* <= 0: the population's timestamps */
     long damage_step_at;  /* < 0: --damage from the start */
@@ -101,14 +117,17 @@ static void usage(void)
 {
     fprintf(stderr,
             "usage: %s [--out DIR | --lcm-url URL|none] [--log FILE] [--speedup X|max]\n"
-            "       [--headway SEC] [--damage-step-at K] [--noise-ms2 STD] [--block N]\n"
+            "       [--headway SEC] [--damage-step-at K|none] [--noise-ms2 STD] [--block N]\n"
             "       [--start-utime US] [--detector-lead SEC]\n"
             "       [--config FILE.yaml] [--population FILE.csv] [--vehicles N]\n"
             "       [--first K] [--damage FRACTION] [--seed S] [--profile A..H|smooth]\n"
             "       [--track-std TRACKS] [--scan-rate HZ] [--noise FRACTION]\n"
-            "       [--speed-error MEAN,STD] [--preceding-gap LO[,HI]] [--pre SEC] [--post SEC]\n"
-            "       [--dt SEC]\n",
-            PROG);
+            "       [--speed-error MEAN,STD] [--preceding-gap LO[,HI]|none] [--pre SEC]\n"
+            "       [--post SEC] [--dt SEC]\n"
+            "Settings: built-in defaults < the configuration file's simulation: section\n"
+            "< flags. Without --config: %s,\n"
+            "else %s, if present.\n",
+            PROG, AMFI_DEFAULT_CONFIG, AMFI_INSTALLED_CONFIG);
 }
 
 static double num(const char *opt, const char *s, double lo, double hi)
@@ -144,22 +163,84 @@ static void pair(const char *opt, const char *s, double lo, double hi, double *a
     *b = comma ? num(opt, comma + 1, lo, hi) : *a;
 }
 
-static void parse(int argc, char **argv, opts *o)
+/* --config FILE (NULL when not given), looked for before the other flags,
+ * which apply over the file. Returns 1 when the command line asks for --help
+ * or is malformed: apply_flags() will then exit before any setting is used,
+ * so no file needs to be read. */
+static int find_config(int argc, char **argv, const char **config)
+{
+    *config = NULL;
+    for (int i = 1; i < argc; i += 2) { /* every option takes one value */
+        const char *k = argv[i];
+        if (!strcmp(k, "--help") || !strcmp(k, "-h") || i + 1 >= argc || strncmp(k, "--", 2))
+            return 1;
+        if (!strcmp(k, "--config"))
+            *config = argv[i + 1];
+    }
+    return 0;
+}
+
+/* The configuration: FILE (--config), else the first of the default places
+ * that exists, else the built-in defaults (*used = NULL). 0 ok, 1 after a
+ * message. */
+static int load_config(const char *file, amfi_site_config *cfg, const char **used)
+{
+    static const char *const places[] = {AMFI_DEFAULT_CONFIG, AMFI_INSTALLED_CONFIG};
+    char err[512];
+    struct stat st;
+
+    amfi_config_defaults(cfg);
+    *used = NULL;
+    for (size_t k = 0; !file && k < sizeof places / sizeof places[0]; k++)
+        if (stat(places[k], &st) == 0)
+            file = places[k];
+    if (!file)
+        return 0;
+    if (amfi_config_load(file, cfg, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    *used = file;
+    return 0;
+}
+
+/* The file's simulation: section (or the defaults) as the starting values. */
+static void opts_from_config(opts *o, const amfi_sim_config *c, const char *file)
 {
     *o = (opts){0};
-    o->vehicles = 10;
-    o->seed = 1;
-    o->profile_class = 'A';
-    o->track_std = 2.0;
-    o->scan_rate = 1000.0;
-    o->pre = 0.5;
-    o->post = 0.5;
-    o->dt = 1e-4;
-    o->speedup = 1.0;
-    o->damage_step_at = -1;
-    o->block = 100;
-    o->start_utime = 1767225600000000LL; /* 2026-01-01T00:00:00Z */
-    o->detector_lead = 1.0;
+    o->config = file;
+    o->population = c->population[0] ? c->population : NULL;
+    o->vehicles = c->vehicles;
+    o->first = c->first;
+    o->damage = c->damage;
+    o->seed = (unsigned long)c->seed;
+    o->profile_class = (char)c->profile_class;
+    o->track_std = c->track_std;
+    o->scan_rate = c->scan_rate_hz;
+    o->noise = c->noise;
+    o->speed_err_mean = c->speed_err_mean;
+    o->speed_err_std = c->speed_err_std;
+    o->preceding = c->preceding;
+    o->gap_lo = c->gap_lo_s;
+    o->gap_hi = c->gap_hi_s;
+    o->pre = c->pre_s;
+    o->post = c->post_s;
+    o->dt = c->dt_s;
+    o->lcm_url = c->lcm_url[0] ? c->lcm_url : NULL;
+    o->log = c->log[0] ? c->log : NULL;
+    o->speedup = c->speedup;
+    o->headway = c->headway_s;
+    o->damage_step_at = c->damage_step_at;
+    o->noise_ms2 = c->noise_ms2;
+    o->block = c->block;
+    o->start_utime = c->start_utime;
+    o->detector_lead = c->detector_lead_s;
+}
+
+/* The flags over the values already in *o; exits 0 after --help, 2 after a
+ * bad command line. */
+static void apply_flags(int argc, char **argv, opts *o)
+{
     for (int i = 1; i < argc; i++) {
         const char *k = argv[i];
         if (!strcmp(k, "--help") || !strcmp(k, "-h")) {
@@ -176,7 +257,7 @@ static void parse(int argc, char **argv, opts *o)
         if (!strcmp(k, "--out"))
             o->out = v;
         else if (!strcmp(k, "--config"))
-            o->config = v;
+            ; /* read by find_config() */
         else if (!strcmp(k, "--population"))
             o->population = v;
         else if (!strcmp(k, "--vehicles"))
@@ -204,7 +285,10 @@ static void parse(int argc, char **argv, opts *o)
             o->noise = num(k, v, 0, 1);
         else if (!strcmp(k, "--speed-error"))
             pair(k, v, -0.5, 0.5, &o->speed_err_mean, &o->speed_err_std, 1);
-        else if (!strcmp(k, "--preceding-gap")) {
+        else if (!strcmp(k, "--preceding-gap") && !strcmp(v, "none")) {
+            o->preceding = 0; /* over a gap in the configuration file */
+            o->gap_lo = o->gap_hi = 0.0;
+        } else if (!strcmp(k, "--preceding-gap")) {
             pair(k, v, -2, 30, &o->gap_lo, &o->gap_hi, 0);
             o->preceding = 1;
             if (o->gap_hi < o->gap_lo) {
@@ -217,8 +301,10 @@ static void parse(int argc, char **argv, opts *o)
             o->post = num(k, v, 0, 30);
         else if (!strcmp(k, "--dt"))
             o->dt = num(k, v, 1e-6, 1e-3);
-        else if (!strcmp(k, "--lcm-url"))
+        else if (!strcmp(k, "--lcm-url")) {
             o->lcm_url = v;
+            o->lcm_url_flag = 1;
+        }
         else if (!strcmp(k, "--log"))
             o->log = v;
         else if (!strcmp(k, "--speedup"))
@@ -226,7 +312,7 @@ static void parse(int argc, char **argv, opts *o)
         else if (!strcmp(k, "--headway"))
             o->headway = num(k, v, 0.1, 3600);
         else if (!strcmp(k, "--damage-step-at"))
-            o->damage_step_at = (long)num(k, v, 0, 1e7);
+            o->damage_step_at = !strcmp(v, "none") ? -1 : (long)num(k, v, 0, 1e7);
         else if (!strcmp(k, "--noise-ms2"))
             o->noise_ms2 = num(k, v, 0, 10);
         else if (!strcmp(k, "--block"))
@@ -246,7 +332,11 @@ static void parse(int argc, char **argv, opts *o)
         exit(2);
     }
     if (!o->out && o->lcm_url && !strcmp(o->lcm_url, "none") && !o->log) {
-        fprintf(stderr, "%s: --lcm-url none without --log would produce nothing\n", PROG);
+        if (o->lcm_url_flag)
+            fprintf(stderr, "%s: --lcm-url none without --log would produce nothing\n", PROG);
+        else
+            fprintf(stderr, "%s: %s: simulation.stream.lcm_url: none without a log "
+                    "(stream.log or --log) would produce nothing\n", PROG, o->config ? o->config : "?");
         exit(2);
     }
 }
@@ -464,7 +554,7 @@ static int stream(const opts *o, amfi_site_config *cfg, const amfi_vehicle_rec *
             double spacing = p->spacing;
             amfi_vehicle_t m = {o->start_utime + (int64_t)llround(p->entry_s * 1e6), p->v.id, 1,
                                 speed, 2, 1, &spacing, PROG};
-            if (EMIT(&b, amfi_vehicle_t, AMFI_CHANNEL_VEHICLE, &m)) {
+            if (EMIT(&b, amfi_vehicle_t, cfg->daemon.ch_vehicle, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
                 goto out;
             }
@@ -483,7 +573,7 @@ static int stream(const opts *o, amfi_site_config *cfg, const amfi_vehicle_rec *
                        (o->noise_ms2 > 0 ? gsl_ran_gaussian(noise, o->noise_ms2) : 0.0);
             amfi_accel_block_t m = {u0, cfg->sensor_id[si], seq[si]++, o->scan_rate,
                                     (int16_t)blk, x};
-            if (EMIT(&b, amfi_accel_block_t, AMFI_CHANNEL_ACCEL, &m)) {
+            if (EMIT(&b, amfi_accel_block_t, cfg->daemon.ch_accel, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
                 goto out;
             }
@@ -495,7 +585,7 @@ static int stream(const opts *o, amfi_site_config *cfg, const amfi_vehicle_rec *
             double axle[2] = {rec->axle_kg[0], rec->axle_kg[1]};
             amfi_truth_t m = {o->start_utime + (int64_t)llround(d.t_entry_s * 1e6), d.id,
                               axle[0] + axle[1], 2, axle, d.mean_force_N, d.speed_mps};
-            if (EMIT(&b, amfi_truth_t, AMFI_CHANNEL_TRUTH, &m)) {
+            if (EMIT(&b, amfi_truth_t, cfg->daemon.ch_truth, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
                 goto out;
             }
@@ -536,17 +626,15 @@ out:
 int main(int argc, char **argv)
 {
     opts o;
-    parse(argc, argv, &o);
+    static amfi_site_config cfg; /* large; o's strings point into it */
+    const char *cfile = NULL, *cused = NULL;
+    amfi_config_defaults(&cfg);
+    if (!find_config(argc, argv, &cfile) && load_config(cfile, &cfg, &cused))
+        return 1;
+    opts_from_config(&o, &cfg.sim, cused);
+    apply_flags(argc, argv, &o);
     amfi_set_blas_threads(1);
     char err[512];
-    static amfi_site_config cfg;
-    amfi_config_defaults(&cfg);
-    const char *cpath = o.config ? o.config : AMFI_DEFAULT_CONFIG;
-    struct stat st;
-    if ((o.config || stat(cpath, &st) == 0) && amfi_config_load(cpath, &cfg, err, sizeof err)) {
-        fprintf(stderr, "%s\n", err);
-        return 1;
-    }
     cfg.bridge.damage = o.damage;
     const char *ppath = o.population ? o.population : AMFI_DEFAULT_POPULATION;
     amfi_vehicle_rec *recs = NULL;

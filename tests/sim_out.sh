@@ -32,6 +32,31 @@ tail -n +2 "$dir/a/meta.csv" | while IFS=, read -r name speed _ spacing entry gv
     exit (e < -0.05 || e > 0.05) }' || fail "$name: GVW error over 5 %"
 done || exit 1
 
+# Configuration file: built-in default < its simulation: section < flag.
+mkdir "$dir/cfg"
+printf 'simulation: {vehicles: 2, seed: 5}\n' > "$dir/cfg/two.yaml"
+"$sim" --config "$dir/cfg/two.yaml" --out "$dir/e" || fail "--config exited $?"
+[ "$(wc -l < "$dir/e/meta.csv")" -eq 3 ] || fail "simulation.vehicles: 2 not applied"
+cmp -s "$dir/a/v00001.csv" "$dir/e/v00001.csv" || fail "simulation.seed: 5 not applied"
+"$sim" --config "$dir/cfg/two.yaml" --out "$dir/f" --vehicles 3 || fail "--vehicles over --config exited $?"
+[ "$(wc -l < "$dir/f/meta.csv")" -eq 4 ] || fail "--vehicles 3 did not override simulation.vehicles"
+cmp -s "$dir/a/v00001.csv" "$dir/f/v00001.csv" || fail "simulation.seed lost under --vehicles"
+# A relative population is read from the file's folder, wherever we run.
+printf 'timestamp_s,lane,speed_mps,gvw_kg,axle1_kg,axle2_kg,spacing1_m\n%s\n%s\n' \
+  '5.856,1,21.82,8003,3820,4183,4.19' '16.827,1,25.52,10034,4828,5206,3.93' > "$dir/cfg/wim.csv"
+printf 'simulation:\n  population: wim.csv\n  vehicles: 2\n' > "$dir/cfg/wim.yaml"
+(cd / && "$sim" --config "$dir/cfg/wim.yaml" --out "$dir/g") || fail "relative population exited $?"
+cut -d, -f3 "$dir/g/meta.csv" | tr '\n' ' ' | grep -q '^speed_true_mps 21.82 25.52 $' ||
+  fail "relative population not read: $(cut -d, -f3 "$dir/g/meta.csv" | tr '\n' ' ')"
+# The stream goes to the file's daemon.channels; lcm_url: none from the file
+# publishes nothing, so the log alone receives it.
+printf '%s\n' 'daemon: {channels: {accel: SITE_A, vehicle: SITE_V, truth: SITE_T}}' \
+  'simulation: {vehicles: 1, stream: {lcm_url: none, speedup: max}}' > "$dir/cfg/ch.yaml"
+"$sim" --config "$dir/cfg/ch.yaml" 2>/dev/null; [ $? -eq 2 ] || fail "lcm_url: none without a log not refused"
+"$sim" --config "$dir/cfg/ch.yaml" --log "$dir/ch.log" 2>/dev/null || fail "--log over lcm_url: none exited $?"
+for c in SITE_A SITE_V SITE_T; do grep -aq "$c" "$dir/ch.log" || fail "nothing on channel $c"; done
+grep -aq AMFI_ "$dir/ch.log" && fail "published on a default channel"
+
 # Bad command lines are refused with one line and status 2.
 "$sim" --lcm-url none --vehicles 3 2>/dev/null; [ $? -eq 2 ] || fail "streaming to nothing not refused"
 "$sim" --out "$dir/d" --damage 2 2>/dev/null; [ $? -eq 2 ] || fail "damage 2 not refused"
