@@ -4,7 +4,8 @@
 # rows: every vehicle a passage row, GVW against the truth, a SIGHUP reload
 # while traffic streams, a clean shutdown on SIGTERM (integrity_check ok),
 # SIGTERM mid-stream losing no received vehicle, and a log replayed twice
-# at two speeds through LCM's file:// provider giving identical rows.
+# at two speeds through LCM's file:// provider giving identical rows (one
+# recorded live with lcm-logger, one written by sim_publisher --log).
 # Usage: daemon_e2e.sh AMFID SIM_PUBLISHER AMFI_REPORT CONFIG
 set -u
 if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
@@ -35,6 +36,8 @@ grep -q "^    baseline_n: 10 " "$dir/amfid.yaml" || fail "the test's indicator s
 apid=$!; pids="$pids $apid"
 i=0; until grep -q "running" "$dir/amfid.log"; do
   i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+lcm-logger -f "$dir/recorded.lcmlog" > "$dir/logger.log" 2>&1 &  # every channel
+lpid=$!; pids="$pids $lpid"
 timeout 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 3 2> "$dir/sim.log" &
 spid=$!; pids="$pids $spid"
 sleep 0.5
@@ -48,6 +51,7 @@ i=0; while kill -0 $apid 2>/dev/null; do
   i=$((i + 1)); [ $i -lt 600 ] || fail "amfid did not stop on SIGTERM"; sleep 0.1; done
 wait $apid; rc=$?
 [ $rc -eq 0 ] || fail "amfid exit status $rc"
+kill -INT $lpid; wait $lpid 2>/dev/null
 rows=$(sqlite3 "$dir/live.db" "SELECT count(*) FROM passages")
 ok=$(sqlite3 "$dir/live.db" "SELECT count(*) FROM passages WHERE status = 'ok'")
 truth=$(sqlite3 "$dir/live.db" "SELECT count(*) FROM truth")
@@ -83,7 +87,25 @@ echo "SIGTERM mid-stream: $received vehicles received, $rows rows ($(sqlite3 "$d
 [ "$rows" -eq "$received" ] || fail "$received vehicles received but $rows rows stored"
 sqlite3 "$dir/term.db" "PRAGMA integrity_check" | grep -qx ok || fail "integrity_check after SIGTERM"
 
-# 3. Replay: one log, read twice through file:// at two speeds: same rows.
+# 3. Replay: the live traffic as lcm-logger recorded it (amfid's own
+#    output channels included, which it must ignore), read twice through
+#    file:// at two speeds: the same rows as each other and as the live run.
+q="SELECT vehicle_id, utime, status, printf('%.6f', gvw_kg), printf('%.6g', lambda) FROM passages ORDER BY id"
+[ -s "$dir/recorded.lcmlog" ] || fail "lcm-logger recorded nothing"
+for speed in 0 8; do
+  "$amfid" --config "$dir/amfid.yaml" --db "$dir/rec$speed.db" \
+    --lcm-url "file://$dir/recorded.lcmlog?speed=$speed" 2> "$dir/rec$speed.log" ||
+    fail "amfid on the lcm-logger log (speed $speed)"
+  sqlite3 "$dir/rec$speed.db" "$q" > "$dir/rec$speed.txt"
+done
+sqlite3 "$dir/live.db" "$q" > "$dir/live.txt"
+[ "$(wc -l < "$dir/rec0.txt")" -eq $N ] || fail "lcm-logger replay: $(wc -l < "$dir/rec0.txt") rows"
+cmp -s "$dir/rec0.txt" "$dir/rec8.txt" || fail "lcm-logger log replayed at two speeds: rows differ"
+cmp -s "$dir/rec0.txt" "$dir/live.txt" || fail "lcm-logger replay differs from the live rows"
+echo "lcm-logger log: $N identical rows replayed at speed 0 and 8, the same as live"
+
+# 4. A log written by sim_publisher itself, read twice through file:// at
+#    two speeds: same rows.
 "$sim" --lcm-url none --log "$dir/traffic.log" --vehicles $N --headway 3 --speedup max --seed 4 \
   2> "$dir/simlog.log" || fail "sim_publisher --log"
 for speed in 0 8; do
@@ -91,7 +113,6 @@ for speed in 0 8; do
     --lcm-url "file://$dir/traffic.log?speed=$speed" 2> "$dir/replay$speed.log" ||
     fail "amfid on the log (speed $speed)"
 done
-q="SELECT vehicle_id, utime, status, printf('%.6f', gvw_kg), printf('%.6g', lambda) FROM passages ORDER BY id"
 sqlite3 "$dir/replay0.db" "$q" > "$dir/a.txt"
 sqlite3 "$dir/replay8.db" "$q" > "$dir/b.txt"
 [ "$(wc -l < "$dir/a.txt")" -eq $N ] || fail "replay: $(wc -l < "$dir/a.txt") rows"
