@@ -2,7 +2,7 @@
 # The main job: install what is missing, build, then on a private bus (a
 # network namespace of its own: nothing leaves this machine) amfid listens
 # while sim_publisher streams 500 vehicles, one every 2 s of data at 25 times
-# real time, the bridge losing 20 % of its stiffness from vehicle 201 on.
+# real time, the bridge losing 20 % of its stiffness from vehicle 251 on (half way).
 # Ends with what amfid stored: passages, indicator trend, alerts.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
@@ -14,7 +14,7 @@ out="$top/build/demo"
 rm -rf "$out"
 mkdir -p "$out"
 config="$top/config/demo.yaml"
-echo "== amfid and sim_publisher on a private bus: 500 vehicles, 20 % damage from vehicle 201"
+echo "== amfid and sim_publisher on a private bus: 500 vehicles, 20 % damage from vehicle 251 (half way)"
 echo "   (about a minute; logs in $out)"
 OPENBLAS_NUM_THREADS=1 unshare --net bash -c '
   set -eu
@@ -24,7 +24,7 @@ OPENBLAS_NUM_THREADS=1 unshare --net bash -c '
   pid=$!
   for i in $(seq 100); do grep -q running "$3/amfid.log" && break; sleep 0.1; done
   "$1/sim_publisher/sim_publisher" --config "$2" --vehicles 500 --headway 2 --speedup 25 \
-    --damage 0.2 --damage-step-at 200 --seed 1 2> "$3/sim_publisher.log"
+    --damage 0.2 --damage-step-at 250 --seed 1 2> "$3/sim_publisher.log"
   sleep 1
   kill -TERM "$pid"
   wait "$pid"
