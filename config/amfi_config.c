@@ -28,6 +28,7 @@
 #include "amfi_config.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <locale.h>
 #include <math.h>
 #include <stdarg.h>
@@ -275,22 +276,14 @@ static int to_llong(const char *s, long long *out)
 
 static int to_long(const char *s, long *out)
 {
-    const char *p = s;
-    char *end;
-    long l;
+    long long l;
+    int rc = to_llong(s, &l);
 
-    if (*p == '+' || *p == '-')
-        p++;
-    if (!*p)
-        return -1;
-    for (; *p; p++)
-        if (*p < '0' || *p > '9')
-            return -1;
-    errno = 0;
-    l = strtol(s, &end, 10);
-    if (errno == ERANGE)
+    if (rc)
+        return rc;
+    if (l < LONG_MIN || l > LONG_MAX)
         return -2;
-    *out = l;
+    *out = (long)l;
     return 0;
 }
 
