@@ -23,6 +23,10 @@ pkgs=(
   libsystemd-dev                 # sd_notify, watchdog, journal (amfid)
   libsqlite3-dev                 # the store of passages, indicators, alerts (daemon/store.c)
   sqlite3                        # sqlite3 CLI: queries on the store, report_cli test fixture
+  scdoc                          # man pages (man/*.scd -> roff)
+  man-db                         # man -l: the install test renders every page
+  systemd                        # systemd-analyze verify; pkg-config systemd (unit directories)
+  dpkg-dev                       # dpkg-shlibdeps: the .deb's runtime dependencies (cpack)
 )
 missing=()
 for p in "${pkgs[@]}"; do

@@ -1,0 +1,63 @@
+#!/bin/sh
+# cmake --install into a DESTDIR staging tree, then check what a site gets:
+# the programs, the configuration, the unit, sysusers/tmpfiles, the man pages,
+# the docs; the installed amfid validates the installed configuration; the
+# installed unit, as installed, passes systemd-analyze verify with the staged
+# prefix mounted over the real one (a private mount namespace: nothing is
+# written outside the staging tree); every man page renders.
+# Usage: install.sh BUILD_DIR BINDIR SYSCONFDIR UNITDIR SYSUSERSDIR TMPFILESDIR MANDIR DOCDIR DATADIR PREFIX
+set -u
+build=$1 bindir=$2 sysconfdir=$3 unitdir=$4 sysusersdir=$5 tmpfilesdir=$6 mandir=$7 docdir=$8 datadir=$9
+shift 9
+prefix=$1
+stage=$(mktemp -d)
+trap 'rm -rf "$stage"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+DESTDIR=$stage cmake --install "$build" >"$stage.log" 2>&1 || { cat "$stage.log"; rm -f "$stage.log"; fail "cmake --install"; }
+rm -f "$stage.log"
+
+for f in "$bindir/amfid" "$bindir/amfi-solve" "$bindir/amfi-report" "$bindir/amfi-spy" \
+         "$bindir/sim_publisher" "$sysconfdir/amfid/amfid.yaml" "$unitdir/amfid.service" \
+         "$sysusersdir/amfid.conf" "$tmpfilesdir/amfid.conf" "$mandir/man8/amfid.8.gz" \
+         "$docdir/README.md" "$docdir/LICENSE" "$docdir/docs/daemon.md" "$datadir/java/amfi_types.jar"; do
+  [ -e "$stage$f" ] || fail "not installed: $f"
+done
+echo "installed files: ok"
+
+# The installed daemon on the installed configuration.
+out=$("$stage$bindir/amfid" --check-config --config "$stage$sysconfdir/amfid/amfid.yaml" 2>&1) ||
+  { echo "$out"; fail "installed amfid --check-config on the installed amfid.yaml"; }
+echo "installed amfid --check-config: ok"
+
+# The unit names the installed binary and configuration, as installed.
+unit=$stage$unitdir/amfid.service
+grep -qx "ExecStart=$bindir/amfid --config $sysconfdir/amfid/amfid.yaml --db %S/amfid/amfi.db" "$unit" ||
+  fail "ExecStart does not name $bindir/amfid and $sysconfdir/amfid/amfid.yaml: $(grep ^ExecStart= "$unit")"
+for k in '^Type=notify$' '^WatchdogSec=' '^User=amfid$' '^StateDirectory=amfid$' '^Documentation=man:amfid(8)'; do
+  grep -q "$k" "$unit" || fail "unit lacks $k"
+done
+grep -q "^d $sysconfdir/amfid " "$stage$tmpfilesdir/amfid.conf" || fail "tmpfiles does not create $sysconfdir/amfid"
+grep -q '^u amfid ' "$stage$sysusersdir/amfid.conf" || fail "sysusers does not declare amfid"
+if command -v systemd-analyze >/dev/null && [ "$prefix" != /usr ] && [ "$prefix" != / ]; then
+  # Mount the staged prefix over the real one, so the unit is checked exactly
+  # as installed (the binary it starts, the man page it documents).
+  v=$(unshare --mount sh -c 'mount --bind "$1$2" "$2" && systemd-analyze verify "$3" 2>&1; echo "rc=$?"' \
+      verify "$stage" "$prefix" "$unit")
+  [ "$v" = "rc=0" ] || { echo "$v"; fail "systemd-analyze verify of the installed unit"; }
+  echo "systemd-analyze verify (installed unit, staged prefix mounted on $prefix): ok"
+else
+  fail "cannot verify the unit: no systemd-analyze, or the prefix $prefix cannot be mounted over"
+fi
+
+# Every installed man page renders without a warning.
+n=0
+for page in "$stage$mandir"/man*/*; do
+  w=$(MANWIDTH=80 man --warnings -l "$page" 2>&1 >/dev/null)
+  [ -z "$w" ] || { echo "$w"; fail "man -l $page"; }
+  MANWIDTH=80 man -l "$page" 2>/dev/null | grep -q NAME || fail "man -l $page: no NAME section"
+  n=$((n + 1))
+done
+[ "$n" -ge 1 ] || fail "no man pages installed"
+echo "man pages: $n render"
+echo "install: ok"
