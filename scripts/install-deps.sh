@@ -27,6 +27,7 @@ pkgs=(
   man-db                         # man -l: the install test renders every page
   systemd                        # systemd-analyze verify; pkg-config systemd (unit directories)
   dpkg-dev                       # dpkg-shlibdeps: the .deb's runtime dependencies (cpack)
+  file                           # cpack's DEB generator needs it for dpkg-shlibdeps
 )
 missing=()
 for p in "${pkgs[@]}"; do
