@@ -13,7 +13,7 @@ pkgs=(
   liblcm-dev                     # LCM C library: the amfi bus (messages/)
   libglib2.0-dev                 # lcm.pc requires glib-2.0; liblcm-dev does not pull it in
   liblcm-bin                     # lcm-gen, lcm-logger, lcm-logplayer
-  liblcm-java                    # lcm.jar: lcm-spy (tools/amfi-spy)
+  liblcm-java                    # lcm.jar: lcm-spy (tools/ops/amfi-spy)
   default-jdk-headless           # javac, jar: amfi_types.jar for lcm-spy
   default-jre                    # AWT/X11 runtime that lcm-spy's window needs
   libjchart2d-java               # lcm-spy's chart library

@@ -31,4 +31,4 @@ OPENBLAS_NUM_THREADS=1 unshare --net bash -c '
 ' demo "$bin" "$config" "$out"
 grep -E "ALERT|alert cleared|baseline" "$out/amfid.log" | sed 's/^<[0-9]>//' || true
 echo
-"$bin/tools/amfi-report" --db "$out/demo.db" --summary --trend --alerts --errors
+"$bin/tools/ops/amfi-report" --db "$out/demo.db" --summary --trend --alerts --errors

@@ -7,7 +7,7 @@
  * rejection, and the defaults on simulated streams (a long healthy stream
  * raises nothing; a 10 % damage step is caught within the delay
  * docs/indicators.md promises). Streams use the model of
- * tools/amfi-indicator-sim.c with fixed seeds.
+ * tools/research/amfi-indicator-sim.c with fixed seeds.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -563,7 +563,7 @@ static void test_reject(void **state)
     amfi_indicators_destroy(b);
 }
 
-/* --- the defaults on simulated streams (tools/amfi-indicator-sim.c) --- */
+/* --- the defaults on simulated streams (tools/research/amfi-indicator-sim.c) --- */
 
 static double draw(gsl_rng *r, double damage)
 {

@@ -15,7 +15,7 @@
  *                      [--mean-clear-ratio C]
  *
  * Stream model (kg). True GVW: the shipped synthetic population's law
- * (tools/amfi-population.c): normal(8765, 1960) truncated to [4000, 15000],
+ * (tools/research/amfi-population.c): normal(8765, 1960) truncated to [4000, 15000],
  * mean 8800 and STD 1900. Inferred GVW = (true + e) / (1 − d), e ~
  * normal(0, σ_e(d)): damage d scales every inferred weight by 1/(1 − d), as
  * amfi-paper measured (docs/results/paper.md: STD and mean both ×1.11 at
@@ -62,7 +62,7 @@
 
 #define PROG "amfi-indicator-sim"
 
-/* The population law of tools/amfi-population.c (kg). */
+/* The population law of tools/research/amfi-population.c (kg). */
 #define GVW_MU 8765.0
 #define GVW_SD 1960.0
 #define GVW_LO 4000.0
@@ -478,7 +478,7 @@ static void usage(void)
             "       [--std-alert-p P] [--std-clear-ratio C] [--raise-after N]\n"
             "       [--clear-after N] [--mean-shift 0|1] [--mean-alert-ratio R]\n"
             "       [--mean-alert-p P] [--mean-clear-ratio C]\n"
-            "(damage in %%, weights in t; see the header of tools/amfi-indicator-sim.c)\n",
+            "(damage in %%, weights in t; see the header of tools/research/amfi-indicator-sim.c)\n",
             PROG);
 }
 

@@ -957,7 +957,7 @@ int main(int argc, char **argv)
         die("%s: %s", path, strerror(errno));
     double t0 = now_s();
     fprintf(c.md, "# The paper's experiments, reproduced\n\n"
-                  "Made by `amfi-paper%s` (tools/amfi-paper.c). Bridge: %s (%.0f m, %d "
+                  "Made by `amfi-paper%s` (tools/research/amfi-paper.c). Bridge: %s (%.0f m, %d "
                   "elements); simulator: half-car vehicles on the FE bridge (sim_publisher/vbi.c),"
                   " accelerometer at %.1f m sampled at %.0f Hz; solver: paper formulation at "
                   "%.0f Hz. Paper numbers from MODEL.md §5. GVW errors are (inferred − true) / "
