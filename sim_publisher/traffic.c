@@ -4,11 +4,13 @@
  *
  * One pass: the header is mapped to column roles once, then every row is
  * cut at commas, each field parsed and range-checked where it is read, and
- * the record appended to an array that doubles when full. Lines are read
- * byte by byte so that a NUL byte inside a line is seen (fgets would hide
- * the rest of the line) and the length limit is exact.
+ * the record appended to an array that doubles when full. The lines come
+ * from the common CSV line reader (common/amfi_csv.h), which also reports
+ * NUL bytes, over-long lines and FILE:LINE: COLUMN: in every message.
  */
 #include "traffic.h"
+
+#include "amfi_csv.h"
 
 #include <errno.h>
 #include <math.h>
@@ -30,118 +32,14 @@ typedef struct column {
 } column;
 
 typedef struct reader {
-    FILE *f;
-    const char *path;
-    long lineno; /* of the line in `line`, 1-based */
-    char *err;
-    size_t errlen;
+    amfi_csv *csv;
     int n_cols, n_axles;
     column col[MAX_COLS];
-    char line[AMFI_TRAFFIC_MAX_LINE + 2]; /* + a CR + NUL */
 } reader;
 
-static void fail(reader *r, long line, const char *colname, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-static void fail(reader *r, long line, const char *colname, const char *fmt, ...)
-{
-    if (!r->err || r->errlen == 0)
-        return;
-    int k = line > 0 ? snprintf(r->err, r->errlen, "%s:%ld: ", r->path, line)
-                     : snprintf(r->err, r->errlen, "%s: ", r->path);
-    if (k >= 0 && (size_t)k < r->errlen && colname)
-        k += snprintf(r->err + k, r->errlen - (size_t)k, "%s: ", colname);
-    if (k < 0 || (size_t)k >= r->errlen)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(r->err + k, r->errlen - (size_t)k, fmt, ap);
-    va_end(ap);
-}
-
-/* At most 24 characters of s[0 .. n), anything but printable ASCII (and the
- * quote) replaced by '?', so that a message stays one readable line. */
-static const char *quote(const char *s, size_t n, char out[32])
-{
-    size_t k = 0;
-    for (; k < n && k < 24; k++) {
-        unsigned char c = (unsigned char)s[k];
-        out[k] = (c >= 0x20 && c < 0x7f && c != '\'') ? (char)c : '?';
-    }
-    if (k < n) {
-        memcpy(out + k, "...", 3);
-        k += 3;
-    }
-    out[k] = '\0';
-    return out;
-}
-
-/* Next line into r->line without CR/LF, NUL-terminated, length in *n.
- * 1: a line, 0: end of file, −1: error (message written). */
-static int next_line(reader *r, size_t *n)
-{
-    const long line = r->lineno + 1;
-    size_t len = 0;
-    int c, any = 0;
-    while ((c = getc(r->f)) != EOF) {
-        any = 1;
-        if (c == '\n')
-            break;
-        if (len == AMFI_TRAFFIC_MAX_LINE + 1) { /* room for one CR before LF */
-            fail(r, line, NULL, "line longer than %d characters", AMFI_TRAFFIC_MAX_LINE);
-            return -1;
-        }
-        r->line[len++] = (char)c;
-    }
-    if (ferror(r->f)) {
-        fail(r, line, NULL, "read error: %s", strerror(errno));
-        return -1;
-    }
-    if (!any)
-        return 0;
-    r->lineno = line;
-    if (len > 0 && r->line[len - 1] == '\r')
-        len--;
-    if (len > AMFI_TRAFFIC_MAX_LINE) {
-        fail(r, line, NULL, "line longer than %d characters", AMFI_TRAFFIC_MAX_LINE);
-        return -1;
-    }
-    if (memchr(r->line, '\0', len)) {
-        fail(r, line, NULL, "NUL byte in line (binary data?)");
-        return -1;
-    }
-    r->line[len] = '\0';
-    *n = len;
-    return 1;
-}
-
-static int is_blank(int c) { return c == ' ' || c == '\t'; }
-
-/* Split s[0 .. n) at commas into trimmed fields; stores at most `max`,
- * returns how many there are. */
-static int split(const char *s, size_t n, const char *start[], size_t flen[], int max)
-{
-    int count = 0;
-    size_t a = 0;
-    for (;;) {
-        size_t b = a;
-        while (b < n && s[b] != ',')
-            b++;
-        size_t x = a, y = b;
-        while (x < y && is_blank((unsigned char)s[x]))
-            x++;
-        while (y > x && is_blank((unsigned char)s[y - 1]))
-            y--;
-        if (count < max) {
-            start[count] = s + x;
-            flen[count] = y - x;
-        }
-        count++;
-        if (b == n)
-            return count;
-        a = b + 1;
-    }
-}
+#define fail(r, line, colname, ...) amfi_csv_fail((r)->csv, line, colname, __VA_ARGS__)
+#define quote amfi_csv_quote
+#define split amfi_csv_split
 
 /* "axle12_kg" → 12 with prefix "axle", suffix "_kg"; 0 if s is not of that
  * form (digits without a leading zero, at most 4 of them). */
@@ -165,7 +63,8 @@ static int numbered(const char *s, size_t n, const char *prefix, const char *suf
 static int read_header(reader *r)
 {
     size_t n = 0;
-    int rc = next_line(r, &n);
+    const char *s = NULL;
+    int rc = amfi_csv_next(r->csv, &s, &n);
     if (rc < 0)
         return -1;
     if (rc == 0) {
@@ -173,11 +72,7 @@ static int read_header(reader *r)
                          "axle1_kg,axle2_kg,...,spacing1_m,...)");
         return -1;
     }
-    const char *s = r->line;
-    if (n >= 3 && memcmp(s, "\xEF\xBB\xBF", 3) == 0) {
-        s += 3;
-        n -= 3;
-    }
+    amfi_csv_strip_bom(&s, &n);
     const char *f[MAX_COLS];
     size_t fl[MAX_COLS];
     int count = split(s, n, f, fl, MAX_COLS);
@@ -286,43 +181,35 @@ static int read_header(reader *r)
 /* Parse field s[0 .. n) of column c as a finite number. */
 static int parse_number(reader *r, const column *c, const char *s, size_t n, double *v)
 {
-    char q[32], tmp[AMFI_TRAFFIC_MAX_LINE + 1];
-    if (n == 0) {
-        fail(r, r->lineno, c->name, "empty value");
-        return -1;
+    char q[32];
+    const long line = amfi_csv_lineno(r->csv);
+    switch (amfi_csv_field_double(s, n, v)) {
+    case 0:
+        return 0;
+    case AMFI_CSV_EMPTY:
+        return fail(r, line, c->name, "empty value");
+    case AMFI_CSV_NOT_NUMBER:
+        return fail(r, line, c->name, "'%s' is not a number", quote(s, n, q));
+    default:
+        return fail(r, line, c->name, "'%s' is not a finite number", quote(s, n, q));
     }
-    /* a NUL-terminated copy, so that strtod cannot run on into the next field */
-    memcpy(tmp, s, n);
-    tmp[n] = '\0';
-    char *end = NULL;
-    double x = strtod(tmp, &end);
-    if (end == tmp || *end != '\0') {
-        fail(r, r->lineno, c->name, "'%s' is not a number", quote(s, n, q));
-        return -1;
-    }
-    if (!isfinite(x)) {
-        fail(r, r->lineno, c->name, "'%s' is not a finite number", quote(s, n, q));
-        return -1;
-    }
-    *v = x;
-    return 0;
 }
 
 static int in_range(reader *r, const column *c, double v, double lo, double hi, const char *unit)
 {
     if (v >= lo && v <= hi)
         return 0;
-    fail(r, r->lineno, c->name, "%g is out of range [%g, %g] %s", v, lo, hi, unit);
+    fail(r, amfi_csv_lineno(r->csv), c->name, "%g is out of range [%g, %g] %s", v, lo, hi, unit);
     return -1;
 }
 
-static int parse_row(reader *r, size_t len, amfi_vehicle_rec *v)
+static int parse_row(reader *r, const char *line, size_t len, amfi_vehicle_rec *v)
 {
     const char *f[MAX_COLS];
     size_t fl[MAX_COLS];
-    int count = split(r->line, len, f, fl, MAX_COLS);
+    int count = split(line, len, f, fl, MAX_COLS);
     if (count != r->n_cols) {
-        fail(r, r->lineno, NULL, "%d fields, the header has %d", count, r->n_cols);
+        fail(r, amfi_csv_lineno(r->csv), NULL, "%d fields, the header has %d", count, r->n_cols);
         return -1;
     }
     memset(v, 0, sizeof *v);
@@ -343,12 +230,12 @@ static int parse_row(reader *r, size_t len, amfi_vehicle_rec *v)
                 ok = end != tmp && *end == '\0' && errno == 0;
             }
             if (!ok) {
-                fail(r, r->lineno, c->name, fl[i] ? "'%s' is not an integer" : "empty value%s",
+                fail(r, amfi_csv_lineno(r->csv), c->name, fl[i] ? "'%s' is not an integer" : "empty value%s",
                      quote(f[i], fl[i], q));
                 return -1;
             }
             if (lane < 1 || lane > AMFI_TRAFFIC_MAX_LANE) {
-                fail(r, r->lineno, c->name, "%ld is out of range 1 .. %d", lane,
+                fail(r, amfi_csv_lineno(r->csv), c->name, "%ld is out of range 1 .. %d", lane,
                      AMFI_TRAFFIC_MAX_LANE);
                 return -1;
             }
@@ -373,7 +260,7 @@ static int parse_row(reader *r, size_t len, amfi_vehicle_rec *v)
             break;
         case R_AXLE:
             if (!(x > 0.0) || x > 100000.0) {
-                fail(r, r->lineno, c->name, "%g is out of range (0, 100000] kg", x);
+                fail(r, amfi_csv_lineno(r->csv), c->name, "%g is out of range (0, 100000] kg", x);
                 return -1;
             }
             v->axle_kg[c->index] = x;
@@ -391,7 +278,7 @@ static int parse_row(reader *r, size_t len, amfi_vehicle_rec *v)
     for (int a = 0; a < v->n_axles; a++)
         sum += v->axle_kg[a];
     if (fabs(v->gvw_kg - sum) > AMFI_TRAFFIC_GVW_TOL * sum) {
-        fail(r, r->lineno, "gvw_kg",
+        fail(r, amfi_csv_lineno(r->csv), "gvw_kg",
              "%g kg differs by %.3g %% from the sum of the axle loads, %g kg (tolerance %g %%)",
              v->gvw_kg, 100.0 * fabs(v->gvw_kg - sum) / sum, sum, 100.0 * AMFI_TRAFFIC_GVW_TOL);
         return -1;
@@ -402,28 +289,17 @@ static int parse_row(reader *r, size_t len, amfi_vehicle_rec *v)
 static int read_rows(reader *r, amfi_vehicle_rec **recs, int *n_out)
 {
     amfi_vehicle_rec *a = NULL;
-    long n = 0, cap = 0, blank_line = 0, prev_line = 0;
+    long n = 0, cap = 0, prev_line = 0;
     for (;;) {
         size_t len = 0;
-        int got = next_line(r, &len);
+        const char *line = NULL;
+        int got = amfi_csv_next_row(r->csv, &line, &len, "blank line before the end of the data");
         if (got < 0)
             goto fail;
         if (got == 0)
             break;
-        size_t k = 0;
-        while (k < len && is_blank((unsigned char)r->line[k]))
-            k++;
-        if (k == len) {
-            if (!blank_line)
-                blank_line = r->lineno;
-            continue;
-        }
-        if (blank_line) {
-            fail(r, blank_line, NULL, "blank line before the end of the data");
-            goto fail;
-        }
         if (n == AMFI_TRAFFIC_MAX_ROWS) {
-            fail(r, r->lineno, NULL, "more than %ld vehicles", AMFI_TRAFFIC_MAX_ROWS);
+            fail(r, amfi_csv_lineno(r->csv), NULL, "more than %ld vehicles", AMFI_TRAFFIC_MAX_ROWS);
             goto fail;
         }
         if (n == cap) {
@@ -432,26 +308,26 @@ static int read_rows(reader *r, amfi_vehicle_rec **recs, int *n_out)
                 ncap = AMFI_TRAFFIC_MAX_ROWS;
             amfi_vehicle_rec *na = realloc(a, (size_t)ncap * sizeof *a);
             if (!na) {
-                fail(r, r->lineno, NULL, "out of memory");
+                fail(r, amfi_csv_lineno(r->csv), NULL, "out of memory");
                 free(a);
                 return AMFI_ENOMEM;
             }
             a = na;
             cap = ncap;
         }
-        if (parse_row(r, len, &a[n]) != 0)
+        if (parse_row(r, line, len, &a[n]) != 0)
             goto fail;
         if (n > 0 && a[n].timestamp_s < a[n - 1].timestamp_s) {
-            fail(r, r->lineno, "timestamp_s",
+            fail(r, amfi_csv_lineno(r->csv), "timestamp_s",
                  "%.10g is earlier than %.10g on line %ld (timestamps must be non-decreasing)",
                  a[n].timestamp_s, a[n - 1].timestamp_s, prev_line);
             goto fail;
         }
-        prev_line = r->lineno;
+        prev_line = amfi_csv_lineno(r->csv);
         n++;
     }
     if (n == 0) {
-        fail(r, r->lineno, NULL, "no vehicles after the header");
+        fail(r, amfi_csv_lineno(r->csv), NULL, "no vehicles after the header");
         goto fail;
     }
     *recs = a;
@@ -475,21 +351,11 @@ int amfi_traffic_read(const char *path, amfi_vehicle_rec **recs, int *n, char *e
             snprintf(err, errlen, "%s: out of memory", path);
         return AMFI_ENOMEM;
     }
-    r->path = path;
-    r->err = err;
-    r->errlen = errlen;
     int rc = AMFI_EINVAL;
-    r->f = fopen(path, "rb");
-    if (!r->f) {
-        fail(r, 0, NULL, "cannot open: %s", strerror(errno));
-        goto done;
-    }
-    if (read_header(r) != 0)
-        goto done;
-    rc = read_rows(r, recs, n);
-done:
-    if (r->f)
-        fclose(r->f);
+    r->csv = amfi_csv_open(path, AMFI_TRAFFIC_MAX_LINE, err, errlen);
+    if (r->csv && read_header(r) == 0)
+        rc = read_rows(r, recs, n);
+    amfi_csv_close(r->csv, 0);
     free(r);
     return rc;
 }

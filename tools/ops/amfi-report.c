@@ -34,7 +34,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "cli.h"
+#include "amfi_cli.h"
 #include "store.h"
 
 #define PROG "amfi-report"
@@ -143,7 +143,7 @@ static int parse_baseline(const char *arg, options *o)
     char buf[96], *f[3], *save = NULL;
     int k = 0;
     if (strlen(arg) >= sizeof buf)
-        return usage_error(opt, "'%s' is too long", cli_shown(arg));
+        return usage_error(opt, "'%s' is too long", amfi_cli_shown(arg));
     snprintf(buf, sizeof buf, "%s", arg);
     for (char *p = buf;; p = NULL) {
         char *t = strtok_r(p, ",", &save);
@@ -151,22 +151,22 @@ static int parse_baseline(const char *arg, options *o)
             break;
         if (k == 3)
             return usage_error(opt, "'%s': expected MEAN_KG,STD_KG,N",
-                               cli_shown(arg));
+                               amfi_cli_shown(arg));
         f[k++] = t;
     }
     if (k != 3)
-        return usage_error(opt, "'%s': expected MEAN_KG,STD_KG,N", cli_shown(arg));
-    if (cli_parse_double(f[0], &o->mean_kg) != 0 || !(o->mean_kg > 0)
+        return usage_error(opt, "'%s': expected MEAN_KG,STD_KG,N", amfi_cli_shown(arg));
+    if (amfi_cli_double(f[0], &o->mean_kg) != 0 || !(o->mean_kg > 0)
         || o->mean_kg > AMFI_STORE_MAX_KG)
         return usage_error(opt, "mean '%s' is not a mass in (0, %g] kg",
-                           cli_shown(f[0]), AMFI_STORE_MAX_KG);
-    if (cli_parse_double(f[1], &o->std_kg) != 0 || !(o->std_kg > 0)
+                           amfi_cli_shown(f[0]), AMFI_STORE_MAX_KG);
+    if (amfi_cli_double(f[1], &o->std_kg) != 0 || !(o->std_kg > 0)
         || o->std_kg > AMFI_STORE_MAX_KG)
-        return usage_error(opt, "STD '%s' is not in (0, %g] kg", cli_shown(f[1]),
+        return usage_error(opt, "STD '%s' is not in (0, %g] kg", amfi_cli_shown(f[1]),
                            AMFI_STORE_MAX_KG);
     if (parse_int(f[2], 2, MAX_BASELINE_N, &o->n) != 0)
         return usage_error(opt, "N '%s' is not an integer in [2, %d]",
-                           cli_shown(f[2]), MAX_BASELINE_N);
+                           amfi_cli_shown(f[2]), MAX_BASELINE_N);
     o->baseline_given = 1;
     return 0;
 }
@@ -203,7 +203,7 @@ static int parse_args(int argc, char **argv, options *o)
             }
         }
         if (which < 0)
-            return usage_error(cli_shown(a), a[0] == '-'
+            return usage_error(amfi_cli_shown(a), a[0] == '-'
                                              ? "unknown option (see --help)"
                                              : "unexpected argument (see --help)");
         const char *opt = valued[which];
@@ -221,7 +221,7 @@ static int parse_args(int argc, char **argv, options *o)
         case 1:
             if (parse_int(val, 2, MAX_BASELINE_N, &o->baseline_last) != 0)
                 return usage_error(opt, "'%s' is not an integer in [2, %d]",
-                                   cli_shown(val), MAX_BASELINE_N);
+                                   amfi_cli_shown(val), MAX_BASELINE_N);
             break;
         case 2:
             if (parse_baseline(val, o) != 0)
@@ -467,7 +467,7 @@ static int section_summary(amfi_store *s)
             rc = col_int(st, 1, 0, INT64_MAX, "passages", -1, &n);
         if (rc == 0 && in_list(name, statuses, N_STATUS) < 0)
             rc = data_error("passages: %lld rows have the unknown status '%s'",
-                            n, cli_shown(name));
+                            n, amfi_cli_shown(name));
         if (rc == 0)
             counts[in_list(name, statuses, N_STATUS)] = n;
     }
@@ -598,8 +598,8 @@ static int section_alerts(amfi_store *s)
         if (rc == 0) rc = col_text(st, 2, "alerts", id, &level);
         if (rc == 0) rc = col_int(st, 3, 0, AMFI_STORE_MAX_UTIME, "alerts", id, &ut);
         if (rc == 0)
-            out("OPEN NOW     %s %s since %s UTC\n", cli_shown(level),
-                   cli_shown(kind), utc(ut, t));
+            out("OPEN NOW     %s %s since %s UTC\n", amfi_cli_shown(level),
+                   amfi_cli_shown(kind), utc(ut, t));
         open++;
     }
     sqlite3_finalize(st);
@@ -637,7 +637,7 @@ static int section_alerts(amfi_store *s)
             m[k] = '\0';
             snprintf(lines[nl++], sizeof lines[0],
                      "%-19.19s  %-7.7s  %-14.40s  %-7s  %9.20s  %.300s",
-                     utc(ut, t), cli_shown(level), cli_shown(kind),
+                     utc(ut, t), amfi_cli_shown(level), amfi_cli_shown(kind),
                      raised ? "raised" : "cleared", is, m);
         }
     }

@@ -30,7 +30,7 @@
 
 #include "accel_csv.h"
 #include "amfi/amfi.h"
-#include "cli.h"
+#include "amfi_cli.h"
 #include "amfi_config.h"
 
 #define PROG "amfi-solve"
@@ -121,22 +121,22 @@ static int parse_spacings(const char *arg, options *o)
         const char *comma = strchr(p, ',');
         size_t n = comma ? (size_t)(comma - p) : strlen(p);
         if (n == 0)
-            return usage_error(opt, "empty value in '%s'", cli_shown(arg));
+            return usage_error(opt, "empty value in '%s'", amfi_cli_shown(arg));
         if (n >= sizeof buf)
-            return usage_error(opt, "value too long in '%s'", cli_shown(arg));
+            return usage_error(opt, "value too long in '%s'", amfi_cli_shown(arg));
         memcpy(buf, p, n);
         buf[n] = '\0';
         if (o->n_spacings == AMFI_MAX_AXLES - 1)
             return usage_error(opt, "more than %d spacings (at most %d axles)",
                                AMFI_MAX_AXLES - 1, AMFI_MAX_AXLES);
         double s;
-        if (cli_parse_double(buf, &s) != 0)
-            return usage_error(opt, "'%s' is not a number", cli_shown(buf));
+        if (amfi_cli_double(buf, &s) != 0)
+            return usage_error(opt, "'%s' is not a number", amfi_cli_shown(buf));
         if (!(s > 0))
-            return usage_error(opt, "'%s' must be > 0 m", cli_shown(buf));
+            return usage_error(opt, "'%s' must be > 0 m", amfi_cli_shown(buf));
         if (s > MAX_SPACING_M)
             return usage_error(opt, "'%s' m is not an axle spacing (max %g m)",
-                               cli_shown(buf), MAX_SPACING_M);
+                               amfi_cli_shown(buf), MAX_SPACING_M);
         o->spacing_m[o->n_spacings++] = s;
         if (!comma)
             return 0;
@@ -171,8 +171,8 @@ static int parse_args(int argc, char **argv, options *o)
         }
         if (which < 0) {
             if (a[0] == '-')
-                return usage_error(cli_shown(a), "unknown option (see --help)");
-            return usage_error(cli_shown(a), "unexpected argument (see --help)");
+                return usage_error(amfi_cli_shown(a), "unknown option (see --help)");
+            return usage_error(amfi_cli_shown(a), "unexpected argument (see --help)");
         }
         const char *opt = names[which];
         if (!val) {
@@ -187,13 +187,13 @@ static int parse_args(int argc, char **argv, options *o)
         case 0: o->config = val; break;
         case 1: o->accel = val; break;
         case 2:
-            if (cli_parse_double(val, &x) != 0)
-                return usage_error(opt, "'%s' is not a number", cli_shown(val));
+            if (amfi_cli_double(val, &x) != 0)
+                return usage_error(opt, "'%s' is not a number", amfi_cli_shown(val));
             if (!(x > 0))
-                return usage_error(opt, "'%s' must be > 0 m/s", cli_shown(val));
+                return usage_error(opt, "'%s' must be > 0 m/s", amfi_cli_shown(val));
             if (x > MAX_SPEED_MPS)
                 return usage_error(opt, "'%s' m/s is absurd for road traffic "
-                                   "(max %g m/s)", cli_shown(val), MAX_SPEED_MPS);
+                                   "(max %g m/s)", amfi_cli_shown(val), MAX_SPEED_MPS);
             o->speed_mps = x;
             break;
         case 3:
@@ -201,15 +201,15 @@ static int parse_args(int argc, char **argv, options *o)
                 return -1;
             break;
         case 4:
-            if (cli_parse_double(val, &x) != 0)
-                return usage_error(opt, "'%s' is not a number", cli_shown(val));
+            if (amfi_cli_double(val, &x) != 0)
+                return usage_error(opt, "'%s' is not a number", amfi_cli_shown(val));
             o->entry_time_s = x;
             break;
         case 5:
             if (strcmp(val, "auto") != 0
-                && (cli_parse_double(val, &x) != 0 || !(x > 0)))
+                && (amfi_cli_double(val, &x) != 0 || !(x > 0)))
                 return usage_error(opt, "'%s' is neither 'auto' nor a "
-                                   "number > 0", cli_shown(val));
+                                   "number > 0", amfi_cli_shown(val));
             o->lambda = val;
             break;
         case 6: o->formulation = val; break;
@@ -409,7 +409,7 @@ int main(int argc, char **argv)
         && amfi_formulation_parse(o.formulation, &cfg.solver.formulation)
                != 0) {
         fprintf(stderr, PROG ": --formulation: unknown formulation '%s'\n",
-                cli_shown(o.formulation));
+                amfi_cli_shown(o.formulation));
         return EXIT_USAGE;
     }
     if (o.lcurve && !cfg.lambda.automatic) {

@@ -44,7 +44,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "cli.h"
+#include "amfi_cli.h"
 
 #define PROG "amfi-batch-power"
 #define N_LEVELS 5
@@ -77,8 +77,8 @@ static void usage(void)
 static double arg_num(const char *opt, const char *s, double lo, double hi)
 {
     double v;
-    if (cli_parse_double(s, &v) || v < lo || v > hi) {
-        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, cli_shown(s), lo,
+    if (amfi_cli_double(s, &v) || v < lo || v > hi) {
+        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, amfi_cli_shown(s), lo,
                 hi);
         exit(2);
     }
@@ -96,7 +96,7 @@ static void parse(int argc, char **argv, opts *o)
             exit(0);
         }
         if (i + 1 >= argc) {
-            fprintf(stderr, "%s: %s: missing value or unknown option\n", PROG, cli_shown(k));
+            fprintf(stderr, "%s: %s: missing value or unknown option\n", PROG, amfi_cli_shown(k));
             usage();
             exit(2);
         }
@@ -132,7 +132,7 @@ static void parse(int argc, char **argv, opts *o)
                 exit(2);
             }
         } else {
-            fprintf(stderr, "%s: unknown option %s\n", PROG, cli_shown(k));
+            fprintf(stderr, "%s: unknown option %s\n", PROG, amfi_cli_shown(k));
             usage();
             exit(2);
         }
@@ -167,7 +167,7 @@ static int split(char *line, char **f, int max)
 
 static int field_num(const char *s, double *v)
 {
-    return cli_parse_double(s, v);
+    return amfi_cli_double(s, v);
 }
 
 /* Read the condition's rows into units (index: order within (rep, level)). */
@@ -222,28 +222,28 @@ static int read_units(const opts *o, unit **out, long *n_out)
         double rep_d, dmg, rec_d, g_true, g_fix;
         if (field_num(fl[1], &rep_d) || rep_d != floor(rep_d) || rep_d < 1 || rep_d > MAX_REPS) {
             fprintf(stderr, "%s:%ld: repetition: '%s' is not an integer in [1, %d]\n", o->path,
-                    lineno, cli_shown(fl[1]), MAX_REPS);
+                    lineno, amfi_cli_shown(fl[1]), MAX_REPS);
             goto out;
         }
         int lev;
         if (field_num(fl[2], &dmg) || (lev = level_of(dmg)) < 0) {
             fprintf(stderr, "%s:%ld: damage: '%s' is not one of 0, 0.025, 0.05, 0.075, 0.1\n",
-                    o->path, lineno, cli_shown(fl[2]));
+                    o->path, lineno, amfi_cli_shown(fl[2]));
             goto out;
         }
         if (field_num(fl[3], &rec_d) || rec_d != floor(rec_d) || rec_d < 1 || rec_d > 1e9) {
             fprintf(stderr, "%s:%ld: record: '%s' is not a positive integer\n", o->path, lineno,
-                    cli_shown(fl[3]));
+                    amfi_cli_shown(fl[3]));
             goto out;
         }
         if (field_num(fl[4], &g_true) || g_true <= 0 || g_true > 1e6) {
             fprintf(stderr, "%s:%ld: gvw_true_kg: '%s' is not in (0, 1e6]\n", o->path, lineno,
-                    cli_shown(fl[4]));
+                    amfi_cli_shown(fl[4]));
             goto out;
         }
         if (field_num(fl[5], &g_fix) || fabs(g_fix) > 1e7) {
             fprintf(stderr, "%s:%ld: gvw_fixed_kg: '%s' is not a finite weight\n", o->path,
-                    lineno, cli_shown(fl[5]));
+                    lineno, amfi_cli_shown(fl[5]));
             goto out;
         }
         int rep = (int)rep_d;
@@ -316,7 +316,7 @@ static int read_units(const opts *o, unit **out, long *n_out)
             }
     if (n_units < 10) {
         fprintf(stderr, "%s: %ld vehicles of condition '%s' (need at least 10)\n", o->path,
-                n_units, cli_shown(o->condition));
+                n_units, amfi_cli_shown(o->condition));
         goto out;
     }
     *out = u;
