@@ -28,6 +28,7 @@ pkgs=(
   systemd                        # systemd-analyze verify; pkg-config systemd (unit directories)
   dpkg-dev                       # dpkg-shlibdeps: the .deb's runtime dependencies (cpack)
   file                           # cpack's DEB generator needs it for dpkg-shlibdeps
+  libjansson-dev                 # JSON output of the tools (common/amfi_json.c): escaped strings
 )
 missing=()
 for p in "${pkgs[@]}"; do

@@ -14,6 +14,8 @@ out="$top/build/demo"
 rm -rf "$out"
 mkdir -p "$out"
 config="$top/config/demo.yaml"
+# the shipped population (and configurations) for a build that is not installed
+export AMFI_DATA_DIR="$top/config:$top/sim_publisher/data"
 echo "== amfid and sim_publisher on a private bus: 500 vehicles, 20 % damage from vehicle 251 (half way)"
 echo "   (about a minute; logs in $out)"
 OPENBLAS_NUM_THREADS=1 unshare --net bash -c '

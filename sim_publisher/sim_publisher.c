@@ -11,8 +11,9 @@
  * Configuration: every setting has a built-in default (amfi_config_defaults(),
  * an ideal simulation), which the configuration file's `simulation:` section
  * overrides, which a flag overrides. The file is --config FILE, else the
- * shipped config/sim_publisher.yaml (source tree, then the installed
- * share/amfi copy) if present; it holds the values built in and documents
+ * shipped sim_publisher.yaml found by common/amfi_datafile.h
+ * ($AMFI_DATA_DIR, then the installed etc/amfi and share/amfi copies) if
+ * present; it holds the values built in and documents
  * each key with its flag. The same file gives the bridge, the sensors and
  * the channels the stream is published on (daemon.channels.accel, vehicle,
  * truth), so any site file amfid reads also drives its simulator.
@@ -69,7 +70,9 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "amfi_cli.h"
 #include "amfi_config.h"
+#include "amfi_datafile.h"
 #include "amfi_messages.h"
 #include "passage.h"
 #include "profile.h"
@@ -79,15 +82,9 @@
 
 #define PROG "sim_publisher"
 
-#ifndef AMFI_DEFAULT_CONFIG
-#define AMFI_DEFAULT_CONFIG "config/sim_publisher.yaml"
-#endif
-#ifndef AMFI_INSTALLED_CONFIG
-#define AMFI_INSTALLED_CONFIG "/usr/local/share/amfi/sim_publisher.yaml"
-#endif
-#ifndef AMFI_DEFAULT_POPULATION
-#define AMFI_DEFAULT_POPULATION "sim_publisher/data/population.csv"
-#endif
+/* The shipped files looked for when none is named (common/amfi_datafile.h). */
+#define DEFAULT_CONFIG_NAME "sim_publisher.yaml"
+#define DEFAULT_POPULATION_NAME "population.csv"
 
 /* The effective settings: the built-in defaults (amfi_config_defaults()),
  * then the configuration file's simulation: section, then the flags. The
@@ -113,9 +110,10 @@ typedef struct opts {
     double detector_lead;
 } opts;
 
-static void usage(void)
+static void usage(FILE *f)
 {
-    fprintf(stderr,
+    char places[512];
+    fprintf(f,
             "usage: %s [--out DIR | --lcm-url URL|none] [--log FILE] [--speedup X|max]\n"
             "       [--headway SEC] [--damage-step-at K|none] [--noise-ms2 STD] [--block N]\n"
             "       [--start-utime US] [--detector-lead SEC]\n"
@@ -124,60 +122,101 @@ static void usage(void)
             "       [--track-std TRACKS] [--scan-rate HZ] [--noise FRACTION]\n"
             "       [--speed-error MEAN,STD] [--preceding-gap LO[,HI]|none] [--pre SEC]\n"
             "       [--post SEC] [--dt SEC]\n"
+            "\n"
+            "Simulated vehicles crossing the bridge: passage files (--out) or a live\n"
+            "LCM stream (docs/simulator.md).\n"
+            "  -o, --out DIR                  write vNNNNN.csv and meta.csv into DIR\n"
+            "  -c, --config FILE              site configuration (simulation: section)\n"
+            "  -p, --population FILE          WIM-style vehicle list (default population.csv)\n"
+            "  -n, --vehicles N               vehicles to simulate\n"
+            "      --first K                  first population record (0-based)\n"
+            "  -d, --damage FRACTION          stiffness loss of the bridge, 0 .. 0.9\n"
+            "  -s, --seed S                   random seed\n"
+            "      --profile A..H|smooth      ISO 8608 road class\n"
+            "      --track-std TRACKS         spread of the wheel track on the carpet\n"
+            "      --scan-rate HZ             accelerometer sampling rate\n"
+            "      --noise FRACTION           measurement noise, fraction of the RMS\n"
+            "      --speed-error MEAN,STD     relative error of the measured speed\n"
+            "      --preceding-gap LO[,HI]|none  a preceding vehicle, gap in s\n"
+            "      --pre SEC, --post SEC      record before entry / after exit\n"
+            "      --dt SEC                   integration step\n"
+            "  -u, --lcm-url URL|none         LCM bus to publish on (none: no bus)\n"
+            "  -l, --log FILE                 also write the events to an LCM log\n"
+            "      --speedup X|max            pacing: data time / wall time\n"
+            "      --headway SEC              time between vehicles\n"
+            "      --damage-step-at K|none    --damage from vehicle K on\n"
+            "      --noise-ms2 STD            noise on the stream, m/s^2\n"
+            "      --block N                  samples per accelerometer message\n"
+            "      --start-utime US           data time of the start, µs\n"
+            "      --detector-lead SEC        vehicle message this long before entry\n"
+            "  -h, --help                     this help\n"
+            "  -V, --version                  print the version\n"
             "Settings: built-in defaults < the configuration file's simulation: section\n"
-            "< flags. Without --config: %s,\n"
-            "else %s, if present.\n",
-            PROG, AMFI_DEFAULT_CONFIG, AMFI_INSTALLED_CONFIG);
+            "< flags. Without --config: sim_publisher.yaml, and without --population:\n"
+            "population.csv, from the first of %s.\n",
+            PROG, amfi_datafile_places(places, sizeof places));
 }
 
-static double num(const char *opt, const char *s, double lo, double hi)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, s, lo, hi);
-        exit(2);
-    }
-    return v;
-}
+enum {
+    O_FIRST = 256, O_PROFILE, O_TRACK_STD, O_SCAN_RATE, O_NOISE, O_SPEED_ERROR,
+    O_PRECEDING_GAP, O_PRE, O_POST, O_DT, O_SPEEDUP, O_HEADWAY, O_DAMAGE_STEP_AT,
+    O_NOISE_MS2, O_BLOCK, O_START_UTIME, O_DETECTOR_LEAD
+};
+
+static const struct option longopts[] = {
+    {"out", required_argument, NULL, 'o'},
+    {"config", required_argument, NULL, 'c'},
+    {"population", required_argument, NULL, 'p'},
+    {"vehicles", required_argument, NULL, 'n'},
+    {"first", required_argument, NULL, O_FIRST},
+    {"damage", required_argument, NULL, 'd'},
+    {"seed", required_argument, NULL, 's'},
+    {"profile", required_argument, NULL, O_PROFILE},
+    {"track-std", required_argument, NULL, O_TRACK_STD},
+    {"scan-rate", required_argument, NULL, O_SCAN_RATE},
+    {"noise", required_argument, NULL, O_NOISE},
+    {"speed-error", required_argument, NULL, O_SPEED_ERROR},
+    {"preceding-gap", required_argument, NULL, O_PRECEDING_GAP},
+    {"pre", required_argument, NULL, O_PRE},
+    {"post", required_argument, NULL, O_POST},
+    {"dt", required_argument, NULL, O_DT},
+    {"lcm-url", required_argument, NULL, 'u'},
+    {"log", required_argument, NULL, 'l'},
+    {"speedup", required_argument, NULL, O_SPEEDUP},
+    {"headway", required_argument, NULL, O_HEADWAY},
+    {"damage-step-at", required_argument, NULL, O_DAMAGE_STEP_AT},
+    {"noise-ms2", required_argument, NULL, O_NOISE_MS2},
+    {"block", required_argument, NULL, O_BLOCK},
+    {"start-utime", required_argument, NULL, O_START_UTIME},
+    {"detector-lead", required_argument, NULL, O_DETECTOR_LEAD},
+    AMFI_CLI_STANDARD,
+    {NULL, 0, NULL, 0}};
 
 /* "A" or "A,B" */
-static void pair(const char *opt, const char *s, double lo, double hi, double *a, double *b,
+static void pair(const amfi_cli *c, const char *s, double lo, double hi, double *a, double *b,
                  int need_two)
 {
-    char buf[128];
-    if (strlen(s) >= sizeof buf) {
-        fprintf(stderr, "%s: %s: too long\n", PROG, opt);
-        exit(2);
-    }
-    strcpy(buf, s);
-    char *comma = strchr(buf, ',');
-    if (!comma && need_two) {
-        fprintf(stderr, "%s: %s: expected two values 'A,B'\n", PROG, opt);
-        exit(2);
-    }
-    if (comma)
-        *comma = 0;
-    *a = num(opt, buf, lo, hi);
-    *b = comma ? num(opt, comma + 1, lo, hi) : *a;
+    double v[2];
+    if (need_two && !strchr(s, ','))
+        amfi_cli_fail(c, "expected two values 'A,B'");
+    int n = amfi_cli_list(c, s, v, 2, lo, hi);
+    if (need_two && n != 2)
+        amfi_cli_fail(c, "expected two values 'A,B'");
+    *a = v[0];
+    *b = n == 2 ? v[1] : v[0];
 }
 
-/* --config FILE (NULL when not given), looked for before the other flags,
- * which apply over the file. Returns 1 when the command line asks for --help
- * or is malformed: apply_flags() will then exit before any setting is used,
- * so no file needs to be read. */
-static int find_config(int argc, char **argv, const char **config)
+/* --config FILE (NULL when not given), read before the other flags, which
+ * apply over the file. A bad command line or --help/--version ends the
+ * program here, before any file is read. */
+static void find_config(int argc, char **argv, const char **config)
 {
+    amfi_cli c;
     *config = NULL;
-    for (int i = 1; i < argc; i += 2) { /* every option takes one value */
-        const char *k = argv[i];
-        if (!strcmp(k, "--help") || !strcmp(k, "-h") || i + 1 >= argc || strncmp(k, "--", 2))
-            return 1;
-        if (!strcmp(k, "--config"))
-            *config = argv[i + 1];
-    }
-    return 0;
+    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;)
+        if (k == 'c')
+            *config = optarg;
 }
 
 /* The configuration: FILE (--config), else the first of the default places
@@ -185,15 +224,13 @@ static int find_config(int argc, char **argv, const char **config)
  * message. */
 static int load_config(const char *file, amfi_site_config *cfg, const char **used)
 {
-    static const char *const places[] = {AMFI_DEFAULT_CONFIG, AMFI_INSTALLED_CONFIG};
+    static char found[4096]; /* *used may point here */
     char err[512];
-    struct stat st;
 
     amfi_config_defaults(cfg);
     *used = NULL;
-    for (size_t k = 0; !file && k < sizeof places / sizeof places[0]; k++)
-        if (stat(places[k], &st) == 0)
-            file = places[k];
+    if (!file && amfi_datafile_find(DEFAULT_CONFIG_NAME, found, sizeof found) == 0)
+        file = found;
     if (!file)
         return 0;
     if (amfi_config_load(file, cfg, err, sizeof err)) {
@@ -241,90 +278,62 @@ static void opts_from_config(opts *o, const amfi_sim_config *c, const char *file
  * bad command line. */
 static void apply_flags(int argc, char **argv, opts *o)
 {
-    for (int i = 1; i < argc; i++) {
-        const char *k = argv[i];
-        if (!strcmp(k, "--help") || !strcmp(k, "-h")) {
-            usage();
-            exit(0);
-        }
-        if (i + 1 >= argc || strncmp(k, "--", 2)) {
-            fprintf(stderr, "%s: %s: %s\n", PROG, k,
-                    strncmp(k, "--", 2) ? "unexpected argument" : "missing value");
-            usage();
-            exit(2);
-        }
-        const char *v = argv[++i];
-        if (!strcmp(k, "--out"))
-            o->out = v;
-        else if (!strcmp(k, "--config"))
-            ; /* read by find_config() */
-        else if (!strcmp(k, "--population"))
-            o->population = v;
-        else if (!strcmp(k, "--vehicles"))
-            o->vehicles = (long)num(k, v, 1, 1e7);
-        else if (!strcmp(k, "--first"))
-            o->first = (long)num(k, v, 0, 1e7);
-        else if (!strcmp(k, "--damage"))
-            o->damage = num(k, v, 0, 0.9);
-        else if (!strcmp(k, "--seed"))
-            o->seed = (unsigned long)num(k, v, 0, 4294967295.0);
-        else if (!strcmp(k, "--profile")) {
+    amfi_cli c;
+    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        const char *v = optarg;
+        switch (k) {
+        case 'o': o->out = v; break;
+        case 'c': break; /* read by find_config() */
+        case 'p': o->population = v; break;
+        case 'n': o->vehicles = (long)amfi_cli_num(&c, v, 1, 1e7); break;
+        case O_FIRST: o->first = (long)amfi_cli_num(&c, v, 0, 1e7); break;
+        case 'd': o->damage = amfi_cli_num(&c, v, 0, 0.9); break;
+        case 's': o->seed = (unsigned long)amfi_cli_num(&c, v, 0, 4294967295.0); break;
+        case O_PROFILE:
             if (!strcmp(v, "smooth"))
                 o->profile_class = 0;
             else if (strlen(v) == 1 && v[0] >= 'A' && v[0] <= 'H')
                 o->profile_class = v[0];
-            else {
-                fprintf(stderr, "%s: --profile: '%s' is not A..H or smooth\n", PROG, v);
-                exit(2);
+            else
+                amfi_cli_fail(&c, "'%s' is not A..H or smooth", amfi_cli_shown(v));
+            break;
+        case O_TRACK_STD: o->track_std = amfi_cli_num(&c, v, 0, 100); break;
+        case O_SCAN_RATE: o->scan_rate = amfi_cli_num(&c, v, 50, 20000); break;
+        case O_NOISE: o->noise = amfi_cli_num(&c, v, 0, 1); break;
+        case O_SPEED_ERROR:
+            pair(&c, v, -0.5, 0.5, &o->speed_err_mean, &o->speed_err_std, 1);
+            break;
+        case O_PRECEDING_GAP:
+            if (!strcmp(v, "none")) {
+                o->preceding = 0; /* over a gap in the configuration file */
+                o->gap_lo = o->gap_hi = 0.0;
+                break;
             }
-        } else if (!strcmp(k, "--track-std"))
-            o->track_std = num(k, v, 0, 100);
-        else if (!strcmp(k, "--scan-rate"))
-            o->scan_rate = num(k, v, 50, 20000);
-        else if (!strcmp(k, "--noise"))
-            o->noise = num(k, v, 0, 1);
-        else if (!strcmp(k, "--speed-error"))
-            pair(k, v, -0.5, 0.5, &o->speed_err_mean, &o->speed_err_std, 1);
-        else if (!strcmp(k, "--preceding-gap") && !strcmp(v, "none")) {
-            o->preceding = 0; /* over a gap in the configuration file */
-            o->gap_lo = o->gap_hi = 0.0;
-        } else if (!strcmp(k, "--preceding-gap")) {
-            pair(k, v, -2, 30, &o->gap_lo, &o->gap_hi, 0);
+            pair(&c, v, -2, 30, &o->gap_lo, &o->gap_hi, 0);
             o->preceding = 1;
-            if (o->gap_hi < o->gap_lo) {
-                fprintf(stderr, "%s: --preceding-gap: LO must not exceed HI\n", PROG);
-                exit(2);
-            }
-        } else if (!strcmp(k, "--pre"))
-            o->pre = num(k, v, 0, 30);
-        else if (!strcmp(k, "--post"))
-            o->post = num(k, v, 0, 30);
-        else if (!strcmp(k, "--dt"))
-            o->dt = num(k, v, 1e-6, 1e-3);
-        else if (!strcmp(k, "--lcm-url")) {
+            if (o->gap_hi < o->gap_lo)
+                amfi_cli_fail(&c, "LO must not exceed HI");
+            break;
+        case O_PRE: o->pre = amfi_cli_num(&c, v, 0, 30); break;
+        case O_POST: o->post = amfi_cli_num(&c, v, 0, 30); break;
+        case O_DT: o->dt = amfi_cli_num(&c, v, 1e-6, 1e-3); break;
+        case 'u':
             o->lcm_url = v;
             o->lcm_url_flag = 1;
-        }
-        else if (!strcmp(k, "--log"))
-            o->log = v;
-        else if (!strcmp(k, "--speedup"))
-            o->speedup = !strcmp(v, "max") ? 0.0 : num(k, v, 0.01, 1e6);
-        else if (!strcmp(k, "--headway"))
-            o->headway = num(k, v, 0.1, 3600);
-        else if (!strcmp(k, "--damage-step-at"))
-            o->damage_step_at = !strcmp(v, "none") ? -1 : (long)num(k, v, 0, 1e7);
-        else if (!strcmp(k, "--noise-ms2"))
-            o->noise_ms2 = num(k, v, 0, 10);
-        else if (!strcmp(k, "--block"))
-            o->block = (int)num(k, v, 1, 160);
-        else if (!strcmp(k, "--start-utime"))
-            o->start_utime = (long long)num(k, v, 1, 4e15);
-        else if (!strcmp(k, "--detector-lead"))
-            o->detector_lead = num(k, v, 0, 60);
-        else {
-            fprintf(stderr, "%s: unknown option %s\n", PROG, k);
-            usage();
-            exit(2);
+            break;
+        case 'l': o->log = v; break;
+        case O_SPEEDUP:
+            o->speedup = !strcmp(v, "max") ? 0.0 : amfi_cli_num(&c, v, 0.01, 1e6);
+            break;
+        case O_HEADWAY: o->headway = amfi_cli_num(&c, v, 0.1, 3600); break;
+        case O_DAMAGE_STEP_AT:
+            o->damage_step_at = !strcmp(v, "none") ? -1 : (long)amfi_cli_num(&c, v, 0, 1e7);
+            break;
+        case O_NOISE_MS2: o->noise_ms2 = amfi_cli_num(&c, v, 0, 10); break;
+        case O_BLOCK: o->block = (int)amfi_cli_num(&c, v, 1, 160); break;
+        case O_START_UTIME: o->start_utime = (long long)amfi_cli_num(&c, v, 1, 4e15); break;
+        case O_DETECTOR_LEAD: o->detector_lead = amfi_cli_num(&c, v, 0, 60); break;
         }
     }
     if (o->speed_err_std < 0) {
@@ -349,6 +358,67 @@ static void seed_vehicle(gsl_rng *r, unsigned long seed, long i)
     h *= 0xBF58476D1CE4E5B9ull;
     h ^= h >> 29;
     gsl_rng_set(r, (unsigned long)(h & 0xffffffffu) | 1u);
+}
+
+/* ---- the simulated world ---------------------------------------------------- */
+
+/* What both modes simulate on: the bridge (healthy; with a damage step
+ * while streaming, also the damaged one), the road carpet, the simulation
+ * settings and the vehicle property law. Built once per run, by
+ * world_build(); owned by main. */
+typedef struct world {
+    amfi_bridge *bridge;  /* the bridge the run starts with */
+    amfi_bridge *damaged; /* --damage-step-at: the bridge from then on, else NULL */
+    amfi_profile *prof;
+    amfi_sim_params sp;
+    amfi_halfcar_dist dist;
+} world;
+
+static void world_free(world *w)
+{
+    amfi_profile_destroy(w->prof);
+    amfi_bridge_destroy(w->damaged);
+    amfi_bridge_destroy(w->bridge);
+    memset(w, 0, sizeof *w);
+}
+
+/* 0, or 1 after a message. */
+static int world_build(const opts *o, const amfi_site_config *cfg, world *w)
+{
+    char err[512];
+    const int step = !o->out && o->damage_step_at >= 0;
+    memset(w, 0, sizeof *w);
+    amfi_bridge_params bp = cfg->bridge;
+    bp.damage = step ? 0.0 : o->damage;
+    if (amfi_bridge_create(&bp, &w->bridge, err, sizeof err)) {
+        fprintf(stderr, "%s: bridge: %s\n", PROG, err);
+        return 1;
+    }
+    if (step) {
+        bp.damage = o->damage;
+        if (amfi_bridge_create(&bp, &w->damaged, err, sizeof err)) {
+            fprintf(stderr, "%s: bridge: %s\n", PROG, err);
+            world_free(w);
+            return 1;
+        }
+    }
+    amfi_sim_params_default(&w->sp, cfg->bridge.span_m);
+    w->sp.dt_s = o->dt;
+    w->sp.scan_rate_hz = o->scan_rate;
+    w->sp.n_sensors = cfg->solver.n_sensors;
+    memcpy(w->sp.sensor_x_m, cfg->solver.sensor_x_m, sizeof w->sp.sensor_x_m);
+    amfi_profile_params pp;
+    amfi_profile_params_default(&pp);
+    pp.iso_class = o->profile_class;
+    pp.seed = o->seed;
+    pp.length_m = w->sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + cfg->bridge.span_m + 100.0;
+    if (amfi_profile_create(&pp, &w->prof, err, sizeof err)) {
+        fprintf(stderr, "%s: profile: %s\n", PROG, err);
+        world_free(w);
+        return 1;
+    }
+    amfi_halfcar_dist_paper(&w->dist);
+    return 0;
 }
 
 /* ---- streaming ----------------------------------------------------------- */
@@ -411,14 +481,12 @@ typedef struct planned {
     double spacing;
 } planned;
 
-static int stream(const opts *o, amfi_site_config *cfg, const amfi_vehicle_rec *recs,
-                  const char *ppath)
+static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
+                  const amfi_vehicle_rec *recs, const char *ppath)
 {
     char err[512];
     int rc = 1;
     bus b = {0};
-    amfi_bridge *healthy = NULL, *damaged = NULL;
-    amfi_profile *prof = NULL;
     amfi_sim *sim = NULL;
     planned *plan = calloc((size_t)o->vehicles, sizeof *plan);
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
@@ -440,45 +508,20 @@ static int stream(const opts *o, amfi_site_config *cfg, const amfi_vehicle_rec *
             goto out;
         }
     }
-    amfi_bridge_params bp = cfg->bridge;
-    bp.damage = o->damage_step_at >= 0 ? 0.0 : o->damage;
-    if (amfi_bridge_create(&bp, &healthy, err, sizeof err)) {
-        fprintf(stderr, "%s: bridge: %s\n", PROG, err);
-        goto out;
-    }
-    if (o->damage_step_at >= 0) {
-        bp.damage = o->damage;
-        if (amfi_bridge_create(&bp, &damaged, err, sizeof err)) {
-            fprintf(stderr, "%s: bridge: %s\n", PROG, err);
-            goto out;
-        }
-    }
-    amfi_sim_params sp;
-    amfi_sim_params_default(&sp, cfg->bridge.span_m);
-    sp.dt_s = o->dt;
-    sp.scan_rate_hz = o->scan_rate;
-    sp.n_sensors = cfg->solver.n_sensors;
-    memcpy(sp.sensor_x_m, cfg->solver.sensor_x_m, sizeof sp.sensor_x_m);
-    amfi_profile_params pp;
-    amfi_profile_params_default(&pp);
-    pp.iso_class = o->profile_class;
-    pp.seed = o->seed;
-    pp.length_m = sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + cfg->bridge.span_m + 100.0;
-    if (amfi_profile_create(&pp, &prof, err, sizeof err) ||
-        amfi_sim_create(healthy, prof, &sp, &sim, err, sizeof err)) {
+    const amfi_sim_params sp = w->sp;
+    amfi_bridge *const damaged = w->damaged;
+    if (amfi_sim_create(w->bridge, w->prof, &sp, &sim, err, sizeof err)) {
         fprintf(stderr, "%s: %s\n", PROG, err);
         goto out;
     }
     /* The plan: entries spaced by the headway (or the population's clock),
      * the first after its full approach. */
-    amfi_halfcar_dist dist;
-    amfi_halfcar_dist_paper(&dist);
     double t = 0.0;
     for (long i = 0; i < o->vehicles; i++) {
         const amfi_vehicle_rec *rec = &recs[o->first + i];
         amfi_passage_spec spec;
         seed_vehicle(rng, o->seed, o->first + i);
-        if (amfi_passage_spec_from_rec(rec, &dist, prof, o->track_std, rng, &spec, err,
+        if (amfi_passage_spec_from_rec(rec, &w->dist, w->prof, o->track_std, rng, &spec, err,
                                        sizeof err)) {
             fprintf(stderr, "%s: %s: vehicle %ld: %s\n", PROG, ppath, o->first + i + 1, err);
             goto out;
@@ -610,9 +653,6 @@ static int stream(const opts *o, amfi_site_config *cfg, const amfi_vehicle_rec *
 out:
     free(acc);
     amfi_sim_destroy(sim);
-    amfi_profile_destroy(prof);
-    amfi_bridge_destroy(damaged);
-    amfi_bridge_destroy(healthy);
     if (b.log)
         lcm_eventlog_destroy(b.log);
     if (b.lcm)
@@ -629,14 +669,25 @@ int main(int argc, char **argv)
     static amfi_site_config cfg; /* large; o's strings point into it */
     const char *cfile = NULL, *cused = NULL;
     amfi_config_defaults(&cfg);
-    if (!find_config(argc, argv, &cfile) && load_config(cfile, &cfg, &cused))
+    find_config(argc, argv, &cfile);
+    if (load_config(cfile, &cfg, &cused))
         return 1;
     opts_from_config(&o, &cfg.sim, cused);
     apply_flags(argc, argv, &o);
     amfi_set_blas_threads(1);
     char err[512];
     cfg.bridge.damage = o.damage;
-    const char *ppath = o.population ? o.population : AMFI_DEFAULT_POPULATION;
+    char found[4096];
+    const char *ppath = o.population;
+    if (!ppath) {
+        if (amfi_datafile_find(DEFAULT_POPULATION_NAME, found, sizeof found) != 0) {
+            char places[512];
+            fprintf(stderr, "%s: no --population and no %s in %s (set AMFI_DATA_DIR)\n", PROG,
+                    DEFAULT_POPULATION_NAME, amfi_datafile_places(places, sizeof places));
+            return 1;
+        }
+        ppath = found;
+    }
     amfi_vehicle_rec *recs = NULL;
     int n_recs = 0;
     if (amfi_traffic_read(ppath, &recs, &n_recs, err, sizeof err)) {
@@ -649,43 +700,31 @@ int main(int argc, char **argv)
         amfi_traffic_free(recs);
         return 2;
     }
+    world w;
+    if (world_build(&o, &cfg, &w)) {
+        amfi_traffic_free(recs);
+        return 1;
+    }
     if (!o.out) {
-        int src = stream(&o, &cfg, recs, ppath);
+        int src = stream(&o, &cfg, &w, recs, ppath);
+        world_free(&w);
         amfi_traffic_free(recs);
         return src;
     }
     if (mkdir(o.out, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "%s: %s: cannot create: %s\n", PROG, o.out, strerror(errno));
+        world_free(&w);
         amfi_traffic_free(recs);
         return 1;
     }
-    amfi_bridge *b = NULL;
-    amfi_profile *prof = NULL;
+    amfi_bridge *const b = w.bridge;
+    amfi_profile *const prof = w.prof;
+    const amfi_sim_params sp = w.sp;
+    const amfi_halfcar_dist dist = w.dist;
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     double *acc = NULL;
     FILE *meta = NULL;
     int rc = 1;
-    if (amfi_bridge_create(&cfg.bridge, &b, err, sizeof err)) {
-        fprintf(stderr, "%s: bridge: %s\n", PROG, err);
-        goto out;
-    }
-    amfi_sim_params sp;
-    amfi_sim_params_default(&sp, cfg.bridge.span_m);
-    sp.dt_s = o.dt;
-    sp.scan_rate_hz = o.scan_rate;
-    sp.n_sensors = cfg.solver.n_sensors;
-    memcpy(sp.sensor_x_m, cfg.solver.sensor_x_m, sizeof sp.sensor_x_m);
-    amfi_profile_params pp;
-    amfi_profile_params_default(&pp);
-    pp.iso_class = o.profile_class;
-    pp.seed = o.seed;
-    pp.length_m = sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + cfg.bridge.span_m + 100.0;
-    if (amfi_profile_create(&pp, &prof, err, sizeof err)) {
-        fprintf(stderr, "%s: profile: %s\n", PROG, err);
-        goto out;
-    }
-    amfi_halfcar_dist dist;
-    amfi_halfcar_dist_paper(&dist);
     const int cap = (int)((o.pre + o.post + 60.0) * o.scan_rate);
     acc = malloc(sizeof(double) * cap * sp.n_sensors);
     char path[4096];
@@ -767,8 +806,7 @@ out:
         fclose(meta);
     free(acc);
     gsl_rng_free(rng);
-    amfi_profile_destroy(prof);
-    amfi_bridge_destroy(b);
+    world_free(&w);
     amfi_traffic_free(recs);
     return rc;
 }

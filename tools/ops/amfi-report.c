@@ -76,41 +76,32 @@ static void usage(FILE *f)
             "[--note TEXT] [--check]\n"
             "\n"
             "Reports on amfid's SQLite store (schema: docs/schema.md).\n"
-            "  --db PATH             the store (must exist)\n"
-            "  --summary             passages by status, GVW of the ok ones, "
-            "time span, baseline\n"
-            "  --trend               the last %d indicators\n"
-            "  --alerts              the last %d alerts and those open now\n"
-            "  --errors              inferred GVW against the truth "
+            "  -d, --db PATH                the store (must exist)\n"
+            "  -s, --summary                passages by status, GVW of the ok "
+            "ones, time span, baseline\n"
+            "  -t, --trend                  the last %d indicators\n"
+            "  -a, --alerts                 the last %d alerts and those open "
+            "now\n"
+            "  -e, --errors                 inferred GVW against the truth "
             "(simulations)\n"
-            "  --set-baseline-last N baseline (source manual) from the last N "
-            "ok passages, N >= 2\n"
-            "  --set-baseline M,S,N  baseline mean M kg, STD S kg, from N "
-            "passages\n"
-            "  --note TEXT           note stored with the baseline (<= 127 "
-            "bytes)\n"
-            "  --check               PRAGMA integrity_check and "
+            "  -B, --set-baseline-last N    baseline (source manual) from the "
+            "last N ok passages, N >= 2\n"
+            "  -b, --set-baseline M,S,N     baseline mean M kg, STD S kg, from "
+            "N passages\n"
+            "  -n, --note TEXT              note stored with the baseline "
+            "(<= 127 bytes)\n"
+            "  -k, --check                  PRAGMA integrity_check and "
             "foreign_key_check\n"
+            "  -h, --help                   this help\n"
+            "  -V, --version                print the version\n"
             "With no option: --summary --trend --alerts.\n"
             "Exit status: 0 ok, 1 database error or check failed, 2 usage "
             "error.\n",
             TREND_ROWS, ALERT_ROWS);
 }
 
-static int usage_error(const char *opt, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
-
 /* "amfi-report: OPT: problem" on stderr; returns −1 */
-static int usage_error(const char *opt, const char *fmt, ...)
-{
-    va_list ap;
-    fprintf(stderr, PROG ": %s: ", opt);
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fputc('\n', stderr);
-    return -1;
-}
+#define usage_error(opt, ...) (amfi_cli_error(PROG, opt, __VA_ARGS__), -1)
 
 static int data_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
@@ -173,61 +164,44 @@ static int parse_baseline(const char *arg, options *o)
 
 static int parse_args(int argc, char **argv, options *o)
 {
-    static const char *const flags[] = {"--summary", "--trend", "--alerts",
-                                        "--errors", "--check"};
-    static const char *const valued[] = {"--db", "--set-baseline-last",
-                                         "--set-baseline", "--note"};
+    static const struct option longopts[] = {
+        {"db", required_argument, NULL, 'd'},
+        {"summary", no_argument, NULL, 's'},
+        {"trend", no_argument, NULL, 't'},
+        {"alerts", no_argument, NULL, 'a'},
+        {"errors", no_argument, NULL, 'e'},
+        {"set-baseline-last", required_argument, NULL, 'B'},
+        {"set-baseline", required_argument, NULL, 'b'},
+        {"note", required_argument, NULL, 'n'},
+        {"check", no_argument, NULL, 'k'},
+        AMFI_CLI_STANDARD,
+        {NULL, 0, NULL, 0}};
     memset(o, 0, sizeof *o);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int which = -1;
-        const char *val = NULL;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            exit(0);
-        }
-        for (int k = 0; k < 5; k++)
-            if (strcmp(a, flags[k]) == 0)
-                which = k;
-        if (which >= 0) {
-            int *f[] = {&o->summary, &o->trend, &o->alerts, &o->errors,
-                        &o->check};
-            *f[which] = 1;
-            continue;
-        }
-        for (int k = 0; k < 4; k++) {
-            size_t n = strlen(valued[k]);
-            if (strncmp(a, valued[k], n) == 0 && (a[n] == '\0' || a[n] == '=')) {
-                which = k;
-                val = a[n] == '=' ? a + n + 1 : NULL;
-            }
-        }
-        if (which < 0)
-            return usage_error(amfi_cli_shown(a), a[0] == '-'
-                                             ? "unknown option (see --help)"
-                                             : "unexpected argument (see --help)");
-        const char *opt = valued[which];
-        if (!val) {
-            if (i + 1 >= argc)
-                return usage_error(opt, "needs a value");
-            val = argv[++i];
-        }
-        switch (which) {
-        case 0:
+    amfi_cli c;
+    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        const char *opt = c.opt, *val = optarg;
+        switch (k) {
+        case 's': o->summary = 1; break;
+        case 't': o->trend = 1; break;
+        case 'a': o->alerts = 1; break;
+        case 'e': o->errors = 1; break;
+        case 'k': o->check = 1; break;
+        case 'd':
             if (!*val)
                 return usage_error(opt, "empty value");
             o->db = val;
             break;
-        case 1:
+        case 'B':
             if (parse_int(val, 2, MAX_BASELINE_N, &o->baseline_last) != 0)
                 return usage_error(opt, "'%s' is not an integer in [2, %d]",
                                    amfi_cli_shown(val), MAX_BASELINE_N);
             break;
-        case 2:
+        case 'b':
             if (parse_baseline(val, o) != 0)
                 return -1;
             break;
-        case 3:
+        case 'n':
             if (strlen(val) > 127)
                 return usage_error(opt, "%zu bytes, at most 127", strlen(val));
             o->note = val;

@@ -32,6 +32,8 @@
 #include "amfi/amfi.h"
 #include "amfi_cli.h"
 #include "amfi_config.h"
+#include "amfi_datafile.h"
+#include "amfi_json.h"
 
 #define PROG "amfi-solve"
 #define EXIT_DATA 1
@@ -39,21 +41,9 @@
 #define MAX_SPEED_MPS 60.0   /* 216 km/h: anything faster is a typo */
 #define MAX_SPACING_M 30.0   /* longer than any road vehicle's axle gap */
 
-#ifndef AMFI_DEFAULT_CONFIG
-#define AMFI_DEFAULT_CONFIG "paper-20m.yaml"
-#endif
-
-/* Where the shipped configuration may be when none is named: the source tree
- * the program was built from, then the installed copies. */
-static const char *const default_configs[] = {
-    AMFI_DEFAULT_CONFIG,
-#ifdef AMFI_INSTALLED_CONFIG
-    AMFI_INSTALLED_CONFIG,
-#endif
-#ifdef AMFI_INSTALLED_CONFIG2
-    AMFI_INSTALLED_CONFIG2,
-#endif
-};
+/* The shipped configuration looked for when none is named
+ * (common/amfi_datafile.h: $AMFI_DATA_DIR, then the installed copies). */
+#define DEFAULT_CONFIG_NAME "paper-20m.yaml"
 
 typedef struct options {
     const char *config;      /* NULL: the default search */
@@ -70,6 +60,7 @@ typedef struct options {
 
 static void usage(FILE *f)
 {
+    char places[512];
     fprintf(f,
             "usage: " PROG " [--config FILE.yaml] --accel CASE.csv[.gz] "
             "--speed MPS --axle-spacing S1[,S2,...]\n"
@@ -79,37 +70,29 @@ static void usage(FILE *f)
             "\n"
             "Solves one recorded passage (CSV 't,accel', plain or gzip) "
             "and prints a JSON line.\n"
-            "  --config FILE      site configuration (default: paper-20m)\n"
-            "  --accel FILE       accelerations, t in s, m/s^2 positive "
+            "  -c, --config FILE        site configuration (default: paper-20m.yaml\n"
+            "                           from %s,\n"
+            "                           else the built-in paper-20m values)\n"
+            "  -a, --accel FILE         accelerations, t in s, m/s^2 positive "
             "downward\n"
-            "  --speed MPS        vehicle speed, 0 < v <= %g m/s\n"
-            "  --axle-spacing S   axle spacings, m, comma-separated "
+            "  -s, --speed MPS          vehicle speed, 0 < v <= %g m/s\n"
+            "  -x, --axle-spacing S     axle spacings, m, comma-separated "
             "(0 < s <= %g)\n"
-            "  --entry-time SEC   time on the file's clock when the first "
+            "  -e, --entry-time SEC     time on the file's clock when the first "
             "axle enters (default 0)\n"
-            "  --lambda L         'auto' (L-curve) or lambda at the config's "
+            "  -l, --lambda L           'auto' (L-curve) or lambda at the config's "
             "lambda reference rate\n"
-            "  --formulation F    solver formulation (default: the config's)\n"
-            "  --forces FILE      write t,x1,force1_N,... per step\n"
-            "  --lcurve FILE      write the L-curve (needs --lambda auto)\n"
+            "  -f, --formulation F      solver formulation (default: the config's)\n"
+            "  -F, --forces FILE        write t,x1,force1_N,... per step\n"
+            "  -L, --lcurve FILE        write the L-curve (needs --lambda auto)\n"
+            "  -h, --help               this help\n"
+            "  -V, --version            print the version\n"
             "Exit status: 0 ok, 1 data or solver error, 2 usage error.\n",
-            MAX_SPEED_MPS, MAX_SPACING_M);
+            amfi_datafile_places(places, sizeof places), MAX_SPEED_MPS, MAX_SPACING_M);
 }
 
 /* "amfi-solve: OPT: problem" on stderr; returns −1 */
-static int usage_error(const char *opt, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
-
-static int usage_error(const char *opt, const char *fmt, ...)
-{
-    va_list ap;
-    fprintf(stderr, PROG ": %s: ", opt);
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fputc('\n', stderr);
-    return -1;
-}
+#define usage_error(opt, ...) (amfi_cli_error(PROG, opt, __VA_ARGS__), -1)
 
 static int parse_spacings(const char *arg, options *o)
 {
@@ -144,49 +127,34 @@ static int parse_spacings(const char *arg, options *o)
     }
 }
 
-/* Options take a value, as "--name VALUE" or "--name=VALUE". */
+/* Options take a value, as "--name VALUE", "--name=VALUE" or "-n VALUE". */
 static int parse_args(int argc, char **argv, options *o)
 {
+    static const struct option longopts[] = {
+        {"config", required_argument, NULL, 'c'},
+        {"accel", required_argument, NULL, 'a'},
+        {"speed", required_argument, NULL, 's'},
+        {"axle-spacing", required_argument, NULL, 'x'},
+        {"entry-time", required_argument, NULL, 'e'},
+        {"lambda", required_argument, NULL, 'l'},
+        {"formulation", required_argument, NULL, 'f'},
+        {"forces", required_argument, NULL, 'F'},
+        {"lcurve", required_argument, NULL, 'L'},
+        AMFI_CLI_STANDARD,
+        {NULL, 0, NULL, 0}};
     memset(o, 0, sizeof *o);
     o->speed_mps = NAN;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            exit(0);
-        }
-        static const char *const names[] = {
-            "--config", "--accel", "--speed", "--axle-spacing", "--entry-time",
-            "--lambda", "--formulation", "--forces", "--lcurve"};
-        int which = -1;
-        const char *val = NULL;
-        for (int k = 0; k < (int)(sizeof names / sizeof names[0]); k++) {
-            size_t n = strlen(names[k]);
-            if (strncmp(a, names[k], n) == 0
-                && (a[n] == '\0' || a[n] == '=')) {
-                which = k;
-                val = a[n] == '=' ? a + n + 1 : NULL;
-                break;
-            }
-        }
-        if (which < 0) {
-            if (a[0] == '-')
-                return usage_error(amfi_cli_shown(a), "unknown option (see --help)");
-            return usage_error(amfi_cli_shown(a), "unexpected argument (see --help)");
-        }
-        const char *opt = names[which];
-        if (!val) {
-            if (i + 1 >= argc)
-                return usage_error(opt, "needs a value");
-            val = argv[++i];
-        }
+    amfi_cli c;
+    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        const char *opt = c.opt, *val = optarg;
         if (val[0] == '\0')
             return usage_error(opt, "empty value");
         double x;
-        switch (which) {
-        case 0: o->config = val; break;
-        case 1: o->accel = val; break;
-        case 2:
+        switch (k) {
+        case 'c': o->config = val; break;
+        case 'a': o->accel = val; break;
+        case 's':
             if (amfi_cli_double(val, &x) != 0)
                 return usage_error(opt, "'%s' is not a number", amfi_cli_shown(val));
             if (!(x > 0))
@@ -196,25 +164,25 @@ static int parse_args(int argc, char **argv, options *o)
                                    "(max %g m/s)", amfi_cli_shown(val), MAX_SPEED_MPS);
             o->speed_mps = x;
             break;
-        case 3:
+        case 'x':
             if (parse_spacings(val, o) != 0)
                 return -1;
             break;
-        case 4:
+        case 'e':
             if (amfi_cli_double(val, &x) != 0)
                 return usage_error(opt, "'%s' is not a number", amfi_cli_shown(val));
             o->entry_time_s = x;
             break;
-        case 5:
+        case 'l':
             if (strcmp(val, "auto") != 0
                 && (amfi_cli_double(val, &x) != 0 || !(x > 0)))
                 return usage_error(opt, "'%s' is neither 'auto' nor a "
                                    "number > 0", amfi_cli_shown(val));
             o->lambda = val;
             break;
-        case 6: o->formulation = val; break;
-        case 7: o->forces = val; break;
-        case 8: o->lcurve = val; break;
+        case 'f': o->formulation = val; break;
+        case 'F': o->forces = val; break;
+        case 'L': o->lcurve = val; break;
         }
     }
     if (!o->accel)
@@ -229,26 +197,18 @@ static int parse_args(int argc, char **argv, options *o)
 /* 0 loaded (or defaults because no file exists), −1 error reported. */
 static int load_config(const options *o, amfi_site_config *c)
 {
-    char err[512];
-    if (o->config) {
-        if (amfi_config_load(o->config, c, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return -1;
-        }
+    char err[512], found[4096];
+    const char *file = o->config;
+    if (!file && amfi_datafile_find(DEFAULT_CONFIG_NAME, found, sizeof found) == 0)
+        file = found;
+    if (!file) {
+        amfi_config_defaults(c);
         return 0;
     }
-    for (size_t k = 0; k < sizeof default_configs / sizeof default_configs[0];
-         k++) {
-        struct stat st;
-        if (stat(default_configs[k], &st) != 0)
-            continue;
-        if (amfi_config_load(default_configs[k], c, err, sizeof err) != 0) {
-            fprintf(stderr, "%s\n", err);
-            return -1;
-        }
-        return 0;
+    if (amfi_config_load(file, c, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return -1;
     }
-    amfi_config_defaults(c);
     return 0;
 }
 
@@ -256,15 +216,6 @@ static double elapsed_ms(const struct timespec *a, const struct timespec *b)
 {
     return (double)(b->tv_sec - a->tv_sec) * 1e3
            + (double)(b->tv_nsec - a->tv_nsec) * 1e-6;
-}
-
-/* JSON has no NaN or Inf: write null for them. */
-static void json_num(FILE *f, double x)
-{
-    if (isfinite(x))
-        fprintf(f, "%.10g", x);
-    else
-        fputs("null", f);
 }
 
 static void csv_num(FILE *f, double x)
@@ -345,46 +296,28 @@ static int write_lcurve(const char *path, const amfi_result *r)
     return finish_file(f, "--lcurve", path);
 }
 
-static void print_json(const amfi_site_config *c, const amfi_result *r,
-                       double scan_rate_hz, double solve_ms)
+/* The result as one JSON line on stdout (common/amfi_json.h). */
+static int print_json(const amfi_site_config *c, const amfi_result *r,
+                      double scan_rate_hz, double solve_ms)
 {
-    FILE *f = stdout;
-    fputs("{\"gvw_kg\":", f);
-    json_num(f, r->gvw_kg);
-    fputs(",\"axle_kg\":[", f);
+    json_t *axle = json_array(), *force = json_array();
     for (int a = 0; a < r->n_axles; a++) {
-        if (a)
-            fputc(',', f);
-        json_num(f, r->axle_kg[a]);
+        json_array_append_new(axle, amfi_json_num(r->axle_kg[a]));
+        json_array_append_new(force, amfi_json_num(r->mean_force_N[a]));
     }
-    fputs("],\"mean_force_N\":[", f);
-    for (int a = 0; a < r->n_axles; a++) {
-        if (a)
-            fputc(',', f);
-        json_num(f, r->mean_force_N[a]);
-    }
-    fputs("],\"lambda\":", f);
-    json_num(f, r->lambda_h);
-    fputs(",\"lambda_ref\":", f);
-    json_num(f, r->lambda_ref);
-    fputs(",\"lambda_ref_rate_hz\":", f);
-    json_num(f, c->lambda.ref_rate_hz);
-    fprintf(f, ",\"formulation\":\"%s\",\"coordinates\":\"%s\",\"modes\":%d",
-            amfi_formulation_name(c->solver.formulation),
-            c->solver.coords == AMFI_COORDS_NODAL ? "nodal" : "modal",
-            r->n_modes);
-    fputs(",\"calc_rate_hz\":", f);
-    json_num(f, c->solver.calc_rate_hz);
-    fputs(",\"scan_rate_hz\":", f);
-    json_num(f, scan_rate_hz);
-    fprintf(f, ",\"n_steps\":%d", r->n_steps);
-    fputs(",\"residual_rms\":", f);
-    json_num(f, r->residual_rms);
-    fputs(",\"signal_rms\":", f);
-    json_num(f, r->signal_rms);
-    fputs(",\"solve_ms\":", f);
-    json_num(f, solve_ms);
-    fprintf(f, ",\"lcurve_points\":%d}\n", r->lcurve_n);
+    json_t *o = json_pack(
+        "{s:o, s:o, s:o, s:o, s:o, s:o, s:s, s:s, s:i, s:o, s:o, s:i, s:o, s:o, s:o, s:i}",
+        "gvw_kg", amfi_json_num(r->gvw_kg), "axle_kg", axle, "mean_force_N", force,
+        "lambda", amfi_json_num(r->lambda_h), "lambda_ref", amfi_json_num(r->lambda_ref),
+        "lambda_ref_rate_hz", amfi_json_num(c->lambda.ref_rate_hz),
+        "formulation", amfi_formulation_name(c->solver.formulation),
+        "coordinates", c->solver.coords == AMFI_COORDS_NODAL ? "nodal" : "modal",
+        "modes", r->n_modes, "calc_rate_hz", amfi_json_num(c->solver.calc_rate_hz),
+        "scan_rate_hz", amfi_json_num(scan_rate_hz), "n_steps", r->n_steps,
+        "residual_rms", amfi_json_num(r->residual_rms),
+        "signal_rms", amfi_json_num(r->signal_rms), "solve_ms", amfi_json_num(solve_ms),
+        "lcurve_points", r->lcurve_n);
+    return amfi_json_print(stdout, o);
 }
 
 int main(int argc, char **argv)
@@ -490,8 +423,8 @@ int main(int argc, char **argv)
         goto done;
     if (o.lcurve && write_lcurve(o.lcurve, &res) != 0)
         goto done;
-    print_json(&cfg, &res, csv.rate_hz, elapsed_ms(&t_a, &t_b));
-    if (fflush(stdout) != 0 || ferror(stdout)) {
+    if (print_json(&cfg, &res, csv.rate_hz, elapsed_ms(&t_a, &t_b)) != 0
+        || fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, PROG ": stdout: %s\n", strerror(errno));
         goto done;
     }

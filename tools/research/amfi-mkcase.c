@@ -29,7 +29,9 @@
 #include <zlib.h>
 
 #include "amfi/amfi.h"
+#include "amfi_cli.h"
 #include "amfi_config.h"
+#include "amfi_json.h"
 
 #define PROG "amfi-mkcase"
 
@@ -45,46 +47,30 @@ static double force(double t, int a, void *user)
     return f->W_N[a] * (1.0 + f->vary * sin(2.0 * M_PI * f->vary_hz * t + 1.3 * a));
 }
 
-static void usage(void)
+static void usage(FILE *f)
 {
-    fprintf(stderr, "usage: %s --out FILE.csv[.gz] [--config FILE.yaml] [--speed MPS]\n"
-                    "       [--axle-loads-kg W1,W2,...] [--axle-spacing S1,...] [--scan-rate HZ]\n"
-                    "       [--pre SEC] [--post SEC] [--noise FRACTION] [--vary FRACTION]\n"
-                    "       [--vary-hz HZ] [--damage FRACTION] [--seed N]\n",
+    fprintf(f,
+            "usage: %s --out FILE.csv[.gz] [--config FILE.yaml] [--speed MPS]\n"
+            "       [--axle-loads-kg W1,W2,...] [--axle-spacing S1,...] [--scan-rate HZ]\n"
+            "       [--pre SEC] [--post SEC] [--noise FRACTION] [--vary FRACTION]\n"
+            "       [--vary-hz HZ] [--damage FRACTION] [--seed N]\n"
+            "  -o, --out FILE            the passage CSV (gzip when it ends in .gz)\n"
+            "  -c, --config FILE         site configuration (default: built-in paper-20m)\n"
+            "  -s, --speed MPS           0.5 .. 60 (default 25)\n"
+            "  -w, --axle-loads-kg LIST  static axle loads, kg\n"
+            "  -x, --axle-spacing LIST   axle spacings, m\n"
+            "  -r, --scan-rate HZ        sampling rate (default 1000)\n"
+            "      --pre SEC             rest before the first axle enters (default 0.5)\n"
+            "      --post SEC            after the last axle leaves (default 0.5)\n"
+            "  -n, --noise FRACTION      Gaussian noise, fraction of the RMS\n"
+            "      --vary FRACTION       sinusoidal force variation\n"
+            "      --vary-hz HZ          its frequency (default 2)\n"
+            "  -d, --damage FRACTION     stiffness loss of the bridge\n"
+            "  -S, --seed N              noise seed (default 1)\n"
+            "  -h, --help                this help\n"
+            "  -V, --version             print the version\n"
+            "stdout: one JSON line with the truth.\n",
             PROG);
-}
-
-/* Parse a number in [lo, hi]; exits with status 2 naming the option. */
-static double num(const char *opt, const char *s, double lo, double hi)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, s, lo, hi);
-        exit(2);
-    }
-    return v;
-}
-
-static int list(const char *opt, const char *s, double *out, int max, double lo, double hi)
-{
-    char buf[512];
-    if (strlen(s) >= sizeof buf) {
-        fprintf(stderr, "%s: %s: list too long\n", PROG, opt);
-        exit(2);
-    }
-    strcpy(buf, s);
-    int n = 0;
-    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok;
-         tok = strtok_r(NULL, ",", &save)) {
-        if (n == max) {
-            fprintf(stderr, "%s: %s: at most %d values\n", PROG, opt, max);
-            exit(2);
-        }
-        out[n++] = num(opt, tok, lo, hi);
-    }
-    return n;
 }
 
 int main(int argc, char **argv)
@@ -97,48 +83,48 @@ int main(int argc, char **argv)
     unsigned long seed = 1;
     forces f = {0};
     f.vary_hz = 2.0;
-    for (int i = 1; i < argc; i++) {
-        const char *o = argv[i];
-        if (i + 1 >= argc) {
-            usage();
-            return 2;
-        }
-        const char *v = argv[++i];
-        if (!strcmp(o, "--out"))
-            out = v;
-        else if (!strcmp(o, "--config"))
-            config = v;
-        else if (!strcmp(o, "--speed"))
-            speed = num(o, v, 0.5, 60.0);
-        else if (!strcmp(o, "--scan-rate"))
-            scan = num(o, v, 10.0, 1e5);
-        else if (!strcmp(o, "--pre"))
-            pre = num(o, v, 0.0, 60.0);
-        else if (!strcmp(o, "--post"))
-            post = num(o, v, 0.0, 60.0);
-        else if (!strcmp(o, "--noise"))
-            noise = num(o, v, 0.0, 1.0);
-        else if (!strcmp(o, "--vary"))
-            f.vary = num(o, v, 0.0, 0.9);
-        else if (!strcmp(o, "--vary-hz"))
-            f.vary_hz = num(o, v, 0.0, 1000.0);
-        else if (!strcmp(o, "--damage"))
-            damage = num(o, v, 0.0, 0.99);
-        else if (!strcmp(o, "--seed"))
-            seed = (unsigned long)num(o, v, 0.0, 4294967295.0);
-        else if (!strcmp(o, "--axle-loads-kg"))
-            n_loads = list(o, v, loads_kg, AMFI_MAX_AXLES, 1.0, 1e5);
-        else if (!strcmp(o, "--axle-spacing"))
-            n_spacing = list(o, v, spacing, AMFI_MAX_AXLES - 1, 0.1, 30.0);
-        else {
-            fprintf(stderr, "%s: unknown option %s\n", PROG, o);
-            usage();
-            return 2;
+    enum { O_PRE = 256, O_POST, O_VARY, O_VARY_HZ };
+    static const struct option longopts[] = {
+        {"out", required_argument, NULL, 'o'},
+        {"config", required_argument, NULL, 'c'},
+        {"speed", required_argument, NULL, 's'},
+        {"axle-loads-kg", required_argument, NULL, 'w'},
+        {"axle-spacing", required_argument, NULL, 'x'},
+        {"scan-rate", required_argument, NULL, 'r'},
+        {"pre", required_argument, NULL, O_PRE},
+        {"post", required_argument, NULL, O_POST},
+        {"noise", required_argument, NULL, 'n'},
+        {"vary", required_argument, NULL, O_VARY},
+        {"vary-hz", required_argument, NULL, O_VARY_HZ},
+        {"damage", required_argument, NULL, 'd'},
+        {"seed", required_argument, NULL, 'S'},
+        AMFI_CLI_STANDARD,
+        {NULL, 0, NULL, 0}};
+    amfi_cli c;
+    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        const char *v = optarg;
+        switch (k) {
+        case 'o': out = v; break;
+        case 'c': config = v; break;
+        case 's': speed = amfi_cli_num(&c, v, 0.5, 60.0); break;
+        case 'r': scan = amfi_cli_num(&c, v, 10.0, 1e5); break;
+        case O_PRE: pre = amfi_cli_num(&c, v, 0.0, 60.0); break;
+        case O_POST: post = amfi_cli_num(&c, v, 0.0, 60.0); break;
+        case 'n': noise = amfi_cli_num(&c, v, 0.0, 1.0); break;
+        case O_VARY: f.vary = amfi_cli_num(&c, v, 0.0, 0.9); break;
+        case O_VARY_HZ: f.vary_hz = amfi_cli_num(&c, v, 0.0, 1000.0); break;
+        case 'd': damage = amfi_cli_num(&c, v, 0.0, 0.99); break;
+        case 'S': seed = (unsigned long)amfi_cli_num(&c, v, 0.0, 4294967295.0); break;
+        case 'w': n_loads = amfi_cli_list(&c, v, loads_kg, AMFI_MAX_AXLES, 1.0, 1e5); break;
+        case 'x':
+            n_spacing = amfi_cli_list(&c, v, spacing, AMFI_MAX_AXLES - 1, 0.1, 30.0);
+            break;
         }
     }
     if (!out) {
         fprintf(stderr, "%s: --out is required\n", PROG);
-        usage();
+        usage(stderr);
         return 2;
     }
     if (n_spacing != n_loads - 1) {
@@ -222,18 +208,26 @@ int main(int argc, char **argv)
     /* Truth: mean of each axle's force over the time it is on the span,
      * sampled at 5000 Hz. */
     double gvw = 0.0;
-    printf("{\"file\":\"%s\",\"entry_time_s\":%.6f,\"speed_mps\":%.6g,\"mean_force_N\":[", out,
-           n_rest / scan, speed);
+    json_t *mean = json_array();
     for (int a = 0; a < n_loads; a++) {
         double sum = 0.0;
         int cnt = 0;
         for (double t = off[a] / speed; speed * t - off[a] <= L; t += 2e-4, cnt++)
             sum += force(t, a, &f);
-        printf("%s%.6g", a ? "," : "", sum / cnt);
+        json_array_append_new(mean, amfi_json_num(sum / cnt));
         gvw += sum / cnt / AMFI_GRAVITY;
     }
-    printf("],\"gvw_kg\":%.6g,\"damage\":%g,\"noise\":%g,\"seed\":%lu}\n", gvw,
-           cfg.bridge.damage, noise, seed);
+    json_t *truth = json_pack("{s:s, s:o, s:o, s:o, s:o, s:o, s:o, s:I}", "file", out,
+                              "entry_time_s", amfi_json_num(n_rest / scan), "speed_mps",
+                              amfi_json_num(speed), "mean_force_N", mean, "gvw_kg",
+                              amfi_json_num(gvw), "damage", amfi_json_num(cfg.bridge.damage),
+                              "noise", amfi_json_num(noise), "seed", (json_int_t)seed);
+    if (amfi_json_print(stdout, truth) != 0) {
+        fprintf(stderr, "%s: stdout: cannot write the truth\n", PROG);
+        free(acc);
+        amfi_bridge_destroy(b);
+        return 1;
+    }
     free(acc);
     amfi_bridge_destroy(b);
     return 0;
