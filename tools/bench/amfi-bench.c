@@ -18,6 +18,7 @@
 #include <time.h>
 
 #include "amfi/amfi.h"
+#include "amfi_cli.h"
 
 static double now_ms(void)
 {
@@ -47,22 +48,30 @@ typedef struct row {
     int automatic;
 } row;
 
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: amfi-bench [--repeat N] [--no-nodal]\n"
+               "  -r, --repeat N    timings per configuration, 1 .. 1000 (default 15)\n"
+               "      --no-nodal    skip the slow nodal reference\n"
+               "  -h, --help        this help\n"
+               "  -V, --version     print the version\n");
+}
+
 int main(int argc, char **argv)
 {
+    static const struct option longopts[] = {
+        {"repeat", required_argument, NULL, 'r'},
+        {"no-nodal", no_argument, NULL, 256},
+        AMFI_CLI_STANDARD,
+        {NULL, 0, NULL, 0}};
     int repeat = 15, nodal = 1;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--repeat") && i + 1 < argc) {
-            repeat = atoi(argv[++i]);
-            if (repeat < 1 || repeat > 1000) {
-                fprintf(stderr, "amfi-bench: --repeat must be 1..1000\n");
-                return 2;
-            }
-        } else if (!strcmp(argv[i], "--no-nodal")) {
+    amfi_cli c;
+    amfi_cli_init(&c, "amfi-bench", argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        if (k == 'r')
+            repeat = (int)amfi_cli_integer(&c, optarg, 1, 1000);
+        else if (k == 256)
             nodal = 0;
-        } else {
-            fprintf(stderr, "usage: amfi-bench [--repeat N] [--no-nodal]\n");
-            return 2;
-        }
     }
     amfi_set_blas_threads(1);
     char err[256];

@@ -45,6 +45,7 @@
 #include <time.h>
 
 #include "amfi_cli.h"
+#include "amfi_csv.h"
 
 #define PROG "amfi-batch-power"
 #define N_LEVELS 5
@@ -67,74 +68,52 @@ typedef struct unit {
     double gvw[N_LEVELS]; /* t; NAN until read */
 } unit;
 
-static void usage(void)
+static void usage(FILE *f)
 {
-    fprintf(stderr, "usage: %s [--vehicles FILE.csv] [--condition NAME] [--n N1,N2,...]\n"
-                    "       [--trials T] [--reps R] [--seed S]\n",
+    fprintf(f, "usage: %s [--vehicles FILE.csv] [--condition NAME] [--n N1,N2,...]\n"
+               "       [--trials T] [--reps R] [--seed S]\n"
+               "  -v, --vehicles FILE   amfi-paper's per-vehicle results\n"
+               "                        (default docs/results/table4_vehicles.csv)\n"
+               "  -c, --condition NAME  the condition to resample (default table5_same)\n"
+               "  -n, --n LIST          batch sizes (default 500,1000,2000,4000)\n"
+               "  -t, --trials T        resampled experiments per size (default 20000)\n"
+               "  -r, --reps R          repetitions in the file (default 3)\n"
+               "  -s, --seed S          random seed (default 1)\n"
+               "  -h, --help            this help\n"
+               "  -V, --version         print the version\n",
             PROG);
-}
-
-static double arg_num(const char *opt, const char *s, double lo, double hi)
-{
-    double v;
-    if (amfi_cli_double(s, &v) || v < lo || v > hi) {
-        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, amfi_cli_shown(s), lo,
-                hi);
-        exit(2);
-    }
-    return v;
 }
 
 static void parse(int argc, char **argv, opts *o)
 {
+    static const struct option longopts[] = {
+        {"vehicles", required_argument, NULL, 'v'},
+        {"condition", required_argument, NULL, 'c'},
+        {"n", required_argument, NULL, 'n'},
+        {"trials", required_argument, NULL, 't'},
+        {"reps", required_argument, NULL, 'r'},
+        {"seed", required_argument, NULL, 's'},
+        AMFI_CLI_STANDARD,
+        {NULL, 0, NULL, 0}};
     *o = (opts){.path = "docs/results/table4_vehicles.csv", .condition = "table5_same",
                 .n = {500, 1000, 2000, 4000}, .n_n = 4, .reps = 3, .trials = 20000, .seed = 1};
-    for (int i = 1; i < argc; i++) {
-        const char *k = argv[i];
-        if (!strcmp(k, "--help") || !strcmp(k, "-h")) {
-            usage();
-            exit(0);
+    amfi_cli c;
+    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        const char *v = optarg;
+        switch (k) {
+        case 'v': o->path = v; break;
+        case 'c': o->condition = v; break;
+        case 't': o->trials = (long)amfi_cli_num(&c, v, 10, 1e7); break;
+        case 'r': o->reps = (int)amfi_cli_num(&c, v, 1, MAX_REPS); break;
+        case 's': o->seed = (unsigned long)amfi_cli_num(&c, v, 0, 4294967295.0); break;
+        case 'n': {
+            double n[MAX_N];
+            o->n_n = amfi_cli_list(&c, v, n, MAX_N, 3, 1e6);
+            for (int i = 0; i < o->n_n; i++)
+                o->n[i] = (int)n[i];
+            break;
         }
-        if (i + 1 >= argc) {
-            fprintf(stderr, "%s: %s: missing value or unknown option\n", PROG, amfi_cli_shown(k));
-            usage();
-            exit(2);
-        }
-        const char *v = argv[++i];
-        if (!strcmp(k, "--vehicles"))
-            o->path = v;
-        else if (!strcmp(k, "--condition"))
-            o->condition = v;
-        else if (!strcmp(k, "--trials"))
-            o->trials = (long)arg_num(k, v, 10, 1e7);
-        else if (!strcmp(k, "--reps"))
-            o->reps = (int)arg_num(k, v, 1, MAX_REPS);
-        else if (!strcmp(k, "--seed"))
-            o->seed = (unsigned long)arg_num(k, v, 0, 4294967295.0);
-        else if (!strcmp(k, "--n")) {
-            char buf[256];
-            if (strlen(v) >= sizeof buf) {
-                fprintf(stderr, "%s: --n: too long\n", PROG);
-                exit(2);
-            }
-            strcpy(buf, v);
-            o->n_n = 0;
-            for (char *save = NULL, *t = strtok_r(buf, ",", &save); t;
-                 t = strtok_r(NULL, ",", &save)) {
-                if (o->n_n == MAX_N) {
-                    fprintf(stderr, "%s: --n: at most %d sizes\n", PROG, MAX_N);
-                    exit(2);
-                }
-                o->n[o->n_n++] = (int)arg_num(k, t, 3, 1e6);
-            }
-            if (o->n_n == 0) {
-                fprintf(stderr, "%s: --n: no batch size\n", PROG);
-                exit(2);
-            }
-        } else {
-            fprintf(stderr, "%s: unknown option %s\n", PROG, amfi_cli_shown(k));
-            usage();
-            exit(2);
         }
     }
 }
@@ -165,22 +144,21 @@ static int split(char *line, char **f, int max)
     return n;
 }
 
-static int field_num(const char *s, double *v)
-{
-    return amfi_cli_double(s, v);
-}
+static int field_num(const char *s, double *v) { return amfi_cli_double(s, v); }
 
 /* Read the condition's rows into units (index: order within (rep, level)). */
 static int read_units(const opts *o, unit **out, long *n_out)
 {
-    FILE *f = fopen(o->path, "r");
+    char err[512];
+    amfi_csv *f = amfi_csv_open(o->path, AMFI_CSV_MAX_LINE, err, sizeof err);
     if (!f) {
-        fprintf(stderr, "%s: %s: %s\n", PROG, o->path, strerror(errno));
+        fprintf(stderr, "%s: %s\n", PROG, err);
         return -1;
     }
-    char *line = NULL;
-    size_t cap = 0;
-    ssize_t len;
+    char line[AMFI_CSV_MAX_LINE + 1];
+    const char *got_line;
+    size_t len;
+    int got;
     long lineno = 0, n_units = 0, cap_units = 0;
     unit *u = NULL;
     /* next[rep][level]: rows of (rep, level) seen so far = the unit's index
@@ -191,14 +169,10 @@ static int read_units(const opts *o, unit **out, long *n_out)
     for (int r = 0; r <= MAX_REPS; r++)
         base[r] = -1;
     int rc = -1;
-    while ((len = getline(&line, &cap, f)) >= 0) {
-        lineno++;
-        if ((size_t)len != strlen(line)) {
-            fprintf(stderr, "%s:%ld: NUL byte in the line\n", o->path, lineno);
-            goto out;
-        }
-        while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r'))
-            line[--len] = 0;
+    /* the common reader cuts the lines, refuses NUL bytes and over-long lines */
+    while ((got = amfi_csv_next(f, &got_line, &len)) > 0) {
+        lineno = amfi_csv_lineno(f);
+        memcpy(line, got_line, len + 1);
         if (lineno == 1) {
             if (strncmp(line, "condition,repetition,damage,record,gvw_true_kg,gvw_fixed_kg", 59)) {
                 fprintf(stderr,
@@ -298,8 +272,8 @@ static int read_units(const opts *o, unit **out, long *n_out)
         }
         x->gvw[lev] = g_fix / 1000.0;
     }
-    if (ferror(f)) {
-        fprintf(stderr, "%s: read error\n", o->path);
+    if (got < 0) {
+        fprintf(stderr, "%s\n", err);
         goto out;
     }
     if (lineno == 0) {
@@ -325,8 +299,7 @@ static int read_units(const opts *o, unit **out, long *n_out)
     rc = 0;
 out:
     free(u);
-    free(line);
-    fclose(f);
+    amfi_csv_close(f, 0);
     return rc;
 }
 

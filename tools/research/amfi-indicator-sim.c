@@ -58,6 +58,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "amfi_cli.h"
 #include "indicators.h"
 
 #define PROG "amfi-indicator-sim"
@@ -469,55 +470,27 @@ static const candidate sweep[] = {
     { 500, 100, 10000, 1.08, 0.01, 1.04, 6, 6 },
 };
 
-static void usage(void)
+static void usage(FILE *f)
 {
-    fprintf(stderr,
+    fprintf(f,
             "usage: %s [--sweep] [--explicit-baseline] [--seed S] [--fa-runs N] [--fa-vehicles N] [--det-runs N]\n"
             "       [--damage P1,P2,...] [--horizon N] [--after N] [--meas-sd T] [--meas-sd-10 T]\n"
             "       [--window W] [--every K] [--baseline-n N] [--std-alert-ratio R]\n"
             "       [--std-alert-p P] [--std-clear-ratio C] [--raise-after N]\n"
             "       [--clear-after N] [--mean-shift 0|1] [--mean-alert-ratio R]\n"
             "       [--mean-alert-p P] [--mean-clear-ratio C]\n"
-            "(damage in %%, weights in t; see the header of tools/research/amfi-indicator-sim.c)\n",
+            "(damage in %%, weights in t; see the header of tools/research/amfi-indicator-sim.c)\n"
+            "  -h, --help      this help\n"
+            "  -V, --version   print the version\n",
             PROG);
 }
 
-/* Parse a number in [lo, hi]; exits with status 2 naming the option. */
-static double num(const char *opt, const char *s, double lo, double hi)
+/* --damage P1,P2,... in %, stored as fractions */
+static void damage_list(const amfi_cli *c, const char *s, sim_opts *o)
 {
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, s, lo, hi);
-        exit(2);
-    }
-    return v;
-}
-
-static long integer(const char *opt, const char *s, double lo, double hi)
-{
-    double v = num(opt, s, lo, hi);
-    if (v != floor(v)) {
-        fprintf(stderr, "%s: %s: '%s' is not an integer\n", PROG, opt, s);
-        exit(2);
-    }
-    return (long)v;
-}
-
-static void damage_list(const char *opt, const char *s, sim_opts *o)
-{
-    char buf[256];
-    snprintf(buf, sizeof buf, "%s", s);
-    o->n_damage = 0;
-    for (char *save = NULL, *t = strtok_r(buf, ",", &save); t;
-         t = strtok_r(NULL, ",", &save)) {
-        if (o->n_damage == MAX_DAMAGE) {
-            fprintf(stderr, "%s: %s: at most %d levels\n", PROG, opt, MAX_DAMAGE);
-            exit(2);
-        }
-        o->damage[o->n_damage++] = num(opt, t, 0.1, 50.0) / 100.0;
-    }
+    o->n_damage = amfi_cli_list(c, s, o->damage, MAX_DAMAGE, 0.1, 50.0);
+    for (int i = 0; i < o->n_damage; i++)
+        o->damage[i] /= 100.0;
 }
 
 int main(int argc, char **argv)
@@ -528,71 +501,64 @@ int main(int argc, char **argv)
     amfi_indicator_params p;
     amfi_indicator_params_default(&p);
     int do_sweep = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *opt = argv[i];
-        if (!strcmp(opt, "-h") || !strcmp(opt, "--help")) {
-            usage();
-            return 0;
-        }
-        if (!strcmp(opt, "--sweep")) {
-            do_sweep = 1;
-            continue;
-        }
-        if (!strcmp(opt, "--explicit-baseline")) {
-            o.explicit_baseline = 1;
-            continue;
-        }
-        if (i + 1 >= argc) {
-            usage();
-            return 2;
-        }
-        const char *v = argv[++i];
-        if (!strcmp(opt, "--seed"))
-            o.seed = (unsigned long)integer(opt, v, 0, 4294967295.0);
-        else if (!strcmp(opt, "--fa-runs"))
-            o.fa_runs = integer(opt, v, 1, 1e7);
-        else if (!strcmp(opt, "--fa-vehicles"))
-            o.fa_vehicles = integer(opt, v, 1, 1e10);
-        else if (!strcmp(opt, "--det-runs"))
-            o.det_runs = integer(opt, v, 1, 1e7);
-        else if (!strcmp(opt, "--after"))
-            o.after = integer(opt, v, 0, 1e9);
-        else if (!strcmp(opt, "--horizon"))
-            o.horizon = integer(opt, v, 1, 1e9);
-        else if (!strcmp(opt, "--damage"))
-            damage_list(opt, v, &o);
-        else if (!strcmp(opt, "--meas-sd"))
-            o.meas_sd = 1000.0 * num(opt, v, 0, 10);
-        else if (!strcmp(opt, "--meas-sd-10"))
-            o.meas_sd_10 = 1000.0 * num(opt, v, 0, 10);
-        else if (!strcmp(opt, "--window"))
-            p.window = (int)integer(opt, v, 2, 1e7);
-        else if (!strcmp(opt, "--every"))
-            p.every = (int)integer(opt, v, 1, 1e7);
-        else if (!strcmp(opt, "--baseline-n"))
-            p.baseline_n = (int)integer(opt, v, 2, 1e9);
-        else if (!strcmp(opt, "--std-alert-ratio"))
-            p.std_alert_ratio = num(opt, v, 1, 100);
-        else if (!strcmp(opt, "--std-alert-p"))
-            p.std_alert_p = num(opt, v, 1e-300, 1);
-        else if (!strcmp(opt, "--std-clear-ratio"))
-            p.std_clear_ratio = num(opt, v, 0, 100);
-        else if (!strcmp(opt, "--raise-after"))
-            p.raise_after = (int)integer(opt, v, 1, 1e6);
-        else if (!strcmp(opt, "--clear-after"))
-            p.clear_after = (int)integer(opt, v, 1, 1e6);
-        else if (!strcmp(opt, "--mean-shift"))
-            p.mean_shift = (int)integer(opt, v, 0, 1);
-        else if (!strcmp(opt, "--mean-alert-ratio"))
-            p.mean_alert_ratio = num(opt, v, 1, 100);
-        else if (!strcmp(opt, "--mean-alert-p"))
-            p.mean_alert_p = num(opt, v, 1e-300, 1);
-        else if (!strcmp(opt, "--mean-clear-ratio"))
-            p.mean_clear_ratio = num(opt, v, 1, 100);
-        else {
-            fprintf(stderr, "%s: unknown option %s\n", PROG, opt);
-            usage();
-            return 2;
+    enum { O_SWEEP = 256, O_EXPLICIT_BASELINE, O_SEED, O_FA_RUNS, O_FA_VEHICLES, O_DET_RUNS,
+           O_AFTER, O_HORIZON, O_DAMAGE, O_MEAS_SD, O_MEAS_SD_10, O_WINDOW, O_EVERY,
+           O_BASELINE_N, O_STD_ALERT_RATIO, O_STD_ALERT_P, O_STD_CLEAR_RATIO, O_RAISE_AFTER,
+           O_CLEAR_AFTER, O_MEAN_SHIFT, O_MEAN_ALERT_RATIO, O_MEAN_ALERT_P, O_MEAN_CLEAR_RATIO };
+    static const struct option longopts[] = {
+        {"sweep", no_argument, NULL, O_SWEEP},
+        {"explicit-baseline", no_argument, NULL, O_EXPLICIT_BASELINE},
+        {"seed", required_argument, NULL, O_SEED},
+        {"fa-runs", required_argument, NULL, O_FA_RUNS},
+        {"fa-vehicles", required_argument, NULL, O_FA_VEHICLES},
+        {"det-runs", required_argument, NULL, O_DET_RUNS},
+        {"after", required_argument, NULL, O_AFTER},
+        {"horizon", required_argument, NULL, O_HORIZON},
+        {"damage", required_argument, NULL, O_DAMAGE},
+        {"meas-sd", required_argument, NULL, O_MEAS_SD},
+        {"meas-sd-10", required_argument, NULL, O_MEAS_SD_10},
+        {"window", required_argument, NULL, O_WINDOW},
+        {"every", required_argument, NULL, O_EVERY},
+        {"baseline-n", required_argument, NULL, O_BASELINE_N},
+        {"std-alert-ratio", required_argument, NULL, O_STD_ALERT_RATIO},
+        {"std-alert-p", required_argument, NULL, O_STD_ALERT_P},
+        {"std-clear-ratio", required_argument, NULL, O_STD_CLEAR_RATIO},
+        {"raise-after", required_argument, NULL, O_RAISE_AFTER},
+        {"clear-after", required_argument, NULL, O_CLEAR_AFTER},
+        {"mean-shift", required_argument, NULL, O_MEAN_SHIFT},
+        {"mean-alert-ratio", required_argument, NULL, O_MEAN_ALERT_RATIO},
+        {"mean-alert-p", required_argument, NULL, O_MEAN_ALERT_P},
+        {"mean-clear-ratio", required_argument, NULL, O_MEAN_CLEAR_RATIO},
+        AMFI_CLI_STANDARD,
+        {NULL, 0, NULL, 0}};
+    amfi_cli c;
+    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        const char *v = optarg;
+        switch (k) {
+        case O_SWEEP: do_sweep = 1; break;
+        case O_EXPLICIT_BASELINE: o.explicit_baseline = 1; break;
+        case O_SEED: o.seed = (unsigned long)amfi_cli_integer(&c, v, 0, 4294967295.0); break;
+        case O_FA_RUNS: o.fa_runs = amfi_cli_integer(&c, v, 1, 1e7); break;
+        case O_FA_VEHICLES: o.fa_vehicles = amfi_cli_integer(&c, v, 1, 1e10); break;
+        case O_DET_RUNS: o.det_runs = amfi_cli_integer(&c, v, 1, 1e7); break;
+        case O_AFTER: o.after = amfi_cli_integer(&c, v, 0, 1e9); break;
+        case O_HORIZON: o.horizon = amfi_cli_integer(&c, v, 1, 1e9); break;
+        case O_DAMAGE: damage_list(&c, v, &o); break;
+        case O_MEAS_SD: o.meas_sd = 1000.0 * amfi_cli_num(&c, v, 0, 10); break;
+        case O_MEAS_SD_10: o.meas_sd_10 = 1000.0 * amfi_cli_num(&c, v, 0, 10); break;
+        case O_WINDOW: p.window = (int)amfi_cli_integer(&c, v, 2, 1e7); break;
+        case O_EVERY: p.every = (int)amfi_cli_integer(&c, v, 1, 1e7); break;
+        case O_BASELINE_N: p.baseline_n = (int)amfi_cli_integer(&c, v, 2, 1e9); break;
+        case O_STD_ALERT_RATIO: p.std_alert_ratio = amfi_cli_num(&c, v, 1, 100); break;
+        case O_STD_ALERT_P: p.std_alert_p = amfi_cli_num(&c, v, 1e-300, 1); break;
+        case O_STD_CLEAR_RATIO: p.std_clear_ratio = amfi_cli_num(&c, v, 0, 100); break;
+        case O_RAISE_AFTER: p.raise_after = (int)amfi_cli_integer(&c, v, 1, 1e6); break;
+        case O_CLEAR_AFTER: p.clear_after = (int)amfi_cli_integer(&c, v, 1, 1e6); break;
+        case O_MEAN_SHIFT: p.mean_shift = (int)amfi_cli_integer(&c, v, 0, 1); break;
+        case O_MEAN_ALERT_RATIO: p.mean_alert_ratio = amfi_cli_num(&c, v, 1, 100); break;
+        case O_MEAN_ALERT_P: p.mean_alert_p = amfi_cli_num(&c, v, 1e-300, 1); break;
+        case O_MEAN_CLEAR_RATIO: p.mean_clear_ratio = amfi_cli_num(&c, v, 1, 100); break;
         }
     }
     if (o.meas_sd_10 < 0)

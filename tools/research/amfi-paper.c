@@ -46,7 +46,9 @@
 #include <time.h>
 
 #include "amfi/amfi.h"
+#include "amfi_cli.h"
 #include "amfi_config.h"
+#include "amfi_datafile.h"
 #include "passage.h"
 #include "profile.h"
 #include "traffic.h"
@@ -55,12 +57,9 @@
 
 #define PROG "amfi-paper"
 #define N_LEVELS 5
-#ifndef AMFI_DEFAULT_CONFIG
-#define AMFI_DEFAULT_CONFIG "config/paper-20m.yaml"
-#endif
-#ifndef AMFI_DEFAULT_POPULATION
-#define AMFI_DEFAULT_POPULATION "sim_publisher/data/population.csv"
-#endif
+/* The shipped files used when none is named (common/amfi_datafile.h). */
+#define DEFAULT_CONFIG_NAME "paper-20m.yaml"
+#define DEFAULT_POPULATION_NAME "population.csv"
 
 static const double levels[N_LEVELS] = {0.0, 0.025, 0.05, 0.075, 0.10};
 
@@ -100,72 +99,81 @@ static void die(const char *fmt, const char *a, const char *b)
     exit(1);
 }
 
-static double num(const char *opt, const char *s, double lo, double hi)
+static void usage(FILE *f)
 {
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, s, lo, hi);
-        exit(2);
-    }
-    return v;
+    char places[512];
+    fprintf(f,
+            "usage: %s [--out DIR] [--quick] [--vehicles N] [--reps R] [--threads T]\n"
+            "       [--lambda-ref VALUE] [--batch-lcurve] [--batches-only]\n"
+            "       [--initial-state rest|free] [--pre-roll SEC] [--config FILE.yaml]\n"
+            "       [--population FILE.csv] [--no-plots]\n"
+            "  -o, --out DIR                   report, CSVs and plots (default docs/results)\n"
+            "  -q, --quick                     the test-suite version (30 vehicles per level)\n"
+            "  -n, --vehicles N                vehicles per batch, 3 .. 5000\n"
+            "  -r, --reps R                    repetitions, 1 .. 20\n"
+            "  -j, --threads T                 worker threads, 1 .. 64\n"
+            "      --lambda-ref VALUE          the fixed lambda at the reference rate\n"
+            "      --batch-lcurve              also solve batches with a per-vehicle L-curve\n"
+            "      --batches-only              skip the single-vehicle experiments\n"
+            "      --initial-state rest|free   the solver's initial state\n"
+            "      --pre-roll SEC              solver pre-roll, 0 .. 0.5 s\n"
+            "  -c, --config FILE               site configuration (default paper-20m.yaml)\n"
+            "  -p, --population FILE           vehicle list (default population.csv)\n"
+            "      --no-plots                  no gnuplot PNGs\n"
+            "  -h, --help                      this help\n"
+            "  -V, --version                   print the version\n"
+            "Default files from the first of %s.\n",
+            PROG, amfi_datafile_places(places, sizeof places));
 }
 
 static void parse(int argc, char **argv, opts *o)
 {
+    enum { O_LAMBDA_REF = 256, O_BATCH_LCURVE, O_BATCHES_ONLY, O_INITIAL_STATE, O_PRE_ROLL,
+           O_NO_PLOTS };
+    static const struct option longopts[] = {
+        {"out", required_argument, NULL, 'o'},
+        {"quick", no_argument, NULL, 'q'},
+        {"vehicles", required_argument, NULL, 'n'},
+        {"reps", required_argument, NULL, 'r'},
+        {"threads", required_argument, NULL, 'j'},
+        {"lambda-ref", required_argument, NULL, O_LAMBDA_REF},
+        {"batch-lcurve", no_argument, NULL, O_BATCH_LCURVE},
+        {"batches-only", no_argument, NULL, O_BATCHES_ONLY},
+        {"initial-state", required_argument, NULL, O_INITIAL_STATE},
+        {"pre-roll", required_argument, NULL, O_PRE_ROLL},
+        {"config", required_argument, NULL, 'c'},
+        {"population", required_argument, NULL, 'p'},
+        {"no-plots", no_argument, NULL, O_NO_PLOTS},
+        AMFI_CLI_STANDARD,
+        {NULL, 0, NULL, 0}};
     *o = (opts){.out = "docs/results", .vehicles = 500, .reps = 3, .threads = 2, .plots = 1,
                 .lambda_ref = 7.94e-9, .free_state = -1, .pre_roll = -1};
     int vehicles_set = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *k = argv[i];
-        if (!strcmp(k, "--quick")) {
-            o->quick = 1;
-            continue;
-        }
-        if (!strcmp(k, "--batch-lcurve")) {
-            o->batch_lcurve = 1;
-            continue;
-        }
-        if (!strcmp(k, "--batches-only")) {
-            o->batches_only = 1;
-            continue;
-        }
-        if (!strcmp(k, "--no-plots")) {
-            o->plots = 0;
-            continue;
-        }
-        if (i + 1 >= argc) {
-            fprintf(stderr, "%s: %s: missing value or unknown option\n", PROG, k);
-            exit(2);
-        }
-        const char *v = argv[++i];
-        if (!strcmp(k, "--out"))
-            o->out = v;
-        else if (!strcmp(k, "--config"))
-            o->config = v;
-        else if (!strcmp(k, "--population"))
-            o->population = v;
-        else if (!strcmp(k, "--vehicles")) {
-            o->vehicles = (int)num(k, v, 3, 5000);
+    amfi_cli c;
+    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        const char *v = optarg;
+        switch (k) {
+        case 'q': o->quick = 1; break;
+        case O_BATCH_LCURVE: o->batch_lcurve = 1; break;
+        case O_BATCHES_ONLY: o->batches_only = 1; break;
+        case O_NO_PLOTS: o->plots = 0; break;
+        case 'o': o->out = v; break;
+        case 'c': o->config = v; break;
+        case 'p': o->population = v; break;
+        case 'n':
+            o->vehicles = (int)amfi_cli_num(&c, v, 3, 5000);
             vehicles_set = 1;
-        } else if (!strcmp(k, "--reps"))
-            o->reps = (int)num(k, v, 1, 20);
-        else if (!strcmp(k, "--threads"))
-            o->threads = (int)num(k, v, 1, 64);
-        else if (!strcmp(k, "--lambda-ref"))
-            o->lambda_ref = num(k, v, 1e-20, 1);
-        else if (!strcmp(k, "--initial-state")) {
-            if (strcmp(v, "rest") && strcmp(v, "free")) {
-                fprintf(stderr, "%s: --initial-state: rest or free\n", PROG);
-                exit(2);
-            }
+            break;
+        case 'r': o->reps = (int)amfi_cli_num(&c, v, 1, 20); break;
+        case 'j': o->threads = (int)amfi_cli_num(&c, v, 1, 64); break;
+        case O_LAMBDA_REF: o->lambda_ref = amfi_cli_num(&c, v, 1e-20, 1); break;
+        case O_INITIAL_STATE:
+            if (strcmp(v, "rest") && strcmp(v, "free"))
+                amfi_cli_fail(&c, "rest or free");
             o->free_state = !strcmp(v, "free");
-        } else if (!strcmp(k, "--pre-roll"))
-            o->pre_roll = num(k, v, 0, 0.5);
-        else {
-            fprintf(stderr, "%s: unknown option %s\n", PROG, k);
-            exit(2);
+            break;
+        case O_PRE_ROLL: o->pre_roll = amfi_cli_num(&c, v, 0, 0.5); break;
         }
     }
     if (o->quick && !vehicles_set)
@@ -920,9 +928,11 @@ int main(int argc, char **argv)
     amfi_set_blas_threads(1);
     char err[512];
     amfi_config_defaults(&c.cfg);
-    const char *cpath = c.o.config ? c.o.config : AMFI_DEFAULT_CONFIG;
-    struct stat st;
-    if ((c.o.config || stat(cpath, &st) == 0) && amfi_config_load(cpath, &c.cfg, err, sizeof err))
+    char cfound[4096], pfound[4096];
+    const char *cpath = c.o.config;
+    if (!cpath && amfi_datafile_find(DEFAULT_CONFIG_NAME, cfound, sizeof cfound) == 0)
+        cpath = cfound;
+    if (cpath && amfi_config_load(cpath, &c.cfg, err, sizeof err))
         die("%s%s", err, "");
     c.cfg.solver.n_sensors = 1; /* one accelerometer, as in the paper */
     if (c.o.free_state >= 0)
@@ -938,7 +948,12 @@ int main(int argc, char **argv)
         if (amfi_bridge_create(&bp, &c.damaged[l], err, sizeof err))
             die("bridge: %s%s", err, "");
     }
-    const char *ppath = c.o.population ? c.o.population : AMFI_DEFAULT_POPULATION;
+    const char *ppath = c.o.population;
+    if (!ppath && amfi_datafile_find(DEFAULT_POPULATION_NAME, pfound, sizeof pfound) != 0)
+        die("no --population and no %s in %s (set AMFI_DATA_DIR)", DEFAULT_POPULATION_NAME,
+            amfi_datafile_places(err, sizeof err));
+    if (!ppath)
+        ppath = pfound;
     if (amfi_traffic_read(ppath, &c.recs, &c.n_recs, err, sizeof err))
         die("%s%s", err, "");
     if (c.n_recs < c.o.vehicles)

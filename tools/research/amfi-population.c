@@ -41,6 +41,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amfi_cli.h"
+#include "amfi_json.h"
 #include "traffic.h"
 
 #define PROG "amfi-population"
@@ -66,34 +68,18 @@
 #define SPEED_HI 32.0
 #define HEADWAY_MIN_S 1.0
 
-static void usage(void)
+static void usage(FILE *f)
 {
-    fprintf(stderr,
-            "usage: %s --out FILE.csv --vehicles N --seed S [--headway-s MEAN] [--batch B]\n",
+    fprintf(f,
+            "usage: %s --out FILE.csv --vehicles N --seed S [--headway-s MEAN] [--batch B]\n"
+            "  -o, --out FILE.csv     the population to write\n"
+            "  -n, --vehicles N       vehicles\n"
+            "  -s, --seed S           random seed\n"
+            "      --headway-s MEAN   mean time between vehicles, s (default 10)\n"
+            "  -b, --batch B          batch size of the statistics printed (default 500)\n"
+            "  -h, --help             this help\n"
+            "  -V, --version          print the version\n",
             PROG);
-}
-
-/* Parse a number in [lo, hi]; exits with status 2 naming the option. */
-static double num(const char *opt, const char *s, double lo, double hi)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) {
-        fprintf(stderr, "%s: %s: '%s' is not a number in [%g, %g]\n", PROG, opt, s, lo, hi);
-        exit(2);
-    }
-    return v;
-}
-
-static double integer(const char *opt, const char *s, double lo, double hi)
-{
-    double v = num(opt, s, lo, hi);
-    if (v != floor(v)) {
-        fprintf(stderr, "%s: %s: '%s' is not an integer\n", PROG, opt, s);
-        exit(2);
-    }
-    return v;
 }
 
 /* normal(mu, sd) redrawn until it falls in [lo, hi] (the acceptance rate of
@@ -125,37 +111,32 @@ int main(int argc, char **argv)
     unsigned long seed = 0;
     int have_seed = 0;
     double headway = 10.0;
-    for (int i = 1; i < argc; i++) {
-        const char *o = argv[i];
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            usage();
-            return 0;
-        }
-        if (i + 1 >= argc) {
-            usage();
-            return 2;
-        }
-        const char *v = argv[++i];
-        if (!strcmp(o, "--out"))
-            out = v;
-        else if (!strcmp(o, "--vehicles"))
-            n_veh = (long)integer(o, v, 1.0, (double)AMFI_TRAFFIC_MAX_ROWS);
-        else if (!strcmp(o, "--seed")) {
-            seed = (unsigned long)integer(o, v, 0.0, 4294967295.0);
+    static const struct option longopts[] = {
+        {"out", required_argument, NULL, 'o'},
+        {"vehicles", required_argument, NULL, 'n'},
+        {"seed", required_argument, NULL, 's'},
+        {"headway-s", required_argument, NULL, 256},
+        {"batch", required_argument, NULL, 'b'},
+        AMFI_CLI_STANDARD,
+        {NULL, 0, NULL, 0}};
+    amfi_cli c;
+    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        const char *v = optarg;
+        switch (k) {
+        case 'o': out = v; break;
+        case 'n': n_veh = amfi_cli_integer(&c, v, 1.0, (double)AMFI_TRAFFIC_MAX_ROWS); break;
+        case 's':
+            seed = (unsigned long)amfi_cli_integer(&c, v, 0.0, 4294967295.0);
             have_seed = 1;
-        } else if (!strcmp(o, "--headway-s"))
-            headway = num(o, v, 1.5, 86400.0);
-        else if (!strcmp(o, "--batch"))
-            batch = (long)integer(o, v, 2.0, (double)AMFI_TRAFFIC_MAX_ROWS);
-        else {
-            fprintf(stderr, "%s: unknown option %s\n", PROG, o);
-            usage();
-            return 2;
+            break;
+        case 256: headway = amfi_cli_num(&c, v, 1.5, 86400.0); break;
+        case 'b': batch = amfi_cli_integer(&c, v, 2.0, (double)AMFI_TRAFFIC_MAX_ROWS); break;
         }
     }
     if (!out || n_veh < 0 || !have_seed) {
         fprintf(stderr, "%s: --out, --vehicles and --seed are required\n", PROG);
-        usage();
+        usage(stderr);
         return 2;
     }
     FILE *f = fopen(out, "w");
@@ -199,15 +180,25 @@ int main(int argc, char **argv)
     }
     double mean, std;
     stats(recs, n, &mean, &std);
-    printf("{\"file\":\"%s\",\"vehicles\":%d,\"seed\":%lu,\"headway_s\":%g,"
-           "\"duration_s\":%.3f,\"gvw_mean_kg\":%.1f,\"gvw_std_kg\":%.1f,\"batch\":%ld,"
-           "\"batches\":[",
-           out, n, seed, headway, recs[n - 1].timestamp_s, mean, std, batch);
+    json_t *batches = json_array();
     for (long b = 0; (b + 1) * batch <= n; b++) {
-        stats(recs + b * batch, (int)batch, &mean, &std);
-        printf("%s{\"gvw_mean_kg\":%.1f,\"gvw_std_kg\":%.1f}", b ? "," : "", mean, std);
+        double bm, bs;
+        stats(recs + b * batch, (int)batch, &bm, &bs);
+        json_array_append_new(batches, json_pack("{s:o, s:o}", "gvw_mean_kg",
+                                                 amfi_json_num(round(bm * 10) / 10),
+                                                 "gvw_std_kg", amfi_json_num(round(bs * 10) / 10)));
     }
-    printf("]}\n");
+    json_t *summary = json_pack(
+        "{s:s, s:i, s:I, s:o, s:o, s:o, s:o, s:I, s:o}", "file", out, "vehicles", n, "seed",
+        (json_int_t)seed, "headway_s", amfi_json_num(headway), "duration_s",
+        amfi_json_num(round(recs[n - 1].timestamp_s * 1000) / 1000), "gvw_mean_kg",
+        amfi_json_num(round(mean * 10) / 10), "gvw_std_kg", amfi_json_num(round(std * 10) / 10),
+        "batch", (json_int_t)batch, "batches", batches);
+    if (amfi_json_print(stdout, summary) != 0) {
+        fprintf(stderr, "%s: stdout: cannot write the summary\n", PROG);
+        amfi_traffic_free(recs);
+        return 1;
+    }
     amfi_traffic_free(recs);
     return 0;
 }
