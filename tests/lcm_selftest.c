@@ -29,6 +29,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "amfi_cli.h"
+
 #include <lcm/lcm.h>
 
 #include "amfi_messages.h"
@@ -617,50 +619,66 @@ static int parse_count(const char *s, int *out)
     return 0;
 }
 
-static void usage(void)
+static void usage(FILE *f)
 {
-    fprintf(stderr, "usage: lcm_selftest URL [N]            publish N rounds at 10 Hz (URL \"\": default)\n"
-                    "       lcm_selftest --roundtrip [URL [N]] publish and check every field (memq://)\n"
-                    "       lcm_selftest --expect I           print round I as text\n");
+    fprintf(f, "usage: lcm_selftest URL [N]            publish N rounds at 10 Hz (URL \"\": default)\n"
+               "       lcm_selftest --roundtrip [URL [N]] publish and check every field (memq://)\n"
+               "       lcm_selftest --expect I           print round I as text\n"
+               "  -r, --roundtrip    publish and receive in this process, check every field\n"
+               "  -e, --expect I     print round I's messages as text\n"
+               "  -h, --help         this help\n"
+               "  -V, --version      print the version\n");
 }
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        usage();
-        return 2;
+    static const struct option longopts[] = {
+        {"roundtrip", no_argument, NULL, 'r'},
+        {"expect", required_argument, NULL, 'e'},
+        AMFI_CLI_STANDARD,
+        {NULL, 0, NULL, 0}};
+    int roundtrip = 0, expect = -1;
+    amfi_cli c;
+    amfi_cli_init(&c, "lcm_selftest", argc, argv, longopts, usage);
+    amfi_cli_allow_operands(&c);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        if (k == 'r')
+            roundtrip = 1;
+        else if (k == 'e' && parse_count(optarg, &expect) != 0)
+            amfi_cli_fail(&c, "'%s' is not a round number", amfi_cli_shown(optarg));
     }
-    if (strcmp(argv[1], "--expect") == 0) {
-        int i;
-        if (argc != 3 || parse_count(argv[2], &i) != 0) {
-            usage();
+    const int nargs = argc - optind;
+    char **args = argv + optind;
+    if (expect >= 0) {
+        if (nargs != 0 || roundtrip) {
+            usage(stderr);
             return 2;
         }
         struct round *r = malloc(sizeof *r);
         if (!r)
             return 1;
-        round_make(r, i);
+        round_make(r, expect);
         print_round(r);
         free(r);
         return 0;
     }
-    if (strcmp(argv[1], "--roundtrip") == 0) {
-        const char *url = argc > 2 ? argv[2] : "memq://";
+    if (roundtrip) {
+        const char *url = nargs > 0 ? args[0] : "memq://";
         int n = 20;
-        if (argc > 4 || (argc == 4 && (parse_count(argv[3], &n) != 0 || n < 1))) {
-            usage();
+        if (nargs > 2 || (nargs == 2 && (parse_count(args[1], &n) != 0 || n < 1))) {
+            usage(stderr);
             return 2;
         }
         return run_roundtrip(url, n);
     }
-    if (argv[1][0] == '-' && argv[1][1] == '-') {
-        usage();
+    if (nargs < 1) {
+        usage(stderr);
         return 2;
     }
-    const char *url = argv[1][0] == 0 || strcmp(argv[1], "-") == 0 ? NULL : argv[1];
+    const char *url = args[0][0] == 0 || strcmp(args[0], "-") == 0 ? NULL : args[0];
     int n = 30;
-    if (argc > 3 || (argc == 3 && parse_count(argv[2], &n) != 0)) {
-        usage();
+    if (nargs > 2 || (nargs == 2 && parse_count(args[1], &n) != 0)) {
+        usage(stderr);
         return 2;
     }
     return run_publish(url, n);
