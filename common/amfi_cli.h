@@ -8,8 +8,7 @@
  *     static const struct option opts[] = {
  *         {"speed", required_argument, NULL, 's'},
  *         {"lcurve", required_argument, NULL, 256},  (no short form: >= 256)
- *         AMFI_CLI_STANDARD,                          (--help/-h, --version/-V)
- *         {0}};
+ *         AMFI_CLI_END};                              (--help/-h, --version/-V)
  *     amfi_cli c;
  *     amfi_cli_init(&c, "amfi-solve", argc, argv, opts, usage);
  *     for (int k; (k = amfi_cli_next(&c)) != -1;)
@@ -27,10 +26,11 @@
 
 #define AMFI_CLI_EXIT_USAGE 2
 
-/* --help (-h) prints the usage on stdout and exits 0; --version (-V)
- * prints "PROG VERSION" and exits 0. */
-#define AMFI_CLI_STANDARD                                                    \
-    {"help", no_argument, NULL, 'h'}, { "version", no_argument, NULL, 'V' }
+/* The end of every option table: --help (-h) prints the usage on stdout
+ * and exits 0; --version (-V) prints "PROG VERSION" and exits 0; then the
+ * terminating entry. */
+#define AMFI_CLI_END                                                         \
+    {"help", no_argument, NULL, 'h'}, {"version", no_argument, NULL, 'V'}, { NULL, 0, NULL, 0 }
 
 typedef struct amfi_cli {
     const char *prog;

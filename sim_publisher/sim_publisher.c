@@ -189,8 +189,7 @@ static const struct option longopts[] = {
     {"block", required_argument, NULL, O_BLOCK},
     {"start-utime", required_argument, NULL, O_START_UTIME},
     {"detector-lead", required_argument, NULL, O_DETECTOR_LEAD},
-    AMFI_CLI_STANDARD,
-    {NULL, 0, NULL, 0}};
+    AMFI_CLI_END};
 
 /* "A" or "A,B" */
 static void pair(const amfi_cli *c, const char *s, double lo, double hi, double *a, double *b,

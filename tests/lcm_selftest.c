@@ -635,8 +635,7 @@ int main(int argc, char **argv)
     static const struct option longopts[] = {
         {"roundtrip", no_argument, NULL, 'r'},
         {"expect", required_argument, NULL, 'e'},
-        AMFI_CLI_STANDARD,
-        {NULL, 0, NULL, 0}};
+        AMFI_CLI_END};
     int roundtrip = 0, expect = -1;
     amfi_cli c;
     amfi_cli_init(&c, "lcm_selftest", argc, argv, longopts, usage);

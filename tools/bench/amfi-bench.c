@@ -62,8 +62,7 @@ int main(int argc, char **argv)
     static const struct option longopts[] = {
         {"repeat", required_argument, NULL, 'r'},
         {"no-nodal", no_argument, NULL, 256},
-        AMFI_CLI_STANDARD,
-        {NULL, 0, NULL, 0}};
+        AMFI_CLI_END};
     int repeat = 15, nodal = 1;
     amfi_cli c;
     amfi_cli_init(&c, "amfi-bench", argc, argv, longopts, usage);

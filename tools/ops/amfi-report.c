@@ -174,8 +174,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"set-baseline", required_argument, NULL, 'b'},
         {"note", required_argument, NULL, 'n'},
         {"check", no_argument, NULL, 'k'},
-        AMFI_CLI_STANDARD,
-        {NULL, 0, NULL, 0}};
+        AMFI_CLI_END};
     memset(o, 0, sizeof *o);
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);

@@ -140,8 +140,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"formulation", required_argument, NULL, 'f'},
         {"forces", required_argument, NULL, 'F'},
         {"lcurve", required_argument, NULL, 'L'},
-        AMFI_CLI_STANDARD,
-        {NULL, 0, NULL, 0}};
+        AMFI_CLI_END};
     memset(o, 0, sizeof *o);
     o->speed_mps = NAN;
     amfi_cli c;

@@ -93,8 +93,7 @@ static void parse(int argc, char **argv, opts *o)
         {"trials", required_argument, NULL, 't'},
         {"reps", required_argument, NULL, 'r'},
         {"seed", required_argument, NULL, 's'},
-        AMFI_CLI_STANDARD,
-        {NULL, 0, NULL, 0}};
+        AMFI_CLI_END};
     *o = (opts){.path = "docs/results/table4_vehicles.csv", .condition = "table5_same",
                 .n = {500, 1000, 2000, 4000}, .n_n = 4, .reps = 3, .trials = 20000, .seed = 1};
     amfi_cli c;

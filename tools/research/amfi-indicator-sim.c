@@ -529,8 +529,7 @@ int main(int argc, char **argv)
         {"mean-alert-ratio", required_argument, NULL, O_MEAN_ALERT_RATIO},
         {"mean-alert-p", required_argument, NULL, O_MEAN_ALERT_P},
         {"mean-clear-ratio", required_argument, NULL, O_MEAN_CLEAR_RATIO},
-        AMFI_CLI_STANDARD,
-        {NULL, 0, NULL, 0}};
+        AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
     for (int k; (k = amfi_cli_next(&c)) != -1;) {

@@ -98,8 +98,7 @@ int main(int argc, char **argv)
         {"vary-hz", required_argument, NULL, O_VARY_HZ},
         {"damage", required_argument, NULL, 'd'},
         {"seed", required_argument, NULL, 'S'},
-        AMFI_CLI_STANDARD,
-        {NULL, 0, NULL, 0}};
+        AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
     for (int k; (k = amfi_cli_next(&c)) != -1;) {

@@ -144,8 +144,7 @@ static void parse(int argc, char **argv, opts *o)
         {"config", required_argument, NULL, 'c'},
         {"population", required_argument, NULL, 'p'},
         {"no-plots", no_argument, NULL, O_NO_PLOTS},
-        AMFI_CLI_STANDARD,
-        {NULL, 0, NULL, 0}};
+        AMFI_CLI_END};
     *o = (opts){.out = "docs/results", .vehicles = 500, .reps = 3, .threads = 2, .plots = 1,
                 .lambda_ref = 7.94e-9, .free_state = -1, .pre_roll = -1};
     int vehicles_set = 0;

@@ -117,8 +117,7 @@ int main(int argc, char **argv)
         {"seed", required_argument, NULL, 's'},
         {"headway-s", required_argument, NULL, 256},
         {"batch", required_argument, NULL, 'b'},
-        AMFI_CLI_STANDARD,
-        {NULL, 0, NULL, 0}};
+        AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
     for (int k; (k = amfi_cli_next(&c)) != -1;) {
