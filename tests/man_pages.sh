@@ -19,7 +19,7 @@ done
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 scdoc < "$page" > "$dir/page" 2> "$dir/scdoc.err" || fail "scdoc: $(cat "$dir/scdoc.err")"
-MANWIDTH=80 MAN_KEEP_FORMATTING= man -l -P cat - < "$dir/page" > "$dir/out" 2> "$dir/man.err" ||
+MANWIDTH=80 man --warnings -l -P cat - < "$dir/page" > "$dir/out" 2> "$dir/man.err" ||
   fail "man -l exited $?: $(cat "$dir/man.err")"
 [ ! -s "$dir/man.err" ] || fail "man -l warned: $(cat "$dir/man.err")"
 name=$(basename "$page" .scd)
