@@ -1,9 +1,10 @@
 #!/bin/sh
 # no_source_tree.sh: no program knows the source tree it was built from. Its
 # --help (which lists where it looks for data files) and its read-only data
-# must not name SRC_DIR; every program answers --version with "NAME VERSION".
-# (Debug information may name the sources: that is for debuggers, not for
-# finding files.) Run with AMFI_DATA_DIR unset.
+# must not name a path inside SRC_DIR other than a source file (.c, .h: the
+# sanitizers keep source locations there, debuggers too; not for finding
+# files); every program answers --version with "NAME VERSION". Run with
+# AMFI_DATA_DIR unset.
 # Usage: no_source_tree.sh SRC_DIR PROGRAM...
 set -u
 src=$1
@@ -14,7 +15,8 @@ for prog in "$@"; do
   name=$(basename "$prog")
   help=$("$prog" --help) || fail "$name --help exited $?"
   case $help in *"$src"*) fail "$name --help names the source tree $src";; esac
-  readelf -p .rodata "$prog" 2>/dev/null | grep -qF "$src" && fail "$name: .rodata names $src"
+  paths=$(readelf -p .rodata "$prog" 2>/dev/null | grep -oE "$src/[^ ]*" | grep -vE '\.[ch]$')
+  [ -z "$paths" ] || fail "$name: .rodata names $(printf '%s' "$paths" | head -1)"
   v=$("$prog" --version) || fail "$name --version exited $?"
   printf '%s\n' "$v" | grep -Eq "^$name [0-9]+\.[0-9]+\.[0-9]+" || fail "$name --version: '$v'"
   echo "ok   $name: $v"
