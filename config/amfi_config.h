@@ -21,6 +21,7 @@
 #include <stddef.h>
 
 #include "amfi/amfi.h"
+#include "indicators.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -39,11 +40,11 @@ typedef struct amfi_daemon_config {
     double margin_s;          /* daemon.window_margin_s: data around the solver window */
     double max_wait_s;        /* daemon.max_wait_s: data time to wait for a window */
     double status_period_s;   /* daemon.status_period_s: heartbeat, wall time */
-    /* daemon.indicators.* (docs/indicators.md) */
-    int ind_window, ind_every, ind_baseline_n, ind_raise_after, ind_clear_after;
-    double ind_std_alert_ratio, ind_std_alert_p, ind_std_clear_ratio;
-    int ind_mean_shift;
-    double ind_mean_alert_ratio, ind_mean_alert_p, ind_mean_clear_ratio;
+    /* daemon.indicators.*: the indicator engine's own parameters
+     * (indicators.h, docs/indicators.md), its defaults from
+     * amfi_indicator_params_default() and checked, at load, by
+     * amfi_indicator_params_check(). */
+    amfi_indicator_params indicators;
 } amfi_daemon_config;
 
 /* The simulator's section (simulation: in the site file). Only

@@ -698,19 +698,7 @@ static int load_config(const char *path, amfi_site_config *c)
 
 static void indicator_params(const amfi_daemon_config *dc, amfi_indicator_params *p)
 {
-    amfi_indicator_params_default(p);
-    p->window = dc->ind_window;
-    p->every = dc->ind_every;
-    p->baseline_n = dc->ind_baseline_n;
-    p->std_alert_ratio = dc->ind_std_alert_ratio;
-    p->std_alert_p = dc->ind_std_alert_p;
-    p->std_clear_ratio = dc->ind_std_clear_ratio;
-    p->raise_after = dc->ind_raise_after;
-    p->clear_after = dc->ind_clear_after;
-    p->mean_shift = dc->ind_mean_shift;
-    p->mean_alert_ratio = dc->ind_mean_alert_ratio;
-    p->mean_alert_p = dc->ind_mean_alert_p;
-    p->mean_clear_ratio = dc->ind_mean_clear_ratio;
+    *p = dc->indicators;
 }
 
 /* 1 when the newest alert of `kind` in the store was a raise (still open). */
@@ -761,8 +749,7 @@ static void reload(daemon_s *d)
     d->cfg.daemon.max_wait_s = n.daemon.max_wait_s;
     amfi_indicator_params ip;
     indicator_params(&n.daemon, &ip);
-    if (memcmp(&n.daemon.ind_window, &d->cfg.daemon.ind_window,
-               sizeof n.daemon - offsetof(amfi_daemon_config, ind_window)))
+    if (memcmp(&n.daemon.indicators, &d->cfg.daemon.indicators, sizeof n.daemon.indicators))
         LOG_WARN("reload: indicator settings take effect at the next start");
     LOG_INFO("reload: configuration %s applied", d->config_path);
 }

@@ -86,62 +86,69 @@ void amfi_indicator_params_default(amfi_indicator_params *p)
     p->mean_clear_ratio = 1.03;
 }
 
-/* The checks of amfi_indicators_create; 0 or AMFI_IND_EINVAL with a message.
- * Written as !(x >= lo) so that NaN fails. */
-static int check_params(const amfi_indicator_params *p, char *err, size_t errlen)
+/* Name the parameter and write the message; returns AMFI_IND_EINVAL. */
+static int bad(const char **field, const char *name, char *err, size_t errlen,
+               const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+
+static int bad(const char **field, const char *name, char *err, size_t errlen,
+               const char *fmt, ...)
 {
-    if (p->window < 2 || p->window > MAX_WINDOW) {
-        set_err(err, errlen, "window must be in [2, %d] (got %d)", MAX_WINDOW, p->window);
-        return AMFI_IND_EINVAL;
+    if (field)
+        *field = name;
+    if (err != NULL && errlen > 0) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, errlen, fmt, ap);
+        va_end(ap);
     }
-    if (p->every < 1) {
-        set_err(err, errlen, "every must be >= 1 (got %d)", p->every);
-        return AMFI_IND_EINVAL;
-    }
-    if (p->baseline_n < 2) {
-        set_err(err, errlen, "baseline_n must be >= 2 (got %d)", p->baseline_n);
-        return AMFI_IND_EINVAL;
-    }
-    if (!(p->std_alert_ratio >= 1.0) || !isfinite(p->std_alert_ratio)) {
-        set_err(err, errlen, "std_alert_ratio must be finite and >= 1 (got %g)",
-                p->std_alert_ratio);
-        return AMFI_IND_EINVAL;
-    }
-    if (!(p->std_alert_p > 0.0 && p->std_alert_p <= 1.0)) {
-        set_err(err, errlen, "std_alert_p must be in (0, 1] (got %g)", p->std_alert_p);
-        return AMFI_IND_EINVAL;
-    }
-    if (!(p->std_clear_ratio > 0.0 && p->std_clear_ratio <= p->std_alert_ratio)) {
-        set_err(err, errlen, "std_clear_ratio must be in (0, std_alert_ratio = %g] (got %g)",
-                p->std_alert_ratio, p->std_clear_ratio);
-        return AMFI_IND_EINVAL;
-    }
-    if (p->raise_after < 1) {
-        set_err(err, errlen, "raise_after must be >= 1 (got %d)", p->raise_after);
-        return AMFI_IND_EINVAL;
-    }
-    if (p->clear_after < 1) {
-        set_err(err, errlen, "clear_after must be >= 1 (got %d)", p->clear_after);
-        return AMFI_IND_EINVAL;
-    }
-    if (p->mean_shift != 0 && p->mean_shift != 1) {
-        set_err(err, errlen, "mean_shift must be 0 or 1 (got %d)", p->mean_shift);
-        return AMFI_IND_EINVAL;
-    }
-    if (!(p->mean_alert_ratio >= 1.0) || !isfinite(p->mean_alert_ratio)) {
-        set_err(err, errlen, "mean_alert_ratio must be finite and >= 1 (got %g)",
-                p->mean_alert_ratio);
-        return AMFI_IND_EINVAL;
-    }
-    if (!(p->mean_alert_p > 0.0 && p->mean_alert_p <= 1.0)) {
-        set_err(err, errlen, "mean_alert_p must be in (0, 1] (got %g)", p->mean_alert_p);
-        return AMFI_IND_EINVAL;
-    }
-    if (!(p->mean_clear_ratio >= 1.0 && p->mean_clear_ratio <= p->mean_alert_ratio)) {
-        set_err(err, errlen, "mean_clear_ratio must be in [1, mean_alert_ratio = %g] (got %g)",
-                p->mean_alert_ratio, p->mean_clear_ratio);
-        return AMFI_IND_EINVAL;
-    }
+    return AMFI_IND_EINVAL;
+}
+
+/* Written as !(x >= lo) so that NaN fails. */
+int amfi_indicator_params_check(const amfi_indicator_params *p, const char **field, char *err,
+                                size_t errlen)
+{
+    if (field)
+        *field = NULL;
+    if (p == NULL)
+        return bad(field, "params", err, errlen, "params is NULL");
+    if (p->window < 2 || p->window > MAX_WINDOW)
+        return bad(field, "window", err, errlen, "window must be in [2, %d] (got %d)",
+                   MAX_WINDOW, p->window);
+    if (p->every < 1)
+        return bad(field, "every", err, errlen, "every must be >= 1 (got %d)", p->every);
+    if (p->baseline_n < 2)
+        return bad(field, "baseline_n", err, errlen, "baseline_n must be >= 2 (got %d)",
+                   p->baseline_n);
+    if (!(p->std_alert_ratio >= 1.0) || !isfinite(p->std_alert_ratio))
+        return bad(field, "std_alert_ratio", err, errlen,
+                   "std_alert_ratio must be finite and >= 1 (got %g)", p->std_alert_ratio);
+    if (!(p->std_alert_p > 0.0 && p->std_alert_p <= 1.0))
+        return bad(field, "std_alert_p", err, errlen, "std_alert_p must be in (0, 1] (got %g)",
+                   p->std_alert_p);
+    if (!(p->std_clear_ratio > 0.0 && p->std_clear_ratio <= p->std_alert_ratio))
+        return bad(field, "std_clear_ratio", err, errlen,
+                   "std_clear_ratio must be > 0 and must not exceed std_alert_ratio = %g "
+                   "(got %g)", p->std_alert_ratio, p->std_clear_ratio);
+    if (p->raise_after < 1)
+        return bad(field, "raise_after", err, errlen, "raise_after must be >= 1 (got %d)",
+                   p->raise_after);
+    if (p->clear_after < 1)
+        return bad(field, "clear_after", err, errlen, "clear_after must be >= 1 (got %d)",
+                   p->clear_after);
+    if (p->mean_shift != 0 && p->mean_shift != 1)
+        return bad(field, "mean_shift", err, errlen, "mean_shift must be 0 or 1 (got %d)",
+                   p->mean_shift);
+    if (!(p->mean_alert_ratio >= 1.0) || !isfinite(p->mean_alert_ratio))
+        return bad(field, "mean_alert_ratio", err, errlen,
+                   "mean_alert_ratio must be finite and >= 1 (got %g)", p->mean_alert_ratio);
+    if (!(p->mean_alert_p > 0.0 && p->mean_alert_p <= 1.0))
+        return bad(field, "mean_alert_p", err, errlen,
+                   "mean_alert_p must be in (0, 1] (got %g)", p->mean_alert_p);
+    if (!(p->mean_clear_ratio >= 1.0 && p->mean_clear_ratio <= p->mean_alert_ratio))
+        return bad(field, "mean_clear_ratio", err, errlen,
+                   "mean_clear_ratio must be >= 1 and must not exceed mean_alert_ratio = %g "
+                   "(got %g)", p->mean_alert_ratio, p->mean_clear_ratio);
     return AMFI_IND_OK;
 }
 
@@ -157,7 +164,7 @@ int amfi_indicators_create(const amfi_indicator_params *p, amfi_indicators **out
         set_err(err, errlen, "params is NULL");
         return AMFI_IND_EINVAL;
     }
-    int rc = check_params(p, err, errlen);
+    int rc = amfi_indicator_params_check(p, NULL, err, errlen);
     if (rc != AMFI_IND_OK)
         return rc;
     amfi_indicators *ind = calloc(1, sizeof *ind);

@@ -88,6 +88,14 @@ typedef struct amfi_indicator_params {
  * docs/indicators.md. */
 void amfi_indicator_params_default(amfi_indicator_params *p);
 
+/* The one validation of the parameters (amfi_indicators_create and the
+ * site-file loader both use it): 0 when *p is valid, else AMFI_IND_EINVAL
+ * with *field (may be NULL) set to the name of the parameter blamed (a
+ * static string, the key under daemon.indicators in the site file) and err
+ * (may be NULL) holding a message that names it. */
+int amfi_indicator_params_check(const amfi_indicator_params *p, const char **field, char *err,
+                                size_t errlen);
+
 /* Validate *p and allocate the engine (the ring of W doubles). On success
  * *out owns it (free with amfi_indicators_destroy) and 0 is returned; on
  * failure *out is NULL, AMFI_IND_EINVAL or AMFI_IND_ENOMEM is returned and

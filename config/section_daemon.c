@@ -1,0 +1,91 @@
+/*
+ * section_daemon.c: the daemon: section of a site file (amfid's bus, store,
+ * threads, waits and damage indicators: amfi_daemon_config). The indicator
+ * keys fill the engine's own amfi_indicator_params; the rules between them
+ * (clear <= alert, ...) are the engine's, checked by
+ * amfi_indicator_params_check() and reported here with the line of the key
+ * the engine blames. Runs on the loader's thread.
+ */
+#include "sections.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define DC(m) offsetof(amfi_site_config, daemon.m)
+#define STR(k, m, minlen) \
+    {.key = k, .kind = &K_STRING, .off = DC(m), .lo = minlen, \
+     .hi = sizeof(((amfi_daemon_config *)0)->m)}
+
+static const field channel_fields[] = {
+    STR("accel", ch_accel, 1),     STR("vehicle", ch_vehicle, 1),
+    STR("truth", ch_truth, 1),     STR("passage", ch_passage, 1),
+    STR("indicator", ch_indicator, 1), STR("alert", ch_alert, 1),
+    STR("status", ch_status, 1),   {.key = NULL}};
+
+static const enum_name sync_names[] = {{"normal", 0}, {"full", 1}, {NULL, 0}};
+
+static const field store_fields[] = {
+    STR("path", db_path, 1),
+    {.key = "sync", .kind = &K_ENUM, .off = DC(sync_full), .aux = sync_names},
+    {.key = NULL}};
+
+/* Offsets of the engine's amfi_indicator_params inside the site config. */
+#define IND(m) DC(indicators.m)
+
+static const enum_name onoff_names[] = {{"off", 0}, {"on", 1}, {NULL, 0}};
+
+static const field indicator_fields[] = {
+    {.key = "window", .kind = &K_INT, .off = IND(window), .lo = 10, .hi = 1000000},
+    {.key = "every", .kind = &K_INT, .off = IND(every), .lo = 1, .hi = 1000000},
+    {.key = "baseline_n", .kind = &K_INT, .off = IND(baseline_n), .lo = 10, .hi = 1000000},
+    {.key = "std_alert_ratio", .kind = &K_DOUBLE, .off = IND(std_alert_ratio), .lo = 1,
+     .hi = 10},
+    {.key = "std_alert_p", .kind = &K_DOUBLE, .off = IND(std_alert_p), .lo = 0, .hi = 1,
+     .flags = F_LO_OPEN},
+    {.key = "std_clear_ratio", .kind = &K_DOUBLE, .off = IND(std_clear_ratio), .lo = 0.5,
+     .hi = 10},
+    {.key = "raise_after", .kind = &K_INT, .off = IND(raise_after), .lo = 1, .hi = 1000},
+    {.key = "clear_after", .kind = &K_INT, .off = IND(clear_after), .lo = 1, .hi = 1000},
+    {.key = "mean_shift", .kind = &K_ENUM, .off = IND(mean_shift), .aux = onoff_names},
+    {.key = "mean_alert_ratio", .kind = &K_DOUBLE, .off = IND(mean_alert_ratio), .lo = 1,
+     .hi = 10},
+    {.key = "mean_alert_p", .kind = &K_DOUBLE, .off = IND(mean_alert_p), .lo = 0, .hi = 1,
+     .flags = F_LO_OPEN},
+    {.key = "mean_clear_ratio", .kind = &K_DOUBLE, .off = IND(mean_clear_ratio), .lo = 0.5,
+     .hi = 10},
+    {.key = NULL}};
+
+const field daemon_fields[] = {
+    STR("lcm_url", lcm_url, 0),
+    {.key = "channels", .kind = &K_MAP, .aux = channel_fields},
+    {.key = "store", .kind = &K_MAP, .aux = store_fields},
+    {.key = "workers", .kind = &K_INT, .off = DC(workers), .lo = 1, .hi = 64},
+    {.key = "queue_size", .kind = &K_INT, .off = DC(queue_size), .lo = 1, .hi = 100000},
+    {.key = "ring_s", .kind = &K_DOUBLE, .off = DC(ring_s), .lo = 5, .hi = 3600},
+    {.key = "window_margin_s", .kind = &K_DOUBLE, .off = DC(margin_s), .lo = 0, .hi = 5},
+    {.key = "max_wait_s", .kind = &K_DOUBLE, .off = DC(max_wait_s), .lo = 0, .hi = 3600,
+     .flags = F_LO_OPEN},
+    {.key = "status_period_s", .kind = &K_DOUBLE, .off = DC(status_period_s), .lo = 0.1,
+     .hi = 3600},
+    {.key = "indicators", .kind = &K_MAP, .aux = indicator_fields},
+    {.key = NULL}};
+
+int daemon_check(ctx *x, amfi_site_config *c)
+{
+    const char *blamed = NULL;
+    char why[256], path[PATH_LEN];
+    int line;
+
+    if (amfi_indicator_params_check(&c->daemon.indicators, &blamed, why, sizeof why) == 0)
+        return 0;
+    pathf(path, "daemon.indicators.%s", blamed ? blamed : "");
+    /* The key blamed, else the latest indicator key given (the one that
+     * moved a limit past the blamed key's default), else the section. */
+    line = noted(x, path);
+    if (!line)
+        line = noted_under(x, "daemon.indicators.");
+    if (!line)
+        line = first_noted(x, "daemon.indicators", "daemon", NULL);
+    return fail(x, line, path, "%s", why);
+}

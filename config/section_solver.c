@@ -1,0 +1,332 @@
+/*
+ * section_solver.c: the sensors: and solver: sections of a site file (the
+ * sensor list and the rest of libamfi's amfi_solver_params, and the λ
+ * policy amfi_lambda): their keys and the checks between them (sensors on
+ * the span, mode counts within the model's DOFs, the L-curve grid, the
+ * initial force and state). Runs on the loader's thread.
+ */
+#include "sections.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define MAX_RATE_HZ 1e6      /* calc_rate_hz, lambda_ref_rate_hz: (0, 1e6] Hz */
+#define MAX_ROLL_S 60.0      /* pre_roll_s, post_roll_s: [0, 60) s */
+#define MAX_DURATION_S 600.0 /* max_duration_s: (0, 600] s; a passage is ~1 s,
+                                a slow crossing of a long bridge under a minute */
+
+/* Enums are written as ints: */
+_Static_assert(sizeof(amfi_coords) == sizeof(int), "amfi_coords is written as an int");
+
+/* sensors: a list of {id, at_m, weight} */
+typedef struct sensor_item {
+    int id;        /* 0 .. 255 */
+    double at_m;   /* m, >= 0 (<= span checked in check_site) */
+    double weight; /* > 0, default 1 */
+} sensor_item;
+
+static const field sensor_fields[] = {
+    {.key = "id", .kind = &K_INT, .off = offsetof(sensor_item, id), .lo = 0, .hi = 255,
+     .flags = F_REQUIRED},
+    {.key = "at_m", .kind = &K_DOUBLE, .off = offsetof(sensor_item, at_m), .lo = 0,
+     .hi = HUGE_VAL, .flags = F_HI_OPEN | F_REQUIRED},
+    {.key = "weight", .kind = &K_DOUBLE, .off = offsetof(sensor_item, weight), .lo = 0,
+     .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
+    {.key = NULL}};
+
+static int p_sensors(ctx *x, yaml_node_t *v, const char *path, const field *f,
+                     void *base)
+{
+    amfi_site_config *c = base;
+    sensor_item s[AMFI_MAX_SENSORS];
+    yaml_node_item_t *items;
+    char ip[PATH_LEN], idp[PATH_LEN];
+    int n = 0;
+
+    (void)f;
+    items = list_items(x, v, path, "sensors", AMFI_MAX_SENSORS, &n);
+    if (!items)
+        return -1;
+    for (int i = 0; i < n; i++) {
+        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
+
+        join_index(ip, path, (size_t)i);
+        if (!it)
+            return fail(x, line_of(v), ip, "malformed list");
+        note_line(x, ip, line_of(it));
+        s[i] = (sensor_item){.id = 0, .at_m = 0.0, .weight = 1.0};
+        if (walk_map(x, it, ip, sensor_fields, &s[i]))
+            return -1;
+        for (int j = 0; j < i; j++)
+            if (s[j].id == s[i].id) {
+                pathf(idp, "%s.id", ip);
+                return fail(x, noted(x, idp), idp, "duplicate id %d (also %s[%d])",
+                            s[i].id, path, j);
+            }
+    }
+    for (int i = 0; i < AMFI_MAX_SENSORS; i++) {
+        c->solver.sensor_x_m[i] = i < n ? s[i].at_m : 0.0;
+        c->solver.sensor_weight[i] = i < n ? s[i].weight : 0.0;
+        c->sensor_id[i] = i < n ? s[i].id : -1;
+    }
+    c->solver.n_sensors = n;
+    return 0;
+}
+
+static void d_sensors(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "1 .. %d sensors", AMFI_MAX_SENSORS);
+}
+
+static void v_sensors(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "one sensor, id 0, at mid-span");
+}
+
+static const sensor_item sensor_default = {.id = 0, .at_m = 0.0, .weight = 1.0};
+const list_schema sensors_list = {sensor_fields, &sensor_default};
+const kind K_SENSORS = {"list", p_sensors, d_sensors, v_sensors, NEST_LIST};
+
+static void formulation_names(char *known, size_t len)
+{
+    size_t used = 0;
+
+    known[0] = '\0';
+    for (int i = 0; strcmp(amfi_formulation_name((amfi_formulation)i), "unknown"); i++)
+        used = advance(used, snprintf(known + used, len - used, "%s%s", i ? ", " : "",
+                                      amfi_formulation_name((amfi_formulation)i)),
+                       len);
+}
+
+/* solver.formulation: a name amfi_formulation_parse() knows */
+static int p_formulation(ctx *x, yaml_node_t *v, const char *path, const field *f,
+                         void *base)
+{
+    amfi_site_config *c = base;
+    char known[128], buf[SHOW_LEN];
+    const char *s = scalar(x, v, path, "a formulation name", 1);
+
+    (void)f;
+    if (!s)
+        return -1;
+    if (amfi_formulation_parse(s, &c->solver.formulation) == 0)
+        return 0;
+    formulation_names(known, sizeof known);
+    return fail(x, line_of(v), path, "expected one of %s; got '%s'", known,
+                show(buf, sizeof buf, v));
+}
+
+static void d_formulation(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    formulation_names(buf, DOC_LEN);
+}
+
+static void v_formulation(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    snprintf(buf, DOC_LEN, "%s",
+             amfi_formulation_name(((const amfi_site_config *)base)->solver.formulation));
+}
+
+/* solver.modes: all | observable | N (the N lowest observable modes) */
+static int p_modes(ctx *x, yaml_node_t *v, const char *path, const field *f,
+                   void *base)
+{
+    amfi_solver_params *p = &((amfi_site_config *)base)->solver;
+    const char *want = "all, observable or a positive mode count";
+    char buf[SHOW_LEN];
+    const char *s = scalar(x, v, path, want, 1);
+    long n = 0;
+
+    (void)f;
+    if (!s)
+        return -1;
+    if (strcmp(s, "all") == 0 || strcmp(s, "observable") == 0) {
+        p->modes = s[0] == 'a' ? AMFI_MODES_ALL : AMFI_MODES_OBSERVABLE;
+        p->n_modes = 0;
+        return 0;
+    }
+    if (!is_plain(v) || to_long(s, &n) != 0)
+        return fail(x, line_of(v), path, "expected %s, got '%s'", want,
+                    show(buf, sizeof buf, v));
+    if (n < 1 || n > MAX_MODE_NO)
+        return fail(x, line_of(v), path, "a mode count must be 1 .. %d, got %ld",
+                    MAX_MODE_NO, n);
+    p->modes = AMFI_MODES_COUNT;
+    p->n_modes = (int)n;
+    return 0;
+}
+
+/* solver.lambda: auto (L-curve) or a fixed λ at lambda_ref_rate_hz, > 0 */
+static int p_lambda(ctx *x, yaml_node_t *v, const char *path, const field *f,
+                    void *base)
+{
+    amfi_lambda *l = &((amfi_site_config *)base)->lambda;
+    const char *want = "auto or a positive number";
+    char buf[SHOW_LEN];
+    const char *s = scalar(x, v, path, want, 1);
+    double d = 0.0;
+    int rc;
+
+    (void)f;
+    if (!s)
+        return -1;
+    if (strcmp(s, "auto") == 0) {
+        l->automatic = 1;
+        return 0;
+    }
+    rc = is_plain(v) ? to_double(s, &d) : -1;
+    if (rc == -1)
+        return fail(x, line_of(v), path, "expected %s, got '%s'", want,
+                    show(buf, sizeof buf, v));
+    if (rc == -2)
+        return fail(x, line_of(v), path, "number out of range: '%s'",
+                    show(buf, sizeof buf, v));
+    if (!(d > 0))
+        return fail(x, line_of(v), path, "must be > 0 (or auto), got %g", d);
+    l->automatic = 0;
+    l->lambda_ref = d;
+    return 0;
+}
+
+static void d_modes(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "all, observable or a count 1 .. %d", MAX_MODE_NO);
+}
+
+static void v_modes(const field *f, const void *base, char *buf)
+{
+    const amfi_solver_params *p = &((const amfi_site_config *)base)->solver;
+
+    (void)f;
+    if (p->modes == AMFI_MODES_COUNT)
+        snprintf(buf, DOC_LEN, "%d", p->n_modes);
+    else
+        snprintf(buf, DOC_LEN, "%s", p->modes == AMFI_MODES_ALL ? "all" : "observable");
+}
+
+static void d_lambda(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "auto or > 0");
+}
+
+static void v_lambda(const field *f, const void *base, char *buf)
+{
+    const amfi_lambda *l = &((const amfi_site_config *)base)->lambda;
+
+    (void)f;
+    if (l->automatic)
+        snprintf(buf, DOC_LEN, "auto");
+    else
+        snprintf(buf, DOC_LEN, "%g", l->lambda_ref);
+}
+
+static const kind K_FORMULATION = {"name", p_formulation, d_formulation, v_formulation,
+                                   NEST_NONE};
+static const kind K_MODES = {"name or integer", p_modes, d_modes, v_modes, NEST_NONE};
+static const kind K_LAMBDA = {"name or number", p_lambda, d_lambda, v_lambda, NEST_NONE};
+
+
+static const enum_name coords_names[] = {
+    {"modal", AMFI_COORDS_MODAL}, {"nodal", AMFI_COORDS_NODAL}, {NULL, 0}};
+
+/* solver.initial_force -> fix_initial_force */
+static const enum_name initial_force_names[] = {{"free", 0}, {"zero", 1}, {NULL, 0}};
+
+/* solver.initial_state -> free_initial_state */
+static const enum_name initial_state_names[] = {{"rest", 0}, {"free", 1}, {NULL, 0}};
+
+static const field lcurve_fields[] = {
+    {.key = "lo", .kind = &K_DOUBLE, .off = SC(lambda.lcurve_lo), .lo = 0,
+     .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
+    {.key = "hi", .kind = &K_DOUBLE, .off = SC(lambda.lcurve_hi), .lo = 0,
+     .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
+    {.key = "per_decade", .kind = &K_INT, .off = SC(lambda.lcurve_per_decade), .lo = 1,
+     .hi = 100},
+    {.key = "refine", .kind = &K_INT, .off = SC(lambda.lcurve_refine_points), .lo = 0,
+     .hi = 100},
+    {.key = NULL}};
+
+const field solver_fields[] = {
+    {.key = "formulation", .kind = &K_FORMULATION},
+    {.key = "coordinates", .kind = &K_ENUM, .off = SC(solver.coords),
+     .aux = coords_names},
+    {.key = "modes", .kind = &K_MODES},
+    {.key = "calc_rate_hz", .kind = &K_DOUBLE, .off = SC(solver.calc_rate_hz), .lo = 0,
+     .hi = MAX_RATE_HZ, .flags = F_LO_OPEN},
+    {.key = "initial_force", .kind = &K_ENUM, .off = SC(solver.fix_initial_force),
+     .aux = initial_force_names},
+    {.key = "initial_state", .kind = &K_ENUM, .off = SC(solver.free_initial_state),
+     .aux = initial_state_names},
+    {.key = "pre_roll_s", .kind = &K_DOUBLE, .off = SC(solver.pre_roll_s), .lo = 0,
+     .hi = MAX_ROLL_S, .flags = F_HI_OPEN},
+    {.key = "post_roll_s", .kind = &K_DOUBLE, .off = SC(solver.post_roll_s), .lo = 0,
+     .hi = MAX_ROLL_S, .flags = F_HI_OPEN},
+    {.key = "max_axles", .kind = &K_INT, .off = SC(solver.max_axles), .lo = 1,
+     .hi = AMFI_MAX_AXLES},
+    {.key = "max_duration_s", .kind = &K_DOUBLE, .off = SC(solver.max_duration_s),
+     .lo = 0, .hi = MAX_DURATION_S, .flags = F_LO_OPEN},
+    {.key = "lambda", .kind = &K_LAMBDA},
+    {.key = "lambda_ref_rate_hz", .kind = &K_DOUBLE, .off = SC(lambda.ref_rate_hz),
+     .lo = 0, .hi = MAX_RATE_HZ, .flags = F_LO_OPEN},
+    {.key = "lcurve", .kind = &K_MAP, .aux = lcurve_fields},
+    {.key = NULL}};
+
+/* Without `sensors` in the file, the one sensor follows bridge.span_m. */
+int sensors_check(ctx *x, amfi_site_config *c)
+{
+    amfi_solver_params *s = &c->solver;
+    int ndof = bridge_free_dofs(&c->bridge);
+    char p[PATH_LEN];
+
+    if (!noted(x, "sensors"))
+        s->sensor_x_m[0] = 0.5 * c->bridge.span_m;
+    if (s->modes == AMFI_MODES_COUNT && s->n_modes > ndof)
+        return fail(x, noted(x, "solver.modes"), "solver.modes",
+                    "%d modes asked, the model has only %d (free DOFs)", s->n_modes,
+                    ndof);
+    for (int i = 0; i < s->n_sensors; i++) {
+        pathf(p, "sensors[%d].at_m", i);
+        if (s->sensor_x_m[i] > c->bridge.span_m)
+            return fail(x, first_noted(x, p, "bridge.span_m", NULL), p,
+                        "%g m is beyond the span (bridge.span_m = %g m)",
+                        s->sensor_x_m[i], c->bridge.span_m);
+    }
+    return 0;
+}
+
+int solver_check(ctx *x, amfi_site_config *c)
+{
+    const amfi_solver_params *s = &c->solver;
+    const amfi_lambda *l = &c->lambda;
+
+    /* λ search grid. */
+    if (!(l->lcurve_lo < l->lcurve_hi))
+        return fail(x, first_noted(x, "solver.lcurve.hi", "solver.lcurve.lo",
+                                   "solver.lcurve"),
+                    "solver.lcurve", "lo (%g) must be below hi (%g)", l->lcurve_lo,
+                    l->lcurve_hi);
+
+    /* g_0 = 0 forces a ramp at entry unless the window starts before it. */
+    if (s->fix_initial_force && !(s->pre_roll_s > 0))
+        return fail(x, first_noted(x, "solver.initial_force", "solver.pre_roll_s", NULL),
+                    "solver.initial_force", "zero needs solver.pre_roll_s > 0");
+    if (s->free_initial_state && s->fix_initial_force)
+        return fail(x, first_noted(x, "solver.initial_state", "solver.initial_force", NULL),
+                    "solver.initial_state", "free needs solver.initial_force: free");
+    if (s->free_initial_state && s->coords != AMFI_COORDS_MODAL)
+        return fail(x, first_noted(x, "solver.initial_state", "solver.coordinates", NULL),
+                    "solver.initial_state", "free needs solver.coordinates: modal");
+    return 0;
+}

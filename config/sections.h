@@ -1,0 +1,56 @@
+/*
+ * sections.h: the four sections of a site file (internal to config/), each
+ * in its own file: its key tables for the walker (yaml_walk.h), its value
+ * kinds that need more than a number or a name, and the checks that involve
+ * several of its keys. amfi_config.c puts them under one top-level table and
+ * runs the checks across sections.
+ *
+ *   section_bridge.c      bridge:      the beam, its damping and supports
+ *   section_solver.c      sensors:, solver:  positions, solver and λ policy,
+ *                         and the bound on the solver's workspace
+ *   section_daemon.c      daemon:      amfid's bus, store, threads, indicators
+ *   section_simulation.c  simulation:  sim_publisher's settings
+ *
+ * Every function runs on the loader's (caller's) thread.
+ */
+#ifndef AMFI_CONFIG_SECTIONS_H
+#define AMFI_CONFIG_SECTIONS_H
+
+#include "amfi_config.h"
+#include "yaml_walk.h"
+
+#define MAX_MODE_NO (2 * (1000 + 1)) /* DOFs of the largest mesh, before supports */
+
+/* Offsets into amfi_site_config. */
+#define SC(m) offsetof(amfi_site_config, m)
+
+/* Bounds on one solver's workspace (amfi_solver_create sizes it for
+ * (max_duration_s + pre_roll_s + post_roll_s) · calc_rate_hz steps; amfid
+ * holds one per worker): documented in amfid.yaml(5). */
+#define AMFI_CONFIG_MAX_STEPS 10000000.0
+#define AMFI_CONFIG_MAX_WORKSPACE_BYTES (1024.0 * 1024.0 * 1024.0)
+
+extern const field bridge_fields[]; /* bridge: */
+extern const kind K_SENSORS;        /* sensors: (a list of sensors_list) */
+extern const list_schema sensors_list;
+extern const field solver_fields[]; /* solver: */
+extern const field daemon_fields[]; /* daemon: */
+extern const field sim_fields[];    /* simulation: */
+
+/* Free DOFs of the beam once the supports (snapped to nodes) are applied. */
+int bridge_free_dofs(const amfi_bridge_params *b);
+
+/* The checks of one section that involve several of its keys (or that
+ * follow defaults of another, noted in each); 0 or −1 after fail(). */
+int bridge_check(ctx *x, amfi_site_config *c);
+int sensors_check(ctx *x, amfi_site_config *c);
+int solver_check(ctx *x, amfi_site_config *c);
+int daemon_check(ctx *x, amfi_site_config *c);
+int sim_check(ctx *x, amfi_site_config *c);
+
+/* The model itself: the bridge built with libamfi (its refusals reported at
+ * the line of the bridge key or section that caused them) and the solver's
+ * workspace counted against the bounds above (section_solver.c). */
+int model_check(ctx *x, amfi_site_config *c);
+
+#endif /* AMFI_CONFIG_SECTIONS_H */

@@ -1,0 +1,169 @@
+/*
+ * yaml_walk.h: the generic half of the site-file loader (internal to
+ * config/): a YAML document walked by tables of keys, strict scalar parsers,
+ * and "FILE:LINE: key.path: problem" messages. It knows nothing about
+ * bridges or daemons; the sections (section_*.c) describe their keys with
+ * the `field` rows below and amfi_config.c puts them together.
+ *
+ * yaml_walk.c: document loading, the walk of a mapping, key paths, the
+ *   record of where each key was seen, messages.
+ * yaml_scalar.c: the strict scalar parsers and the generic value kinds
+ *   (number, integer, name from a list, string, file path, mapping), each
+ *   with its parser and its description for the manual (amfi_config_keys.h).
+ *
+ * Workload and ownership: one ctx per amfi_config_load call, on the caller's
+ * thread; no global state. The walk is bounded by the schema, not by the
+ * document: it descends only where a table has a mapping or a list, and
+ * lists have bounded length, so self-referencing aliases or deep nesting
+ * cannot make it loop or recurse.
+ */
+#ifndef AMFI_YAML_WALK_H
+#define AMFI_YAML_WALK_H
+
+#include <stddef.h>
+
+#include <yaml.h>
+
+#define PATH_LEN 96   /* key paths such as "bridge.supports[15].at_m" */
+#define MAX_NOTES 256 /* key paths remembered for cross-checks */
+#define MAX_FIELDS 32 /* rows per table */
+#define SHOW_LEN 40   /* bytes of an offending value quoted in a message */
+#define DOC_LEN 160   /* a key's type, range or default, as the manual shows it */
+
+typedef struct note {
+    char path[PATH_LEN];
+    int line; /* 1-based line of the key */
+} note;
+
+typedef struct ctx {
+    const char *file;     /* as the caller named it, for messages */
+    yaml_document_t *doc; /* the loaded document, owned by the loader */
+    char *err;            /* caller's buffer, may be NULL */
+    size_t errlen;
+    int n_notes;
+    note notes[MAX_NOTES]; /* every key path seen, with its line */
+} ctx;
+
+typedef struct field field;
+
+/* Parse value node v of key path `path` into base (the struct the row's
+ * offsets are relative to). 0 ok, −1 after fail(). */
+typedef int (*parse_fn)(ctx *x, yaml_node_t *v, const char *path, const field *f,
+                        void *base);
+
+/* Describe row f for the manual into buf[DOC_LEN]: its allowed values, or
+ * (with base = the defaults) its default value. */
+typedef void (*describe_fn)(const field *f, const void *base, char *buf);
+
+enum { NEST_NONE, NEST_MAP, NEST_LIST };
+
+/* A kind of value: how to read it and how to describe it. */
+typedef struct kind {
+    const char *type;     /* for the manual: "number", "integer", ... */
+    parse_fn parse;
+    describe_fn range;    /* the allowed values */
+    describe_fn dflt;     /* the value at base (the defaults) */
+    int nest;             /* NEST_MAP: aux is a field[] under this key;
+                             NEST_LIST: aux is a list_schema for its items */
+} kind;
+
+/* A list of mappings (bridge.supports, sensors): the table of an item's
+ * keys and an item holding their defaults. */
+typedef struct list_schema {
+    const field *items;
+    const void *item_default;
+} list_schema;
+
+#define F_LO_OPEN 1u  /* lo itself is not allowed */
+#define F_HI_OPEN 2u  /* hi itself is not allowed */
+#define F_REQUIRED 4u /* the key must be present (list items) */
+#define F_FILE_DIR 8u /* K_PATH: a relative path is joined to the file's folder */
+
+struct field {
+    const char *key;   /* NULL ends a table */
+    const kind *kind;
+    size_t off;        /* destination, bytes from base */
+    double lo, hi;     /* K_DOUBLE, K_INT, ...: allowed range (HUGE_VAL: none);
+                          K_STRING, K_PATH: lo minimum length, hi capacity */
+    unsigned flags;    /* F_* */
+    const void *aux;   /* K_MAP and lists: const field[]; K_ENUM: const enum_name[] */
+};
+
+typedef struct enum_name {
+    const char *name; /* NULL ends the list */
+    int value;
+} enum_name;
+
+/* ---- messages and key paths (yaml_walk.c) ---- */
+
+/* Write "FILE[:LINE]: [path: ]message" into the caller's buffer; returns −1.
+ * line <= 0 omits the line, an empty path omits the path. */
+int fail(ctx *x, int line, const char *path, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+int line_of(const yaml_node_t *n);
+const char *show(char *buf, size_t len, const yaml_node_t *v); /* a value, sanitised */
+const char *what(const yaml_node_t *v); /* "a mapping", "a list", ... */
+size_t advance(size_t used, int n, size_t len); /* snprintf bookkeeping */
+void pathf(char *out, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+void join_index(char *out, const char *path, size_t i);
+void note_line(ctx *x, const char *path, int line);
+int noted(const ctx *x, const char *path); /* line of key path, 0: not given */
+/* The line of the first of a, b, c (b and c may be NULL) given in the file. */
+int first_noted(const ctx *x, const char *a, const char *b, const char *c);
+/* The latest line of any key given under `prefix` ("daemon.indicators."). */
+int noted_under(const ctx *x, const char *prefix);
+
+/* Parse mapping m (key path `path`, "" at the top) with `table` into base:
+ * type check, unknown, duplicate and required keys, then each row's kind. */
+int walk_map(ctx *x, yaml_node_t *m, const char *path, const field *table, void *base);
+
+/* The items of list node v, checked to be 1 .. max long; NULL after fail(). */
+yaml_node_item_t *list_items(ctx *x, yaml_node_t *v, const char *path,
+                             const char *what_items, int max, int *n);
+
+/* Read `path` (at most 1 MiB, a single YAML document nested at most 16
+ * deep), walk its root with `top` into base in the C numeric locale, then
+ * run check(x, base) if not NULL. 0 ok, −1 after fail(). */
+int walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *base));
+
+/* Call visit once per key of `table` and of the tables under it, depth
+ * first, in table order, with the key's path ("solver.lcurve.lo", list
+ * items as "sensors[].at_m"), kind name, allowed values and default (from
+ * base; "required" for a required item key). Stops at and returns the first
+ * non-zero value of visit. */
+typedef int (*key_visit)(const char *path, const char *type, const char *range,
+                         const char *dflt, void *arg);
+int describe_table(const field *table, const char *prefix, const void *base,
+                   key_visit visit, void *arg);
+
+/* ---- scalars and kinds (yaml_scalar.c) ---- */
+
+int is_plain(const yaml_node_t *v);
+int is_null_node(const yaml_node_t *v); /* `key:`, `~`, `null` */
+/* The text of scalar node v, or NULL after an error saying what was `want`ed.
+ * Numbers must be plain (unquoted) scalars: allow_quoted = 0. */
+const char *scalar(ctx *x, const yaml_node_t *v, const char *path, const char *want,
+                   int allow_quoted);
+/* Strict decimal parsers: 0 ok, −1 not a number, −2 out of range. */
+int to_double(const char *s, double *out);
+int to_llong(const char *s, long long *out);
+int to_long(const char *s, long *out);
+int get_double(ctx *x, const yaml_node_t *v, const char *path, double *out);
+int get_long(ctx *x, const yaml_node_t *v, const char *path, long *out);
+int out_of_range(double d, const field *f);
+int range_fail(ctx *x, const yaml_node_t *v, const char *path, const field *f, double d);
+/* Row f's [lo, hi] as the messages write it: "[0, 1)", "> 0", "1 .. 64". */
+void describe_interval(const field *f, char *buf);
+void describe_count(const field *f, char *buf);
+void describe_names(const enum_name *names, char *buf); /* "a | b | c" */
+const char *enum_label(const enum_name *names, int value); /* NULL: not listed */
+
+extern const kind K_DOUBLE; /* double at off, in [lo, hi] (F_*_OPEN) */
+extern const kind K_INT;    /* int at off, lo .. hi */
+extern const kind K_LLONG;  /* long long at off, lo .. hi */
+extern const kind K_ENUM;   /* int at off, one of aux's names */
+extern const kind K_STRING; /* char[hi] at off, printable, lo .. hi − 1 bytes */
+extern const kind K_PATH;   /* char[hi] at off; "" or null: none */
+extern const kind K_MAP;    /* a mapping walked with aux's table */
+
+#endif /* AMFI_YAML_WALK_H */
