@@ -400,6 +400,53 @@ static void test_span_follows(void **state)
     assert_true(c.solver.calc_rate_hz == d.solver.calc_rate_hz);
 }
 
+/* The daemon's indicator settings are the engine's own parameters, with the
+ * engine's defaults. */
+static void test_indicator_defaults_are_the_engines(void **state)
+{
+    amfi_site_config c;
+    amfi_indicator_params p;
+    char err[ERRLEN];
+
+    (void)state;
+    memset(&p, 0, sizeof p);
+    amfi_indicator_params_default(&p);
+    amfi_config_defaults(&c);
+    assert_memory_equal(&p, &c.daemon.indicators, sizeof p);
+    assert_int_equal(0, amfi_indicator_params_check(&c.daemon.indicators, NULL, NULL, 0));
+    if (load_text("daemon:\n  indicators: {window: 20, mean_shift: off, "
+                  "std_clear_ratio: 1.08}\n", &c, err))
+        fail_msg("%s", err);
+    assert_int_equal(20, c.daemon.indicators.window);
+    assert_int_equal(0, c.daemon.indicators.mean_shift);
+    assert_true(c.daemon.indicators.std_clear_ratio == 1.08); /* = alert: allowed */
+}
+
+/* Steps and workspace just under the bounds load; just over, they do not. */
+static void test_workspace_bounds(void **state)
+{
+    amfi_site_config c;
+    char err[ERRLEN];
+
+    (void)state;
+    /* 1 300 001 steps × 8 B × (2·1 + 2·2 + 2·(2·20 + 2)) = 0.87 GiB */
+    if (load_text("solver: {calc_rate_hz: 1e6, max_duration_s: 1}\n", &c, err))
+        fail_msg("%s", err);
+    assert_true(c.solver.calc_rate_hz == 1e6);
+    assert_int_equal(-1, load_text("solver: {calc_rate_hz: 1e6, max_duration_s: 1.3}\n",
+                                   &c, err));
+    assert_non_null(strstr(err, ":1: solver.calc_rate_hz: the solver's workspace would be"));
+    /* 10 000 000 steps (56 B each with one axle and one mode): at the bound */
+    if (load_text("solver: {calc_rate_hz: 1e6, max_duration_s: 9.699999, max_axles: 1,"
+                  " modes: 1}\n", &c, err))
+        fail_msg("%s", err);
+    assert_int_equal(-1, load_text("solver: {calc_rate_hz: 1e6, max_duration_s: 9.7,"
+                                   " max_axles: 1, modes: 1}\n", &c, err));
+    assert_non_null(strstr(err, ":1: solver.calc_rate_hz: 1e+06 Hz over (max_duration_s "
+                                "9.7 + pre_roll_s 0.3 + post_roll_s 0) s is 10000001 "
+                                "solver steps, above the limit of 10000000 steps"));
+}
+
 /* A short list replaces the default list whole; unused slots are cleared. */
 static void test_list_replaces(void **state)
 {
@@ -539,6 +586,25 @@ static const bad_case bad_cases[] = {
     {"daemon_clear_above_alert",
      "daemon:\n  indicators: {std_alert_ratio: 1.05, std_clear_ratio: 1.2}\n", 2,
      "daemon.indicators.std_clear_ratio", "must not exceed"},
+    {"daemon_alert_below_default_clear",
+     "daemon:\n  indicators:\n    mean_alert_ratio: 1.02\n", 3,
+     "daemon.indicators.mean_clear_ratio", "must not exceed mean_alert_ratio = 1.02"},
+    /* issue 9 item 6: refused at load, with the line and the limit, not later
+     * "out of memory for 600300001 steps" */
+    {"steps_over_limit", "solver:\n  calc_rate_hz: 1e6\n  max_duration_s: 600\n", 2,
+     "solver.calc_rate_hz", "is 600300001 solver steps, above the limit of 10000000 steps"},
+    {"steps_over_limit_rolls", "solver:\n  max_duration_s: 600\n  post_roll_s: 59\n"
+     "  pre_roll_s: 59\n  calc_rate_hz: 14000\n", 5, "solver.calc_rate_hz",
+     "is 10052001 solver steps, above the limit of 10000000"},
+    {"workspace_over_limit", "solver:\n  max_duration_s: 600\n  max_axles: 12\n", 2,
+     "solver.max_duration_s", "14.54 GiB (3001501 steps of 12 axles over 40 states), "
+     "above the limit of 1 GiB per solver"},
+    {"workspace_over_limit_nodal", "bridge:\n  elements: 400\nsolver:\n"
+     "  coordinates: nodal\n  initial_state: rest\n  max_axles: 4\n", 6,
+     "solver.max_axles", "steps of 4 axles over 3200 states), above the limit of 1 GiB"},
+    /* a refusal of libamfi's bridge model names the file and the line */
+    {"model_refused", "bridge:\n  density_kgm3: 1e-200\n  A_m2: 1e-200\n", 1, "bridge",
+     "the bridge model is refused: eigenproblem failed"},
     {"unknown_key_in_item", "sensors:\n  - {id: 0, at_m: 1}\n  - {id: 1, pos: 2}\n", 3,
      "sensors[1].pos", "unknown key"},
     {"map_for_scalar", "bridge:\n  span_m: {value: 20}\n", 2, "bridge.span_m",
@@ -808,6 +874,8 @@ int main(void)
         cmocka_unit_test(test_sim_population_folder),
         cmocka_unit_test(test_span_follows),
         cmocka_unit_test(test_list_replaces),
+        cmocka_unit_test(test_indicator_defaults_are_the_engines),
+        cmocka_unit_test(test_workspace_bounds),
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_too_large),
         cmocka_unit_test(test_deep_nesting),
