@@ -129,7 +129,11 @@ void amfi_config_defaults(amfi_site_config *c);
  *   "FILE:LINE: key.path: problem"   e.g. "site.yaml:12: solver.lamda: unknown key"
  * (without ":LINE" for a missing or unreadable file, and without the key path
  * for a YAML syntax error). Numbers use a decimal point whatever the
- * process locale. */
+ * process locale. Once every key is valid the bridge model is built with
+ * libamfi (a refusal is reported at the line of the bridge key or section
+ * that caused it), and a solver workspace above 10^7 steps or 1 GiB is
+ * refused (amfid.yaml(5), LIMITS). Every key, its range and default:
+ * amfi_config_keys() (amfi_config_keys.h) and amfid.yaml(5). */
 int amfi_config_load(const char *path, amfi_site_config *c, char *err,
                      size_t errlen);
 
