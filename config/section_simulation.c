@@ -17,21 +17,14 @@ static int p_speedup(ctx *x, yaml_node_t *v, const char *path, const field *f,
                      void *base)
 {
     const char *want = "max or a number";
-    char buf[SHOW_LEN];
     const char *s = scalar(x, v, path, want, 1);
     double d = 0.0;
-    int rc;
 
     if (!s)
         return -1;
     if (strcmp(s, "max") != 0) {
-        rc = is_plain(v) ? to_double(s, &d) : -1;
-        if (rc == -1)
-            return fail(x, line_of(v), path, "expected %s, got '%s'", want,
-                        show(buf, sizeof buf, v));
-        if (rc == -2)
-            return fail(x, line_of(v), path, "number out of range: '%s'",
-                        show(buf, sizeof buf, v));
+        if (get_number(x, v, path, want, &d))
+            return -1;
         if (out_of_range(d, f))
             return fail(x, line_of(v), path, "must be max or in [%g, %g], got %g", f->lo,
                         f->hi, d);

@@ -98,9 +98,7 @@ static void formulation_names(char *known, size_t len)
 
     known[0] = '\0';
     for (int i = 0; strcmp(amfi_formulation_name((amfi_formulation)i), "unknown"); i++)
-        used = advance(used, snprintf(known + used, len - used, "%s%s", i ? ", " : "",
-                                      amfi_formulation_name((amfi_formulation)i)),
-                       len);
+        used = append_name(known, len, used, amfi_formulation_name((amfi_formulation)i));
 }
 
 /* solver.formulation: a name amfi_formulation_parse() knows */
@@ -170,10 +168,8 @@ static int p_lambda(ctx *x, yaml_node_t *v, const char *path, const field *f,
 {
     amfi_lambda *l = &((amfi_site_config *)base)->lambda;
     const char *want = "auto or a positive number";
-    char buf[SHOW_LEN];
     const char *s = scalar(x, v, path, want, 1);
     double d = 0.0;
-    int rc;
 
     (void)f;
     if (!s)
@@ -182,13 +178,8 @@ static int p_lambda(ctx *x, yaml_node_t *v, const char *path, const field *f,
         l->automatic = 1;
         return 0;
     }
-    rc = is_plain(v) ? to_double(s, &d) : -1;
-    if (rc == -1)
-        return fail(x, line_of(v), path, "expected %s, got '%s'", want,
-                    show(buf, sizeof buf, v));
-    if (rc == -2)
-        return fail(x, line_of(v), path, "number out of range: '%s'",
-                    show(buf, sizeof buf, v));
+    if (get_number(x, v, path, want, &d))
+        return -1;
     if (!(d > 0))
         return fail(x, line_of(v), path, "must be > 0 (or auto), got %g", d);
     l->automatic = 0;

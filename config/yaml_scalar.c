@@ -134,6 +134,21 @@ int get_double(ctx *x, const yaml_node_t *v, const char *path, double *out)
     return 0;
 }
 
+int get_number(ctx *x, const yaml_node_t *v, const char *path, const char *want,
+               double *out)
+{
+    char buf[SHOW_LEN];
+    int rc = is_plain(v) ? to_double((const char *)v->data.scalar.value, out) : -1;
+
+    if (rc == -1)
+        return fail(x, line_of(v), path, "expected %s, got '%s'", want,
+                    show(buf, sizeof buf, v));
+    if (rc == -2)
+        return fail(x, line_of(v), path, "number out of range: '%s'",
+                    show(buf, sizeof buf, v));
+    return 0;
+}
+
 int get_long(ctx *x, const yaml_node_t *v, const char *path, long *out)
 {
     char buf[SHOW_LEN];
@@ -238,8 +253,7 @@ static void list_names(char *buf, size_t len, const enum_name *names)
 
     buf[0] = '\0';
     for (const enum_name *e = names; e->name; e++)
-        used = advance(used, snprintf(buf + used, len - used, "%s%s",
-                                      e == names ? "" : ", ", e->name), len);
+        used = append_name(buf, len, used, e->name);
 }
 
 void describe_names(const enum_name *names, char *buf)

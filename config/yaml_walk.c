@@ -166,14 +166,19 @@ int noted_under(const ctx *x, const char *prefix)
 
 /* ---- the walk ------------------------------------------------------------ */
 
+size_t append_name(char *buf, size_t len, size_t used, const char *name)
+{
+    return advance(used, snprintf(buf + used, len - used, "%s%s", used ? ", " : "", name),
+                   len);
+}
+
 static void list_keys(char *buf, size_t len, const field *table)
 {
     size_t used = 0;
 
     buf[0] = '\0';
     for (const field *f = table; f->key; f++)
-        used = advance(used, snprintf(buf + used, len - used, "%s%s",
-                                      f == table ? "" : ", ", f->key), len);
+        used = append_name(buf, len, used, f->key);
 }
 
 /* Parse mapping m (key path `path`, "" at the top) with `table` into base. */

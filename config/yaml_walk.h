@@ -104,6 +104,8 @@ int line_of(const yaml_node_t *n);
 const char *show(char *buf, size_t len, const yaml_node_t *v); /* a value, sanitised */
 const char *what(const yaml_node_t *v); /* "a mapping", "a list", ... */
 size_t advance(size_t used, int n, size_t len); /* snprintf bookkeeping */
+/* Append ", name" (or "name" at used = 0) to buf[len]; the new length. */
+size_t append_name(char *buf, size_t len, size_t used, const char *name);
 void pathf(char *out, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 void join_index(char *out, const char *path, size_t i);
 void note_line(ctx *x, const char *path, int line);
@@ -150,6 +152,10 @@ int to_llong(const char *s, long long *out);
 int to_long(const char *s, long *out);
 int get_double(ctx *x, const yaml_node_t *v, const char *path, double *out);
 int get_long(ctx *x, const yaml_node_t *v, const char *path, long *out);
+/* A plain number in scalar v (already checked by scalar()), else "expected
+ * `want`" or "number out of range"; 0 or −1 after fail(). */
+int get_number(ctx *x, const yaml_node_t *v, const char *path, const char *want,
+               double *out);
 int out_of_range(double d, const field *f);
 int range_fail(ctx *x, const yaml_node_t *v, const char *path, const field *f, double d);
 /* Row f's [lo, hi] as the messages write it: "[0, 1)", "> 0", "1 .. 64". */
