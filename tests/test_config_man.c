@@ -52,9 +52,12 @@ static int print_key(const amfi_config_key *k, void *arg)
  * "; required)". */
 static int is_entry(const char *l)
 {
-    size_t n = strlen(l), p = strcspn(l + 1, "* \t") + 1;
+    size_t n = strlen(l), p;
 
-    return l[0] == '*' && p > 1 && strncmp(l + p, "* (", 3) == 0 && n && l[n - 1] == ')' &&
+    if (l[0] != '*')
+        return 0;
+    p = strcspn(l + 1, "* \t") + 1;
+    return p > 1 && strncmp(l + p, "* (", 3) == 0 && n && l[n - 1] == ')' &&
            (strstr(l, "; default ") || strstr(l, "; required)"));
 }
 
