@@ -51,7 +51,6 @@
 #include "amfi_truth_t.h"
 #include "amfi_vehicle_t.h"
 #include "indicators.h"
-#include <sqlite3.h>
 #include "ring.h"
 #include "store.h"
 #include "tracker.h"
@@ -704,16 +703,13 @@ static void indicator_params(const amfi_daemon_config *dc, amfi_indicator_params
 /* 1 when the newest alert of `kind` in the store was a raise (still open). */
 static int last_alert_raised(amfi_store *st, const char *kind)
 {
-    sqlite3_stmt *q = NULL;
-    int raised = 0;
-    if (sqlite3_prepare_v2(amfi_store_db(st),
-                           "SELECT raised FROM alerts WHERE kind = ?1 ORDER BY id DESC LIMIT 1",
-                           -1, &q, NULL) == SQLITE_OK &&
-        sqlite3_bind_text(q, 1, kind, -1, SQLITE_STATIC) == SQLITE_OK &&
-        sqlite3_step(q) == SQLITE_ROW && sqlite3_column_type(q, 0) == SQLITE_INTEGER)
-        raised = sqlite3_column_int(q, 0) == 1;
-    sqlite3_finalize(q);
-    return raised;
+    char err[256];
+    int open = 0;
+    if (amfi_store_alert_open(st, kind, &open, err, sizeof err) != 0) {
+        LOG_WARN("store: %s", err);
+        return 0;
+    }
+    return open;
 }
 
 /* SIGHUP: apply what can change while running, report the rest. */

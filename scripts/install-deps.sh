@@ -21,7 +21,7 @@ pkgs=(
   x11-apps                       # xwd: the amfi_spy test's screenshot
   iproute2                       # ip: the amfi_spy test's private network namespace
   libsystemd-dev                 # sd_notify, watchdog, journal (amfid)
-  libsqlite3-dev                 # the store of passages, indicators, alerts (daemon/store.c)
+  libsqlite3-dev                 # the store of passages, indicators, alerts (store/)
   sqlite3                        # sqlite3 CLI: queries on the store, report_cli test fixture
   scdoc                          # man pages (man/*.scd -> roff)
   man-db                         # man -l: the install test renders every page

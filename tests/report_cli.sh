@@ -38,8 +38,8 @@ awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
     cat "$tmp/ddl.sql"
     cat <<'EOF'
 PRAGMA journal_mode = WAL;
-PRAGMA user_version = 1;
-INSERT INTO schema_migrations (version, description) VALUES (1, 'report_cli fixture');
+PRAGMA user_version = 2;
+INSERT INTO schema_migrations (version, description) VALUES (1, 'report_cli fixture'), (2, 'runs');
 WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 40)
 INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status,
                       reason, lambda, residual_rms, formulation, solve_ms)
@@ -243,7 +243,7 @@ bad foreign 1 'not an amfi store' --db "$tmp/recipes.db"
 
 cp "$tmp/pristine.db" "$tmp/newer.db"
 sqlite3 "$tmp/newer.db" "PRAGMA user_version = 7"
-bad newer 1 'schema version 7 is newer than this program.s 1' --db "$tmp/newer.db"
+bad newer 1 'schema version 7 is newer than this program.s 2' --db "$tmp/newer.db"
 
 cp "$tmp/pristine.db" "$tmp/damaged.db"
 sqlite3 "$tmp/damaged.db" "PRAGMA ignore_check_constraints = ON; UPDATE passages SET gvw_kg = -1 WHERE id = 3"

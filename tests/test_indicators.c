@@ -1,5 +1,5 @@
 /*
- * test_indicators.c: amfid's damage indicator engine (daemon/indicators.c):
+ * test_indicators.c: amfid's damage indicator engine (indicators/indicators.c):
  * parameter checks, the automatic and explicit baselines, prefill, the
  * evaluation cadence, the window statistics against a naive recomputation,
  * the F and Welch p-values against hand-computed closed forms, the

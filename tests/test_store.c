@@ -1,5 +1,5 @@
 /*
- * test_store.c: unit tests of amfid's SQLite store (daemon/store.h).
+ * test_store.c: unit tests of amfid's SQLite store (store/store.h).
  *
  * Each test works in a fresh directory under /tmp (removed afterwards) and
  * looks at the file with a second, raw sqlite3 connection: the schema
@@ -198,7 +198,7 @@ static void test_create_and_reopen(void **state)
     static const char *const objects[] = {
         "passages", "axles", "truth", "truth_axles", "indicators", "alerts",
         "baseline", "meta", "schema_migrations", "daily_trend", "window_trend",
-        "passage_errors", "passages_utime", "passages_status_utime"};
+        "passage_errors", "passages_utime", "passages_status_utime", "runs"};
     for (size_t k = 0; k < sizeof objects / sizeof objects[0]; k++) {
         sqlite3_stmt *st = NULL;
         assert_int_equal(SQLITE_OK, sqlite3_prepare_v2(db,
@@ -209,7 +209,7 @@ static void test_create_and_reopen(void **state)
             fail_msg("schema object %s missing", objects[k]);
         sqlite3_finalize(st);
     }
-    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     sqlite3_close(db);
 
     /* reopen: nothing migrates again, data stays */
@@ -221,9 +221,9 @@ static void test_create_and_reopen(void **state)
     assert_int_not_equal(0, access(wal, F_OK)); /* checkpointed and removed */
     assert_int_equal(0, amfi_store_open(f->path, 1, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
-    assert_int_equal(1, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
     sqlite3_close(db);
 }
 
@@ -812,8 +812,169 @@ static void test_readonly(void **state)
     assert_int_equal(0, amfi_store_recent_ok_gvw(ro, 4, g, &n, err, sizeof err));
     assert_int_equal(1, n);
     assert_int_equal(0, amfi_store_get_baseline(ro, &b, &found, err, sizeof err));
-    assert_non_null(amfi_store_db(ro));
+    /* the read-only handle answers the report queries */
+    int64_t count = 0;
+    assert_int_equal(0, amfi_store_count(ro, AMFI_STORE_PASSAGES, &count, err, sizeof err));
+    assert_int_equal(1, count);
     amfi_store_close(ro);
+}
+
+/* ---- version 2: runs; a version-1 file migrates ------------------------------ */
+
+static void test_runs_and_migration_from_v1(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN], buf[128];
+    int64_t id = 0;
+    amfi_store *ro = NULL;
+    sqlite3 *db;
+
+    assert_int_equal(0, amfi_store_add_run(f->s, "0.1.0", "/etc/amfid/amfid.yaml", &id,
+                                           err, sizeof err));
+    assert_true(id > 0);
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_run(f->s, "", "/x", NULL, err, sizeof err));
+    assert_non_null(strstr(err, "runs.version"));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_run(f->s, "1\n2", "/x", NULL, err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_run(f->s, "1", "", NULL, err, sizeof err));
+    assert_non_null(strstr(err, "runs.config_path"));
+    add_ok(f->s, 1, DAY_US, 18000.0, NULL);
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    /* make it a version-1 file, as an older amfid left it */
+    db = raw_open(f->path);
+    assert_string_equal("0.1.0", raw_text(db, "SELECT version FROM runs", buf, sizeof buf));
+    assert_string_equal("/etc/amfid/amfid.yaml",
+                        raw_text(db, "SELECT config_path FROM runs", buf, sizeof buf));
+    assert_int_equal(1, raw_int(db, "SELECT started_at LIKE '____-__-__T__:__:__.___Z' FROM runs"));
+    raw_exec(db, "DROP TABLE runs; DELETE FROM schema_migrations WHERE version = 2; "
+                 "PRAGMA user_version = 1");
+    sqlite3_close(db);
+
+    /* read-only openers do not migrate: they say so */
+    assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
+    assert_non_null(strstr(err, "schema version 1 is older than this program's 2"));
+    assert_null(ro);
+
+    /* read-write: migrated, the data kept */
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(2, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(2, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(0, raw_int(db, "SELECT count(*) FROM runs"));
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
+    sqlite3_close(db);
+    assert_int_equal(0, amfi_store_add_run(f->s, "0.2.0", "a.yaml", &id, err, sizeof err));
+    assert_int_equal(1, id);
+}
+
+/* ---- what amfid and amfi-report read back ------------------------------------ */
+
+static void test_alert_open_and_report_queries(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    int open = -1, n = 0;
+    int64_t ind = 0, count = -1, other = -1;
+    amfi_indicator_rec irec[4];
+    amfi_alert_rec arec[4], *open_alerts = NULL;
+    amfi_passage_summary sum;
+    double *g = NULL;
+    size_t ng = 0;
+    sqlite3 *db;
+
+    assert_int_equal(0, amfi_store_alert_open(f->s, "std_increase", &open, err, sizeof err));
+    assert_int_equal(0, open);
+    assert_int_equal(AMFI_EINVAL, amfi_store_alert_open(f->s, "Bad Kind", &open, err, sizeof err));
+    assert_int_equal(0, amfi_store_passage_summary(f->s, &sum, err, sizeof err));
+    assert_int_equal(0, sum.total);
+    assert_int_equal(0, sum.utime_last);
+
+    amfi_indicator_row r = {DAY_US + 5, 20, 18000, 2000, 18000, 1900, 1.05, 0.3, "normal"};
+    assert_int_equal(0, amfi_store_add_indicator(f->s, &r, &ind, err, sizeof err));
+    r = (amfi_indicator_row){DAY_US + 9, 20, NAN, NAN, NAN, NAN, NAN, NAN, "baseline"};
+    assert_int_equal(0, amfi_store_add_indicator(f->s, &r, NULL, err, sizeof err));
+    assert_int_equal(0, amfi_store_add_alert(f->s, DAY_US + 5, "warning", "std_increase",
+                                             "raised once", ind, 1, NULL, err, sizeof err));
+    assert_int_equal(0, amfi_store_add_alert(f->s, DAY_US + 6, "info", "mean_shift", "up",
+                                             0, 1, NULL, err, sizeof err));
+    assert_int_equal(0, amfi_store_alert_open(f->s, "std_increase", &open, err, sizeof err));
+    assert_int_equal(1, open);
+    assert_int_equal(0, amfi_store_add_alert(f->s, DAY_US + 7, "info", "mean_shift", "back",
+                                             0, 0, NULL, err, sizeof err));
+    assert_int_equal(0, amfi_store_alert_open(f->s, "mean_shift", &open, err, sizeof err));
+    assert_int_equal(0, open);
+
+    add_ok(f->s, 1, DAY_US, 18000.0, NULL);
+    add_ok(f->s, 2, DAY_US + 3, 20000.0, NULL);
+    amfi_passage_row gap;
+    ok_row(&gap, 3, DAY_US + 4, NAN);
+    gap.status = "gap";
+    gap.reason = "samples missing";
+    gap.axle_kg[0] = gap.axle_kg[1] = NAN;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &gap, NULL, err, sizeof err));
+    assert_int_equal(0, amfi_store_add_truth(f->s, 1, DAY_US, 17640.0, 2,
+                                             (double[]){7056, 10584}, NULL, 25.0, err,
+                                             sizeof err));
+    assert_int_equal(0, amfi_store_add_truth(f->s, 3, DAY_US + 4, 10000.0, 2,
+                                             (double[]){4000, 6000}, NULL, 25.0, err,
+                                             sizeof err));
+
+    assert_int_equal(0, amfi_store_count(f->s, AMFI_STORE_ALERTS, &count, err, sizeof err));
+    assert_int_equal(3, count);
+    assert_int_equal(0, amfi_store_count(f->s, AMFI_STORE_TRUTH, &count, err, sizeof err));
+    assert_int_equal(2, count);
+    assert_int_equal(0, amfi_store_passage_summary(f->s, &sum, err, sizeof err));
+    assert_int_equal(3, sum.total);
+    assert_int_equal(DAY_US, sum.utime_first);
+    assert_int_equal(DAY_US + 4, sum.utime_last);
+    assert_int_equal(2, sum.by_status[0]);
+    assert_string_equal("gap", amfi_store_status_name(1));
+    assert_int_equal(1, sum.by_status[1]);
+    assert_null(amfi_store_status_name(AMFI_STORE_N_STATUS));
+    assert_int_equal(0, amfi_store_all_ok_gvw(f->s, &g, &ng, err, sizeof err));
+    assert_int_equal(2, ng);
+    assert_true(g[0] == 18000.0 && g[1] == 20000.0);
+    free(g);
+
+    assert_int_equal(0, amfi_store_recent_indicators(f->s, 4, irec, &n, err, sizeof err));
+    assert_int_equal(2, n);
+    assert_string_equal("baseline", irec[0].row.state); /* newest first */
+    assert_true(isnan(irec[0].row.std_kg));
+    assert_int_equal(ind, irec[1].id);
+    assert_true(irec[1].row.std_ratio == 1.05);
+    assert_int_equal(0, amfi_store_recent_alerts(f->s, 2, arec, &n, err, sizeof err));
+    assert_int_equal(2, n);
+    assert_string_equal("back", arec[0].message);
+    assert_int_equal(0, arec[0].indicator_id);
+    /* a message with a control character, written by another program */
+    db = raw_open(f->path);
+    raw_exec(db, "UPDATE alerts SET message = 'raised' || char(9) || 'once' WHERE id = 1");
+    sqlite3_close(db);
+    assert_int_equal(0, amfi_store_open_alerts(f->s, &open_alerts, &n, err, sizeof err));
+    assert_int_equal(1, n);
+    assert_string_equal("std_increase", open_alerts[0].kind);
+    assert_string_equal("warning", open_alerts[0].level);
+    assert_string_equal("raised?once", open_alerts[0].message); /* one line */
+    assert_int_equal(ind, open_alerts[0].indicator_id);
+    free(open_alerts);
+    assert_int_equal(0, amfi_store_gvw_errors(f->s, &g, &ng, &other, err, sizeof err));
+    assert_int_equal(1, ng);
+    assert_int_equal(1, other);
+    assert_true(fabs(g[0] - 100.0 * (18000.0 - 17640.0) / 17640.0) < 1e-9);
+    free(g);
+
+    /* damaged rows behind the store's back: named by table, row and column */
+    db = raw_open(f->path);
+    raw_exec(db, "PRAGMA ignore_check_constraints = ON; "
+                 "UPDATE passages SET gvw_kg = -1 WHERE vehicle_id = 2; "
+                 "UPDATE alerts SET raised = 7 WHERE kind = 'std_increase'");
+    sqlite3_close(db);
+    assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_all_ok_gvw(f->s, &g, &ng, err, sizeof err));
+    assert_non_null(strstr(err, "passages row 2: gvw_kg is out of range for an ok passage"));
+    assert_int_equal(AMFI_STORE_ECORRUPT,
+                     amfi_store_alert_open(f->s, "std_increase", &open, err, sizeof err));
+    assert_non_null(strstr(err, "alerts row 1: raised"));
 }
 
 /* ---- the DDL in docs/schema.md -------------------------------------------- */
@@ -1040,6 +1201,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_integrity_check, setup, teardown),
         cmocka_unit_test_setup_teardown(test_corrupt_rows_reported, setup, teardown),
         cmocka_unit_test_setup_teardown(test_readonly, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_runs_and_migration_from_v1, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
         cmocka_unit_test_setup_teardown(test_many_passages, setup, teardown),
     };

@@ -26,7 +26,6 @@
  * passages take 8 MB and well under a second) plus a few indexed queries.
  */
 #include <math.h>
-#include <sqlite3.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -221,92 +220,6 @@ static int parse_args(int argc, char **argv, options *o)
     return 0;
 }
 
-/* ---- reading rows, every value checked --------------------------------- */
-
-static const char *const statuses[] = {"ok", "gap", "late", "overload",
-                                       "multiple", "invalid", "error"};
-#define N_STATUS 7
-static const char *const states[] = {"baseline", "normal", "watch", "alert"};
-
-static int prepare(sqlite3 *db, const char *sql, sqlite3_stmt **st)
-{
-    if (sqlite3_prepare_v2(db, sql, -1, st, NULL) != SQLITE_OK)
-        return data_error("%s", sqlite3_errmsg(db));
-    return 0;
-}
-
-/* Step st: 1 row, 0 done, −1 error (reported). */
-static int step(sqlite3 *db, sqlite3_stmt *st)
-{
-    int rc = sqlite3_step(st);
-    if (rc == SQLITE_ROW)
-        return 1;
-    if (rc == SQLITE_DONE)
-        return 0;
-    return data_error("%s", sqlite3_errmsg(db));
-}
-
-static int bad_value(const char *table, long long rowid, sqlite3_stmt *st,
-                     int col, const char *problem)
-{
-    if (rowid >= 0)
-        return data_error("%s row %lld: %s %s", table, rowid,
-                          sqlite3_column_name(st, col), problem);
-    return data_error("%s: %s %s", table, sqlite3_column_name(st, col), problem);
-}
-
-/* A finite number; NULL gives NaN when nullable, else an error. */
-static int col_real(sqlite3_stmt *st, int col, int nullable, const char *table,
-                    long long rowid, double *out)
-{
-    int t = sqlite3_column_type(st, col);
-    if (t == SQLITE_NULL && nullable) {
-        *out = NAN;
-        return 0;
-    }
-    if (t != SQLITE_FLOAT && t != SQLITE_INTEGER)
-        return bad_value(table, rowid, st, col,
-                         t == SQLITE_NULL ? "is NULL, expected a number"
-                                          : "is not a number");
-    *out = sqlite3_column_double(st, col);
-    if (!isfinite(*out))
-        return bad_value(table, rowid, st, col, "is not finite");
-    return 0;
-}
-
-/* An integer in lo .. hi. */
-static int col_int(sqlite3_stmt *st, int col, long long lo, long long hi,
-                   const char *table, long long rowid, long long *out)
-{
-    if (sqlite3_column_type(st, col) != SQLITE_INTEGER)
-        return bad_value(table, rowid, st, col, "is not an integer");
-    *out = sqlite3_column_int64(st, col);
-    if (*out < lo || *out > hi)
-        return bad_value(table, rowid, st, col, "is out of range");
-    return 0;
-}
-
-/* Text, NUL-free; *out points into the statement's row. */
-static int col_text(sqlite3_stmt *st, int col, const char *table,
-                    long long rowid, const char **out)
-{
-    if (sqlite3_column_type(st, col) != SQLITE_TEXT)
-        return bad_value(table, rowid, st, col, "is not text");
-    const char *t = (const char *)sqlite3_column_text(st, col);
-    if (!t || strlen(t) != (size_t)sqlite3_column_bytes(st, col))
-        return bad_value(table, rowid, st, col, "holds a NUL byte");
-    *out = t;
-    return 0;
-}
-
-static int in_list(const char *s, const char *const *list, int n)
-{
-    for (int k = 0; k < n; k++)
-        if (strcmp(s, list[k]) == 0)
-            return k;
-    return -1;
-}
-
 /* µs since 1970 → "YYYY-MM-DD HH:MM:SS" (UTC). */
 static const char *utc(long long utime, char buf[32])
 {
@@ -364,26 +277,6 @@ static void mean_std(const double *v, size_t n, double *mean, double *std)
     *std = n > 1 ? sqrt(q / (double)(n - 1)) : NAN;
 }
 
-/* A growing array of doubles. */
-typedef struct vec {
-    double *v;
-    size_t n, cap;
-} vec;
-
-static int vec_push(vec *a, double x)
-{
-    if (a->n == a->cap) {
-        size_t cap = a->cap ? 2 * a->cap : 1024;
-        double *v = realloc(a->v, cap * sizeof *v);
-        if (!v)
-            return data_error("out of memory");
-        a->v = v;
-        a->cap = cap;
-    }
-    a->v[a->n++] = x;
-    return 0;
-}
-
 /* ---- sections ------------------------------------------------------------ */
 
 static int print_baseline(amfi_store *s)
@@ -406,281 +299,148 @@ static int print_baseline(amfi_store *s)
 
 static int section_summary(amfi_store *s)
 {
-    sqlite3 *db = amfi_store_db(s);
-    sqlite3_stmt *st = NULL;
-    long long total = 0, t0 = 0, t1 = 0, counts[N_STATUS] = {0};
-    vec g = {0};
-    char a[32], b[32], c[32];
-    int rc = prepare(db, "SELECT count(*), min(utime), max(utime) FROM passages",
-                     &st);
-    if (rc == 0 && (rc = step(db, st)) == 1) {
-        rc = col_int(st, 0, 0, INT64_MAX, "passages", -1, &total);
-        if (rc == 0 && total > 0)
-            rc = col_int(st, 1, 0, AMFI_STORE_MAX_UTIME, "passages", -1, &t0);
-        if (rc == 0 && total > 0)
-            rc = col_int(st, 2, 0, AMFI_STORE_MAX_UTIME, "passages", -1, &t1);
-    }
-    sqlite3_finalize(st);
-    st = NULL;
-    if (rc < 0)
-        return -1;
+    amfi_passage_summary sum;
+    double *g = NULL;
+    size_t ng = 0;
+    char a[32], b[32], c[32], err[512];
+    if (amfi_store_passage_summary(s, &sum, err, sizeof err) != 0)
+        return data_error("%s", err);
     out("== passages\n");
-    if (total == 0)
+    if (sum.total == 0)
         out("time span    (no passages yet)\n");
     else
-        out("time span    %s .. %s UTC (%s)\n", utc(t0, a), utc(t1, b),
-               duration((double)(t1 - t0) / 1e6, c));
-    rc = prepare(db, "SELECT status, count(*) FROM passages GROUP BY status",
-                 &st);
-    while (rc == 0 && (rc = step(db, st)) == 1) {
-        const char *name;
-        long long n;
-        rc = col_text(st, 0, "passages", -1, &name);
-        if (rc == 0)
-            rc = col_int(st, 1, 0, INT64_MAX, "passages", -1, &n);
-        if (rc == 0 && in_list(name, statuses, N_STATUS) < 0)
-            rc = data_error("passages: %lld rows have the unknown status '%s'",
-                            n, amfi_cli_shown(name));
-        if (rc == 0)
-            counts[in_list(name, statuses, N_STATUS)] = n;
+        out("time span    %s .. %s UTC (%s)\n", utc(sum.utime_first, a),
+               utc(sum.utime_last, b),
+               duration((double)(sum.utime_last - sum.utime_first) / 1e6, c));
+    out("passages     %lld\n", (long long)sum.total);
+    for (int k = 0; k < AMFI_STORE_N_STATUS; k++)
+        out("  %-10s %8lld  %5.1f %%\n", amfi_store_status_name(k),
+               (long long)sum.by_status[k],
+               sum.total ? 100.0 * (double)sum.by_status[k] / (double)sum.total : 0.0);
+    if (amfi_store_all_ok_gvw(s, &g, &ng, err, sizeof err) != 0)
+        return data_error("%s", err);
+    double mean, std;
+    if (ng == 0) {
+        out("GVW, ok      (no ok passages)\n");
+    } else {
+        qsort(g, ng, sizeof *g, cmp_double);
+        mean_std(g, ng, &mean, &std);
+        out("GVW, ok      n %zu, mean %.0f kg, STD %s kg, min %.0f, "
+               "median %.0f, max %.0f kg\n",
+               ng, mean, num(std, "%.0f", a), g[0],
+               percentile(g, ng, 50), g[ng - 1]);
     }
-    sqlite3_finalize(st);
-    st = NULL;
-    if (rc < 0)
-        return -1;
-    out("passages     %lld\n", total);
-    for (int k = 0; k < N_STATUS; k++)
-        out("  %-10s %8lld  %5.1f %%\n", statuses[k], counts[k],
-               total ? 100.0 * (double)counts[k] / (double)total : 0.0);
-    rc = prepare(db, "SELECT id, gvw_kg FROM passages WHERE status = 'ok'", &st);
-    while (rc == 0 && (rc = step(db, st)) == 1) {
-        long long id = sqlite3_column_int64(st, 0);
-        double x;
-        rc = col_real(st, 1, 0, "passages", id, &x);
-        if (rc == 0 && !(x > 0 && x <= AMFI_STORE_MAX_KG))
-            rc = bad_value("passages", id, st, 1, "is out of range for an ok "
-                           "passage");
-        if (rc == 0)
-            rc = vec_push(&g, x);
-    }
-    sqlite3_finalize(st);
-    if (rc == 0) {
-        double mean, std;
-        if (g.n == 0) {
-            out("GVW, ok      (no ok passages)\n");
-        } else {
-            qsort(g.v, g.n, sizeof *g.v, cmp_double);
-            mean_std(g.v, g.n, &mean, &std);
-            out("GVW, ok      n %zu, mean %.0f kg, STD %s kg, min %.0f, "
-                   "median %.0f, max %.0f kg\n",
-                   g.n, mean, num(std, "%.0f", a), g.v[0],
-                   percentile(g.v, g.n, 50), g.v[g.n - 1]);
-        }
-        rc = print_baseline(s);
-    }
-    free(g.v);
-    return rc < 0 ? -1 : 0;
+    free(g);
+    return print_baseline(s);
 }
 
 static int section_trend(amfi_store *s)
 {
-    sqlite3 *db = amfi_store_db(s);
-    sqlite3_stmt *st = NULL;
-    long long total = 0;
-    char lines[TREND_ROWS][256];
+    int64_t total = 0;
+    amfi_indicator_rec rec[TREND_ROWS];
     int nl = 0;
-    int rc = prepare(db, "SELECT count(*) FROM indicators", &st);
-    if (rc == 0 && (rc = step(db, st)) == 1)
-        rc = col_int(st, 0, 0, INT64_MAX, "indicators", -1, &total);
-    sqlite3_finalize(st);
-    st = NULL;
-    if (rc < 0)
-        return -1;
+    char err[512];
+    if (amfi_store_count(s, AMFI_STORE_INDICATORS, &total, err, sizeof err) != 0)
+        return data_error("%s", err);
     out("== indicators (last %lld of %lld)\n",
-           total < TREND_ROWS ? total : (long long)TREND_ROWS, total);
+           total < TREND_ROWS ? (long long)total : (long long)TREND_ROWS,
+           (long long)total);
     if (total == 0) {
         out("(none yet: amfid writes one every few ok passages once its "
                "window is full)\n");
         return 0;
     }
-    rc = prepare(db, "SELECT id, utime, n, mean_kg, std_kg, std_ratio, p_value, "
-                     "state FROM indicators ORDER BY utime DESC, id DESC "
-                     "LIMIT ?1", &st);
-    if (rc == 0)
-        sqlite3_bind_int(st, 1, TREND_ROWS);
-    while (rc == 0 && nl < TREND_ROWS && (rc = step(db, st)) == 1) {
-        long long id = sqlite3_column_int64(st, 0), ut = 0, n = 0;
-        double mean = 0, std = 0, ratio = 0, p = 0;
-        const char *state = NULL;
-        char t[32], b1[32], b2[32], b3[32], b4[32];
-        rc = col_int(st, 1, 0, AMFI_STORE_MAX_UTIME, "indicators", id, &ut);
-        if (rc == 0) rc = col_int(st, 2, 0, INT32_MAX, "indicators", id, &n);
-        if (rc == 0) rc = col_real(st, 3, 1, "indicators", id, &mean);
-        if (rc == 0) rc = col_real(st, 4, 1, "indicators", id, &std);
-        if (rc == 0) rc = col_real(st, 5, 1, "indicators", id, &ratio);
-        if (rc == 0) rc = col_real(st, 6, 1, "indicators", id, &p);
-        if (rc == 0) rc = col_text(st, 7, "indicators", id, &state);
-        if (rc == 0 && in_list(state, states, 4) < 0)
-            rc = bad_value("indicators", id, st, 7, "is not a known state");
-        if (rc == 0)
-            snprintf(lines[nl++], sizeof lines[0],
-                     "%-19.19s  %6lld  %9.31s  %8.31s  %6.31s  %8.31s  %.8s", utc(ut, t), n,
-                     num(mean, "%.0f", b1), num(std, "%.0f", b2),
-                     num(ratio, "%.3f", b3), num(p, "%.2e", b4), state);
-    }
-    sqlite3_finalize(st);
-    if (rc < 0)
-        return -1;
+    if (amfi_store_recent_indicators(s, TREND_ROWS, rec, &nl, err, sizeof err) != 0)
+        return data_error("%s", err);
     out("%-19s  %6s  %9s  %8s  %6s  %8s  %s\n", "time (UTC)", "n",
            "mean kg", "STD kg", "ratio", "p", "state");
-    for (int k = nl - 1; k >= 0; k--) /* oldest first */
-        out("%s\n", lines[k]);
+    for (int k = nl - 1; k >= 0; k--) { /* oldest first */
+        const amfi_indicator_row *r = &rec[k].row;
+        char t[32], b1[32], b2[32], b3[32], b4[32];
+        out("%-19.19s  %6lld  %9.31s  %8.31s  %6.31s  %8.31s  %.8s\n",
+            utc(r->utime, t), (long long)r->n, num(r->mean_kg, "%.0f", b1),
+            num(r->std_kg, "%.0f", b2), num(r->std_ratio, "%.3f", b3),
+            num(r->p_value, "%.2e", b4), r->state);
+    }
     return 0;
 }
 
 static int section_alerts(amfi_store *s)
 {
-    sqlite3 *db = amfi_store_db(s);
-    sqlite3_stmt *st = NULL;
-    long long total = 0;
-    char lines[ALERT_ROWS][512];
-    int nl = 0, open = 0;
-    int rc = prepare(db, "SELECT count(*) FROM alerts", &st);
-    if (rc == 0 && (rc = step(db, st)) == 1)
-        rc = col_int(st, 0, 0, INT64_MAX, "alerts", -1, &total);
-    sqlite3_finalize(st);
-    st = NULL;
-    if (rc < 0)
-        return -1;
+    int64_t total = 0;
+    amfi_alert_rec rec[ALERT_ROWS], *open = NULL;
+    int nl = 0, n_open = 0;
+    char err[512];
+    if (amfi_store_count(s, AMFI_STORE_ALERTS, &total, err, sizeof err) != 0)
+        return data_error("%s", err);
     out("== alerts (last %lld of %lld)\n",
-           total < ALERT_ROWS ? total : (long long)ALERT_ROWS, total);
+           total < ALERT_ROWS ? (long long)total : (long long)ALERT_ROWS,
+           (long long)total);
     if (total == 0) {
         out("(none)\n");
         return 0;
     }
-    /* open now: the newest event of each kind is a raise */
-    rc = prepare(db, "SELECT a.id, a.kind, a.level, a.utime FROM alerts AS a "
-                     "WHERE a.raised = 1 AND a.id = (SELECT b.id FROM alerts "
-                     "AS b WHERE b.kind = a.kind ORDER BY b.utime DESC, b.id "
-                     "DESC LIMIT 1) ORDER BY a.utime", &st);
-    while (rc == 0 && (rc = step(db, st)) == 1) {
-        long long id = sqlite3_column_int64(st, 0), ut = 0;
-        const char *kind = NULL, *level = NULL;
+    if (amfi_store_open_alerts(s, &open, &n_open, err, sizeof err) != 0)
+        return data_error("%s", err);
+    for (int k = 0; k < n_open; k++) {
         char t[32];
-        rc = col_text(st, 1, "alerts", id, &kind);
-        if (rc == 0) rc = col_text(st, 2, "alerts", id, &level);
-        if (rc == 0) rc = col_int(st, 3, 0, AMFI_STORE_MAX_UTIME, "alerts", id, &ut);
-        if (rc == 0)
-            out("OPEN NOW     %s %s since %s UTC\n", amfi_cli_shown(level),
-                   amfi_cli_shown(kind), utc(ut, t));
-        open++;
+        out("OPEN NOW     %s %s since %s UTC\n", amfi_cli_shown(open[k].level),
+               amfi_cli_shown(open[k].kind), utc(open[k].utime, t));
     }
-    sqlite3_finalize(st);
-    st = NULL;
-    if (rc < 0)
-        return -1;
-    if (open == 0)
+    free(open);
+    if (n_open == 0)
         out("open now     none\n");
-    rc = prepare(db, "SELECT id, utime, level, kind, raised, indicator_id, "
-                     "message FROM alerts ORDER BY utime DESC, id DESC "
-                     "LIMIT ?1", &st);
-    if (rc == 0)
-        sqlite3_bind_int(st, 1, ALERT_ROWS);
-    while (rc == 0 && nl < ALERT_ROWS && (rc = step(db, st)) == 1) {
-        long long id = sqlite3_column_int64(st, 0), ut = 0, raised = 0, ind = 0;
-        const char *level = NULL, *kind = NULL, *msg = NULL;
-        char t[32], is[32], m[301];
-        rc = col_int(st, 1, 0, AMFI_STORE_MAX_UTIME, "alerts", id, &ut);
-        if (rc == 0) rc = col_text(st, 2, "alerts", id, &level);
-        if (rc == 0) rc = col_text(st, 3, "alerts", id, &kind);
-        if (rc == 0) rc = col_int(st, 4, 0, 1, "alerts", id, &raised);
-        if (rc == 0 && sqlite3_column_type(st, 5) != SQLITE_NULL)
-            rc = col_int(st, 5, 1, INT64_MAX, "alerts", id, &ind);
-        if (rc == 0) rc = col_text(st, 6, "alerts", id, &msg);
-        if (rc == 0) {
-            if (ind > 0)
-                snprintf(is, sizeof is, "%lld", ind);
-            else
-                snprintf(is, sizeof is, "-");
-            /* one line per alert whatever the row holds */
-            size_t k = 0;
-            for (; msg[k] && k < sizeof m - 1; k++)
-                m[k] = ((unsigned char)msg[k] < 0x20 || msg[k] == 0x7f)
-                           ? '?' : msg[k];
-            m[k] = '\0';
-            snprintf(lines[nl++], sizeof lines[0],
-                     "%-19.19s  %-7.7s  %-14.40s  %-7s  %9.20s  %.300s",
-                     utc(ut, t), amfi_cli_shown(level), amfi_cli_shown(kind),
-                     raised ? "raised" : "cleared", is, m);
-        }
-    }
-    sqlite3_finalize(st);
-    if (rc < 0)
-        return -1;
+    if (amfi_store_recent_alerts(s, ALERT_ROWS, rec, &nl, err, sizeof err) != 0)
+        return data_error("%s", err);
     out("%-19s  %-7s  %-14s  %-7s  %9s  %s\n", "time (UTC)", "level",
            "kind", "event", "indicator", "message");
-    for (int k = nl - 1; k >= 0; k--)
-        out("%s\n", lines[k]);
+    for (int k = nl - 1; k >= 0; k--) {
+        const amfi_alert_rec *a = &rec[k];
+        char t[32], is[32];
+        if (a->indicator_id > 0)
+            snprintf(is, sizeof is, "%lld", (long long)a->indicator_id);
+        else
+            snprintf(is, sizeof is, "-");
+        /* one line per alert: the store shows control characters as '?' */
+        out("%-19.19s  %-7.7s  %-14.40s  %-7s  %9.20s  %.300s\n",
+            utc(a->utime, t), amfi_cli_shown(a->level), amfi_cli_shown(a->kind),
+            a->raised ? "raised" : "cleared", is, a->message);
+    }
     return 0;
 }
 
 static int section_errors(amfi_store *s)
 {
-    sqlite3 *db = amfi_store_db(s);
-    sqlite3_stmt *st = NULL;
-    long long n_truth = 0, not_ok = 0;
-    vec e = {0};
-    char b[4][32];
-    int rc = prepare(db, "SELECT count(*) FROM truth", &st);
-    if (rc == 0 && (rc = step(db, st)) == 1)
-        rc = col_int(st, 0, 0, INT64_MAX, "truth", -1, &n_truth);
-    sqlite3_finalize(st);
-    st = NULL;
-    if (rc < 0)
-        return -1;
+    int64_t n_truth = 0, not_ok = 0;
+    double *e = NULL;
+    size_t ne = 0;
+    char b[4][32], err[512];
+    if (amfi_store_count(s, AMFI_STORE_TRUTH, &n_truth, err, sizeof err) != 0)
+        return data_error("%s", err);
     out("== errors against the truth\n");
     if (n_truth == 0) {
         out("(no truth rows: the truth is recorded in simulations only)\n");
         return 0;
     }
-    rc = prepare(db, "SELECT passage_id, status, gvw_error_pct "
-                     "FROM passage_errors", &st);
-    while (rc == 0 && (rc = step(db, st)) == 1) {
-        long long id = sqlite3_column_int64(st, 0);
-        const char *status = NULL;
-        double x;
-        rc = col_text(st, 1, "passages", id, &status);
-        if (rc == 0 && strcmp(status, "ok") != 0) {
-            not_ok++;
-            continue;
-        }
-        if (rc == 0)
-            rc = col_real(st, 2, 0, "passages", id, &x);
-        if (rc == 0)
-            rc = vec_push(&e, x);
-    }
-    sqlite3_finalize(st);
-    if (rc < 0) {
-        free(e.v);
-        return -1;
-    }
+    if (amfi_store_gvw_errors(s, &e, &ne, &not_ok, err, sizeof err) != 0)
+        return data_error("%s", err);
     out("truth rows   %lld; ok passages matched %zu; other passages "
-           "matched %lld\n", n_truth, e.n, not_ok);
-    if (e.n > 0) {
+           "matched %lld\n", (long long)n_truth, ne, (long long)not_ok);
+    if (ne > 0) {
         double mean, std;
-        mean_std(e.v, e.n, &mean, &std);
+        mean_std(e, ne, &mean, &std);
         out("GVW error    mean %+.2f %%, STD %s %%\n", mean,
                num(std, "%.2f", b[0]));
-        for (size_t k = 0; k < e.n; k++)
-            e.v[k] = fabs(e.v[k]);
-        qsort(e.v, e.n, sizeof *e.v, cmp_double);
+        for (size_t k = 0; k < ne; k++)
+            e[k] = fabs(e[k]);
+        qsort(e, ne, sizeof *e, cmp_double);
         out("|GVW error|  median %.2f %%, 90 %% %.2f %%, 95 %% %.2f %%, "
                "99 %% %.2f %%, max %.2f %%\n",
-               percentile(e.v, e.n, 50), percentile(e.v, e.n, 90),
-               percentile(e.v, e.n, 95), percentile(e.v, e.n, 99),
-               e.v[e.n - 1]);
+               percentile(e, ne, 50), percentile(e, ne, 90),
+               percentile(e, ne, 95), percentile(e, ne, 99),
+               e[ne - 1]);
     }
-    free(e.v);
+    free(e);
     return 0;
 }
 
@@ -718,15 +478,11 @@ static int set_baseline(const options *o)
     }
     /* it applies from the newest passage stored (data time) */
     if (rc == 0) {
-        sqlite3_stmt *st = NULL;
-        long long t = 0;
-        rc = prepare(amfi_store_db(s), "SELECT max(utime) FROM passages", &st);
-        if (rc == 0 && (rc = step(amfi_store_db(s), st)) == 1
-            && sqlite3_column_type(st, 0) != SQLITE_NULL)
-            rc = col_int(st, 0, 0, AMFI_STORE_MAX_UTIME, "passages", -1, &t);
-        sqlite3_finalize(st);
-        b.utime_set = t;
-        rc = rc < 0 ? -1 : 0;
+        amfi_passage_summary sum;
+        if (amfi_store_passage_summary(s, &sum, err, sizeof err) != 0)
+            rc = data_error("%s", err);
+        else
+            b.utime_set = sum.utime_last;
     }
     if (rc == 0) {
         snprintf(b.source, sizeof b.source, "manual");

@@ -7,6 +7,15 @@
  * which holds the exact DDL this file's store.c creates (tests/test_store.c
  * checks that they agree).
  *
+ * The store owns every SQL statement: programs get typed rows and queries
+ * from the functions below, never the SQLite connection.
+ *
+ * Files: store_schema.c (the DDL and the migrations), store_open.c (open,
+ * close, migrate, the prepared statements, messages), store_check.c
+ * (argument checks, statement helpers), store_write.c (inserts),
+ * store_read.c (what amfid reads back, maintenance), store_report.c (the
+ * queries of reports); store_internal.h is shared by them only.
+ *
  * Workload: one writer thread in amfid opens one handle at start-up, adds one
  * passage per vehicle (a few per second at most, one transaction each: the
  * passage row and its axle rows) plus an indicator row per window step and
@@ -54,7 +63,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 1
+#define AMFI_STORE_SCHEMA_VERSION 2
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -95,11 +104,6 @@ int amfi_store_open_readonly(const char *path, amfi_store **out, char *err,
 /* Finalize the statements, run PRAGMA optimize and checkpoint the WAL
  * (truncating it) when writable, close. NULL-safe. */
 void amfi_store_close(amfi_store *s);
-
-/* The SQLite connection, borrowed (valid until amfi_store_close; do not
- * close it or change its pragmas), for tools' own read-only queries.
- * `struct sqlite3` is sqlite3.h's `sqlite3`. */
-struct sqlite3 *amfi_store_db(amfi_store *s);
 
 /* ---- passages ---------------------------------------------------------- */
 
@@ -212,6 +216,96 @@ int amfi_store_meta_get(amfi_store *s, const char *key, char *val,
 /* Insert or replace; val: 0 .. 4096 bytes of UTF-8 text. */
 int amfi_store_meta_set(amfi_store *s, const char *key, const char *val,
                         char *err, size_t errlen);
+
+/* ---- runs: one row per start of amfid ----------------------------------- */
+
+/* Record that a program run started now (wall clock, UTC, in runs.started_at):
+ * version: 1 .. 63 bytes of printable text (amfid --version); config_path:
+ * 1 .. 4096 bytes of UTF-8 text (the configuration file it read). *id (when
+ * not NULL) gets the row's id. */
+int amfi_store_add_run(amfi_store *s, const char *version,
+                       const char *config_path, int64_t *id, char *err,
+                       size_t errlen);
+
+/* ---- alerts read back ---------------------------------------------------- */
+
+/* *open = 1 when the newest alert row (by id) of `kind` is a raise, 0 when
+ * it is a clear or there is none: an alert open before a restart stays open. */
+int amfi_store_alert_open(amfi_store *s, const char *kind, int *open,
+                          char *err, size_t errlen);
+
+/* ---- queries of reports (amfi-report) ------------------------------------ */
+
+/* Number of statuses in AMFI_STORE_STATUSES, and the k-th of them (in that
+ * order; NULL outside 0 .. AMFI_STORE_N_STATUS − 1). */
+#define AMFI_STORE_N_STATUS 7
+const char *amfi_store_status_name(int k);
+
+/* Tables amfi_store_count counts. */
+typedef enum amfi_store_table {
+    AMFI_STORE_PASSAGES,
+    AMFI_STORE_INDICATORS,
+    AMFI_STORE_ALERTS,
+    AMFI_STORE_TRUTH
+} amfi_store_table;
+
+/* *n = the number of rows of the table. */
+int amfi_store_count(amfi_store *s, amfi_store_table t, int64_t *n, char *err,
+                     size_t errlen);
+
+typedef struct amfi_passage_summary {
+    int64_t total;                /* passages */
+    int64_t utime_first;          /* min and max utime, µs; 0 when total is 0 */
+    int64_t utime_last;
+    int64_t by_status[AMFI_STORE_N_STATUS]; /* amfi_store_status_name order */
+} amfi_passage_summary;
+
+/* Counts by status and the time span of every passage. */
+int amfi_store_passage_summary(amfi_store *s, amfi_passage_summary *out,
+                               char *err, size_t errlen);
+
+/* GVW of every ok passage, in rowid order: *gvw is malloc'd (free it; NULL
+ * when *n is 0). A value outside (0, 1e6] kg is AMFI_STORE_ECORRUPT. */
+int amfi_store_all_ok_gvw(amfi_store *s, double **gvw, size_t *n, char *err,
+                          size_t errlen);
+
+/* An indicator row read back: row.state is a static string. */
+typedef struct amfi_indicator_rec {
+    int64_t id;
+    amfi_indicator_row row;
+} amfi_indicator_rec;
+
+/* The newest (by utime, then id) min(max, rows) indicators, newest first,
+ * into out[0 .. *n − 1]. max >= 1. */
+int amfi_store_recent_indicators(amfi_store *s, int max,
+                                 amfi_indicator_rec *out, int *n, char *err,
+                                 size_t errlen);
+
+/* An alert row read back. */
+typedef struct amfi_alert_rec {
+    int64_t id;
+    int64_t utime;          /* data time, µs */
+    int64_t indicator_id;   /* 0: none */
+    const char *level;      /* static: "info" or "warning" */
+    char kind[32];
+    int raised;             /* 1 raised, 0 cleared */
+    char message[AMFI_STORE_REASON_MAX + 1]; /* control characters as '?' */
+} amfi_alert_rec;
+
+/* The newest min(max, rows) alerts (by utime, then id), newest first. */
+int amfi_store_recent_alerts(amfi_store *s, int max, amfi_alert_rec *out,
+                             int *n, char *err, size_t errlen);
+
+/* The alerts open now (the newest event of their kind, by utime then id, is
+ * a raise), oldest first: *out is malloc'd (free it; NULL when *n is 0). */
+int amfi_store_open_alerts(amfi_store *s, amfi_alert_rec **out, int *n,
+                           char *err, size_t errlen);
+
+/* The GVW error of every ok passage matched with a truth row (view
+ * passage_errors), %, in the view's order: *pct is malloc'd (free it; NULL
+ * when *n is 0); *n_other counts the matched passages not ok. */
+int amfi_store_gvw_errors(amfi_store *s, double **pct, size_t *n,
+                          int64_t *n_other, char *err, size_t errlen);
 
 /* ---- maintenance ------------------------------------------------------- */
 

@@ -1,0 +1,169 @@
+/*
+ * store_internal.h: what the store's own files share (store_*.c), never
+ * included outside store/: the handle's layout, the prepared statements,
+ * the ranges and word lists of the checks, and the helpers that write
+ * messages, check arguments, run statements and read values back.
+ * Threads: as store.h: a handle is used by one thread at a time.
+ */
+#ifndef AMFI_STORE_INTERNAL_H
+#define AMFI_STORE_INTERNAL_H
+
+#include <math.h>
+#include <sqlite3.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "store.h"
+
+/* ---- schema (store_schema.c) --------------------------------------------- */
+
+typedef struct st_migration {
+    int version;             /* user_version once applied, 1, 2, ... */
+    const char *description; /* recorded in schema_migrations */
+    const char *sql;         /* one or more statements */
+} st_migration;
+
+extern const st_migration st_migrations[];
+extern const int st_n_migrations;
+
+/* ---- prepared statements (store_open.c) ---------------------------------- */
+
+enum {
+    ST_BEGIN,
+    ST_COMMIT,
+    ST_ROLLBACK,
+    ST_INS_PASSAGE,
+    ST_INS_AXLE,
+    ST_INS_TRUTH,
+    ST_INS_TRUTH_AXLE,
+    ST_INS_INDICATOR,
+    ST_INS_ALERT,
+    ST_GET_BASELINE,
+    ST_INS_BASELINE,
+    ST_RECENT_OK,
+    ST_META_GET,
+    ST_META_SET,
+    ST_INTEGRITY,
+    ST_FK_CHECK,
+    ST_INS_RUN,
+    ST_ALERT_LAST_OF_KIND,
+    ST_COUNT_PASSAGES,
+    ST_COUNT_INDICATORS,
+    ST_COUNT_ALERTS,
+    ST_COUNT_TRUTH,
+    ST_PASSAGE_SPAN,
+    ST_PASSAGE_BY_STATUS,
+    ST_ALL_OK_GVW,
+    ST_RECENT_INDICATORS,
+    ST_RECENT_ALERTS,
+    ST_OPEN_ALERTS,
+    ST_GVW_ERRORS,
+    N_STMT
+};
+
+struct amfi_store {
+    sqlite3 *db;
+    int readonly;                /* opened with amfi_store_open_readonly */
+    sqlite3_stmt *st[N_STMT];    /* prepared at open, reset after each use */
+    char path[256];              /* for messages (truncated) */
+};
+
+/* ---- messages (store_open.c) --------------------------------------------- */
+
+/* Writes the message into err (when there is room) and returns status. */
+int st_fail(char *err, size_t errlen, int status, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+/* At most 40 bytes of s, control bytes as '?', "..." when cut. */
+const char *st_excerpt(const char *s, char out[48]);
+/* SQLite result code (extended) to amfi status. */
+int st_status_of(int sqlite_rc);
+/* "WHAT: sqlite's message" for a failed call on s->db. */
+int st_db_fail(amfi_store *s, int sqlite_rc, const char *what, char *err,
+               size_t errlen);
+
+/* ---- argument checks (store_check.c) ------------------------------------- */
+
+/* Closed or half-open range of a number. */
+typedef struct range {
+    double lo, hi;   /* bounds; hi may be HUGE_VAL (no upper bound) */
+    int lo_open;     /* 1: x > lo, 0: x >= lo */
+    const char *unit;
+} range;
+
+static const range R_SPEED = {0.0, AMFI_STORE_MAX_SPEED_MPS, 0, "m/s"};
+static const range R_SPEED_POS = {0.0, AMFI_STORE_MAX_SPEED_MPS, 1, "m/s"};
+static const range R_SPACING = {0.0, AMFI_STORE_MAX_SPACING_M, 1, "m"};
+static const range R_KG = {-AMFI_STORE_MAX_KG, AMFI_STORE_MAX_KG, 0, "kg"};
+static const range R_KG_POS = {0.0, AMFI_STORE_MAX_KG, 1, "kg"};
+static const range R_KG_NONNEG = {0.0, AMFI_STORE_MAX_KG, 0, "kg"};
+static const range R_FORCE = {-AMFI_STORE_MAX_FORCE_N, AMFI_STORE_MAX_FORCE_N, 0, "N"};
+static const range R_POS = {0.0, HUGE_VAL, 1, ""};
+static const range R_NONNEG = {0.0, HUGE_VAL, 0, ""};
+static const range R_MS = {0.0, HUGE_VAL, 0, "ms"};
+static const range R_RATIO = {0.0, 1e6, 0, ""};
+static const range R_PROB = {0.0, 1.0, 0, ""};
+static const range R_FINITE = {-HUGE_VAL, HUGE_VAL, 0, ""};
+
+/* NULL-terminated word lists of the schema's enumerations. */
+static const char *const st_statuses[] = {"ok", "gap", "late", "overload",
+                                          "multiple", "invalid", "error", NULL};
+static const char *const st_states[] = {"baseline", "normal", "watch", "alert",
+                                        NULL};
+static const char *const st_levels[] = {"info", "warning", NULL};
+static const char *const st_sources[] = {"auto", "manual", NULL};
+
+int st_in_range(double x, const range *rg);
+int st_range_fail(const char *prefix, const char *name, double x,
+                  const range *rg, int status, char *err, size_t errlen);
+int st_check_num(const char *name, double x, const range *rg, char *err,
+                 size_t errlen);
+int st_check_known(const char *name, double x, const range *rg, char *err,
+                   size_t errlen);
+int st_check_utime(const char *name, int64_t t, char *err, size_t errlen);
+size_t st_utf8_scan(const unsigned char *s, size_t n, int *bad);
+int st_check_text(const char *name, const char *s, size_t min, size_t max,
+                  char *err, size_t errlen);
+int st_check_enum(const char *name, const char *s, const char *const *list,
+                  const char *shown, char *err, size_t errlen);
+int st_check_token(const char *name, const char *s, size_t max,
+                   const char *allowed, int lower, char *err, size_t errlen);
+int st_check_handle(const amfi_store *s, int write, char *err, size_t errlen);
+int st_check_meta_key(const char *key, char *err, size_t errlen);
+
+/* ---- statement helpers (store_check.c) ----------------------------------- */
+
+int st_bind_real(sqlite3_stmt *st, int i, double x);
+int st_bind_text(sqlite3_stmt *st, int i, const char *t);
+void st_done_with(sqlite3_stmt *st);
+int st_run(amfi_store *s, int which, int sqlite_rc, const char *what,
+           char *err, size_t errlen);
+int st_begin(amfi_store *s, char *err, size_t errlen);
+int st_commit(amfi_store *s, char *err, size_t errlen);
+void st_rollback(amfi_store *s);
+int st_one_off(amfi_store *s, const char *sql, const char *what,
+               int64_t *ival, char *text, size_t textlen, char *err,
+               size_t errlen);
+
+/* ---- reads: every value checked (store_read.c) --------------------------- */
+
+/* Where a value read back came from, for the message; rowid < 0: an
+ * aggregate (no row). */
+typedef struct origin {
+    const char *table;
+    int64_t rowid;
+} origin;
+
+int st_corrupt(const origin *o, sqlite3_stmt *st, int col, char *err,
+               size_t errlen, const char *problem);
+int st_read_real(sqlite3_stmt *st, int col, const range *rg,
+                 const origin *o, double *out, char *err, size_t errlen);
+/* The same, NULL read as NaN. */
+int st_read_real_or_null(sqlite3_stmt *st, int col, const range *rg,
+                         const origin *o, double *out, char *err,
+                         size_t errlen);
+int st_read_int(sqlite3_stmt *st, int col, int64_t lo, int64_t hi,
+                const origin *o, int64_t *out, char *err, size_t errlen);
+int st_read_text(sqlite3_stmt *st, int col, size_t max, const origin *o,
+                 char *buf, size_t buflen, char *err, size_t errlen);
+
+#endif /* AMFI_STORE_INTERNAL_H */
