@@ -86,6 +86,16 @@ void amfi_indicator_params_default(amfi_indicator_params *p)
     p->mean_clear_ratio = 1.03;
 }
 
+int amfi_indicator_params_equal(const amfi_indicator_params *a, const amfi_indicator_params *b)
+{
+    return a->window == b->window && a->every == b->every && a->baseline_n == b->baseline_n &&
+           a->std_alert_ratio == b->std_alert_ratio && a->std_alert_p == b->std_alert_p &&
+           a->std_clear_ratio == b->std_clear_ratio && a->raise_after == b->raise_after &&
+           a->clear_after == b->clear_after && a->mean_shift == b->mean_shift &&
+           a->mean_alert_ratio == b->mean_alert_ratio && a->mean_alert_p == b->mean_alert_p &&
+           a->mean_clear_ratio == b->mean_clear_ratio;
+}
+
 /* Name the parameter and write the message; returns AMFI_IND_EINVAL. */
 static int bad(const char **field, const char *name, char *err, size_t errlen,
                const char *fmt, ...) __attribute__((format(printf, 5, 6)));

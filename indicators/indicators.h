@@ -96,6 +96,10 @@ void amfi_indicator_params_default(amfi_indicator_params *p);
 int amfi_indicator_params_check(const amfi_indicator_params *p, const char **field, char *err,
                                 size_t errlen);
 
+/* 1 when every field of a equals the same field of b (compared field by
+ * field, not by memory: padding and field order do not matter), else 0. */
+int amfi_indicator_params_equal(const amfi_indicator_params *a, const amfi_indicator_params *b);
+
 /* Validate *p and allocate the engine (the ring of W doubles). On success
  * *out owns it (free with amfi_indicators_destroy) and 0 is returned; on
  * failure *out is NULL, AMFI_IND_EINVAL or AMFI_IND_ENOMEM is returned and

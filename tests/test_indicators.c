@@ -135,6 +135,36 @@ static void test_params(void **state)
 
 /* --- baselines --- */
 
+/* Equality is field by field: each field changed alone makes a difference. */
+static void test_params_equal(void **state)
+{
+    (void)state;
+    amfi_indicator_params a, b;
+    amfi_indicator_params_default(&a);
+    memset(&b, 0xa5, sizeof b); /* different padding must not matter */
+    amfi_indicator_params_default(&b);
+    assert_true(amfi_indicator_params_equal(&a, &b));
+    for (int k = 0; k < 12; k++) {
+        amfi_indicator_params_default(&b);
+        switch (k) {
+        case 0: b.window++; break;
+        case 1: b.every++; break;
+        case 2: b.baseline_n++; break;
+        case 3: b.std_alert_ratio += 0.01; break;
+        case 4: b.std_alert_p /= 2; break;
+        case 5: b.std_clear_ratio += 0.01; break;
+        case 6: b.raise_after++; break;
+        case 7: b.clear_after++; break;
+        case 8: b.mean_shift = !b.mean_shift; break;
+        case 9: b.mean_alert_ratio += 0.01; break;
+        case 10: b.mean_alert_p /= 2; break;
+        case 11: b.mean_clear_ratio += 0.01; break;
+        }
+        if (amfi_indicator_params_equal(&a, &b))
+            fail_msg("field %d changed, yet equal", k);
+    }
+}
+
 static void test_baseline_auto(void **state)
 {
     (void)state;
@@ -660,6 +690,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_params),
+        cmocka_unit_test(test_params_equal),
         cmocka_unit_test(test_baseline_auto),
         cmocka_unit_test(test_baseline_constant_recollects),
         cmocka_unit_test(test_baseline_explicit),

@@ -1,0 +1,113 @@
+/*
+ * amfid.h: the daemon's state and the functions its files share (amfid's
+ * own header; nothing outside daemon/ includes it).
+ *
+ * Threads and ownership: everything in `daemon_s` except `pool`'s queues is
+ * owned by the main thread: the configuration, the bus, the sample rings,
+ * the tracker, the reorder buffer, the store, the indicators and the
+ * counters. The solver threads touch only the jobs they are handed and
+ * their own solvers (pool.h); nothing else is shared between threads.
+ *
+ * Files: amfid.c (main: start-up, loop, shutdown), options.c (command
+ * line), intake.c (bus handlers, validation, windows to jobs), pool.c (job
+ * queues, solver threads), pipeline.c (in-order store, indicators,
+ * publish), control.c (configuration, heartbeat, reload, restart state).
+ */
+#ifndef AMFID_H
+#define AMFID_H
+
+#include <lcm/lcm.h>
+#include <stdint.h>
+#include <systemd/sd-daemon.h>
+
+#include "amfi/amfi.h"
+#include "amfi_config.h"
+#include "indicators.h"
+#include "pool.h"
+#include "ring.h"
+#include "store.h"
+#include "tracker.h"
+
+#ifndef AMFID_DEFAULT_CONFIG
+#define AMFID_DEFAULT_CONFIG "/etc/amfid/amfid.yaml"
+#endif
+#ifndef AMFI_VERSION_STRING
+#define AMFI_VERSION_STRING "unknown"
+#endif
+
+/* ---- logging (stderr, journald reads the <N> prefixes) ----------------- */
+
+void amfid_log(const char *prefix, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+#define LOG_INFO(...) amfid_log(SD_INFO "amfid: ", __VA_ARGS__)
+#define LOG_WARN(...) amfid_log(SD_WARNING "amfid: ", __VA_ARGS__)
+#define LOG_ERR(...) amfid_log(SD_ERR "amfid: ", __VA_ARGS__)
+
+double amfid_mono_s(void);
+
+/* ---- command line (options.c) ------------------------------------------- */
+
+typedef struct amfid_options {
+    const char *config;   /* --config, default AMFID_DEFAULT_CONFIG */
+    const char *db;       /* --db, NULL: the file's */
+    const char *lcm_url;  /* --lcm-url, NULL: the file's */
+    int check_only;       /* --check-config */
+} amfid_options;
+
+/* 0 run; 1 done (--help, --version printed), exit 0; −1 bad command line
+ * (reported on stderr), exit 2. */
+int amfid_parse_options(int argc, char **argv, amfid_options *o);
+
+/* ---- the daemon ---------------------------------------------------------- */
+
+typedef struct daemon_s {
+    amfi_site_config cfg;
+    const char *config_path;
+    amfi_bridge *bridge;           /* immutable once built: the solvers share it */
+    lcm_t *lcm;
+    amfi_store *store;
+    amfi_indicators *ind;
+    amfi_indicator_params ind_params; /* in force (a reload reports changes) */
+    amfi_tracker *tracker;
+    amfi_ring *rings[AMFI_MAX_SENSORS];
+    pool pool;
+    /* reorder: results stored in seq order */
+    job **pending;                 /* ring of size pend_cap indexed by seq */
+    int pend_cap;
+    int64_t next_seq;              /* next seq to store */
+    int64_t released;              /* windows released by the tracker */
+    /* counters (status_t) */
+    int64_t blocks_received, blocks_rejected, vehicles_received, vehicles_rejected;
+    int64_t messages_malformed, passages_stored, passages_ok, truth_received;
+    int64_t newest_utime;
+    char last_error[256];
+    const char *state;
+} daemon_s;
+
+void set_error(daemon_s *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* ---- bus intake (intake.c), main thread ---------------------------------- */
+
+void intake_subscribe(daemon_s *d);
+/* Windows the tracker has decided: to the solvers, or straight to the store. */
+void release_windows(daemon_s *d, int flush);
+
+/* ---- in-order pipeline (pipeline.c), main thread -------------------------- */
+
+/* Park a finished job by seq; store, feed and publish every consecutive one. */
+int pipeline_complete(daemon_s *d, job *j);
+/* Store a job now, outside the entry order (invalid vehicles). */
+int pipeline_store_now(daemon_s *d, job *j);
+/* Read the eventfd and complete every result the solvers handed back. */
+void pipeline_drain_results(daemon_s *d);
+
+/* ---- configuration, state, heartbeat, reload (control.c), main thread ----- */
+
+int load_config(const char *path, amfi_site_config *c);
+void indicator_params(const amfi_daemon_config *dc, amfi_indicator_params *p);
+/* The baseline, the window's GVWs and the open alerts from the store. */
+void restore_indicator_state(daemon_s *d);
+void heartbeat(daemon_s *d);
+/* SIGHUP: apply what can change while running, report the rest. */
+void reload(daemon_s *d);
+
+#endif /* AMFID_H */

@@ -1,0 +1,225 @@
+/*
+ * intake.c: amfid's bus intake: the LCM handlers of accelerometer blocks,
+ * vehicle events and (simulations) the truth, each message validated where
+ * it enters (messages name the channel and the field); samples into the
+ * rings, vehicles into the tracker; and the windows the tracker decides,
+ * filled from the rings into jobs for the solver pool (or straight to the
+ * pipeline when they cannot be solved).
+ *
+ * Thread: the main thread only (inside lcm_handle and the loop). Owns the
+ * rings (created here at the first block of each sensor) and feeds the
+ * tracker; a job leaves it complete: the λ policy and the sample rate it
+ * needs are copied into it here, so the solver threads read nothing shared.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amfi_accel_block_t.h"
+#include "amfi_truth_t.h"
+#include "amfi_vehicle_t.h"
+#include "amfid.h"
+
+#define MAX_BLOCK 4096 /* samples per accel block accepted */
+
+/* ---- windows to jobs ---------------------------------------------------- */
+
+void release_windows(daemon_s *d, int flush)
+{
+    amfi_window w;
+    const int ns = d->cfg.solver.n_sensors;
+    while (amfi_tracker_next(d->tracker, d->rings, flush, &w)) {
+        d->released++;
+        job *j = calloc(1, sizeof *j);
+        if (!j) {
+            set_error(d, "out of memory for a passage");
+            continue;
+        }
+        j->w = w;
+        j->n_sensors = ns;
+        j->gvw_kg = NAN;
+        /* everything the solver thread reads travels with the job */
+        j->lambda = d->cfg.lambda;
+        j->scan_rate_hz = amfi_ring_rate(d->rings[0]);
+        snprintf(j->status, sizeof j->status, "%s", w.status);
+        snprintf(j->reason, sizeof j->reason, "%s", w.reason);
+        if (strcmp(w.status, "ok") == 0) {
+            j->accel = malloc(sizeof(double) * (size_t)ns * (size_t)(w.n > 0 ? w.n : 1));
+            int missing = 0;
+            for (int s = 0; s < ns && j->accel; s++) {
+                int m = amfi_ring_get(d->rings[s], w.k0[s], w.n, j->accel + (size_t)s * w.n);
+                missing += m < 0 ? w.n : m;
+            }
+            if (!j->accel || missing > 0) {
+                snprintf(j->status, sizeof j->status, "gap");
+                snprintf(j->reason, sizeof j->reason, "%d samples missing in the window",
+                         missing);
+            } else if (queue_push(&d->pool.jobs, j) == 0) {
+                continue; /* a solver thread has it */
+            } else {
+                snprintf(j->status, sizeof j->status, "overload");
+                snprintf(j->reason, sizeof j->reason,
+                         "solver queue full (%d passages waiting)", d->cfg.daemon.queue_size);
+            }
+        }
+        pipeline_complete(d, j);
+    }
+}
+
+/* ---- bus handlers: validate at the boundary ---------------------------- */
+
+static int sensor_index(const daemon_s *d, int id)
+{
+    for (int i = 0; i < d->cfg.solver.n_sensors; i++)
+        if (d->cfg.sensor_id[i] == id)
+            return i;
+    return -1;
+}
+
+static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    daemon_s *d = user;
+    amfi_accel_block_t m;
+    memset(&m, 0, sizeof m);
+    if (amfi_accel_block_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) {
+        d->messages_malformed++;
+        set_error(d, "%s: malformed accel_block_t (%u bytes) rejected", ch, rb->data_size);
+        amfi_accel_block_t_decode_cleanup(&m); /* it may have allocated before failing */
+        return;
+    }
+    d->blocks_received++;
+    const char *why = NULL;
+    int idx = sensor_index(d, m.sensor_id);
+    if (idx < 0)
+        why = "sensor_id not in the configuration";
+    else if (!(m.sample_rate_hz > 0 && m.sample_rate_hz <= 100000))
+        why = "sample_rate_hz out of (0, 100000]";
+    else if (m.n < 1 || m.n > MAX_BLOCK)
+        why = "n out of 1 .. 4096";
+    else if (m.utime <= 0)
+        why = "utime must be > 0";
+    for (int i = 0; !why && i < m.n; i++)
+        if (!isfinite(m.accel[i]) || fabs(m.accel[i]) > 1000.0)
+            why = "accel has a non-finite or absurd (> 1000 m/s²) value";
+    if (!why && !d->rings[idx]) {
+        d->rings[idx] = amfi_ring_create(m.sample_rate_hz, d->cfg.daemon.ring_s);
+        if (!d->rings[idx])
+            why = "cannot create the sample ring";
+    }
+    if (!why) {
+        const char *rwhy = NULL;
+        int rc = amfi_ring_put(d->rings[idx], m.utime, m.sample_rate_hz, m.n, m.accel, &rwhy);
+        if (rc == AMFI_RING_REJECT)
+            why = rwhy;
+        else if (m.utime > d->newest_utime)
+            d->newest_utime = m.utime;
+    }
+    if (why) {
+        d->blocks_rejected++;
+        set_error(d, "%s: accel_block_t sensor %d seq %lld rejected: %s", ch, m.sensor_id,
+                  (long long)m.seq, why);
+    }
+    amfi_accel_block_t_decode_cleanup(&m);
+}
+
+static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
+{
+    /* A rejected vehicle is still a stored passage, with the reason; the raw
+     * values that failed are in the reason, not in the typed columns. */
+    job *j = calloc(1, sizeof *j);
+    if (!j)
+        return;
+    j->w.v.vehicle_id = m->vehicle_id;
+    j->w.v.utime = (m->utime > 0 && m->utime < 253402300800000000LL) ? m->utime
+                                                                       : d->newest_utime;
+    j->w.v.lane = m->lane; /* int16_t on the bus */
+    j->w.v.speed_mps = NAN;
+    j->w.v.n_axles = 0;
+    j->gvw_kg = NAN;
+    snprintf(j->status, sizeof j->status, "invalid");
+    snprintf(j->reason, sizeof j->reason, "%.120s (speed_mps %.6g, n_axles %d, utime %lld)",
+             why, m->speed_mps, m->n_axles, (long long)m->utime);
+    /* outside the entry order: stored now */
+    pipeline_store_now(d, j);
+    job_free(j);
+}
+
+static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    daemon_s *d = user;
+    amfi_vehicle_t m;
+    memset(&m, 0, sizeof m);
+    if (amfi_vehicle_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) {
+        d->messages_malformed++;
+        set_error(d, "%s: malformed vehicle_t (%u bytes) rejected", ch, rb->data_size);
+        amfi_vehicle_t_decode_cleanup(&m); /* it may have allocated before failing */
+        return;
+    }
+    d->vehicles_received++;
+    const char *why = NULL;
+    char buf[200];
+    if (!(m.speed_mps >= 1.0 && m.speed_mps <= 60.0))
+        why = "speed_mps out of [1, 60]";
+    else if (m.n_axles < 1 || m.n_axles > d->cfg.solver.max_axles)
+        why = "n_axles out of range for the solver";
+    else if (m.n_spacings != m.n_axles - 1)
+        why = "n_spacings must be n_axles - 1";
+    else if (m.utime <= 0)
+        why = "utime must be > 0";
+    for (int a = 0; !why && a < m.n_spacings; a++)
+        if (!(m.axle_spacing_m[a] >= 0.5 && m.axle_spacing_m[a] <= 30.0))
+            why = "axle_spacing_m out of [0.5, 30]";
+    if (!why) {
+        amfi_vehicle_ev v;
+        memset(&v, 0, sizeof v);
+        v.vehicle_id = m.vehicle_id;
+        v.utime = m.utime;
+        v.lane = m.lane;
+        v.speed_mps = m.speed_mps;
+        v.n_axles = m.n_axles;
+        for (int a = 0; a < m.n_spacings; a++)
+            v.spacing_m[a] = m.axle_spacing_m[a];
+        const char *twhy = NULL;
+        if (amfi_tracker_add(d->tracker, &v, &twhy) != 0)
+            why = twhy;
+    }
+    if (why) {
+        d->vehicles_rejected++;
+        snprintf(buf, sizeof buf, "%s: vehicle_t %lld rejected: %s", ch, (long long)m.vehicle_id,
+                 why);
+        set_error(d, "%s", buf);
+        store_invalid(d, &m, buf);
+    }
+    amfi_vehicle_t_decode_cleanup(&m);
+}
+
+static void on_truth(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    daemon_s *d = user;
+    amfi_truth_t m;
+    memset(&m, 0, sizeof m);
+    if (amfi_truth_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) {
+        d->messages_malformed++;
+        set_error(d, "%s: malformed truth_t (%u bytes) rejected", ch, rb->data_size);
+        amfi_truth_t_decode_cleanup(&m); /* it may have allocated before failing */
+        return;
+    }
+    char err[256];
+    if (!(m.gvw_kg > 0 && m.gvw_kg < 1e6) || m.n_axles < 1 || m.n_axles > AMFI_MAX_AXLES)
+        set_error(d, "%s: truth_t %lld rejected: gvw or n_axles out of range", ch,
+                  (long long)m.vehicle_id);
+    else if (amfi_store_add_truth(d->store, m.vehicle_id, m.utime, m.gvw_kg, m.n_axles,
+                                  m.axle_kg, m.mean_force_N, m.speed_true_mps, err, sizeof err))
+        set_error(d, "%s: truth_t %lld: %s", ch, (long long)m.vehicle_id, err);
+    else
+        d->truth_received++;
+    amfi_truth_t_decode_cleanup(&m);
+}
+
+void intake_subscribe(daemon_s *d)
+{
+    lcm_subscribe(d->lcm, d->cfg.daemon.ch_accel, on_accel, d);
+    lcm_subscribe(d->lcm, d->cfg.daemon.ch_vehicle, on_vehicle, d);
+    lcm_subscribe(d->lcm, d->cfg.daemon.ch_truth, on_truth, d);
+}

@@ -1,0 +1,185 @@
+/*
+ * pipeline.c: amfid's in-order pipeline: finished passages (solved or not)
+ * parked by their release order and, in that order, stored (one
+ * transaction each), published on the passage channel, and the ok ones fed
+ * to the indicator engine, whose baselines, indicators and alerts are
+ * stored and published too.
+ *
+ * Thread: the main thread only. Owns the reorder buffer (d->pending), the
+ * store handle's writes and the indicator engine; it takes jobs back from
+ * the solver pool's result queue (pool.h), after which they are its own.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "amfi_alert_t.h"
+#include "amfi_indicator_t.h"
+#include "amfi_passage_t.h"
+#include "amfid.h"
+
+static void publish_passage(daemon_s *d, const job *j, int64_t id)
+{
+    amfi_passage_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = j->w.v.utime;
+    m.passage_id = id;
+    m.vehicle_id = j->w.v.vehicle_id;
+    m.lane = (int16_t)j->w.v.lane;
+    m.speed_mps = j->w.v.speed_mps;
+    m.status = (char *)j->status;
+    m.reason = (char *)j->reason;
+    m.gvw_kg = j->solved ? j->gvw_kg : NAN;
+    m.n_axles = (int16_t)(j->solved ? j->w.v.n_axles : 0);
+    m.axle_kg = (double *)j->axle_kg;
+    m.lambda = j->solved ? j->lambda_used : NAN;
+    m.residual_rms = j->solved ? j->residual_rms : NAN;
+    m.formulation = (char *)amfi_formulation_name(d->cfg.solver.formulation);
+    m.solve_ms = j->solve_ms;
+    amfi_passage_t_publish(d->lcm, d->cfg.daemon.ch_passage, &m);
+}
+
+static void feed_indicators(daemon_s *d, const job *j)
+{
+    amfi_indicator_eval ev;
+    amfi_alert_event al[2];
+    int n_al = 0;
+    int bits = amfi_indicators_push(d->ind, j->gvw_kg, &ev, al, &n_al);
+    if (bits < 0) {
+        set_error(d, "indicators: GVW %.1f kg of vehicle %lld refused", j->gvw_kg,
+                  (long long)j->w.v.vehicle_id);
+        return;
+    }
+    char err[256];
+    if (bits & AMFI_IND_BASELINE) {
+        amfi_baseline b;
+        memset(&b, 0, sizeof b);
+        b.utime_set = j->w.v.utime;
+        b.n = ev.n;
+        b.mean_kg = ev.baseline_mean_kg;
+        b.std_kg = ev.baseline_std_kg;
+        snprintf(b.source, sizeof b.source, "auto");
+        snprintf(b.note, sizeof b.note, "first %d ok passages", ev.n);
+        if (amfi_store_set_baseline(d->store, &b, err, sizeof err))
+            set_error(d, "store: %s", err);
+        LOG_INFO("baseline established: mean %.0f kg, STD %.0f kg over %d passages",
+                 ev.baseline_mean_kg, ev.baseline_std_kg, ev.n);
+    }
+    int64_t ind_id = 0;
+    if (bits & AMFI_IND_EVAL) {
+        amfi_indicator_row row = {j->w.v.utime, ev.n, ev.mean_kg, ev.std_kg,
+                                  ev.baseline_mean_kg, ev.baseline_std_kg, ev.std_ratio,
+                                  ev.p_value, ev.state};
+        if (amfi_store_add_indicator(d->store, &row, &ind_id, err, sizeof err))
+            set_error(d, "store: %s", err);
+        amfi_indicator_t m = {j->w.v.utime, ind_id, ev.n, ev.mean_kg, ev.std_kg,
+                              ev.baseline_mean_kg, ev.baseline_std_kg, ev.std_ratio,
+                              ev.p_value, (char *)ev.state};
+        amfi_indicator_t_publish(d->lcm, d->cfg.daemon.ch_indicator, &m);
+    }
+    for (int i = 0; (bits & AMFI_IND_ALERT) && i < n_al; i++) {
+        int64_t aid = 0;
+        if (amfi_store_add_alert(d->store, j->w.v.utime, al[i].level, al[i].kind, al[i].message,
+                                 ind_id, al[i].raised, &aid, err, sizeof err))
+            set_error(d, "store: %s", err);
+        amfi_alert_t m = {j->w.v.utime, aid, (char *)al[i].level, (char *)al[i].kind,
+                          al[i].message, ind_id, (int8_t)al[i].raised};
+        amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
+        if (al[i].raised)
+            LOG_WARN("ALERT %s (%s): %s", al[i].kind, al[i].level, al[i].message);
+        else
+            LOG_INFO("alert cleared %s: %s", al[i].kind, al[i].message);
+    }
+}
+
+static int store_job(daemon_s *d, job *j)
+{
+    amfi_passage_row r;
+    memset(&r, 0, sizeof r);
+    r.vehicle_id = j->w.v.vehicle_id;
+    r.utime = j->w.v.utime;
+    r.lane = j->w.v.lane;
+    r.speed_mps = j->w.v.speed_mps;
+    r.n_axles = j->w.v.n_axles;
+    for (int a = 0; a + 1 < r.n_axles; a++)
+        r.spacing_m[a] = j->w.v.spacing_m[a];
+    for (int a = 0; a < r.n_axles; a++)
+        r.axle_kg[a] = j->solved ? j->axle_kg[a] : NAN;
+    r.gvw_kg = j->solved ? j->gvw_kg : NAN;
+    r.status = j->status;
+    r.reason = j->reason;
+    r.lambda = j->solved ? j->lambda_used : NAN;
+    r.residual_rms = j->solved ? j->residual_rms : NAN;
+    r.formulation = amfi_formulation_name(d->cfg.solver.formulation);
+    r.solve_ms = j->solve_ms;
+    int64_t id = 0;
+    char err[256];
+    if (amfi_store_add_passage(d->store, &r, &id, err, sizeof err)) {
+        set_error(d, "store: passage of vehicle %lld: %s", (long long)r.vehicle_id, err);
+        return -1;
+    }
+    d->passages_stored++;
+    publish_passage(d, j, id);
+    if (j->solved) {
+        d->passages_ok++;
+        feed_indicators(d, j);
+    }
+    return 0;
+}
+
+/* Park a finished job by seq; store every consecutive one from next_seq.
+ * The parking ring grows when the solvers fall far behind (windows that
+ * bypass them keep arriving): a passage is never dropped for lack of room. */
+int pipeline_complete(daemon_s *d, job *j)
+{
+    int64_t seq = j->w.seq;
+    if (seq - d->next_seq >= d->pend_cap) {
+        int cap = d->pend_cap;
+        while (seq - d->next_seq >= cap)
+            cap *= 2;
+        job **np = calloc((size_t)cap, sizeof *np);
+        if (!np) { /* out of memory: store it now, out of order, rather than lose it */
+            set_error(d, "out of memory for the reorder buffer: passage %lld stored out of order",
+                      (long long)seq);
+            int rc = store_job(d, j);
+            job_free(j);
+            return rc;
+        }
+        for (int i = 0; i < d->pend_cap; i++)
+            if (d->pending[i])
+                np[d->pending[i]->w.seq % cap] = d->pending[i];
+        free(d->pending);
+        d->pending = np;
+        d->pend_cap = cap;
+    }
+    d->pending[seq % d->pend_cap] = j;
+    int rc = 0;
+    while (d->pending[d->next_seq % d->pend_cap] &&
+           d->pending[d->next_seq % d->pend_cap]->w.seq == d->next_seq) {
+        job *k = d->pending[d->next_seq % d->pend_cap];
+        d->pending[d->next_seq % d->pend_cap] = NULL;
+        if (store_job(d, k))
+            rc = -1;
+        job_free(k);
+        d->next_seq++;
+    }
+    return rc;
+}
+
+void pipeline_drain_results(daemon_s *d)
+{
+    uint64_t v;
+    if (read(d->pool.efd, &v, sizeof v) < 0 && errno != EAGAIN)
+        set_error(d, "eventfd: %s", strerror(errno));
+    job *j;
+    while ((j = queue_pop(&d->pool.results, 0)) != NULL)
+        pipeline_complete(d, j);
+}
+
+int pipeline_store_now(daemon_s *d, job *j)
+{
+    return store_job(d, j);
+}

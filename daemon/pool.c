@@ -1,0 +1,244 @@
+/*
+ * pool.c: amfid's solver pool (pool.h): the job queues and the solver
+ * threads that weigh one passage each with A-MFI.
+ *
+ * Threads: worker_main runs on the solver threads; it owns its solver and,
+ * between a pop and a push, the job; it reads nothing else. The queue
+ * functions run on both sides under the queue's mutex. pool_start,
+ * pool_join and pool_stop run on the main thread.
+ */
+#define _GNU_SOURCE
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/eventfd.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "pool.h"
+
+void job_free(job *j)
+{
+    if (j) {
+        free(j->accel);
+        free(j);
+    }
+}
+
+/* ---- queues ------------------------------------------------------------- */
+
+int queue_init(queue *q, int cap)
+{
+    memset(q, 0, sizeof *q);
+    q->items = calloc((size_t)cap, sizeof *q->items);
+    q->cap = cap;
+    pthread_mutex_init(&q->mu, NULL);
+    pthread_cond_init(&q->cv, NULL);
+    return q->items ? 0 : -1;
+}
+
+void queue_fini(queue *q)
+{
+    free(q->items);
+    q->items = NULL;
+    pthread_mutex_destroy(&q->mu);
+    pthread_cond_destroy(&q->cv);
+}
+
+int queue_push(queue *q, job *j)
+{
+    int rc = -1;
+    pthread_mutex_lock(&q->mu);
+    if (q->n < q->cap) {
+        q->items[(q->head + q->n) % q->cap] = j;
+        q->n++;
+        rc = 0;
+        pthread_cond_signal(&q->cv);
+    }
+    pthread_mutex_unlock(&q->mu);
+    return rc;
+}
+
+job *queue_pop(queue *q, int wait)
+{
+    job *j = NULL;
+    pthread_mutex_lock(&q->mu);
+    while (wait && q->n == 0 && !q->closed)
+        pthread_cond_wait(&q->cv, &q->mu);
+    if (q->n > 0) {
+        j = q->items[q->head];
+        q->head = (q->head + 1) % q->cap;
+        q->n--;
+    }
+    pthread_mutex_unlock(&q->mu);
+    return j;
+}
+
+int queue_depth(queue *q)
+{
+    pthread_mutex_lock(&q->mu);
+    int n = q->n;
+    pthread_mutex_unlock(&q->mu);
+    return n;
+}
+
+void queue_close(queue *q)
+{
+    pthread_mutex_lock(&q->mu);
+    q->closed = 1;
+    pthread_cond_broadcast(&q->cv);
+    pthread_mutex_unlock(&q->mu);
+}
+
+/* ---- solver threads ------------------------------------------------------- */
+
+static double mono_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+/* Weigh the job's passage; the result goes into the job. */
+static void solve_job(amfi_solver *s, job *j)
+{
+    amfi_passage p;
+    memset(&p, 0, sizeof p);
+    p.n_samples = j->w.n;
+    p.scan_rate_hz = j->scan_rate_hz;
+    p.t_first_s = j->w.t_first_s;
+    for (int i = 0; i < j->n_sensors; i++)
+        p.accel[i] = j->accel + (size_t)i * j->w.n;
+    p.speed_mps = j->w.v.speed_mps;
+    p.n_axles = j->w.v.n_axles;
+    for (int a = 0; a + 1 < p.n_axles; a++)
+        p.axle_spacing_m[a] = j->w.v.spacing_m[a];
+    amfi_result r;
+    char err[256];
+    double t0 = mono_s();
+    int rc = amfi_solve(s, &p, &j->lambda, &r, err, sizeof err);
+    j->solve_ms = 1e3 * (mono_s() - t0);
+    if (rc != 0) {
+        snprintf(j->status, sizeof j->status, "error");
+        snprintf(j->reason, sizeof j->reason, "solver: %.180s", err);
+        j->gvw_kg = NAN;
+        return;
+    }
+    if (!(r.gvw_kg > 0.0) || !isfinite(r.gvw_kg)) {
+        /* e.g. a silent sensor: stored as an error with the number, not lost */
+        snprintf(j->status, sizeof j->status, "error");
+        snprintf(j->reason, sizeof j->reason,
+                 "inferred GVW %.0f kg is not positive: no response from the bridge?", r.gvw_kg);
+        j->gvw_kg = NAN;
+        return;
+    }
+    j->solved = 1;
+    snprintf(j->status, sizeof j->status, "ok");
+    j->gvw_kg = r.gvw_kg;
+    for (int a = 0; a < r.n_axles; a++)
+        j->axle_kg[a] = r.axle_kg[a];
+    j->lambda_used = r.lambda_ref;
+    j->residual_rms = r.residual_rms;
+}
+
+typedef struct worker_arg {
+    pool *p;
+    amfi_solver *solver;
+} worker_arg;
+
+static void *worker_main(void *arg)
+{
+    worker_arg wa = *(worker_arg *)arg;
+    free(arg);
+    job *j;
+    while ((j = queue_pop(&wa.p->jobs, 1)) != NULL) {
+        solve_job(wa.solver, j);
+        while (queue_push(&wa.p->results, j) != 0) /* never full: sized with jobs */
+            usleep(1000);
+        uint64_t one = 1;
+        if (write(wa.p->efd, &one, sizeof one) < 0)
+            continue; /* the main thread also polls the queue */
+    }
+    return NULL;
+}
+
+int pool_start(pool *p, const amfi_bridge *bridge, const amfi_solver_params *sp,
+               int n_threads, int queue_size, char *err, size_t errlen)
+{
+    memset(p, 0, sizeof *p);
+    p->efd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    p->efd_open = p->efd >= 0;
+    if (p->efd < 0 || queue_init(&p->jobs, queue_size)) {
+        snprintf(err, errlen, "out of memory at start-up");
+        return -1;
+    }
+    if (queue_init(&p->results, queue_size + n_threads + 1)) {
+        queue_fini(&p->jobs);
+        snprintf(err, errlen, "out of memory at start-up");
+        return -1;
+    }
+    p->init = 1;
+    p->n_threads = n_threads;
+    p->threads = calloc((size_t)n_threads, sizeof *p->threads);
+    p->solvers = calloc((size_t)n_threads, sizeof *p->solvers);
+    if (!p->threads || !p->solvers) {
+        snprintf(err, errlen, "out of memory at start-up");
+        return -1;
+    }
+    for (int i = 0; i < n_threads; i++) {
+        char serr[256] = "";
+        worker_arg *wa = malloc(sizeof *wa);
+        if (!wa || amfi_solver_create(bridge, sp, &p->solvers[i], serr, sizeof serr)) {
+            snprintf(err, errlen, "solver thread %d: %s", i, wa ? serr : "out of memory");
+            free(wa);
+            return -1;
+        }
+        wa->p = p;
+        wa->solver = p->solvers[i];
+        if (pthread_create(&p->threads[i], NULL, worker_main, wa) != 0) {
+            snprintf(err, errlen, "solver thread %d: cannot start it", i);
+            free(wa);
+            return -1;
+        }
+        p->started++;
+    }
+    return 0;
+}
+
+void pool_join(pool *p)
+{
+    if (!p->init)
+        return;
+    queue_close(&p->jobs);
+    for (int i = 0; i < p->started; i++)
+        pthread_join(p->threads[i], NULL);
+    p->started = 0;
+    for (int i = 0; p->solvers && i < p->n_threads; i++) {
+        amfi_solver_destroy(p->solvers[i]);
+        p->solvers[i] = NULL;
+    }
+}
+
+void pool_stop(pool *p)
+{
+    pool_join(p);
+    if (p->init) {
+        job *j;
+        while ((j = queue_pop(&p->jobs, 0)) != NULL)
+            job_free(j);
+        while ((j = queue_pop(&p->results, 0)) != NULL)
+            job_free(j);
+        queue_fini(&p->jobs);
+        queue_fini(&p->results);
+        p->init = 0;
+    }
+    free(p->threads);
+    free(p->solvers);
+    p->threads = NULL;
+    p->solvers = NULL;
+    if (p->efd_open)
+        close(p->efd);
+    p->efd_open = 0;
+    p->efd = -1;
+}

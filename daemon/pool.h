@@ -1,0 +1,78 @@
+/*
+ * pool.h: amfid's solver pool: the job a passage travels in, the bounded
+ * queues between the threads, and the solver threads.
+ *
+ * Threads: the main thread fills a job completely (window, samples, λ
+ * policy, sample rate) and pushes it on `jobs`; a solver thread pops it,
+ * solves it with its own solver (built from the immutable bridge before
+ * the thread started), writes the result into the job and pushes it on
+ * `results`, then wakes the main thread through the eventfd. A job
+ * belongs to exactly one thread at a time (the queue hands it over under
+ * its mutex); a solver thread reads nothing else that is shared.
+ */
+#ifndef AMFID_POOL_H
+#define AMFID_POOL_H
+
+#include <pthread.h>
+
+#include "amfi/amfi.h"
+#include "tracker.h"
+
+/* One passage between the threads: all a solver thread reads is here. */
+typedef struct job {
+    amfi_window w;           /* the window (and its status) */
+    int n_sensors;
+    double *accel;           /* n_sensors × w.n, owned */
+    amfi_lambda lambda;      /* λ policy at release (a reload changes the next jobs) */
+    double scan_rate_hz;     /* sample rate of the window's samples */
+    /* result */
+    int solved;
+    double gvw_kg, axle_kg[AMFI_MAX_AXLES], lambda_used, residual_rms, solve_ms;
+    char status[16];
+    char reason[200];
+} job;
+
+void job_free(job *j);
+
+/* A bounded FIFO of jobs, safe between threads. */
+typedef struct queue {
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    job **items;
+    int cap, head, n;
+    int closed;
+} queue;
+
+int queue_init(queue *q, int cap);     /* 0, or −1 out of memory */
+void queue_fini(queue *q);             /* after queue_init succeeded */
+int queue_push(queue *q, job *j);      /* 0 queued, −1 full */
+job *queue_pop(queue *q, int wait);    /* NULL: empty (and closed when wait) */
+int queue_depth(queue *q);
+void queue_close(queue *q);            /* wakes every waiting pop */
+
+/* The solver threads and their queues. */
+typedef struct pool {
+    queue jobs, results;
+    int efd;                 /* eventfd: results ready */
+    int efd_open;
+    int n_threads, started;
+    pthread_t *threads;
+    amfi_solver **solvers;   /* one per thread, owned by it while it runs */
+    int init;                /* queues initialised */
+} pool;
+
+/* Queues (jobs: queue_size; results: room for every job in flight), the
+ * eventfd, one solver per thread and the threads. 0, or −1 with the reason
+ * in err (the pool is then half built: pool_stop releases it). */
+int pool_start(pool *p, const amfi_bridge *bridge, const amfi_solver_params *sp,
+               int n_threads, int queue_size, char *err, size_t errlen);
+
+/* Close the job queue, let the threads finish what is queued, join them,
+ * free the solvers. The results stay queued for the caller. Idempotent. */
+void pool_join(pool *p);
+
+/* pool_join, then free the queues (and any job left in them) and close the
+ * eventfd. Safe on a zeroed or half-started pool. */
+void pool_stop(pool *p);
+
+#endif /* AMFID_POOL_H */
