@@ -79,10 +79,11 @@ int amfid_parse_options(int argc, char **argv, amfid_options *o)
             fprintf(stderr, "amfid: %s: needs a value (see --help)\n", shown);
             return -1;
         default:
-            if (optopt)
-                fprintf(stderr, "amfid: -%c: unknown option (see --help)\n", optopt);
+            if (strncmp(shown, "--", 2) == 0)
+                fprintf(stderr, "amfid: %s: unknown option, or a value to an option that "
+                        "takes none (see --help)\n", shown);
             else
-                fprintf(stderr, "amfid: %s: unknown option (see --help)\n", shown);
+                fprintf(stderr, "amfid: -%c: unknown option (see --help)\n", optopt);
             return -1;
         }
     }
