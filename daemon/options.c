@@ -13,7 +13,7 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: amfid [-c FILE] [-d PATH] [-u URL] [-t] [-h] [-V]\n"
+            "usage: amfid [-c FILE] [-d PATH] [-u URL] [-C] [-h] [-V]\n"
             "\n"
             "The bridge monitoring daemon: weighs every vehicle from the bridge's\n"
             "accelerations (LCM bus), stores the passages in SQLite, watches the spread\n"
@@ -23,7 +23,7 @@ static void usage(FILE *f)
             "  -d, --db PATH       the store, over daemon.db_path of the file\n"
             "  -u, --lcm-url URL   the LCM bus, over daemon.lcm_url of the file\n"
             "                      (file://LOG?speed=0 replays a log)\n"
-            "  -t, --check-config  check the configuration (bridge, solver, indicators)\n"
+            "  -C, --check-config  check the configuration (bridge, solver, indicators)\n"
             "                      and exit\n"
             "  -h, --help          this help\n"
             "  -V, --version       the version\n"
@@ -39,7 +39,7 @@ int amfid_parse_options(int argc, char **argv, amfid_options *o)
         {"config", required_argument, NULL, 'c'},
         {"db", required_argument, NULL, 'd'},
         {"lcm-url", required_argument, NULL, 'u'},
-        {"check-config", no_argument, NULL, 't'},
+        {"check-config", no_argument, NULL, 'C'},
         {"help", no_argument, NULL, 'h'},
         {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0},
@@ -49,7 +49,7 @@ int amfid_parse_options(int argc, char **argv, amfid_options *o)
     opterr = 0; /* our own messages, naming the option */
     optind = 1;
     int c;
-    while ((c = getopt_long(argc, argv, ":c:d:u:thV", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, ":c:d:u:ChV", longopts, NULL)) != -1) {
         const char *shown = argv[optind - 1];
         switch (c) {
         case 'c':
@@ -66,7 +66,7 @@ int amfid_parse_options(int argc, char **argv, amfid_options *o)
             else
                 o->lcm_url = optarg;
             break;
-        case 't':
+        case 'C':
             o->check_only = 1;
             break;
         case 'h':

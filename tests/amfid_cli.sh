@@ -39,19 +39,19 @@ ok version '^amfid [0-9]+\.[0-9]+' --version
 ok version-short '^amfid [0-9]+\.[0-9]+' -V
 ok check-long ': ok \(bridge' --config "$config" --check-config
 ok check-equals ': ok \(bridge' --config="$config" --check-config
-ok check-short ': ok \(bridge' -c "$config" -t
-ok check-joined ': ok \(bridge' -c"$config" -t
-ok db-override 'store /tmp/x\.db\)' -t -c "$config" --db=/tmp/x.db
-ok db-short 'store /tmp/y\.db\)' -t -c "$config" -d /tmp/y.db -u file:///dev/null
-ok dashdash ': ok' -c "$config" -t --
+ok check-short ': ok \(bridge' -c "$config" -C
+ok check-joined ': ok \(bridge' -c"$config" -C
+ok db-override 'store /tmp/x\.db\)' -C -c "$config" --db=/tmp/x.db
+ok db-short 'store /tmp/y\.db\)' -C -c "$config" -d /tmp/y.db -u file:///dev/null
+ok dashdash ': ok' -c "$config" -C --
 
 bad unknown '^amfid: --bogus: unknown option' --bogus
 bad unknown-short '^amfid: -x: unknown option' -x
 bad missing '^amfid: --config: needs a value' --config
 bad missing-short '^amfid: -c: needs a value' -c
-bad empty '^amfid: --db=: empty value' -t --db=
-bad stray '^amfid: extra: unexpected argument' -c "$config" -t extra
-bad after-dashdash '^amfid: --help: unexpected argument' -c "$config" -t -- --help
+bad empty '^amfid: --db=: empty value' -C --db=
+bad stray '^amfid: extra: unexpected argument' -c "$config" -C extra
+bad after-dashdash '^amfid: --help: unexpected argument' -c "$config" -C -- --help
 bad no-flag-value '^amfid: --check-config=1: ' --check-config=1
 bad no-config '' --config "$tmp/none.yaml" --check-config
 
