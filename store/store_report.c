@@ -48,6 +48,18 @@ static int vec_push(vec *a, double x, char *err, size_t errlen)
     return 0;
 }
 
+/* rc 0: the array becomes the caller's (*out, *n); else it is freed. */
+static int vec_hand_over(vec *a, int rc, double **out, size_t *n)
+{
+    if (rc != 0) {
+        free(a->v);
+        return rc;
+    }
+    *out = a->v;
+    *n = a->n;
+    return 0;
+}
+
 /* Step st to completion: rc 0 with src SQLITE_DONE is a clean end. */
 static int end_of(amfi_store *s, int rc, int src, const char *what, char *err,
                   size_t errlen)
@@ -157,13 +169,7 @@ int amfi_store_all_ok_gvw(amfi_store *s, double **gvw, size_t *n, char *err,
     }
     rc = end_of(s, rc, src, "passages: read ok GVW", err, errlen);
     st_done_with(st);
-    if (rc != 0) {
-        free(g.v);
-        return rc;
-    }
-    *gvw = g.v;
-    *n = g.n;
-    return 0;
+    return vec_hand_over(&g, rc, gvw, n);
 }
 
 int amfi_store_recent_indicators(amfi_store *s, int max,
@@ -342,12 +348,7 @@ int amfi_store_gvw_errors(amfi_store *s, double **pct, size_t *n,
     }
     rc = end_of(s, rc, src, "passage_errors: read", err, errlen);
     st_done_with(st);
-    if (rc != 0) {
-        free(e.v);
-        return rc;
-    }
-    *pct = e.v;
-    *n = e.n;
-    *n_other = other;
-    return 0;
+    if (rc == 0)
+        *n_other = other;
+    return vec_hand_over(&e, rc, pct, n);
 }
