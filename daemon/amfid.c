@@ -120,7 +120,7 @@ static int start_runtime(daemon_s *d)
     }
     char abs[PATH_MAX];
     const char *cfg_path = realpath(d->config_path, abs) ? abs : d->config_path;
-    if (amfi_store_add_run(d->store, AMFI_VERSION_STRING, cfg_path, NULL, err, sizeof err)) {
+    if (amfi_store_add_run(d->store, amfi_version(), cfg_path, NULL, err, sizeof err)) {
         LOG_ERR("store %s: %s", d->cfg.daemon.db_path, err);
         return 1;
     }
@@ -167,7 +167,7 @@ static int run(daemon_s *d)
     d->state = "running";
     sd_notify(0, "READY=1");
     LOG_INFO("running: amfid %s, bus '%s', store %s, %d solver thread(s), bridge %s",
-             AMFI_VERSION_STRING, d->cfg.daemon.lcm_url[0] ? d->cfg.daemon.lcm_url : "(default)",
+             amfi_version(), d->cfg.daemon.lcm_url[0] ? d->cfg.daemon.lcm_url : "(default)",
              d->cfg.daemon.db_path, d->pool.n_threads, d->cfg.name);
     uint64_t wd_usec = 0;
     int wd = sd_watchdog_enabled(0, &wd_usec) > 0;

@@ -22,6 +22,7 @@
 
 #include "amfi/amfi.h"
 #include "amfi_config.h"
+#include "amfi_version.h"
 #include "indicators.h"
 #include "pool.h"
 #include "ring.h"
@@ -30,9 +31,6 @@
 
 #ifndef AMFID_DEFAULT_CONFIG
 #define AMFID_DEFAULT_CONFIG "/etc/amfid/amfid.yaml"
-#endif
-#ifndef AMFI_VERSION_STRING
-#define AMFI_VERSION_STRING "unknown"
 #endif
 
 /* ---- logging (stderr, journald reads the <N> prefixes) ----------------- */

@@ -73,7 +73,7 @@ int amfid_parse_options(int argc, char **argv, amfid_options *o)
             usage(stdout);
             return 1;
         case 'V':
-            printf("amfid %s\n", AMFI_VERSION_STRING);
+            printf("amfid %s\n", amfi_version());
             return 1;
         case ':':
             fprintf(stderr, "amfid: %s: needs a value (see --help)\n", shown);
