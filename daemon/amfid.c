@@ -249,9 +249,7 @@ static void stop(daemon_s *d)
 int main(int argc, char **argv)
 {
     amfid_options o;
-    int pr = amfid_parse_options(argc, argv, &o);
-    if (pr != 0)
-        return pr > 0 ? 0 : 2;
+    amfid_parse_options(argc, argv, &o);
     static daemon_s d; /* large; zeroed */
     int rc = start_config(&d, &o);
     if (rc == 0 && o.check_only)

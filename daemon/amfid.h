@@ -51,9 +51,9 @@ typedef struct amfid_options {
     int check_only;       /* --check-config */
 } amfid_options;
 
-/* 0 run; 1 done (--help, --version printed), exit 0; −1 bad command line
- * (reported on stderr), exit 2. */
-int amfid_parse_options(int argc, char **argv, amfid_options *o);
+/* 0: run. --help and --version print and exit 0; a bad command line is
+ * reported on stderr and exits 2 (amfi_cli.h). */
+void amfid_parse_options(int argc, char **argv, amfid_options *o);
 
 /* ---- the daemon ---------------------------------------------------------- */
 

@@ -1,13 +1,14 @@
 /*
- * options.c: amfid's command line (getopt_long: long and short options,
- * `--opt=value` and `--opt value`, `--` ends the options), --help and
- * --version. Runs once on the main thread before anything else; owns
- * nothing (the strings point into argv).
+ * options.c: amfid's command line, on common/'s getopt_long helpers
+ * (amfi_cli.h: long and short options, `--opt=value` and `--opt value`,
+ * `--` ends the options, --help and --version; a bad command line is one
+ * line on stderr and exit 2). Runs once on the main thread before anything
+ * else; owns nothing (the strings point into argv).
  */
-#include <getopt.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "amfi_cli.h"
 #include "amfid.h"
 
 static void usage(FILE *f)
@@ -33,35 +34,29 @@ static void usage(FILE *f)
             "bus); 2 bad command line or configuration.\n");
 }
 
-int amfid_parse_options(int argc, char **argv, amfid_options *o)
+void amfid_parse_options(int argc, char **argv, amfid_options *o)
 {
     static const struct option longopts[] = {
         {"config", required_argument, NULL, 'c'},
         {"db", required_argument, NULL, 'd'},
         {"lcm-url", required_argument, NULL, 'u'},
         {"check-config", no_argument, NULL, 'C'},
-        {"help", no_argument, NULL, 'h'},
-        {"version", no_argument, NULL, 'V'},
-        {NULL, 0, NULL, 0},
+        AMFI_CLI_END,
     };
     memset(o, 0, sizeof *o);
     o->config = AMFID_DEFAULT_CONFIG;
-    opterr = 0; /* our own messages, naming the option */
-    optind = 1;
-    int c;
-    while ((c = getopt_long(argc, argv, ":c:d:u:ChV", longopts, NULL)) != -1) {
-        const char *shown = argv[optind - 1];
-        switch (c) {
+    amfi_cli c;
+    amfi_cli_init(&c, "amfid", argc, argv, longopts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        switch (k) {
         case 'c':
         case 'd':
         case 'u':
-            if (!*optarg) {
-                fprintf(stderr, "amfid: %s: empty value\n", shown);
-                return -1;
-            }
-            if (c == 'c')
+            if (!*optarg)
+                amfi_cli_fail(&c, "empty value");
+            if (k == 'c')
                 o->config = optarg;
-            else if (c == 'd')
+            else if (k == 'd')
                 o->db = optarg;
             else
                 o->lcm_url = optarg;
@@ -69,27 +64,8 @@ int amfid_parse_options(int argc, char **argv, amfid_options *o)
         case 'C':
             o->check_only = 1;
             break;
-        case 'h':
-            usage(stdout);
-            return 1;
-        case 'V':
-            printf("amfid %s\n", amfi_version());
-            return 1;
-        case ':':
-            fprintf(stderr, "amfid: %s: needs a value (see --help)\n", shown);
-            return -1;
-        default:
-            if (strncmp(shown, "--", 2) == 0)
-                fprintf(stderr, "amfid: %s: unknown option, or a value to an option that "
-                        "takes none (see --help)\n", shown);
-            else
-                fprintf(stderr, "amfid: -%c: unknown option (see --help)\n", optopt);
-            return -1;
+        default: /* not in the table: cannot happen */
+            amfi_cli_fail(&c, "unhandled option");
         }
     }
-    if (optind < argc) {
-        fprintf(stderr, "amfid: %s: unexpected argument (see --help)\n", argv[optind]);
-        return -1;
-    }
-    return 0;
 }

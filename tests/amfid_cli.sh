@@ -2,7 +2,7 @@
 # amfid_cli.sh: amfid's command line (getopt_long): --help and --version
 # exit 0 on stdout; long and short options, "--opt=value" and "--opt value",
 # "--" ending the options; every bad command line exits 2 with one line on
-# stderr naming the option, and nothing on stdout.
+# stderr naming the option by its long name, and nothing on stdout.
 # Usage: amfid_cli.sh AMFID CONFIG
 set -u
 amfid=$1 config=$2
@@ -48,11 +48,11 @@ ok dashdash ': ok' -c "$config" -C --
 bad unknown '^amfid: --bogus: unknown option' --bogus
 bad unknown-short '^amfid: -x: unknown option' -x
 bad missing '^amfid: --config: needs a value' --config
-bad missing-short '^amfid: -c: needs a value' -c
-bad empty '^amfid: --db=: empty value' -C --db=
+bad missing-short '^amfid: --config: needs a value' -c
+bad empty '^amfid: --db: empty value' -C --db=
 bad stray '^amfid: extra: unexpected argument' -c "$config" -C extra
 bad after-dashdash '^amfid: --help: unexpected argument' -c "$config" -C -- --help
-bad no-flag-value '^amfid: --check-config=1: ' --check-config=1
+bad no-flag-value '^amfid: --check-config: unknown option' --check-config=1
 bad no-config '' --config "$tmp/none.yaml" --check-config
 
 echo "amfid_cli.sh: $failures failed"
