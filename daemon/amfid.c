@@ -112,6 +112,16 @@ static int start_config(daemon_s *d, const amfid_options *o)
 static int start_runtime(daemon_s *d)
 {
     char err[512];
+    /* First: a signal during start-up is remembered (the loop then stops
+     * at once, or reloads), never the default action. */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop;
+    sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGINT, &sa, NULL);
+    sa.sa_handler = on_hup;
+    sigaction(SIGHUP, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
     amfi_set_blas_threads(1);
     if (amfi_store_open(d->cfg.daemon.db_path, d->cfg.daemon.sync_full, &d->store, err,
                         sizeof err)) {
@@ -148,14 +158,6 @@ static int start_runtime(daemon_s *d)
         LOG_ERR("%s", err);
         return 1;
     }
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_stop;
-    sigaction(SIGTERM, &sa, NULL);
-    sigaction(SIGINT, &sa, NULL);
-    sa.sa_handler = on_hup;
-    sigaction(SIGHUP, &sa, NULL);
-    signal(SIGPIPE, SIG_IGN);
     return 0;
 }
 

@@ -38,6 +38,9 @@ cp "$dir/base.yaml" "$dir/amfid.yaml"
 "$amfid" --config "$dir/amfid.yaml" --db "$dir/reload.db" \
   --lcm-url "file://$dir/traffic.lcmlog?speed=0" 2> "$dir/amfid.log" &
 apid=$!
+i=0; until grep -q "running" "$dir/amfid.log"; do
+  i=$((i + 1)); [ $i -lt 600 ] || fail "amfid did not start"
+  kill -0 $apid 2>/dev/null || fail "amfid exited at start-up"; sleep 0.1; done
 k=0
 while kill -0 $apid 2>/dev/null; do
   sleep 0.1
