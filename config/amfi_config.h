@@ -1,8 +1,8 @@
 /*
  * amfi_config.h: a bridge site's configuration, loaded from YAML.
  *
- * One file describes one site: the bridge model (MODEL.md §1), the sensors
- * and the solver with its λ policy (MODEL.md §4), the daemon's settings and
+ * One file describes one site: the bridge model (docs/model.md §1), the sensors
+ * and the solver with its λ policy (docs/model.md §7), the daemon's settings and
  * the simulator's. The shipped files document every key and reproduce
  * amfi_config_defaults() exactly: config/paper-20m.yaml (bridge, sensors,
  * solver), config/sim_publisher.yaml (bridge, sensors, simulation).

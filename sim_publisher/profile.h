@@ -1,5 +1,5 @@
 /*
- * profile.h: random road profiles for the simulator (MODEL.md §3): ISO 8608
+ * profile.h: random road profiles for the simulator (docs/simulator-inputs.md §1): ISO 8608
  * roughness classes, one track or a "carpet" of parallel, correlated tracks.
  *
  * Roughness: ISO 8608:2016 displacement PSD (one-sided, per cycle/m)

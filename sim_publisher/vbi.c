@@ -64,7 +64,7 @@ void amfi_sim_params_default(amfi_sim_params *p, double span_m)
     memset(p, 0, sizeof *p);
     p->dt_s = 1e-4;
     p->scan_rate_hz = 1000.0;
-    p->approach_m = 100.0; /* MODEL.md §3, assumed */
+    p->approach_m = 100.0; /* assumed, docs/simulator.md */
     p->exit_m = 5.0;
     p->n_sensors = 1;
     p->sensor_x_m[0] = 0.5 * span_m;

@@ -47,7 +47,7 @@ void amfi_halfcar_baseline(amfi_halfcar *v)
     v->ms_kg = 18000.0 - 1100.0 - 700.0;
     v->D1_m = 2.13;
     v->D2_m = 2.87;
-    v->Is_kgm2 = v->ms_kg * v->D1_m * v->D2_m; /* assumed, MODEL.md §2 */
+    v->Is_kgm2 = v->ms_kg * v->D1_m * v->D2_m; /* assumed, docs/simulator.md */
     v->ks_Nm[0] = 0.4e6;
     v->ks_Nm[1] = 1.0e6;
     v->cs_Nsm[0] = 10e3;

@@ -1,5 +1,5 @@
 /*
- * vehicle.h: the half-car vehicle of MODEL.md §2 (paper §3.1, Table 2).
+ * vehicle.h: the half-car vehicle of docs/simulator.md (paper §3.1, Table 2).
  *
  * Four DOF, all positive downward and measured from static equilibrium on a
  * flat rigid road: body bounce y_s, body pitch θ (positive when the rear
@@ -27,7 +27,7 @@ typedef struct amfi_halfcar {
  * with a message when a value is out of range. */
 int amfi_halfcar_finish(amfi_halfcar *v, char *err, size_t errlen);
 
-/* The baseline 18 t vehicle of MODEL.md §2: Table 2 means, S = 5 m,
+/* The baseline 18 t vehicle of docs/simulator.md: Table 2 means, S = 5 m,
  * D1 = 2.13 m, D2 = 2.87 m (static loads 102.0 and 74.6 kN). */
 void amfi_halfcar_baseline(amfi_halfcar *v);
 

@@ -43,7 +43,7 @@ static void fe_frequencies(void **state)
     (void)state;
     const double *w = amfi_bridge_omega(bridge);
     const double L = 20.0, EI = 3.5e10 * 0.2991, mu = 2400.0 * 2.046;
-    /* MODEL.md §1: f1 = 5.734 Hz within 0.1 %. */
+    /* docs/model.md §1: f1 = 5.734 Hz within 0.1 %. */
     double f1 = w[0] / (2 * M_PI);
     assert_true(fabs(f1 / 5.734 - 1.0) < 1e-3);
     /* Simply supported beam: f_k = k²π/(2L²)·√(EI/μ); 20 cubic elements
@@ -470,7 +470,7 @@ static void compare_truth(const amfi_result *r, case_forces *cf, double *mean_er
  * sensors (quarter, mid, three-quarter span) the split is identified, and
  * the 0.5 % / 5 % targets hold per axle. The data are noise-free, so λ is
  * the smallest of the range 1e-12..1e-8 where the baseline GVW is flat
- * (MODEL.md §4). Axle 2's mean carries a bias from its first metres on the
+ * (an earlier independent check). Axle 2's mean carries a bias from its first metres on the
  * span, where no sensor sees it and smoothing sets its force: with three
  * sensors and 1000 Hz data it is −0.33 % at λ = 1e-12, −0.53 % at 1e-10,
  * −0.51 % at 1e-9; the paper's 7.94e-9 gives −1.6 % at 5000 Hz. */
@@ -619,10 +619,10 @@ static void solve_rejects_bad_passages(void **state)
     amfi_solver_destroy(s);
 }
 
-/* g_0 = 0 with a pre-roll (MODEL.md §4): the window starts 0.2 s before
+/* g_0 = 0 with a pre-roll (docs/model.md §6): the window starts 0.2 s before
  * entry on a bridge at rest. The smoothing term spreads the ramp from 0 to
  * the axle load into the first part of the span, so the weights come out
- * low: −2.7 % here on constant forces (the independent check of MODEL.md saw
+ * low: −2.7 % here on constant forces (an earlier independent check saw
  * −2.1 % with vehicle dynamics), where a free g_0 gives −0.2 %. That is why
  * g_0 is free by default. */
 static void zero_initial_force_with_preroll(void **state)

@@ -119,7 +119,7 @@ static void static_equilibrium(void **state)
     assert_true(fabs(v.car.W_N[0] - 6000 * AMFI_GRAVITY) < 1e-6);
     assert_true(fabs(v.car.W_N[1] - 4000 * AMFI_GRAVITY) < 1e-6);
     assert_true(fabs(v.car.D1_m + v.car.D2_m - 4.5) < 1e-12);
-    /* The baseline: 102.0 and 74.6 kN (MODEL.md §2). */
+    /* The baseline: 102.0 and 74.6 kN (docs/simulator.md). */
     amfi_halfcar base;
     amfi_halfcar_baseline(&base);
     assert_true(fabs(base.W_N[0] - 102.0e3) < 0.1e3 && fabs(base.W_N[1] - 74.6e3) < 0.1e3);

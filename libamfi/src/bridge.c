@@ -1,5 +1,5 @@
 /*
- * bridge.c: Euler-Bernoulli beam finite elements (MODEL.md §1).
+ * bridge.c: Euler-Bernoulli beam finite elements (docs/model.md §1).
  *
  * Equal elements, 2 DOF per node (w down, θ), consistent mass, supports that
  * remove DOFs, a uniform damage factor on E, Rayleigh damping matched at two

@@ -1,5 +1,5 @@
 /*
- * discretise.c: zero-order-hold discretisation of the bridge (MODEL.md §4),
+ * discretise.c: zero-order-hold discretisation of the bridge (docs/model.md §3),
  * in modal coordinates (closed form per mode) and in nodal coordinates
  * (Padé matrix exponential).
  */

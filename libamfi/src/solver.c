@@ -1,6 +1,6 @@
 /*
  * solver.c: the A-MFI solver's workspace, the passage window, the data at
- * the calculation rate, and the per-axle means (MODEL.md §4).
+ * the calculation rate, and the per-axle means (docs/model.md §6-§8).
  *
  * Create once per site and thread: discretisation and all buffers are sized
  * here. amfi_solve() allocates only when a passage is longer than the
@@ -379,7 +379,7 @@ int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
         s->off[a] = s->off[a - 1] + ps->axle_spacing_m[a - 1];
     resample(s, ps);
 
-    /* λ_h = λ_ref·(h_ref/h)² (MODEL.md §4: λ scales with the rate squared). */
+    /* λ_h = λ_ref·(h_ref/h)² (docs/model.md §7: λ scales with the rate squared). */
     const double scale = (s->p.calc_rate_hz / lam->ref_rate_hz) *
                          (s->p.calc_rate_hz / lam->ref_rate_hz);
     double lam_h = lam->lambda_ref * scale;

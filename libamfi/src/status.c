@@ -20,7 +20,7 @@ const char *amfi_strerror(int status)
     }
 }
 
-/* MODEL.md §1: the paper's 20 m simply supported concrete beam. */
+/* docs/model.md §1: the paper's 20 m simply supported concrete beam. */
 void amfi_bridge_params_paper20(amfi_bridge_params *p)
 {
     memset(p, 0, sizeof *p);

@@ -2,7 +2,7 @@
  * sweep_modal.c: the A-MFI backward/forward sweep in modal coordinates on
  * the reduced state z = [q₁, q₁', …, q_m, q_m', g₁ … g_na] (2m + na).
  *
- * Why reduced: in the paper formulation (MODEL.md §4) the X' block of the
+ * Why reduced: in the paper formulation (docs/model.md §4) the X' block of the
  * augmented state never feeds forward, and y_{j+1} = Q x_{j+1} is a function
  * of [X_j; g_j] only:
  *     y_{j+1} = C_j z_j,  C_j = [Cx, Cg_j],  Cx = ψ(x_s)·(velocity row of (Φ − I)/h),

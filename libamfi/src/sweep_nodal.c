@@ -1,5 +1,5 @@
 /*
- * sweep_nodal.c: the reference A-MFI sweep, exactly as MODEL.md §4 writes
+ * sweep_nodal.c: the reference A-MFI sweep, exactly as docs/model.md §4-§5 writes
  * the paper formulation: nodal coordinates, the full augmented state
  * x = [X; X'; g] (4n + na), dense F_j, Q picking u'' at the sensors.
  *     F_j = [[Φ, 0, P_j], [(Φ − I)/h, 0, P_j/h], [0, 0, I]],  T = [0; 0; I]

@@ -1,7 +1,7 @@
 /*
  * amfi-paper: the paper's experiments (§3.2 to §4.2), reproduced with the
  * project's simulator and solver and printed side by side with the paper's
- * numbers (MODEL.md §5).
+ * numbers (the paper is cited in docs/model.md).
  *
  *   amfi-paper [--out DIR] [--quick] [--vehicles N] [--reps R] [--threads T]
  *              [--lambda-ref VALUE] [--batch-lcurve] [--batches-only]

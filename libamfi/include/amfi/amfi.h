@@ -7,7 +7,7 @@
  * not NULL, writes a one-line message of at most `errlen` bytes into it.
  *
  * Matrices are row-major doubles; every matrix argument states its shape.
- * Sign convention (MODEL.md §1): deflection, acceleration and axle forces
+ * Sign convention (docs/model.md §0): deflection, acceleration and axle forces
  * are positive downward. Units are SI unless a name says otherwise.
  *
  * Workload: one bridge model per site (created once), one solver workspace
@@ -45,7 +45,7 @@ const char *amfi_strerror(int status); /* static string; never NULL */
  * OpenBLAS's idle threads spinning against the workers on a 2-core box. */
 void amfi_set_blas_threads(int n);
 
-/* ---- bridge: Euler-Bernoulli FE beam (MODEL.md §1) --------------------- */
+/* ---- bridge: Euler-Bernoulli FE beam (docs/model.md §1) ---------------- */
 
 typedef struct amfi_support {
     double x_m;         /* position along the beam, m, snapped to the nearest node */
@@ -68,7 +68,7 @@ typedef struct amfi_bridge_params {
     double damage;         /* δ: E_used = (1 − δ)·E in every element, 0 <= δ < 1 */
 } amfi_bridge_params;
 
-/* The paper-20m reference values of MODEL.md §1 (simply supported, 20 m). */
+/* The paper-20m reference values of docs/model.md §1 (simply supported, 20 m). */
 void amfi_bridge_params_paper20(amfi_bridge_params *p);
 
 typedef struct amfi_bridge amfi_bridge; /* opaque, read-only once created */
@@ -108,7 +108,7 @@ int amfi_bridge_mode_values(const amfi_bridge *b, double x_m, double *phi /* n *
  * −1 when that DOF is restrained or out of range. */
 int amfi_bridge_dof(const amfi_bridge *b, int node, int rot);
 
-/* ---- discretisation (MODEL.md §4) -------------------------------------- */
+/* ---- discretisation (docs/model.md §3) --------------------------------- */
 
 /* E = expm(A) by scaling and squaring with Padé approximants (Higham 2005,
  * SIAM J. Matrix Anal. Appl. 26(4), Algorithm 2.3). A, E: n × n. E may not
@@ -149,7 +149,7 @@ int amfi_forward_newmark(const amfi_bridge *b, double speed_mps, int n_axles,
 
 /* ---- the A-MFI solver -------------------------------------------------- */
 
-/* Output equation. Only the paper's is kept: the alternatives of MODEL.md §4
+/* Output equation. Only the paper's is kept (docs/model.md §4): the alternatives
  * were implemented and measured worse (docs/solver.md). */
 typedef enum amfi_formulation {
     AMFI_FORM_PAPER = 0 /* eqs 13-20: backward-difference acceleration */
@@ -192,7 +192,7 @@ typedef struct amfi_solver_params {
  * at mid-span of `span_m` with weight 1, 2 axles, 2 s, g_0 free, no rolls. */
 void amfi_solver_params_default(amfi_solver_params *p, double span_m);
 
-/* λ policy. λ is stored rate-independent (MODEL.md §4): the residual sum has
+/* λ policy. λ is stored rate-independent (docs/model.md §7): the residual sum has
  * N ∝ 1/h terms and r ∝ h, so the per-step λ_h = lambda_ref·(h_ref/h)², with
  * h_ref = 1/ref_rate_hz. lambda_ref is the λ one would use at ref_rate_hz
  * (the paper's 7.94e-9 at 5000 Hz). */
