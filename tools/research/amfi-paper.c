@@ -974,7 +974,7 @@ int main(int argc, char **argv)
                   "Made by `amfi-paper%s` (tools/research/amfi-paper.c). Bridge: %s (%.0f m, %d "
                   "elements); simulator: half-car vehicles on the FE bridge (sim_publisher/vbi.c),"
                   " accelerometer at %.1f m sampled at %.0f Hz; solver: paper formulation at "
-                  "%.0f Hz. Paper numbers from MODEL.md §5. GVW errors are (inferred − true) / "
+                  "%.0f Hz. Paper numbers from the paper itself (§3.2 to §4.2; cited in docs/model.md). GVW errors are (inferred − true) / "
                   "true.\n\n",
             c.o.quick ? " --quick" : "", c.cfg.name, c.cfg.bridge.span_m,
             c.cfg.bridge.n_elements, c.sp.sensor_x_m[0], c.sp.scan_rate_hz,
