@@ -20,6 +20,8 @@ rm -f "$stage.log"
 for f in "$bindir/amfid" "$bindir/amfi-solve" "$bindir/amfi-report" "$bindir/amfi-spy" \
          "$bindir/sim_publisher" "$sysconfdir/amfid/amfid.yaml" "$unitdir/amfid.service" \
          "$sysusersdir/amfid.conf" "$tmpfilesdir/amfid.conf" "$mandir/man8/amfid.8.gz" \
+         "$mandir/man5/amfid.yaml.5.gz" "$mandir/man1/amfi-solve.1.gz" "$mandir/man1/amfi-report.1.gz" \
+         "$mandir/man1/sim_publisher.1.gz" "$datadir/amfi/population.csv" \
          "$docdir/README.md" "$docdir/LICENSE" "$docdir/docs/daemon.md" "$datadir/java/amfi_types.jar"; do
   [ -e "$stage$f" ] || fail "not installed: $f"
 done
@@ -29,6 +31,11 @@ echo "installed files: ok"
 out=$("$stage$bindir/amfid" --check-config --config "$stage$sysconfdir/amfid/amfid.yaml" 2>&1) ||
   { echo "$out"; fail "installed amfid --check-config on the installed amfid.yaml"; }
 echo "installed amfid --check-config: ok"
+for p in amfid amfi-solve amfi-report sim_publisher amfi-mkcase amfi-bench amfi-population; do
+  v=$("$stage$bindir/$p" --version 2>&1) || fail "installed $p --version exited non-zero"
+  case "$v" in "$p "[0-9]*) ;; *) fail "installed $p --version said: $v" ;; esac
+done
+echo "installed programs answer --version: ok ($v)"
 
 # The unit names the installed binary and configuration, as installed.
 unit=$stage$unitdir/amfid.service
