@@ -1,5 +1,21 @@
 /*
  * internal.h: helpers shared by libamfi's sources; not part of the API.
+ *
+ * Call graph between libamfi's files (file -> files it calls). No file calls
+ * back into one that calls it; tests/libamfi_calls.sh (ctest libamfi_calls)
+ * reads the library with nm, fails on a cycle and fails when this list
+ * differs from the code:
+ *   solver.c -> bridge.c discretise.c lcurve.c status.c sweep.c sweep_modal.c sweep_nodal.c
+ *   lcurve.c -> sweep.c
+ *   sweep.c -> sweep_modal.c sweep_nodal.c
+ *   sweep_modal.c -> bridge.c dense.c
+ *   sweep_nodal.c -> bridge.c dense.c
+ *   newmark.c -> bridge.c status.c
+ *   discretise.c -> expm.c
+ *   bridge.c -> status.c
+ * Leaves (LAPACK/BLAS only): dense.c, expm.c, status.c. solver.c calls the
+ * sweeps directly only for their scratch sizes; the axle position (axle_x)
+ * and the λ rate scale are inline in solver_internal.h.
  */
 #ifndef AMFI_INTERNAL_H
 #define AMFI_INTERNAL_H

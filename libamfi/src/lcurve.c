@@ -78,9 +78,9 @@ static int curvature(struct amfi_solver *s)
     return best;
 }
 
-int amfi_lcurve(struct amfi_solver *s, const amfi_lambda *l, double *lam_h, int *n_solves)
+int amfi_lcurve(struct amfi_solver *s, const amfi_lambda *l, double scale, double *lam_h,
+                int *n_solves)
 {
-    const double scale = (s->p.calc_rate_hz / l->ref_rate_hz) * (s->p.calc_rate_hz / l->ref_rate_hz);
     const double dec = log10(l->lcurve_hi / l->lcurve_lo);
     int ngrid = (int)floor(dec * l->lcurve_per_decade + 1e-9) + 1;
     if (ngrid < 3)

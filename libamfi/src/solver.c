@@ -1,49 +1,18 @@
 /*
  * solver.c: the A-MFI solver's workspace, the passage window, the data at
- * the calculation rate, and the per-axle means (docs/model.md §6-§8).
+ * the calculation rate, and the per-axle means (docs/model.md §6-§8). The top of
+ * libamfi's call graph (internal.h): calls the sweep dispatcher and the
+ * L-curve, never called back by them.
  *
  * Create once per site and thread: discretisation and all buffers are sized
  * here. amfi_solve() allocates only when a passage is longer than the
  * capacity, before any time loop.
  */
-#include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "solver_internal.h"
-
-int amfi_spd_inverse(int na, double *A)
-{
-    lapack_int info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', na, A, na);
-    if (info == 0)
-        info = LAPACKE_dpotri_work(LAPACK_COL_MAJOR, 'L', na, A, na);
-    if (info != 0)
-        return (int)info;
-    for (int i = 0; i < na; i++) /* mirror the lower triangle */
-        for (int j = i + 1; j < na; j++)
-            A[j * na + i] = A[i * na + j];
-    return 0;
-}
-
-int amfi_spd_solve(int n, double *A, double *b)
-{
-    /* The entries span many orders of magnitude (a slow mode's displacement,
-     * a fast mode's velocity, a force not yet on the span), so any ridge is
-     * relative to each diagonal entry: it changes a well-posed answer by
-     * round-off only. A state the data cannot see at all (zero row) is
-     * pinned at zero. */
-    for (int i = 0; i < n; i++) {
-        double *d = &A[(size_t)i * n + i];
-        if (*d > 0.0) {
-            *d *= 1.0 + 1e-13;
-        } else {
-            *d = 1.0;
-            b[i] = 0.0;
-        }
-    }
-    return LAPACKE_dposv_work(LAPACK_COL_MAJOR, 'U', n, 1, A, n, b, n) == 0 ? 0 : -1;
-}
 
 void amfi_solver_destroy(amfi_solver *s)
 {
@@ -287,11 +256,18 @@ fail:
     return rc;
 }
 
-int amfi_sweep(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm)
+amfi_passage_times amfi_passage_window(double span_m, double speed_mps, int n_axles,
+                                       const double *axle_spacing_m, double pre_roll_s,
+                                       double post_roll_s)
 {
-    if (s->p.coords == AMFI_COORDS_NODAL)
-        return amfi_sweep_nodal(s, lam, res_norm, smo_norm);
-    return amfi_sweep_modal(s, lam, res_norm, smo_norm);
+    double total = 0.0;
+    for (int a = 0; a + 1 < n_axles; a++)
+        total += axle_spacing_m[a];
+    amfi_passage_times w;
+    w.start_s = 0.0 - pre_roll_s;
+    w.on_span_s = (span_m + total) / speed_mps;
+    w.end_s = w.on_span_s + post_roll_s;
+    return w;
 }
 
 /* Linear interpolation of the scan-rate samples to the calculation steps
@@ -334,12 +310,9 @@ int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
     REQ(isfinite(ps->scan_rate_hz) && ps->scan_rate_hz > 0, AMFI_EINVAL,
         "scan rate must be > 0");
     REQ(isfinite(ps->t_first_s), AMFI_EINVAL, "t_first_s is not finite");
-    double total = 0.0;
-    for (int a = 0; a + 1 < ps->n_axles; a++) {
+    for (int a = 0; a + 1 < ps->n_axles; a++)
         REQ(isfinite(ps->axle_spacing_m[a]) && ps->axle_spacing_m[a] > 0, AMFI_EINVAL,
             "axle spacing %d must be > 0", a + 1);
-        total += ps->axle_spacing_m[a];
-    }
     for (int si = 0; si < s->ns; si++)
         REQ(ps->accel[si], AMFI_EINVAL, "sensor %d has no samples", si);
     if (lam->automatic) {
@@ -357,8 +330,9 @@ int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
         "lambda reference rate must be > 0");
 
     /* Window: entry − pre_roll .. last axle's exit + post_roll. */
-    const double t_start = -s->p.pre_roll_s;
-    const double t_end = (L + total) / ps->speed_mps + s->p.post_roll_s;
+    const amfi_passage_times win = amfi_passage_window(
+        L, ps->speed_mps, ps->n_axles, ps->axle_spacing_m, s->p.pre_roll_s, s->p.post_roll_s);
+    const double t_start = win.start_s, t_end = win.end_s;
     const double t_last = ps->t_first_s + (ps->n_samples - 1) / ps->scan_rate_hz;
     const double tol = 1e-9 + 1e-6 / ps->scan_rate_hz;
     REQ(ps->t_first_s <= t_start + tol && t_last >= t_end - tol, AMFI_ERANGE,
@@ -379,14 +353,12 @@ int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
         s->off[a] = s->off[a - 1] + ps->axle_spacing_m[a - 1];
     resample(s, ps);
 
-    /* λ_h = λ_ref·(h_ref/h)² (docs/model.md §7: λ scales with the rate squared). */
-    const double scale = (s->p.calc_rate_hz / lam->ref_rate_hz) *
-                         (s->p.calc_rate_hz / lam->ref_rate_hz);
+    const double scale = amfi_lambda_scale(s, lam);
     double lam_h = lam->lambda_ref * scale;
     int n_solves = 0, rc;
     s->lc_n = 0;
     if (lam->automatic) {
-        rc = amfi_lcurve(s, lam, &lam_h, &n_solves);
+        rc = amfi_lcurve(s, lam, scale, &lam_h, &n_solves);
         if (rc)
             return amfi_fail(err, errlen, rc, "L-curve search failed: %s", amfi_strerror(rc));
     }

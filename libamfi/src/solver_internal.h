@@ -54,33 +54,35 @@ struct amfi_solver {
     double *lc_lam, *lc_res, *lc_smo, *lc_kap;
 };
 
-/* Position of axle a at step j. */
+/* Position of axle a at step j, m (x = speed·t − off[a], t = t0 + j·h):
+ * inline beside the passage fields it reads, so the sweeps need no call
+ * into solver.c. */
 static inline double axle_x(const struct amfi_solver *s, int a, int j)
 {
     return s->speed * (s->t0 + j * s->h) - s->off[a];
 }
 
 /* One backward and forward sweep at per-step λ: fills s->force (N + 1 rows),
- * s->y, and the two norms. */
+ * s->y, and the two norms (sweep_modal.c, sweep_nodal.c). */
 int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
 int amfi_sweep_nodal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
 size_t amfi_sweep_modal_scratch(int m, int na, int ns);
 size_t amfi_sweep_nodal_scratch(int n, int na, int ns);
 
-/* Run the sweep of the solver's coordinates. */
+/* Run the sweep of the solver's coordinates (sweep.c). */
 int amfi_sweep(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
 
-/* L-curve search; returns the chosen per-step λ in *lam_h. */
-int amfi_lcurve(struct amfi_solver *s, const amfi_lambda *l, double *lam_h, int *n_solves);
+/* Factor from a rate-independent λ (given at l->ref_rate_hz) to the per-step
+ * λ_h at the solver's calculation rate: λ_h = λ_ref·(h_ref/h)² (docs/model.md §7:
+ * the residual sum has N ∝ 1/h terms and r ∝ h). */
+static inline double amfi_lambda_scale(const struct amfi_solver *s, const amfi_lambda *l)
+{
+    return (s->p.calc_rate_hz / l->ref_rate_hz) * (s->p.calc_rate_hz / l->ref_rate_hz);
+}
 
-/* Solve a small SPD system in place (column-major, na ≤ 12): A ← A⁻¹.
- * No allocation. Returns 0 or a LAPACK info. */
-int amfi_spd_inverse(int na, double *A);
-
-/* Solve A x = b in place (b ← x) for a symmetric positive semi-definite A
- * (n × n, overwritten): each diagonal entry raised by 1e-13 of itself (an
- * empty row pinned at zero), then Cholesky (LAPACK dposv). Once per solve,
- * not per step. */
-int amfi_spd_solve(int n, double *A, double *b);
+/* L-curve search over λ_ref; each sweep runs at λ_ref·scale, scale from
+ * amfi_lambda_scale(). Returns the chosen per-step λ in *lam_h (lcurve.c). */
+int amfi_lcurve(struct amfi_solver *s, const amfi_lambda *l, double scale, double *lam_h,
+                int *n_solves);
 
 #endif

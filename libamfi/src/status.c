@@ -1,12 +1,25 @@
 /*
- * status.c: status strings and the documented default parameter sets.
+ * status.c: status strings, the error-message helper and the documented
+ * default parameter sets. Leaf of libamfi's call graph.
  */
 #include <cblas.h>
+#include <stdio.h>
 #include <string.h>
 
-#include "amfi/amfi.h"
+#include "internal.h"
 
 void amfi_set_blas_threads(int n) { openblas_set_num_threads(n > 0 ? n : 1); }
+
+int amfi_fail(char *err, size_t errlen, int status, const char *fmt, ...)
+{
+    if (err && errlen) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, errlen, fmt, ap);
+        va_end(ap);
+    }
+    return status;
+}
 
 const char *amfi_strerror(int status)
 {

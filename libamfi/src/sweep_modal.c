@@ -21,6 +21,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "dense.h"
 #include "solver_internal.h"
 
 size_t amfi_sweep_modal_scratch(int m, int na, int ns)

@@ -16,6 +16,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "dense.h"
 #include "solver_internal.h"
 
 size_t amfi_sweep_nodal_scratch(int n, int na, int ns)

@@ -224,6 +224,23 @@ typedef struct amfi_passage {
     double axle_spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1 spacings, > 0 */
 } amfi_passage;
 
+/* The passage window, in seconds relative to entry (t = 0 when the first
+ * axle reaches x = 0): the vehicle is on the span over [0, on_span_s]; a
+ * solve needs data over [start_s, end_s]. */
+typedef struct amfi_passage_times {
+    double start_s;   /* entry − pre_roll_s (never −0) */
+    double on_span_s; /* (span_m + Σ axle spacings) / speed: the last axle leaves */
+    double end_s;     /* on_span_s + post_roll_s */
+} amfi_passage_times;
+
+/* The window of a passage of n_axles axles (axle_spacing_m: n_axles − 1
+ * spacings, m, summed in order) at speed_mps over a span of span_m. The one
+ * definition the solver, the daemon and the tools share; no validation
+ * (amfi_solve checks its passage). */
+amfi_passage_times amfi_passage_window(double span_m, double speed_mps, int n_axles,
+                                       const double *axle_spacing_m, double pre_roll_s,
+                                       double post_roll_s);
+
 typedef struct amfi_result {
     double lambda_h;     /* per-step λ actually used */
     double lambda_ref;   /* the same, at ref_rate_hz */
