@@ -38,17 +38,17 @@ amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p)
 void amfi_tracker_destroy(amfi_tracker *t) { free(t); }
 int amfi_tracker_pending(const amfi_tracker *t) { return t->n_pend; }
 
-static double on_span_s(const amfi_tracker *t, const amfi_vehicle_ev *v)
+/* The vehicle's passage window (libamfi's one definition), seconds from its entry. */
+static amfi_passage_times window_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
 {
-    double s = 0.0;
-    for (int a = 0; a + 1 < v->n_axles; a++)
-        s += v->spacing_m[a];
-    return (t->p.span_m + s) / v->speed_mps;
+    return amfi_passage_window(t->p.span_m, v->speed_mps, v->n_axles, v->spacing_m,
+                               t->p.pre_s, t->p.post_s);
 }
 
 static span span_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
 {
-    span s = {v->vehicle_id, (double)v->utime, (double)v->utime + 1e6 * on_span_s(t, v)};
+    span s = {v->vehicle_id, (double)v->utime,
+              (double)v->utime + 1e6 * window_of(t, v).on_span_s};
     return s;
 }
 
@@ -105,8 +105,9 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
         return 0;
     const amfi_vehicle_ev *v = &t->pend[0];
     const int ns = t->p.n_sensors;
-    const double t0 = (double)v->utime - 1e6 * t->p.pre_s;
-    const double t1 = (double)v->utime + 1e6 * (on_span_s(t, v) + t->p.post_s);
+    const amfi_passage_times w = window_of(t, v);
+    const double t0 = (double)v->utime + 1e6 * w.start_s;
+    const double t1 = (double)v->utime + 1e6 * w.end_s;
     memset(out, 0, sizeof *out);
     out->v = *v;
     out->status = "ok";

@@ -350,15 +350,14 @@ int main(int argc, char **argv)
     }
 
     int n_axles = o.n_spacings + 1;
-    double wheelbase_m = 0;
-    for (int k = 0; k < o.n_spacings; k++)
-        wheelbase_m += o.spacing_m[k];
     /* the window, relative to entry (amfi.h: entry − pre_roll .. last exit
      * + post_roll) */
-    const double span_m = cfg.bridge.span_m;
-    const double crossing_s = (span_m + wheelbase_m) / o.speed_mps;
-    const double win_lo = 0.0 - cfg.solver.pre_roll_s; /* never "-0" */
-    const double win_hi = crossing_s + cfg.solver.post_roll_s;
+    const amfi_passage_times win =
+        amfi_passage_window(cfg.bridge.span_m, o.speed_mps, n_axles, o.spacing_m,
+                            cfg.solver.pre_roll_s, cfg.solver.post_roll_s);
+    const double crossing_s = win.on_span_s;
+    const double win_lo = win.start_s; /* never "-0" */
+    const double win_hi = win.end_s;
 
     /* single-sensor CSV: sensor 0 of the configuration */
     cfg.solver.n_sensors = 1;

@@ -153,7 +153,9 @@ int main(int argc, char **argv)
         if (a > 0)
             off[a] = off[a - 1] + spacing[a - 1];
     }
-    const double L = cfg.bridge.span_m, T = (L + off[n_loads - 1]) / speed + post;
+    /* the recording: pre seconds at rest, then entry .. last exit + post */
+    const double L = cfg.bridge.span_m,
+                 T = amfi_passage_window(L, speed, n_loads, spacing, pre, post).end_s;
     const int n_rest = (int)lround(pre * scan), n_move = (int)floor(T * scan) + 1;
     const int n = n_rest + n_move;
     double *acc = calloc(n, sizeof(double));
