@@ -74,7 +74,11 @@ void amfi_bridge_params_paper20(amfi_bridge_params *p);
 typedef struct amfi_bridge amfi_bridge; /* opaque, read-only once created */
 
 /* Assemble M, K (consistent mass), apply supports, solve K ψ = ω² M ψ
- * (LAPACK dsygvd), build Rayleigh C. Free with amfi_bridge_destroy(). */
+ * (LAPACK dsygvd; inverted, M ψ = K ψ/ω², when the spectrum is wide enough
+ * to cost the low modes accuracy), build Rayleigh C. Supports that leave a
+ * rigid-body motion (no w held at two distinct nodes, nor w and θ) are
+ * refused with AMFI_EINVAL. Work O(n³): milliseconds at 20 elements, about
+ * 1.4 s of CPU at 1000 (2000 DOF). Free with amfi_bridge_destroy(). */
 int amfi_bridge_create(const amfi_bridge_params *p, amfi_bridge **out,
                        char *err, size_t errlen);
 void amfi_bridge_destroy(amfi_bridge *b); /* NULL-safe */
