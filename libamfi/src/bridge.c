@@ -195,9 +195,9 @@ static int solve_pencil(amfi_bridge *b, int inverted, double *work, char *err, s
  * the shipped 20-element models, it is solved again direct, which is also
  * the most accurate on the high modes the all-modes path uses (microseconds
  * to milliseconds at that size; the results are those of earlier versions).
- * work: n·n + 2n doubles.
- * Dense dsygvd measured faster than the banded dsbgvd (2000 DOFs: 3.4 s
- * against 5.3 s under load, dominated by dsbtrd's rotations). */
+ * Dense dsygvd measured faster than the banded dsbgvd (2000 DOF: 1.2-1.3 s
+ * of CPU against 2.15 s, dominated by dsbtrd's rotations; docs/solver.md).
+ * work: n·n + 2n doubles. */
 static int modes(amfi_bridge *b, double *work, char *err, size_t errlen)
 {
     const int n = b->n;
