@@ -4,9 +4,11 @@
  * and the limits stated in the .lcm comments. See docs/messages.md.
  *
  * Decoding: lcm-gen's _decode() checks the type fingerprint and the buffer
- * length but not the values; a negative count decodes to a NULL array. Check
- * the counts and ranges below before using a message, and call _decode_cleanup()
- * on the (zeroed) struct even when _decode() failed: it may have allocated.
+ * length but not the counts: a negative count or string length makes it call
+ * malloc() with a huge size and memcpy() past the buffer. Never call it on
+ * bytes from the bus; call amfi_msg_decode_checked() or amfi_msg_decode_TYPE()
+ * (amfi_msg_check.h), which check the raw buffer against the type and the
+ * limits in amfi_msg_limits.h first. Check the values' ranges after decoding.
  */
 #ifndef AMFI_MESSAGES_H
 #define AMFI_MESSAGES_H
@@ -30,9 +32,8 @@
 /* lcm_subscribe() regular expression for every amfi channel. */
 #define AMFI_CHANNEL_ALL       "AMFI_.*"
 
-/* Limits from the .lcm comments. */
-#define AMFI_ACCEL_BLOCK_MAX_SAMPLES 160 /* accel_block_t.n: 1 .. 160, one UDP datagram */
-#define AMFI_SENSOR_ID_MAX           255 /* accel_block_t.sensor_id: 0 .. 255 */
-#define AMFI_MAX_AXLES               12  /* vehicle_t.n_axles: 1 .. 12 */
+/* The limits (AMFI_ACCEL_BLOCK_MAX_SAMPLES, AMFI_SENSOR_ID_MAX, AMFI_MAX_AXLES,
+ * the checker's AMFI_MSG_MAX_*). */
+#include "amfi_msg_limits.h"
 
 #endif /* AMFI_MESSAGES_H */
