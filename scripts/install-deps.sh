@@ -29,6 +29,8 @@ pkgs=(
   dpkg-dev                       # dpkg-shlibdeps: the .deb's runtime dependencies (cpack)
   file                           # cpack's DEB generator needs it for dpkg-shlibdeps
   libjansson-dev                 # JSON output of the tools (common/amfi_json.c): escaped strings
+  clang                          # libFuzzer builds of fuzz/ (the fuzz_* tests, docs/fuzzing.md)
+  libclang-rt-14-dev             # clang 14's libFuzzer and sanitizer runtimes (-fsanitize=fuzzer)
 )
 missing=()
 for p in "${pkgs[@]}"; do
