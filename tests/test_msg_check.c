@@ -195,31 +195,21 @@ static enc random_message(amfi_msg_type t, int big)
     return e;
 }
 
+#define SIZE_CASE(E, T) case E: return sizeof(amfi_##T);
 static size_t type_size(amfi_msg_type t)
 {
     switch (t) {
-    case AMFI_MSG_ACCEL_BLOCK_T: return sizeof(amfi_accel_block_t);
-    case AMFI_MSG_VEHICLE_T: return sizeof(amfi_vehicle_t);
-    case AMFI_MSG_TRUTH_T: return sizeof(amfi_truth_t);
-    case AMFI_MSG_PASSAGE_T: return sizeof(amfi_passage_t);
-    case AMFI_MSG_INDICATOR_T: return sizeof(amfi_indicator_t);
-    case AMFI_MSG_ALERT_T: return sizeof(amfi_alert_t);
-    case AMFI_MSG_STATUS_T: return sizeof(amfi_status_t);
+    AMFI_MSG_FOR_EACH(SIZE_CASE)
     case AMFI_MSG_NTYPES: break;
     }
     return 0;
 }
 
+#define FREE_CASE(E, T) case E: amfi_##T##_decode_cleanup(m); break;
 static void free_message(amfi_msg_type t, void *m)
 {
     switch (t) {
-    case AMFI_MSG_ACCEL_BLOCK_T: amfi_accel_block_t_decode_cleanup(m); break;
-    case AMFI_MSG_VEHICLE_T: amfi_vehicle_t_decode_cleanup(m); break;
-    case AMFI_MSG_TRUTH_T: amfi_truth_t_decode_cleanup(m); break;
-    case AMFI_MSG_PASSAGE_T: amfi_passage_t_decode_cleanup(m); break;
-    case AMFI_MSG_INDICATOR_T: amfi_indicator_t_decode_cleanup(m); break;
-    case AMFI_MSG_ALERT_T: amfi_alert_t_decode_cleanup(m); break;
-    case AMFI_MSG_STATUS_T: amfi_status_t_decode_cleanup(m); break;
+    AMFI_MSG_FOR_EACH(FREE_CASE)
     case AMFI_MSG_NTYPES: break;
     }
 }
@@ -275,16 +265,12 @@ static void roundtrip(amfi_msg_type t, const enc *e)
         n = amfi_##TYPE##_encode(again, 0, (int)e->len, &m);                          \
         amfi_##TYPE##_decode_cleanup(&m);                                             \
     } while (0)
+#define RT_CASE(E, T) case E: RT(T); break;
     switch (t) {
-    case AMFI_MSG_ACCEL_BLOCK_T: RT(accel_block_t); break;
-    case AMFI_MSG_VEHICLE_T: RT(vehicle_t); break;
-    case AMFI_MSG_TRUTH_T: RT(truth_t); break;
-    case AMFI_MSG_PASSAGE_T: RT(passage_t); break;
-    case AMFI_MSG_INDICATOR_T: RT(indicator_t); break;
-    case AMFI_MSG_ALERT_T: RT(alert_t); break;
-    case AMFI_MSG_STATUS_T: RT(status_t); break;
+    AMFI_MSG_FOR_EACH(RT_CASE)
     case AMFI_MSG_NTYPES: break;
     }
+#undef RT_CASE
 #undef RT
     assert_int_equal(n, (int)e->len);
     assert_memory_equal(again, e->buf, e->len);
