@@ -209,6 +209,7 @@ static int run(daemon_s *d)
         double now = amfid_mono_s();
         if (now - last_beat >= d->cfg.daemon.status_period_s) {
             heartbeat(d);
+            reject_tick(d);
             last_beat = now;
         }
         if (wd && now - last_wd >= 0.5e-6 * (double)wd_usec) {
@@ -222,6 +223,7 @@ static int run(daemon_s *d)
     pool_join(&d->pool);
     pipeline_drain_results(d);
     heartbeat(d);
+    reject_final(d);
     LOG_INFO("stopped: %lld passages stored (%lld ok), %lld blocks, %lld vehicles, %lld "
              "rejected messages",
              (long long)d->passages_stored, (long long)d->passages_ok,

@@ -22,6 +22,7 @@
 
 #include "amfi/amfi.h"
 #include "amfi_config.h"
+#include "amfi_msg_check.h"
 #include "amfi_version.h"
 #include "indicators.h"
 #include "pool.h"
@@ -57,6 +58,20 @@ void amfid_parse_options(int argc, char **argv, amfid_options *o);
 
 /* ---- the daemon ---------------------------------------------------------- */
 
+/* Refused bus messages (reject.c): per input and reason. The reasons are
+ * the raw-buffer checker's (amfi_msg_reason, messages/amfi_msg_check.h) and
+ * REJECT_INVALID, a message that decoded but failed amfid's validation. */
+enum { REJECT_ACCEL, REJECT_VEHICLE, REJECT_TRUTH, REJECT_NINPUTS };
+#define REJECT_INVALID AMFI_MSG_NREASONS
+#define REJECT_NREASONS (AMFI_MSG_NREASONS + 1)
+typedef struct reject_state {
+    int64_t count[REJECT_NINPUTS][REJECT_NREASONS]; /* since start */
+    int64_t total;
+    int64_t held, held_by[REJECT_NINPUTS][REJECT_NREASONS]; /* not logged this period */
+    int logged;                                             /* lines logged this period */
+    double period_start;                                    /* amfid_mono_s() */
+} reject_state;
+
 typedef struct daemon_s {
     amfi_site_config cfg;
     const char *config_path;
@@ -77,11 +92,24 @@ typedef struct daemon_s {
     int64_t blocks_received, blocks_rejected, vehicles_received, vehicles_rejected;
     int64_t messages_malformed, passages_stored, passages_ok, truth_received;
     int64_t newest_utime;
+    reject_state rej;
     char last_error[256];
     const char *state;
 } daemon_s;
 
 void set_error(daemon_s *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* ---- refused messages (reject.c), main thread ----------------------------- */
+
+/* Count a refused message of `input` for `reason`; the formatted line becomes
+ * last_error and is logged within the rate limit. */
+void reject_note(daemon_s *d, int input, int reason, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+/* The period's summary line when the period is over (from the loop). */
+void reject_tick(daemon_s *d);
+/* The last summary and the totals by channel and reason (at stop). */
+void reject_final(daemon_s *d);
+const char *reject_reason_name(int reason);
 
 /* ---- bus intake (intake.c), main thread ---------------------------------- */
 

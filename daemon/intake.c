@@ -6,6 +6,12 @@
  * filled from the rings into jobs for the solver pool (or straight to the
  * pipeline when they cannot be solved).
  *
+ * Every message is checked against its type on the raw bytes before
+ * lcm-gen's decoder runs (amfi_msg_decode_checked, messages/amfi_msg_check.h):
+ * a negative count or length in a datagram can no longer crash amfid. Refused
+ * messages are counted per input and reason and logged within a rate limit
+ * (reject.c).
+ *
  * Thread: the main thread only (inside lcm_handle and the loop). Owns the
  * rings (created here at the first block of each sensor) and feeds the
  * tracker; a job leaves it complete: the λ policy and the sample rate it
@@ -15,6 +21,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "amfi_accel_block_t.h"
 #include "amfi_truth_t.h"
@@ -81,11 +88,13 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     daemon_s *d = user;
     amfi_accel_block_t m;
-    memset(&m, 0, sizeof m);
-    if (amfi_accel_block_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) {
+    char cwhy[160];
+    int cr = amfi_msg_decode_checked(AMFI_MSG_ACCEL_BLOCK_T, rb->data, rb->data_size, &m, cwhy,
+                                     sizeof cwhy);
+    if (cr != AMFI_MSG_OK) { /* nothing decoded, nothing allocated */
         d->messages_malformed++;
-        set_error(d, "%s: malformed accel_block_t (%u bytes) rejected", ch, rb->data_size);
-        amfi_accel_block_t_decode_cleanup(&m); /* it may have allocated before failing */
+        reject_note(d, REJECT_ACCEL, cr, "%s: malformed accel_block_t (%u bytes) rejected: %s", ch,
+                    rb->data_size, cwhy);
         return;
     }
     d->blocks_received++;
@@ -97,8 +106,8 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
         why = "sample_rate_hz out of (0, 100000]";
     else if (m.n < 1 || m.n > MAX_BLOCK)
         why = "n out of 1 .. 4096";
-    else if (m.utime <= 0)
-        why = "utime must be > 0";
+    else if (m.utime <= 0 || m.utime > AMFI_STORE_MAX_UTIME)
+        why = "utime out of (0, year 9999]";
     for (int i = 0; !why && i < m.n; i++)
         if (!isfinite(m.accel[i]) || fabs(m.accel[i]) > 1000.0)
             why = "accel has a non-finite or absurd (> 1000 m/s²) value";
@@ -117,8 +126,8 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
     }
     if (why) {
         d->blocks_rejected++;
-        set_error(d, "%s: accel_block_t sensor %d seq %lld rejected: %s", ch, m.sensor_id,
-                  (long long)m.seq, why);
+        reject_note(d, REJECT_ACCEL, REJECT_INVALID, "%s: accel_block_t sensor %d seq %lld rejected: %s",
+                    ch, m.sensor_id, (long long)m.seq, why);
     }
     amfi_accel_block_t_decode_cleanup(&m);
 }
@@ -131,8 +140,17 @@ static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
     if (!j)
         return;
     j->w.v.vehicle_id = m->vehicle_id;
-    j->w.v.utime = (m->utime > 0 && m->utime < 253402300800000000LL) ? m->utime
-                                                                       : d->newest_utime;
+    /* Its own time if the store can hold it, else the newest data time, else
+     * the wall clock: never a time the store refuses (the row must exist). */
+    if (m->utime > 0 && m->utime <= AMFI_STORE_MAX_UTIME)
+        j->w.v.utime = m->utime;
+    else if (d->newest_utime > 0 && d->newest_utime <= AMFI_STORE_MAX_UTIME)
+        j->w.v.utime = d->newest_utime;
+    else {
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        j->w.v.utime = (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+    }
     j->w.v.lane = m->lane; /* int16_t on the bus */
     j->w.v.speed_mps = NAN;
     j->w.v.n_axles = 0;
@@ -149,11 +167,15 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     daemon_s *d = user;
     amfi_vehicle_t m;
-    memset(&m, 0, sizeof m);
-    if (amfi_vehicle_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) {
+    char cwhy[160];
+    int cr = amfi_msg_decode_checked(AMFI_MSG_VEHICLE_T, rb->data, rb->data_size, &m, cwhy,
+                                     sizeof cwhy);
+    if (cr != AMFI_MSG_OK) { /* nothing decoded, nothing allocated */
+        /* Not a vehicle we can name: no row (there is no id to store it
+         * under); counted per reason and in the status message. */
         d->messages_malformed++;
-        set_error(d, "%s: malformed vehicle_t (%u bytes) rejected", ch, rb->data_size);
-        amfi_vehicle_t_decode_cleanup(&m); /* it may have allocated before failing */
+        reject_note(d, REJECT_VEHICLE, cr, "%s: malformed vehicle_t (%u bytes) rejected: %s", ch,
+                    rb->data_size, cwhy);
         return;
     }
     d->vehicles_received++;
@@ -165,8 +187,8 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
         why = "n_axles out of range for the solver";
     else if (m.n_spacings != m.n_axles - 1)
         why = "n_spacings must be n_axles - 1";
-    else if (m.utime <= 0)
-        why = "utime must be > 0";
+    else if (m.utime <= 0 || m.utime > AMFI_STORE_MAX_UTIME)
+        why = "utime out of (0, year 9999]";
     for (int a = 0; !why && a < m.n_spacings; a++)
         if (!(m.axle_spacing_m[a] >= 0.5 && m.axle_spacing_m[a] <= 30.0))
             why = "axle_spacing_m out of [0.5, 30]";
@@ -188,7 +210,7 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
         d->vehicles_rejected++;
         snprintf(buf, sizeof buf, "%s: vehicle_t %lld rejected: %s", ch, (long long)m.vehicle_id,
                  why);
-        set_error(d, "%s", buf);
+        reject_note(d, REJECT_VEHICLE, REJECT_INVALID, "%s", buf);
         store_invalid(d, &m, buf);
     }
     amfi_vehicle_t_decode_cleanup(&m);
@@ -198,17 +220,20 @@ static void on_truth(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     daemon_s *d = user;
     amfi_truth_t m;
-    memset(&m, 0, sizeof m);
-    if (amfi_truth_t_decode(rb->data, 0, (int)rb->data_size, &m) < 0) {
+    char cwhy[160];
+    int cr = amfi_msg_decode_checked(AMFI_MSG_TRUTH_T, rb->data, rb->data_size, &m, cwhy,
+                                     sizeof cwhy);
+    if (cr != AMFI_MSG_OK) { /* nothing decoded, nothing allocated */
         d->messages_malformed++;
-        set_error(d, "%s: malformed truth_t (%u bytes) rejected", ch, rb->data_size);
-        amfi_truth_t_decode_cleanup(&m); /* it may have allocated before failing */
+        reject_note(d, REJECT_TRUTH, cr, "%s: malformed truth_t (%u bytes) rejected: %s", ch,
+                    rb->data_size, cwhy);
         return;
     }
     char err[256];
     if (!(m.gvw_kg > 0 && m.gvw_kg < 1e6) || m.n_axles < 1 || m.n_axles > AMFI_MAX_AXLES)
-        set_error(d, "%s: truth_t %lld rejected: gvw or n_axles out of range", ch,
-                  (long long)m.vehicle_id);
+        reject_note(d, REJECT_TRUTH, REJECT_INVALID,
+                    "%s: truth_t %lld rejected: gvw or n_axles out of range", ch,
+                    (long long)m.vehicle_id);
     else if (amfi_store_add_truth(d->store, m.vehicle_id, m.utime, m.gvw_kg, m.n_axles,
                                   m.axle_kg, m.mean_force_N, m.speed_true_mps, err, sizeof err))
         set_error(d, "%s: truth_t %lld: %s", ch, (long long)m.vehicle_id, err);

@@ -1,0 +1,105 @@
+/*
+ * reject.c: amfid's count of refused bus messages, per input channel and per
+ * reason, and the rate limit on their log lines (issue: 40 000 bad messages
+ * once wrote 15 049 lines). Every refusal is counted and becomes the status
+ * message's last_error; the log gets at most REJECT_LOG_BURST lines in full
+ * per REJECT_LOG_PERIOD_S seconds of wall time, and then, once the period
+ * is over, one summary line with what was held back, by channel and reason.
+ *
+ * Thread: the main thread only (the bus handlers, the heartbeat, the drain).
+ * Owns d->rej.
+ */
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "amfi_msg_check.h"
+#include "amfid.h"
+
+#define REJECT_LOG_BURST 20
+#define REJECT_LOG_PERIOD_S 60.0
+
+static const char *const input_name[REJECT_NINPUTS] = {"accel", "vehicle", "truth"};
+
+const char *reject_reason_name(int reason)
+{
+    if (reason == REJECT_INVALID)
+        return "invalid";
+    return amfi_msg_reason_name(reason);
+}
+
+static const char *channel_of(const daemon_s *d, int input)
+{
+    switch (input) {
+    case REJECT_ACCEL: return d->cfg.daemon.ch_accel;
+    case REJECT_VEHICLE: return d->cfg.daemon.ch_vehicle;
+    default: return d->cfg.daemon.ch_truth;
+    }
+}
+
+/* One line: what was held back since the period began (nothing if none). */
+static void summarise(daemon_s *d, double now)
+{
+    reject_state *r = &d->rej;
+    if (r->held > 0) {
+        char line[1024];
+        size_t n = (size_t)snprintf(line, sizeof line,
+                                    "%lld more refused messages not logged in the last %.0f s:",
+                                    (long long)r->held, now - r->period_start);
+        for (int i = 0; i < REJECT_NINPUTS; i++)
+            for (int k = 0; k < REJECT_NREASONS; k++)
+                if (r->held_by[i][k] > 0 && n < sizeof line)
+                    n += (size_t)snprintf(line + n, sizeof line - n, " %s/%s %lld",
+                                          channel_of(d, i), reject_reason_name(k),
+                                          (long long)r->held_by[i][k]);
+        LOG_WARN("%s (totals since start: amfid's status message and log at stop)", line);
+    }
+    r->held = 0;
+    memset(r->held_by, 0, sizeof r->held_by);
+    r->logged = 0;
+    r->period_start = now;
+}
+
+void reject_note(daemon_s *d, int input, int reason, const char *fmt, ...)
+{
+    reject_state *r = &d->rej;
+    if (input < 0 || input >= REJECT_NINPUTS || reason < 0 || reason >= REJECT_NREASONS)
+        return;
+    r->count[input][reason]++;
+    r->total++;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(d->last_error, sizeof d->last_error, fmt, ap);
+    va_end(ap);
+    double now = amfid_mono_s();
+    if (now - r->period_start >= REJECT_LOG_PERIOD_S)
+        summarise(d, now);
+    if (r->logged < REJECT_LOG_BURST) {
+        r->logged++;
+        LOG_WARN("%s", d->last_error);
+        if (r->logged == REJECT_LOG_BURST)
+            LOG_WARN("further refused messages are counted and summarised once per %.0f s",
+                     REJECT_LOG_PERIOD_S);
+    } else {
+        r->held++;
+        r->held_by[input][reason]++;
+    }
+}
+
+void reject_tick(daemon_s *d)
+{
+    double now = amfid_mono_s();
+    if (now - d->rej.period_start >= REJECT_LOG_PERIOD_S)
+        summarise(d, now);
+}
+
+void reject_final(daemon_s *d)
+{
+    summarise(d, amfid_mono_s());
+    const reject_state *r = &d->rej;
+    for (int i = 0; i < REJECT_NINPUTS; i++)
+        for (int k = 0; k < REJECT_NREASONS; k++)
+            if (r->count[i][k] > 0)
+                LOG_INFO("refused since start: %s (%s) %s: %lld", channel_of(d, i),
+                         input_name[i], reject_reason_name(k), (long long)r->count[i][k]);
+}
