@@ -63,7 +63,8 @@ void amfid_parse_options(int argc, char **argv, amfid_options *o);
  * REJECT_INVALID, a message that decoded but failed amfid's validation. */
 enum { REJECT_ACCEL, REJECT_VEHICLE, REJECT_TRUTH, REJECT_NINPUTS };
 #define REJECT_INVALID AMFI_MSG_NREASONS
-#define REJECT_NREASONS (AMFI_MSG_NREASONS + 1)
+#define REJECT_QUARANTINE (AMFI_MSG_NREASONS + 1) /* an accel block far from the stream */
+#define REJECT_NREASONS (AMFI_MSG_NREASONS + 2)
 typedef struct reject_state {
     int64_t count[REJECT_NINPUTS][REJECT_NREASONS]; /* since start */
     int64_t total;

@@ -118,11 +118,36 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
     }
     if (!why) {
         const char *rwhy = NULL;
-        int rc = amfi_ring_put(d->rings[idx], m.utime, m.sample_rate_hz, m.n, m.accel, &rwhy);
-        if (rc == AMFI_RING_REJECT)
+        amfi_ring *r = d->rings[idx];
+        int rc = amfi_ring_put(r, m.utime, m.sample_rate_hz, m.n, m.accel, &rwhy);
+        if (rc == AMFI_RING_REJECT) {
             why = rwhy;
-        else if (m.utime > d->newest_utime)
-            d->newest_utime = m.utime;
+        } else if (rc == AMFI_RING_QUARANTINE) {
+            reject_note(d, REJECT_ACCEL, REJECT_QUARANTINE,
+                        "%s: accel_block_t sensor %d seq %lld quarantined: it starts %.3f s "
+                        "from the stream's newest sample; adopted only when %d blocks in a row "
+                        "confirm the jump",
+                        ch, m.sensor_id, (long long)m.seq,
+                        1e-6 * ((double)m.utime - amfi_ring_utime(r, amfi_ring_newest(r))),
+                        AMFI_RING_CONFIRM);
+        } else {
+            if (rc == AMFI_RING_RESTART)
+                LOG_WARN("%s: sensor %d: the data's time jumped by %+.3f s, confirmed by %d "
+                         "blocks in a row: the ring restarts at utime %lld; passages in the "
+                         "hole are stored as gap",
+                         ch, m.sensor_id, amfi_ring_stats_of(r)->last_jump_s, AMFI_RING_CONFIRM,
+                         (long long)m.utime);
+            /* the stream's time: the newest sample of any ring (it may go
+             * back after a confirmed jump) */
+            int64_t newest = 0;
+            for (int s = 0; s < d->cfg.solver.n_sensors; s++)
+                if (d->rings[s] && amfi_ring_newest(d->rings[s]) >= 0) {
+                    double u = amfi_ring_utime(d->rings[s], amfi_ring_newest(d->rings[s]));
+                    if (u > (double)newest)
+                        newest = (int64_t)u;
+                }
+            d->newest_utime = newest;
+        }
     }
     if (why) {
         d->blocks_rejected++;

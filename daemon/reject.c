@@ -25,6 +25,8 @@ const char *reject_reason_name(int reason)
 {
     if (reason == REJECT_INVALID)
         return "invalid";
+    if (reason == REJECT_QUARANTINE)
+        return "quarantined";
     return amfi_msg_reason_name(reason);
 }
 

@@ -14,6 +14,9 @@ struct amfi_ring {
     int64_t newest;     /* index of the newest sample, −1 before any */
     double *buf;        /* cap, sample k at buf[k mod cap]; NaN = missing */
     amfi_ring_stats st;
+    /* a jump under test: blocks far from the stream that continue each other */
+    int cand_count;     /* 0: none */
+    double cand_next;   /* µs where the next block of the candidate starts */
 };
 
 amfi_ring *amfi_ring_create(double rate_hz, double seconds)
@@ -48,6 +51,7 @@ double amfi_ring_rate(const amfi_ring *r) { return r->rate; }
 int amfi_ring_started(const amfi_ring *r) { return r->started; }
 int64_t amfi_ring_newest(const amfi_ring *r) { return r->newest; }
 const amfi_ring_stats *amfi_ring_stats_of(const amfi_ring *r) { return &r->st; }
+int amfi_ring_jump_pending(const amfi_ring *r) { return r->cand_count > 0; }
 
 int64_t amfi_ring_oldest(const amfi_ring *r)
 {
@@ -92,15 +96,41 @@ int amfi_ring_put(amfi_ring *r, int64_t utime, double rate_hz, int n, const doub
         r->origin = utime;
         r->started = 1;
     }
+    int restarted = 0;
     double exact = (double)(utime - r->origin) * r->rate * 1e-6;
+    /* Far from the stream: more than AMFI_RING_FAR_S (or the ring's length,
+     * if longer) past either end of what the ring holds? */
+    const double far = fmax((double)r->cap, AMFI_RING_FAR_S * r->rate);
+    if (r->newest >= 0 && (exact - (double)r->newest > far ||
+                           exact + n - 1 < (double)amfi_ring_oldest(r) - far)) {
+        const double period_us = 1e6 / r->rate;
+        if (r->cand_count > 0 && fabs((double)utime - r->cand_next) <= 0.25 * period_us)
+            r->cand_count++;
+        else
+            r->cand_count = 1;
+        r->cand_next = (double)utime + n * period_us;
+        if (r->cand_count < AMFI_RING_CONFIRM) {
+            *why = "block far from the stream's time (quarantined until confirmed)";
+            r->st.quarantined++;
+            return AMFI_RING_QUARANTINE;
+        }
+        /* Confirmed: start over on the new time line at this block. */
+        r->st.last_jump_s = ((double)utime - amfi_ring_utime(r, r->newest + 1)) * 1e-6;
+        r->origin = utime;
+        r->newest = -1;
+        for (int64_t i = 0; i < r->cap; i++)
+            r->buf[i] = NAN;
+        r->st.restarts++;
+        r->st.restart_utime = utime;
+        r->cand_count = 0;
+        restarted = 1;
+        exact = 0.0;
+    } else {
+        r->cand_count = 0; /* the stream goes on: no jump */
+    }
     int64_t k0 = (int64_t)llround(exact);
     if (fabs(exact - (double)k0) > 0.25) {
         *why = "block start is off the sample grid";
-        r->st.rejected++;
-        return AMFI_RING_REJECT;
-    }
-    if (r->newest >= 0 && k0 - r->newest > (int64_t)(3600.0 * r->rate)) {
-        *why = "block starts more than an hour after the newest sample";
         r->st.rejected++;
         return AMFI_RING_REJECT;
     }
@@ -155,7 +185,7 @@ int amfi_ring_put(amfi_ring *r, int64_t utime, double rate_hz, int n, const doub
     if (k1 > r->newest)
         r->newest = k1;
     r->st.blocks++;
-    return AMFI_RING_OK;
+    return restarted ? AMFI_RING_RESTART : AMFI_RING_OK;
 }
 
 int amfi_ring_get(const amfi_ring *r, int64_t k0, int n, double *out)

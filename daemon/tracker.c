@@ -112,7 +112,8 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
     out->v = *v;
     out->status = "ok";
     /* Decide: all data present, data gone, or waited long enough. */
-    int complete = 1, gone = 0;
+    int complete = 1, gone = 0, jumping = 0;
+    int64_t restart_utime = 0;
     double newest_us = -INFINITY;
     int n = -1;
     for (int s = 0; s < ns; s++) {
@@ -131,11 +132,23 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
             complete = 0;
         if (k0 < amfi_ring_oldest(r))
             gone = 1;
+        jumping |= amfi_ring_jump_pending(r);
+        const amfi_ring_stats *st = amfi_ring_stats_of(r);
+        if (st->restarts > 0 && st->restart_utime > restart_utime)
+            restart_utime = st->restart_utime;
     }
+    if (jumping && (gone || !complete) && !flush)
+        return 0; /* a jump of the data's time is under test: decide after it */
     out->n = n > 0 ? n : 0;
     if (!complete && !gone && !flush && !(newest_us > t1 + 1e6 * t->p.max_wait_s))
         return 0; /* keep waiting */
-    if (gone) {
+    if (gone && restart_utime > 0 && t0 < (double)restart_utime) {
+        out->status = "gap";
+        snprintf(out->reason, sizeof out->reason,
+                 "no data for this passage: the sensor stream jumped or resumed after an "
+                 "outage (ring restarted %.3f s after the window's start)",
+                 1e-6 * ((double)restart_utime - t0));
+    } else if (gone) {
         out->status = "late";
         snprintf(out->reason, sizeof out->reason,
                  "the data for this passage had left the ring (window starts %.3f s before "

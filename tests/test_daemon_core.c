@@ -67,8 +67,11 @@ static void ring_rejects_and_late(void **state)
     assert_non_null(strstr(why, "rate"));
     assert_int_equal(amfi_ring_put(r, T0 + 100400, RATE, 100, x, &why), AMFI_RING_REJECT);
     assert_non_null(strstr(why, "grid"));
+    /* one block two hours ahead is quarantined, not adopted (issue 9: it used
+     * to be refused, and after a real outage every later block with it) */
     assert_int_equal(amfi_ring_put(r, T0 + 7200000000LL, RATE, 100, x, &why),
-                     AMFI_RING_REJECT);
+                     AMFI_RING_QUARANTINE);
+    assert_int_equal(amfi_ring_newest(r), 99);
     /* run 10 s ahead; the first block is now older than the ring */
     for (int k = 1; k <= 100; k++)
         assert_int_equal(amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL),
@@ -98,6 +101,95 @@ static amfi_vehicle_ev vehicle(int64_t id, double entry_s)
     v.n_axles = 2;
     v.spacing_m[0] = 5.0;
     return v;
+}
+
+/* A single block dated far ahead never moves the stream's time; the stream
+ * goes on and the candidate is dropped. */
+static void ring_one_wrong_time_is_ignored(void **state)
+{
+    (void)state;
+    amfi_ring *r = amfi_ring_create(RATE, 5.0);
+    double x[100];
+    block(x, 100, 1.0);
+    for (int k = 0; k < 10; k++)
+        assert_int_equal(amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL), AMFI_RING_OK);
+    const int64_t far[] = {T0 + 3600000000LL, (int64_t)253402300799000000LL, INT64_MAX / 2};
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(amfi_ring_put(r, far[i], RATE, 100, x, NULL), AMFI_RING_QUARANTINE);
+        assert_int_equal(amfi_ring_put(r, T0 + (10 + i) * 100000LL, RATE, 100, x, NULL),
+                         AMFI_RING_OK);
+        assert_int_equal(amfi_ring_jump_pending(r), 0);
+    }
+    assert_int_equal(amfi_ring_newest(r), 1299);
+    assert_int_equal(amfi_ring_stats_of(r)->quarantined, 3);
+    assert_int_equal(amfi_ring_stats_of(r)->restarts, 0);
+    amfi_ring_destroy(r);
+}
+
+/* An outage of two hours, then the stream resumes: confirmed after
+ * AMFI_RING_CONFIRM blocks, the ring restarts and holds the new data. */
+static void ring_outage_then_resume(void **state)
+{
+    (void)state;
+    amfi_ring *r = amfi_ring_create(RATE, 5.0);
+    double x[100], out[100];
+    block(x, 100, 2.0);
+    for (int k = 0; k < 10; k++)
+        amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL);
+    const int64_t T1 = T0 + 7200000000LL;
+    for (int k = 0; k < AMFI_RING_CONFIRM - 1; k++) {
+        assert_int_equal(amfi_ring_put(r, T1 + k * 100000LL, RATE, 100, x, NULL),
+                         AMFI_RING_QUARANTINE);
+        assert_int_equal(amfi_ring_jump_pending(r), 1);
+    }
+    assert_int_equal(amfi_ring_put(r, T1 + (AMFI_RING_CONFIRM - 1) * 100000LL, RATE, 100, x, NULL),
+                     AMFI_RING_RESTART);
+    const amfi_ring_stats *st = amfi_ring_stats_of(r);
+    assert_int_equal(st->restarts, 1);
+    assert_int_equal(st->restart_utime, T1 + (AMFI_RING_CONFIRM - 1) * 100000LL);
+    assert_true(fabs(st->last_jump_s - (7200.0 + 0.1 * (AMFI_RING_CONFIRM - 1) - 1.0)) < 1e-6);
+    /* the stream goes on after the restart */
+    assert_int_equal(amfi_ring_put(r, T1 + AMFI_RING_CONFIRM * 100000LL, RATE, 100, x, NULL),
+                     AMFI_RING_OK);
+    int64_t k = amfi_ring_index(r, T1 + AMFI_RING_CONFIRM * 100000LL);
+    assert_int_equal(amfi_ring_get(r, k, 100, out), 0);
+    assert_true(out[0] == 2.0);
+    amfi_ring_destroy(r);
+}
+
+/* A poisoned first block (an hour ahead of the real stream): the real blocks
+ * confirm the jump back, and a vehicle of the real stream is weighed, not
+ * stored late (issue 9). While the jump is under test, the tracker waits. */
+static void tracker_after_poisoned_first_block(void **state)
+{
+    (void)state;
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1};
+    amfi_tracker *t = amfi_tracker_create(&p);
+    amfi_ring *r = amfi_ring_create(RATE, 60.0);
+    amfi_ring *rings[1] = {r};
+    double x[100];
+    block(x, 100, 0.5);
+    assert_int_equal(amfi_ring_put(r, T0 + 3600000000LL, RATE, 100, x, NULL), AMFI_RING_OK);
+    amfi_vehicle_ev a = vehicle(1, 0.5);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
+    amfi_window w;
+    assert_int_equal(amfi_ring_put(r, T0, RATE, 100, x, NULL), AMFI_RING_QUARANTINE);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0); /* waits: a jump under test */
+    for (int k = 1; k < 30; k++)
+        assert_true(amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL) >= 0);
+    assert_int_equal(amfi_ring_stats_of(r)->restarts, 1);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    /* its window begins 0.15 s after T0: the restart at T0 + 0.2 s leaves a
+     * gap at its start, stored as such with the reason */
+    assert_string_equal(w.status, "gap");
+    assert_non_null(strstr(w.reason, "stream jumped"));
+    /* a vehicle after the restart is ok */
+    amfi_vehicle_ev b = vehicle(2, 1.8);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "ok");
+    amfi_ring_destroy(r);
+    amfi_tracker_destroy(t);
 }
 
 static void tracker_windows(void **state)
@@ -213,6 +305,9 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(ring_in_order_and_gaps),
         cmocka_unit_test(ring_rejects_and_late),
+        cmocka_unit_test(ring_one_wrong_time_is_ignored),
+        cmocka_unit_test(ring_outage_then_resume),
+        cmocka_unit_test(tracker_after_poisoned_first_block),
         cmocka_unit_test(tracker_windows),
         cmocka_unit_test(tracker_multiple_and_late),
     };
