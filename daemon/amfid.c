@@ -202,6 +202,8 @@ static int run(daemon_s *d)
         }
         release_windows(d, 0);
         pipeline_drain_results(d);
+        if (d->held_n > 0)
+            pipeline_retry(d, 0);
         if (reload_flag) {
             reload_flag = 0;
             reload(d);
@@ -222,12 +224,18 @@ static int run(daemon_s *d)
     release_windows(d, 1);
     pool_join(&d->pool);
     pipeline_drain_results(d);
+    if (d->held_n > 0) { /* the store still refuses: keep trying a while */
+        LOG_WARN("store: %d passages held at shutdown; retrying for up to 20 s", d->held_n);
+        pipeline_retry(d, 20.0);
+    }
     heartbeat(d);
     reject_final(d);
-    LOG_INFO("stopped: %lld passages stored (%lld ok), %lld blocks, %lld vehicles, %lld "
-             "rejected messages",
+    if (d->passages_lost > 0)
+        rc = 1; /* acknowledged passages are safe; these never were */
+    LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld blocks, "
+             "%lld vehicles, %lld rejected messages",
              (long long)d->passages_stored, (long long)d->passages_ok,
-             (long long)d->blocks_received, (long long)d->vehicles_received,
+             (long long)d->passages_lost, (long long)d->blocks_received, (long long)d->vehicles_received,
              (long long)(d->blocks_rejected + d->vehicles_rejected + d->messages_malformed));
     return rc;
 }
@@ -235,6 +243,12 @@ static int run(daemon_s *d)
 /* The one tear-down: whatever start_* built, in reverse; NULL-safe. */
 static void stop(daemon_s *d)
 {
+    for (; d->held && d->held_n > 0; d->held_n--) { /* only left on an early error */
+        job_free(d->held[d->held_head]);
+        d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;
+    }
+    free(d->held);
+    d->held = NULL;
     pool_stop(&d->pool);
     if (d->lcm)
         lcm_destroy(d->lcm);

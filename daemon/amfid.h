@@ -94,6 +94,13 @@ typedef struct daemon_s {
     int64_t messages_malformed, passages_stored, passages_ok, truth_received;
     int64_t newest_utime;
     reject_state rej;
+    /* passages the store could not take (disk full, I/O error, read-only):
+     * held in order and retried (pipeline.c); nothing acknowledged is lost */
+    job **held;
+    int held_n, held_head, held_peak;
+    int64_t passages_lost;         /* held queue overflowed (each logged) */
+    double retry_at, retry_wait;   /* amfid_mono_s() of the next try; backoff */
+    int degraded;
     char last_error[256];
     const char *state;
 } daemon_s;
@@ -122,10 +129,16 @@ void release_windows(daemon_s *d, int flush);
 
 /* Park a finished job by seq; store, feed and publish every consecutive one. */
 int pipeline_complete(daemon_s *d, job *j);
-/* Store a job now, outside the entry order (invalid vehicles). */
+/* Store a job now, outside the entry order (invalid vehicles); takes the job
+ * (held, in order, if the store cannot write). */
 int pipeline_store_now(daemon_s *d, job *j);
 /* Read the eventfd and complete every result the solvers handed back. */
 void pipeline_drain_results(daemon_s *d);
+/* Retry the held passages when their time has come (the loop); with
+ * final != 0 (stopping) keep trying for up to final seconds. */
+void pipeline_retry(daemon_s *d, double final);
+/* The held-queue bound: passages kept while the store cannot write. */
+#define STORE_HOLD_MAX 20000
 
 /* ---- configuration, state, heartbeat, reload (control.c), main thread ----- */
 

@@ -184,8 +184,7 @@ static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
     snprintf(j->reason, sizeof j->reason, "%.120s (speed_mps %.6g, n_axles %d, utime %lld)",
              why, m->speed_mps, m->n_axles, (long long)m->utime);
     /* outside the entry order: stored now */
-    pipeline_store_now(d, j);
-    job_free(j);
+    pipeline_store_now(d, j); /* takes the job */
 }
 
 static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)

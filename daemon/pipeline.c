@@ -5,8 +5,17 @@
  * to the indicator engine, whose baselines, indicators and alerts are
  * stored and published too.
  *
+ * A passage is acknowledged when its transaction has committed; only then
+ * is it published and fed to the indicators. When the store cannot write
+ * (disk full, I/O error, read-only, locked) the passage is held, in order,
+ * in a bounded queue (STORE_HOLD_MAX) and retried with a backoff (1 s
+ * doubling to 30 s); amfid is then degraded (status message state,
+ * sd_notify STATUS, a `store_degraded` alert on the bus and in the log,
+ * cleared when the queue has drained). What overflows the queue is counted
+ * and each such vehicle logged with its id and time.
+ *
  * Thread: the main thread only. Owns the reorder buffer (d->pending), the
- * store handle's writes and the indicator engine; it takes jobs back from
+ * held queue, the store handle's writes and the indicator engine; it takes jobs back from
  * the solver pool's result queue (pool.h), after which they are its own.
  */
 #include <errno.h>
@@ -14,6 +23,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "amfi_alert_t.h"
@@ -95,7 +105,7 @@ static void feed_indicators(daemon_s *d, const job *j)
     }
 }
 
-static int store_job(daemon_s *d, job *j)
+static int store_now(daemon_s *d, job *j)
 {
     amfi_passage_row r;
     memset(&r, 0, sizeof r);
@@ -130,6 +140,126 @@ static int store_job(daemon_s *d, job *j)
     return 0;
 }
 
+static void publish_store_alert(daemon_s *d, int raised, const char *msg)
+{
+    amfi_alert_t m = {d->newest_utime, 0, (char *)"warning", (char *)"store_degraded",
+                      (char *)msg, 0, (int8_t)raised};
+    amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
+    if (raised)
+        LOG_ERR("ALERT store_degraded (warning): %s", msg);
+    else
+        LOG_INFO("alert cleared store_degraded: %s", msg);
+}
+
+static void set_degraded(daemon_s *d, int on)
+{
+    char msg[1200];
+    if (on && !d->degraded) {
+        d->degraded = 1;
+        d->state = "degraded";
+        snprintf(msg, sizeof msg,
+                 "the store %.300s cannot be written (%.300s); passages are held in memory (up to %d) "
+                 "and retried",
+                 d->cfg.daemon.db_path, d->last_error, STORE_HOLD_MAX);
+        publish_store_alert(d, 1, msg);
+        sd_notifyf(0, "STATUS=degraded: store cannot be written, %d passages held", d->held_n);
+    } else if (!on && d->degraded) {
+        d->degraded = 0;
+        if (strcmp(d->state, "degraded") == 0)
+            d->state = "running";
+        snprintf(msg, sizeof msg,
+                 "the store %.300s takes writes again; every held passage is stored (%d at most "
+                 "were held, %lld lost to overflow)",
+                 d->cfg.daemon.db_path, d->held_peak, (long long)d->passages_lost);
+        publish_store_alert(d, 0, msg);
+    }
+}
+
+/* Hold a passage the store refused, in order (the job keeps only what the
+ * row needs: its samples are freed). */
+static void hold(daemon_s *d, job *j)
+{
+    if (!d->held) {
+        d->held = calloc(STORE_HOLD_MAX, sizeof *d->held);
+        d->held_n = d->held_head = 0;
+    }
+    if (!d->held || d->held_n >= STORE_HOLD_MAX) {
+        d->passages_lost++;
+        LOG_ERR("store: passage of vehicle %lld at utime %lld LOST: the held queue is full "
+                "(%d passages; %lld lost in all)",
+                (long long)j->w.v.vehicle_id, (long long)j->w.v.utime, STORE_HOLD_MAX,
+                (long long)d->passages_lost);
+        job_free(j);
+        return;
+    }
+    free(j->accel);
+    j->accel = NULL;
+    d->held[(d->held_head + d->held_n) % STORE_HOLD_MAX] = j;
+    d->held_n++;
+    if (d->held_n > d->held_peak)
+        d->held_peak = d->held_n;
+    if (!d->degraded) {
+        d->retry_wait = 1.0;
+        d->retry_at = amfid_mono_s() + d->retry_wait;
+    }
+    set_degraded(d, 1);
+}
+
+/* Store in order: behind any held passage, or now. Takes the job. */
+static int store_job(daemon_s *d, job *j)
+{
+    if (d->held_n > 0 || store_now(d, j) != 0) {
+        hold(d, j);
+        return -1;
+    }
+    job_free(j);
+    return 0;
+}
+
+void pipeline_retry(daemon_s *d, double final)
+{
+    double until = amfid_mono_s() + final;
+    while (d->held_n > 0) {
+        double now = amfid_mono_s();
+        if (now < d->retry_at) {
+            if (final <= 0 || now >= until)
+                return;
+            double w = fmin(d->retry_at - now, until - now);
+            struct timespec ts = {(time_t)w, (long)(1e9 * (w - floor(w)))};
+            nanosleep(&ts, NULL);
+            continue;
+        }
+        while (d->held_n > 0 && store_now(d, d->held[d->held_head]) == 0) {
+            job_free(d->held[d->held_head]);
+            d->held[d->held_head] = NULL;
+            d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;
+            d->held_n--;
+        }
+        if (d->held_n == 0) {
+            LOG_INFO("store: the held passages are stored (peak %d)", d->held_peak);
+            set_degraded(d, 0);
+            return;
+        }
+        d->retry_wait = fmin(2.0 * d->retry_wait, 30.0);
+        d->retry_at = amfid_mono_s() + d->retry_wait;
+        sd_notifyf(0, "STATUS=degraded: store cannot be written, %d passages held", d->held_n);
+        if (final <= 0 || amfid_mono_s() >= until) {
+            if (final > 0)
+                break;
+            return;
+        }
+    }
+    for (; d->held_n > 0; d->held_n--) { /* stopping, and the store still refuses */
+        job *j = d->held[d->held_head];
+        LOG_ERR("store: passage of vehicle %lld at utime %lld NOT STORED: the store still "
+                "refuses writes at shutdown (%s)",
+                (long long)j->w.v.vehicle_id, (long long)j->w.v.utime, d->last_error);
+        d->passages_lost++;
+        job_free(j);
+        d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;
+    }
+}
+
 /* Park a finished job by seq; store every consecutive one from next_seq.
  * The parking ring grows when the solvers fall far behind (windows that
  * bypass them keep arriving): a passage is never dropped for lack of room. */
@@ -144,9 +274,7 @@ int pipeline_complete(daemon_s *d, job *j)
         if (!np) { /* out of memory: store it now, out of order, rather than lose it */
             set_error(d, "out of memory for the reorder buffer: passage %lld stored out of order",
                       (long long)seq);
-            int rc = store_job(d, j);
-            job_free(j);
-            return rc;
+            return store_job(d, j);
         }
         for (int i = 0; i < d->pend_cap; i++)
             if (d->pending[i])
@@ -163,7 +291,6 @@ int pipeline_complete(daemon_s *d, job *j)
         d->pending[d->next_seq % d->pend_cap] = NULL;
         if (store_job(d, k))
             rc = -1;
-        job_free(k);
         d->next_seq++;
     }
     return rc;
