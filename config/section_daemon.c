@@ -62,6 +62,8 @@ const field daemon_fields[] = {
     {.key = "store", .kind = &K_MAP, .aux = store_fields},
     {.key = "workers", .kind = &K_INT, .off = DC(workers), .lo = 1, .hi = 64},
     {.key = "queue_size", .kind = &K_INT, .off = DC(queue_size), .lo = 1, .hi = 100000},
+    {.key = "recv_buf_bytes", .kind = &K_INT, .off = DC(recv_buf_bytes), .lo = 0,
+     .hi = 1073741824},
     {.key = "ring_s", .kind = &K_DOUBLE, .off = DC(ring_s), .lo = 5, .hi = 3600},
     {.key = "window_margin_s", .kind = &K_DOUBLE, .off = DC(margin_s), .lo = 0, .hi = 5},
     {.key = "max_wait_s", .kind = &K_DOUBLE, .off = DC(max_wait_s), .lo = 0, .hi = 3600,

@@ -147,9 +147,11 @@ static int start_runtime(daemon_s *d)
         LOG_ERR("out of memory at start-up");
         return 1;
     }
-    d->lcm = lcm_create(d->cfg.daemon.lcm_url[0] ? d->cfg.daemon.lcm_url : NULL);
+    char url[512];
+    bus_url(&d->cfg.daemon, url, sizeof url);
+    d->lcm = lcm_create(url);
     if (!d->lcm) {
-        LOG_ERR("cannot open the LCM bus '%s'", d->cfg.daemon.lcm_url);
+        LOG_ERR("cannot open the LCM bus '%s'", url);
         return 1;
     }
     intake_subscribe(d);

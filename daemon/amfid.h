@@ -93,6 +93,7 @@ typedef struct daemon_s {
     int64_t blocks_received, blocks_rejected, vehicles_received, vehicles_rejected;
     int64_t messages_malformed, passages_stored, passages_ok, truth_received;
     int64_t newest_utime;
+    int64_t udp_drops, udp_drops_logged; /* kernel drops on our sockets */
     reject_state rej;
     /* passages the store could not take (disk full, I/O error, read-only):
      * held in order and retried (pipeline.c); nothing acknowledged is lost */
@@ -106,6 +107,14 @@ typedef struct daemon_s {
 } daemon_s;
 
 void set_error(daemon_s *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* ---- the bus (bus.c), main thread ----------------------------------------- */
+
+/* The URL amfid opens: the configured one (or LCM's default) with
+ * recv_buf_size for a udpm:// bus; warns when the kernel caps it lower. */
+void bus_url(const amfi_daemon_config *dc, char *url, size_t n);
+/* UDP datagrams the kernel dropped on this process's sockets, or -1. */
+int64_t bus_udp_drops(void);
 
 /* ---- refused messages (reject.c), main thread ----------------------------- */
 

@@ -102,6 +102,19 @@ void heartbeat(daemon_s *d)
     m.passages_stored = d->passages_stored;
     m.passages_ok = d->passages_ok;
     m.queue_depth = queue_depth(&d->pool.jobs);
+    int64_t drops = bus_udp_drops();
+    if (drops > d->udp_drops)
+        d->udp_drops = drops;
+    if (d->udp_drops > d->udp_drops_logged) {
+        LOG_WARN("the kernel dropped %lld UDP datagrams on amfid's sockets since start (%lld "
+                 "new): the receive buffer overflowed; raise daemon.recv_buf_bytes and "
+                 "net.core.rmem_max, or add solver threads",
+                 (long long)d->udp_drops, (long long)(d->udp_drops - d->udp_drops_logged));
+        d->udp_drops_logged = d->udp_drops;
+    }
+    m.messages_refused = d->rej.total;
+    m.datagrams_dropped = d->udp_drops;
+    m.passages_held = d->held_n;
     m.state = (char *)d->state;
     m.last_error = d->last_error;
     amfi_status_t_publish(d->lcm, d->cfg.daemon.ch_status, &m);

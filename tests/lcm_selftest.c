@@ -168,6 +168,9 @@ static void round_make(struct round *r, int i)
     r->status.passages_stored = i + 1;
     r->status.passages_ok = i;
     r->status.queue_depth = i % 3;
+    r->status.messages_refused = 2 * i;
+    r->status.datagrams_dropped = i / 2;
+    r->status.passages_held = i % 4;
     r->status.state = "running";
     r->status.last_error = i % 5 == 4 ? "AMFI_VEHICLE: lane 7 not in the site configuration" : "";
 }
@@ -286,6 +289,9 @@ static void print_round(const struct round *r)
     put_i("passages_stored", s->passages_stored, ";");
     put_i("passages_ok", s->passages_ok, ";");
     put_i("queue_depth", s->queue_depth, ";");
+    put_i("messages_refused", s->messages_refused, ";");
+    put_i("datagrams_dropped", s->datagrams_dropped, ";");
+    put_i("passages_held", s->passages_held, ";");
     put_s("state", s->state, ";");
     put_s("last_error", s->last_error, "\n");
 }
@@ -458,6 +464,9 @@ static int same_status(const char *c, const amfi_status_t *a, const amfi_status_
            same_i(c, "passages_stored", a->passages_stored, b->passages_stored) +
            same_i(c, "passages_ok", a->passages_ok, b->passages_ok) +
            same_i(c, "queue_depth", a->queue_depth, b->queue_depth) +
+           same_i(c, "messages_refused", a->messages_refused, b->messages_refused) +
+           same_i(c, "datagrams_dropped", a->datagrams_dropped, b->datagrams_dropped) +
+           same_i(c, "passages_held", a->passages_held, b->passages_held) +
            same_s(c, "state", a->state, b->state) +
            same_s(c, "last_error", a->last_error, b->last_error);
 }

@@ -180,7 +180,8 @@ static enc random_message(amfi_msg_type t, int big)
     case AMFI_MSG_STATUS_T: {
         amfi_status_t m = {(int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(),
                            (int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(),
-                           (int64_t)rnd(), (int32_t)rnd(), NULL, NULL};
+                           (int64_t)rnd(), (int32_t)rnd(), (int64_t)rnd(), (int64_t)rnd(),
+                           (int32_t)rnd(), NULL, NULL};
         m.state = rnd_string(AMFI_MSG_MAX_STATUS_STATE);
         m.last_error = rnd_string(AMFI_MSG_MAX_STATUS_LAST_ERROR);
         ENCODE(status_t, m);
