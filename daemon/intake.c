@@ -260,7 +260,8 @@ static void on_truth(const lcm_recv_buf_t *rb, const char *ch, void *user)
                     (long long)m.vehicle_id);
     else if (amfi_store_add_truth(d->store, m.vehicle_id, m.utime, m.gvw_kg, m.n_axles,
                                   m.axle_kg, m.mean_force_N, m.speed_true_mps, err, sizeof err))
-        set_error(d, "%s: truth_t %lld: %s", ch, (long long)m.vehicle_id, err);
+        reject_note(d, REJECT_TRUTH, REJECT_INVALID, "%s: truth_t %lld: %s", ch,
+                    (long long)m.vehicle_id, err);
     else
         d->truth_received++;
     amfi_truth_t_decode_cleanup(&m);
