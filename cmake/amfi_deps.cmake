@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Every library and program the build needs, found in one place. A missing one
 # stops the configure step with the Debian package that provides it
 # (scripts/install-deps.sh installs them all).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # cpack -G DEB: the amfi .deb (scripts/package.sh builds it from a tree
 # configured with -DCMAKE_INSTALL_PREFIX=/usr, so that the compiled-in paths,
 # the unit and the package's files agree). Runtime dependencies come from

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_cli.c: getopt_long-based command-line parsing for every amfi
  * program (see amfi_cli.h). Runs on the main thread before anything else.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_cli.h: command-line parsing shared by every amfi program, on
  * getopt_long: long and short options, "--opt=value" and "--opt value",

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_csv.c: the CSV line reader (see amfi_csv.h).
  *

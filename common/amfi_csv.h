@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_csv.h: the one CSV line reader of amfi (passage files, WIM traffic
  * lists, per-vehicle results), plain or gzip, with errors as one line

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_datafile.c: the data-file lookup (see amfi_datafile.h).
  */

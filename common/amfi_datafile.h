@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_datafile.h: where the programs find their shipped data files
  * (paper-20m.yaml, sim_publisher.yaml, population.csv) when none is named on

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_json.c: JSON output helpers on libjansson (see amfi_json.h).
  */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_json.h: the programs' JSON output through libjansson: one object per
  * line, keys in insertion order, numbers with 10 significant digits, NaN

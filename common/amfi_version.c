@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_version.c: amfi_version() from the header common/version.cmake
  * generates at build time.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_version.h: the one version string of every amfi program: the CMake
  * project version, plus "+" and `git describe --always --dirty` when the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # version.cmake (cmake -P): writes OUT from TEMPLATE with AMFI_VERSION_STRING
 # = VERSION, plus "+DESCRIBE" (git describe --always --dirty) when SRC is a
 # git checkout and git is installed. Rewrites OUT only when it changes.

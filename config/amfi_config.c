@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_config.c: YAML site file -> amfi_site_config, validated, with
  * "FILE:LINE: key.path: problem" errors (amfi_config.h). This file only puts

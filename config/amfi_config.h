@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_config.h: a bridge site's configuration, loaded from YAML.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_config_keys.h: every key a site file may hold, as the loader itself
  * reads it, for the manual amfid.yaml(5) and its test (tests/test_config_man.c

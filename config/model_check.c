@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * model_check.c: the checks that need the model itself, run once the whole
  * site file is read and every key is valid on its own.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * section_bridge.c: the bridge: section of a site file (the finite-element
  * beam of libamfi's amfi_bridge_params): its keys, the supports list, and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * section_daemon.c: the daemon: section of a site file (amfid's bus, store,
  * threads, waits and damage indicators: amfi_daemon_config). The indicator

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * section_simulation.c: the simulation: section of a site file
  * (sim_publisher's amfi_sim_config; the daemon and the tools accept and

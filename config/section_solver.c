@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * section_solver.c: the sensors: and solver: sections of a site file (the
  * sensor list and the rest of libamfi's amfi_solver_params, and the λ

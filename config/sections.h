@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sections.h: the four sections of a site file (internal to config/), each
  * in its own file: its key tables for the walker (yaml_walk.h), its value

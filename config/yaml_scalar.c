@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * yaml_scalar.c: the strict scalar parsers of the site-file loader and the
  * generic kinds of value (yaml_walk.h): number, integer, name from a list,

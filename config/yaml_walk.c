@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * yaml_walk.c: the site file as a YAML document, walked by tables of keys
  * (see yaml_walk.h), and the "FILE:LINE: key.path: problem" messages.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * yaml_walk.h: the generic half of the site-file loader (internal to
  * config/): a YAML document walked by tables of keys, strict scalar parsers,

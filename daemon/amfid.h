@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfid.h: the daemon's state and the functions its files share (amfid's
  * own header; nothing outside daemon/ includes it).

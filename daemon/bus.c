@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * bus.c: amfid's LCM bus: the URL it opens (for a udpm:// bus, LCM's
  * recv_buf_size option from daemon.recv_buf_bytes, checked against the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * control.c: amfid's configuration and control: loading the configuration,
  * the indicator parameters taken from it, the indicator state restored

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * intake.c: amfid's bus intake: the LCM handlers of accelerometer blocks,
  * vehicle events and (simulations) the truth, each message validated where

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * options.c: amfid's command line, on common/'s getopt_long helpers
  * (amfi_cli.h: long and short options, `--opt=value` and `--opt value`,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * pipeline.c: amfid's in-order pipeline: finished passages (solved or not)
  * parked by their release order and, in that order, stored (one

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * pool.c: amfid's solver pool (pool.h): the job queues and the solver
  * threads that weigh one passage each with A-MFI.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * pool.h: amfid's solver pool: the job a passage travels in, the bounded
  * queues between the threads, and the solver threads.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * reject.c: amfid's count of refused bus messages, per input channel and per
  * reason, and the rate limit on their log lines (issue: 40 000 bad messages

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ring.c: the per-sensor sample ring (see ring.h).
  */

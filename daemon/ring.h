@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ring.h: one sensor's recent samples, indexed by absolute sample number.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * tracker.c: passage windows from vehicle events and sample rings.
  */

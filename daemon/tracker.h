@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * tracker.h: cuts the sample stream into vehicle passages.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* fuzz_accel_csv.c: libFuzzer target for the passage CSV reader
  * (accel_csv_read_max, CMake target amfi_accel_csv): plain text and gzip,
  * detected from the content. The input goes through a temporary file; the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* fuzz_config.c: libFuzzer target for the YAML site loader
  * (config/amfi_config.c, amfi_config_load). The input is written to a
  * temporary file (the loader reads files only). Findings: any sanitizer

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* fuzz_file.c: the temporary input file of the path-based fuzz targets
  * (fuzz_file.h). Single-threaded. */
 #include "fuzz_file.h"

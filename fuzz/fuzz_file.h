@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* fuzz_file.h: for the libFuzzer targets whose reader takes a path
  * (fuzz_config, fuzz_accel_csv, fuzz_traffic): one temporary file per
  * process, rewritten with each input and removed at exit, and the check that

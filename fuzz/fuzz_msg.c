@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* fuzz_msg.c: libFuzzer target for one bus message type, compiled once per
  * type (fuzz/CMakeLists.txt: -DFUZZ_MSG=vehicle_t -DFUZZ_MSG_ENUM=
  * AMFI_MSG_VEHICLE_T gives fuzz_msg_vehicle_t): the raw-buffer check, lcm-gen's

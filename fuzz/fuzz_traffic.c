@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* fuzz_traffic.c: libFuzzer target for the WIM traffic reader of the
  * simulator (sim_publisher/traffic.c, amfi_traffic_read, CMake target
  * amfi_sim). The input goes through a temporary file. Findings: any

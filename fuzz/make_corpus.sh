@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # make_corpus.sh: (re)writes the committed seed corpora of the fuzz targets,
 # fuzz/corpus/NAME/, small valid and invalid examples (docs/fuzzing.md).
 #   sh fuzz/make_corpus.sh BUILD     BUILD: a configured and built tree (any

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # run.sh: the fuzz targets in the test suite (tests/CMakeLists.txt) and by hand
 # (docs/fuzzing.md).
 #   sh fuzz/run.sh build SRC DIR

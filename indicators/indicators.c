@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * indicators.c: the damage indicator engine of amfid (see indicators.h for
  * the rules and docs/indicators.md for the defaults and their simulation).

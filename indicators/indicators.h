@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * indicators.h: amfid's damage indicator engine. It watches the spread of
  * the inferred gross vehicle weights (GVW) of ok passages: the paper's

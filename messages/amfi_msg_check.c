@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* amfi_msg_check.c: the raw-buffer checker of the amfi bus messages
  * (amfi_msg_check.h). Walks an LCM buffer field by field with the tables
  * generated from messages/ *.lcm (amfi_msg_fields.c) before lcm-gen's

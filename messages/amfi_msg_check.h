@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* amfi_msg_check.h: check a raw LCM buffer against an amfi message type
  * before lcm-gen's _decode() runs on it (docs/messages.md, "Checking raw
  * buffers"). lcm-gen's decoder trusts the counts and string lengths: a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* amfi_msg_check_impl.h: internal to messages/: the per-type wire layout
  * tables that messages/gen_msg_check.cmake generates (amfi_msg_fields.c) and
  * messages/amfi_msg_check.c walks. Not for other folders. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* amfi_msg_limits.h: the limits of the amfi bus message types, in one place
  * (docs/messages.md, "Limits"). The raw-buffer checker (amfi_msg_check.h)
  * refuses a message whose count or string exceeds them before lcm-gen's

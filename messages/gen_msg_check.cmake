@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # gen_msg_check.cmake: generates the field tables of the raw-buffer checker
 # (amfi_msg_check.c) from the messages/*.lcm files, at build time, so that a
 # field added to a .lcm file cannot be forgotten by the checker.

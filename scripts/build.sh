@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Configure and build one tree. Usage: scripts/build.sh DIR [extra cmake args]
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Install the Debian packages amfi needs to build and test; a no-op when they
 # are all present. Run as root on Debian 12 (bookworm).
 set -euo pipefail

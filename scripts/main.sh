@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The main job: install what is missing, build, then on a private bus (a
 # network namespace of its own: nothing leaves this machine) amfid listens
 # while sim_publisher streams 500 vehicles, one every 2 s of data at 25 times

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Build the amfi .deb: a release tree configured for /usr (so the compiled-in
 # paths, the systemd unit and the package's files agree), then cpack -G DEB.
 # Usage: scripts/package.sh [BUILD_DIR]   (default build/deb); prints the .deb's path.

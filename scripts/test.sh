@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Install what is missing, build with AddressSanitizer + UndefinedBehaviorSanitizer
 # and warnings as errors, and run the whole test suite under ctest; then a
 # ThreadSanitizer tree of only what the daemon's thread test needs (amfid,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * passage.c: simulate and measure one passage (see passage.h).
  */

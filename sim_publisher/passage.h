@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * passage.h: one simulated and measured vehicle passage, the unit of the
  * paper's experiments and of sim_publisher's offline output.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * profile.c: ISO 8608 road profiles, single track or correlated carpet (see
  * profile.h for the model, the method and the references).

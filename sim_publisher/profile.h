@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * profile.h: random road profiles for the simulator (docs/simulator-inputs.md §1): ISO 8608
  * roughness classes, one track or a "carpet" of parallel, correlated tracks.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sim_publisher: simulated vehicles crossing the bridge, written as the
  * passages a site would record.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * traffic.c: WIM-style vehicle list reader (format and messages in
  * traffic.h).

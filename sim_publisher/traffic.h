@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * traffic.h: reader for a weigh-in-motion (WIM) style vehicle list, the
  * traffic the simulator drives over the bridge (docs/simulator-inputs.md).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * vbi.c: coupled vehicle-bridge time integration (see vbi.h).
  *

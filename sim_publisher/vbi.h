@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * vbi.h: vehicle-bridge interaction: half-car vehicles driving over a road
  * profile onto the FE bridge, the coupled system integrated in time.

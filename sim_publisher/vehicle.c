@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * vehicle.c: half-car parameters, the baseline vehicle and per-vehicle draws
  * from the paper's Table 2.

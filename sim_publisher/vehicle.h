@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * vehicle.h: the half-car vehicle of docs/simulator.md (paper §3.1, Table 2).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store.h: amfid's SQLite store of vehicle passages, truth (simulation),
  * indicators, alerts, the healthy baseline and small daemon state.

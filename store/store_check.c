@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_check.c: the checks every argument passes before anything is
  * written (numbers in their ranges or NaN, UTF-8 text without control

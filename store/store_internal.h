@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_internal.h: what the store's own files share (store_*.c), never
  * included outside store/: the handle's layout, the prepared statements,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_open.c: opening and closing a store: the file's identity, the
  * migrations (store_schema.c) applied in one IMMEDIATE transaction, the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_read.c: what amfid reads back at start-up (the baseline, the newest
  * ok GVWs, meta keys, whether an alert is open), the typed column readers

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_report.c: the queries of reports (amfi-report): counts, the passage
  * summary, the ok GVWs, the newest indicators and alerts, the alerts open

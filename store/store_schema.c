@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_schema.c: the store's schema as SQL, and the ordered list of
  * migrations that builds it from an empty file (store_open.c applies them).

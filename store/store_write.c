@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_write.c: the store's inserts (passages with their axles, truth,
  * indicators, alerts, baselines, meta, runs). Every argument is checked

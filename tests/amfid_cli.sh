@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # amfid_cli.sh: amfid's command line (getopt_long): --help and --version
 # exit 0 on stdout; long and short options, "--opt=value" and "--opt value",
 # "--" ending the options; every bad command line exits 2 with one line on

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # amfi-batch-power: a synthetic per-vehicle file whose inferred STD grows
 # exactly linearly with damage gives a monotonic trend with R² ~ 1 in every
 # trial with the same vehicles at every level; bad files give FILE:LINE and

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The damage alert end to end: the real sim_publisher and amfid on LCM's UDP
 # multicast inside a private network namespace (nothing leaves it). A
 # healthy bridge for the commissioning baseline and a healthy stretch after

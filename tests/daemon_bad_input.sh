@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # amfid on bad input from the bus (no network: an LCM log read through
 # file://): a duplicate, a truncated and an unknown-sensor accel block,
 # random bytes on each input channel, an invalid vehicle, two blocks out of

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Bus fuzzing of amfid (issue 9): real traffic with COUNT mutated messages
 # spread through it (tests/lcm_fuzzlog.c), replayed through file:// (no
 # network) or, with "live", played by lcm-logplayer on LCM's UDP multicast in

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # amfid's receive side (issue 9, finding 4), on LCM's UDP multicast inside a
 # private network namespace: (1) a receive buffer above the kernel's cap is
 # reported at start with the sysctl to set; (2) datagrams the kernel drops on

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # amfid end to end: the real sim_publisher and amfid on LCM's UDP multicast
 # inside a private network namespace (nothing leaves it), then the stored
 # rows: every vehicle a passage row, GVW against the truth, a SIGHUP reload

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # amfid on the hostile datagrams of issue 9 (an LCM log through file://, no
 # network): the 56-byte vehicle_t with a negative string length that crashed
 # amfid inside lcm-gen's decoder, negative array counts on accel, vehicle and

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # kill -9 of amfid at random moments while traffic streams (issue 9), on
 # LCM's UDP multicast inside a private network namespace: lcm-logplayer
 # plays a recorded stream, lcm-logger records every AMFI_PASSAGE amfid

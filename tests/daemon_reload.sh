@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # daemon_reload.sh: reload the configuration with a different λ while
 # passages are being solved. sim_publisher writes a log (no network); amfid
 # replays it through LCM's file:// provider as fast as its solver threads

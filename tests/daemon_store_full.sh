@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # amfid when its store cannot be written (issue 9, finding 5), in a private
 # mount namespace on a small tmpfs (nothing is mounted outside it):
 # (1) the disk fills while amfid writes (a log replayed at 4x through

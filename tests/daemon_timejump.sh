@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # amfid when the data's time jumps (issue 9, finding 2), through file:// logs:
 # (1) an accel block dated an hour ahead arrives first: the real stream
 #     confirms the jump back, and the real vehicles are weighed (they used to

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The amfi .deb (scripts/package.sh: a release tree for /usr, cpack -G DEB):
 # its dependencies are runtime packages (never -dev), its files are where a
 # Debian service puts them, the configuration is a conffile, and the packaged

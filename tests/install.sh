@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # cmake --install into a DESTDIR staging tree, then check what a site gets:
 # the programs, the configuration, the unit, sysusers/tmpfiles, the man pages,
 # the docs; the installed amfid validates the installed configuration; the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * json_check: reads one JSON document on stdin with libjansson and checks
  * that it parses and, for each KEY=VALUE argument, that the object's

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * lcm_fuzzlog: copy an LCM log of real traffic, adding COUNT mutated
  * messages spread evenly between its events: copies of earlier real

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * lcm_hostile: copy an LCM log, splicing in the hostile datagrams of issue 9
  * after the 50th AMFI_ACCEL event, for tests/daemon_hostile.sh:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * lcm_inject: copy an LCM log, splicing in the bad input a site's bus can
  * carry, for amfid's bad-input test (tests/daemon_bad_input.sh):

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * lcm_passages: print the passages an LCM log recorded on AMFI_PASSAGE, one
  * line each, "PASSAGE_ID VEHICLE_ID STATUS", for tests/daemon_kill9.sh (what

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* lcm_selftest: one of each amfi message (messages/ *.lcm) with plausible
  * values, for checking the generated C, the bus and lcm-spy.
  *

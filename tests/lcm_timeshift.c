@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * lcm_timeshift: copy an LCM log with the data's time made to jump, for
  * tests/daemon_timejump.sh (issue 9, finding 2):

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # libamfi_calls.sh: libamfi's files must not call each other in a circle.
 #
 # Reads the static library's members with nm: a member that leaves a symbol

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # man_pages.sh: a program's man page (scdoc source) lists every long option
 # its --help prints, and renders with scdoc and man -l without a warning.
 # Usage: man_pages.sh PROGRAM PAGE.scd

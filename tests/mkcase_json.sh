@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # mkcase_json.sh: amfi-mkcase prints its truth as JSON a parser accepts
 # whatever the output file is called (quotes, backslashes, control
 # characters); the file name comes back unchanged.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # no_source_tree.sh: no program knows the source tree it was built from. Its
 # --help (which lists where it looks for data files) and its read-only data
 # must not name a path inside SRC_DIR other than a source file (.c, .h: the

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # report_cli.sh: amfi-report on a fixture store. The fixture is built with
 # the sqlite3 program from the DDL in docs/schema.md (the same DDL the store
 # creates: test_store checks that), then filled with known rows; every mode

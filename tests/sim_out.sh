@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # sim_publisher's offline output: the files amfi-solve reads, meta.csv with
 # the truth, the same seed giving the same bytes, and the weights amfi-solve
 # infers from them close to the truth on the ideal defaults.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # solve_errors.sh: amfi-solve on bad input. Every case must fail cleanly:
 # exit status 1 (data) or 2 (usage), never a crash (status >= 128), exactly
 # one line on stderr, naming the file and line or the option at fault.

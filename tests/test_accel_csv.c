@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_accel_csv.c: the passage CSV reader (tools/accel_csv.c) on good
  * files, plain and gzip, and on every kind of bad input it must reject with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_config.c: unit tests of the YAML site loader (config/amfi_config.h).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_config_man.c: the manual amfid.yaml(5) against the loader. For every
  * key the loader reads (amfi_config_keys(): its own tables and defaults)

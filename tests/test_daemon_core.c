@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_daemon_core.c: the sample ring (gaps, duplicates, out-of-order and
  * late blocks) and the passage tracker (windows in data time, release

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_indicators.c: amfid's damage indicator engine (indicators/indicators.c):
  * parameter checks, the automatic and explicit baselines, prefill, the

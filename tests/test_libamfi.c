@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_libamfi.c: unit tests of the numerical core against analytical
  * results, slow reference paths and an independent forward integrator.

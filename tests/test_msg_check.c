@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* test_msg_check: the raw-buffer checker of the amfi bus messages
  * (messages/amfi_msg_check.h). Random valid messages of every type, encoded by
  * lcm-gen's encoder, are accepted and consume exactly their encoded size (a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_profile.c: road profiles (sim_publisher/profile.c) against ISO 8608
  * and the isotropic coherence model they document.

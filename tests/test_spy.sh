@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # amfi_spy: tools/ops/amfi-spy (lcm-spy with amfi_types.jar) starts headless under
 # Xvfb, finds the seven amfi types and decodes every AMFI_* channel that
 # lcm_selftest publishes on LCM's default UDP multicast URL.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_store.c: unit tests of amfid's SQLite store (store/store.h).
  *

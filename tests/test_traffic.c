@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_traffic.c: the WIM traffic reader (sim_publisher/traffic.c) on good
  * files and on every kind of bad input it must reject with a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_vbi.c: the vehicle-bridge interaction simulator against analytical
  * results and physical invariants (issue 3 §3).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * accel_csv.c: passage CSV reader (see accel_csv.h for the format), on the
  * common CSV line reader (common/amfi_csv.h), which cuts the lines, counts

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * accel_csv.h: reader for one recorded passage as CSV, plain or gzip.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * bridge.c: Euler-Bernoulli beam finite elements (docs/model.md §1).
  *

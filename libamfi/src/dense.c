@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * dense.c: the small dense linear-algebra helpers of the sweeps (dense.h):
  * an SPD inverse and a ridged SPD solve, both on LAPACK's Cholesky.

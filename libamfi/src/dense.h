@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * dense.h: the small dense linear-algebra helpers of the sweeps, on LAPACK.
  * Leaf of libamfi's call graph (internal.h): calls LAPACK only.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * discretise.c: zero-order-hold discretisation of the bridge (docs/model.md §3),
  * in modal coordinates (closed form per mode) and in nodal coordinates

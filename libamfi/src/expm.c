@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * expm.c: matrix exponential by scaling and squaring with Padé approximants.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * internal.h: helpers shared by libamfi's sources; not part of the API.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * lcurve.c: choice of λ by the L-curve (Hansen 1992; paper Figure 2).
  *

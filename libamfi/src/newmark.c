@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * newmark.c: bridge response to moving point forces, Newmark's average
  * acceleration method (γ = 1/2, β = 1/4; unconditionally stable, second

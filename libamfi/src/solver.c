@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * solver.c: the A-MFI solver's workspace, the passage window, the data at
  * the calculation rate, and the per-axle means (docs/model.md §6-§8). The top of

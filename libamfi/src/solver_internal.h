@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * solver_internal.h: the solver workspace shared by solver.c, the two sweeps
  * and the L-curve search. Dimensions use: n bridge DOFs, m modes kept,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * status.c: status strings, the error-message helper and the documented
  * default parameter sets. Leaf of libamfi's call graph.

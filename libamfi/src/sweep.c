@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sweep.c: the sweep dispatcher: one backward/forward sweep in the solver's
  * coordinates (modal or nodal). Called by solver.c and lcurve.c; calls only

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sweep_modal.c: the A-MFI backward/forward sweep in modal coordinates on
  * the reduced state z = [q₁, q₁', …, q_m, q_m', g₁ … g_na] (2m + na).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sweep_nodal.c: the reference A-MFI sweep, exactly as docs/model.md §4-§5 writes
  * the paper formulation: nodal coordinates, the full augmented state

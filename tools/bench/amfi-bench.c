@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi-bench: speed and memory of the A-MFI solver on the baseline passage.
  *

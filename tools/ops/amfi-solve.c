@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi-solve: offline A-MFI solve of one recorded passage.
  *

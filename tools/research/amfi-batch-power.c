@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi-batch-power: how often a batch experiment like the paper's Table 4
  * shows the STD trend, given the per-vehicle results amfi-paper measured.

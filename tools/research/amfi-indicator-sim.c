@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi-indicator-sim: Monte-Carlo false-alarm rate and detection delay of
  * amfid's damage indicator engine (daemon/indicators.c, used as is) on

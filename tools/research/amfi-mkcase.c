@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi-mkcase: write a synthetic passage CSV from known moving forces.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi-paper: the paper's experiments (§3.2 to §4.2), reproduced with the
  * project's simulator and solver and printed side by side with the paper's

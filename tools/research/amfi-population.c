@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi-population: write a SYNTHETIC two-axle truck population as a WIM-style
  * CSV (the format of sim_publisher/traffic.h) for the simulator.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi.h: the numerical core of amfi: acceleration-based moving force
  * identification (A-MFI) on a finite-element beam bridge.
