@@ -2,13 +2,16 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # make_corpus.sh: (re)writes the committed seed corpora of the fuzz targets,
 # fuzz/corpus/NAME/, small valid and invalid examples (docs/fuzzing.md).
-#   sh fuzz/make_corpus.sh BUILD     BUILD: a configured and built tree (any
-#                                    flavour) holding tests/test_msg_check
-# Deterministic: the same sources give the same files.
+#   sh fuzz/make_corpus.sh BUILD [OUT]
+#       BUILD: a configured and built tree (any flavour) holding
+#       tests/test_msg_check; OUT: where to write (default fuzz/corpus)
+# Deterministic: the same sources give the same files, so the fuzz_corpus
+# test can tell a committed corpus that a changed .lcm or config/*.yaml left
+# stale (a message seed with the old fingerprint seeds nothing).
 set -eu
 top=$(cd "$(dirname "$0")/.." && pwd)
-build=${1:?usage: make_corpus.sh BUILD}
-c=$top/fuzz/corpus
+build=${1:?usage: make_corpus.sh BUILD [OUT]}
+c=${2:-$top/fuzz/corpus}
 rm -rf "$c"
 mkdir -p "$c/config" "$c/accel_csv" "$c/traffic"
 
