@@ -308,6 +308,20 @@ int amfi_store_open_alerts(amfi_store *s, amfi_alert_rec **out, int *n,
 int amfi_store_gvw_errors(amfi_store *s, double **pct, size_t *n,
                           int64_t *n_other, char *err, size_t errlen);
 
+/* ---- passage listing (store_export.c) ------------------------------------ */
+
+/* Called once per passage; row->status and row->reason are valid during the
+   call only. A nonzero return stops the listing and is returned. */
+typedef int (*amfi_store_passage_fn)(void *ctx, int64_t id,
+                                     const amfi_passage_row *row);
+
+/* Every passage with from <= utime <= to (µs) and, when status is not NULL,
+   of that status (one of AMFI_STORE_STATUSES), oldest first (utime, id),
+   with its axle rows (spacing_m[k], axle_kg[k]; NaN where NULL). */
+int amfi_store_each_passage(amfi_store *s, int64_t from, int64_t to,
+                            const char *status, amfi_store_passage_fn fn,
+                            void *ctx, char *err, size_t errlen);
+
 /* ---- maintenance ------------------------------------------------------- */
 
 /* PRAGMA integrity_check, then PRAGMA foreign_key_check. `result` (len > 0)

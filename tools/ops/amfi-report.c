@@ -35,6 +35,8 @@
 #include <time.h>
 
 #include "amfi_cli.h"
+#include "amfi_config.h"
+#include "report_plot.h"
 #include "store.h"
 
 #define PROG "amfi-report"
@@ -52,6 +54,8 @@ typedef struct options {
     double mean_kg, std_kg;
     int n;
     const char *note;    /* NULL: empty */
+    const char *plot_dir;   /* --plot DIR, NULL: none */
+    const char *config;     /* --config FILE, NULL: none */
 } options;
 
 static const char *g_db = "?"; /* for messages */
@@ -74,6 +78,7 @@ static void usage(FILE *f)
             "[--errors]\n"
             "       [--set-baseline-last N | --set-baseline MEAN_KG,STD_KG,N] "
             "[--note TEXT] [--check]\n"
+            "       [--plot DIR] [--config FILE]\n"
             "\n"
             "Reports on amfid's SQLite store (schema: docs/schema.md).\n"
             "  -d, --db PATH                the store (must exist)\n"
@@ -92,6 +97,10 @@ static void usage(FILE *f)
             "(<= 127 bytes)\n"
             "  -k, --check                  PRAGMA integrity_check and "
             "foreign_key_check\n"
+            "  -p, --plot DIR               draw PNGs into DIR (gnuplot): GVW, "
+            "trend, histogram, per hour, speed\n"
+            "  -c, --config FILE            the site's amfid.yaml: alert "
+            "thresholds and site name\n"
             "  -h, --help                   this help\n"
             "  -V, --version                print the version\n"
             "With no option: --summary --trend --alerts.\n"
@@ -174,6 +183,8 @@ static int parse_args(int argc, char **argv, options *o)
         {"set-baseline", required_argument, NULL, 'b'},
         {"note", required_argument, NULL, 'n'},
         {"check", no_argument, NULL, 'k'},
+        {"plot", required_argument, NULL, 'p'},
+        {"config", required_argument, NULL, 'c'},
         AMFI_CLI_END};
     memset(o, 0, sizeof *o);
     amfi_cli c;
@@ -190,6 +201,12 @@ static int parse_args(int argc, char **argv, options *o)
             if (!*val)
                 return usage_error(opt, "empty value");
             o->db = val;
+            break;
+        case 'p':
+        case 'c':
+            if (!*val)
+                return usage_error(opt, "empty value");
+            *(k == 'p' ? &o->plot_dir : &o->config) = val;
             break;
         case 'B':
             if (parse_int(val, 2, MAX_BASELINE_N, &o->baseline_last) != 0)
@@ -216,7 +233,7 @@ static int parse_args(int argc, char **argv, options *o)
         return usage_error("--note", "only with --set-baseline-last or "
                            "--set-baseline");
     if (!o->summary && !o->trend && !o->alerts && !o->errors && !o->check
-        && !o->baseline_last && !o->baseline_given)
+        && !o->plot_dir && !o->baseline_last && !o->baseline_given)
         o->summary = o->trend = o->alerts = 1;
     return 0;
 }
@@ -577,6 +594,45 @@ static int run_section(int (*fn)(amfi_store *), amfi_store *s, int *printed)
     return rc;
 }
 
+/* --plot: site name from the store's meta (site.name), else the config's
+ * bridge.name, else the database's file name; thresholds from --config or
+ * the indicator defaults. */
+static int plot(const options *o, amfi_store *s)
+{
+    char site[256], err[1024];
+    int found = 0;
+    amfi_indicator_params ip;
+    amfi_indicator_params_default(&ip);
+    if (amfi_store_meta_get(s, "site.name", site, sizeof site, &found, err,
+                            sizeof err) != 0)
+        return data_error("%s", err);
+    if (o->config) {
+        amfi_site_config *c = malloc(sizeof *c);
+        if (!c)
+            return data_error("out of memory");
+        if (amfi_config_load(o->config, c, err, sizeof err) != 0) {
+            free(c);
+            fprintf(stderr, PROG ": --config: %s\n", err);
+            return -1;
+        }
+        ip = c->daemon.indicators;
+        if (!found) {
+            snprintf(site, sizeof site, "%s", c->name);
+            found = 1;
+        }
+        free(c);
+    }
+    if (!found) {
+        const char *b = strrchr(o->db, '/');
+        snprintf(site, sizeof site, "%s", b ? b + 1 : o->db);
+    }
+    if (report_plot(s, o->plot_dir, site, &ip, err, sizeof err) != 0) {
+        fprintf(stderr, PROG ": --plot: %s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     options o;
@@ -607,6 +663,12 @@ int main(int argc, char **argv)
         rc = run_section(section_alerts, s, &printed);
     if (rc == 0 && o.errors)
         rc = run_section(section_errors, s, &printed);
+    if (rc == 0 && o.plot_dir) {
+        if (printed)
+            printf("\n");
+        rc = plot(&o, s);
+        printed = 1;
+    }
     if (rc == 0 && o.check) {
         char result[1024];
         int st = amfi_store_integrity_check(s, result, sizeof result, err,
