@@ -268,5 +268,52 @@ rc=$?
 grep -q 'foreign key: a axles row refers to a missing passages row' "$tmp/out" || problem "stdout: $(cat "$tmp/out")"
 [ "$(wc -l < "$tmp/err")" -eq 1 ] || problem "stderr: $(cat "$tmp/err")"
 
+# ---- --plot DIR: five valid PNGs, one alert marker per alerts row -----------
+# png_ok FILE: PNG magic, IHDR width/height in [200, 4000], size in
+# [5 kB, 2 MB] (a blank or failed render is smaller, a runaway larger).
+png_ok() {
+    [ -f "$1" ] || { problem "$1: missing"; return; }
+    magic=$(od -An -tx1 -N8 "$1" | tr -d ' \n')
+    [ "$magic" = 89504e470d0a1a0a ] || problem "$1: not a PNG (magic $magic)"
+    ihdr=$(od -An -c -j12 -N4 "$1" | tr -d ' \n')
+    [ "$ihdr" = IHDR ] || problem "$1: no IHDR chunk first ($ihdr)"
+    w=$(od -An -tu1 -j16 -N4 "$1" | awk '{ print $1 * 16777216 + $2 * 65536 + $3 * 256 + $4 }')
+    h=$(od -An -tu1 -j20 -N4 "$1" | awk '{ print $1 * 16777216 + $2 * 65536 + $3 * 256 + $4 }')
+    { [ "$w" -ge 200 ] && [ "$w" -le 4000 ] && [ "$h" -ge 200 ] && [ "$h" -le 4000 ]; } ||
+        problem "$1: IHDR size ${w}x$h"
+    sz=$(wc -c < "$1")
+    { [ "$sz" -ge 5000 ] && [ "$sz" -le 2000000 ]; } || problem "$1: $sz bytes"
+}
+if command -v gnuplot > /dev/null; then
+    cp "$tmp/pristine.db" "$tmp/plot.db"
+    if ok plot --db "$tmp/plot.db" --plot "$tmp/plots"; then
+        for p in gvw trend gvw_histogram passages_per_hour speed; do
+            png_ok "$tmp/plots/$p.png"
+            has "^plot  $tmp/plots/$p\\.png  "
+        done
+        # the markers drawn on trend.png are the rows of alerts.dat, which
+        # must be the alerts table: id, time, raised, level, kind, in order
+        sqlite3 -separator ' ' "$tmp/plot.db" \
+            "SELECT id, printf('%.3f', utime / 1e6), raised, level, kind FROM alerts ORDER BY id" > "$tmp/alerts.want"
+        grep -v '^#' "$tmp/plots/data/alerts.dat" > "$tmp/alerts.got"
+        cmp -s "$tmp/alerts.want" "$tmp/alerts.got" ||
+            problem "alerts.dat differs from the alerts table: $(diff "$tmp/alerts.want" "$tmp/alerts.got" | head -5)"
+        [ "$(wc -l < "$tmp/alerts.got")" -eq 3 ] || problem "alerts.dat: $(wc -l < "$tmp/alerts.got") markers, expected 3"
+        grep -c 'set arrow from' "$tmp/plots/data/plots.gp" | grep -qx 3 ||
+            problem "plots.gp: not one arrow per alert"
+        [ -s "$tmp/plots/data/gnuplot.log" ] && problem "gnuplot said: $(head -c 300 "$tmp/plots/data/gnuplot.log")"
+        cmp -s "$tmp/pristine.db" "$tmp/plot.db" || problem "--plot changed the store"
+    fi
+    # an empty store still draws (empty plots saying so), a missing dir parent fails
+    sqlite3 "$tmp/empty.db" < "$tmp/ddl.sql"
+    sqlite3 "$tmp/empty.db" "PRAGMA user_version = 2; INSERT INTO schema_migrations (version, description) VALUES (1, 'e'), (2, 'e')"
+    if ok plot-empty --db "$tmp/empty.db" --plot "$tmp/plots-empty"; then
+        for p in gvw trend gvw_histogram passages_per_hour speed; do png_ok "$tmp/plots-empty/$p.png"; done
+    fi
+    bad plot-nodir 1 '^amfi-report: .*/no/such/dir' --db "$db" --plot "$tmp/no/such/dir"
+else
+    echo "report_cli.sh: no gnuplot: --plot cases skipped"
+fi
+
 echo "report_cli.sh: $cases cases, $failures failed"
 [ "$failures" -eq 0 ]

@@ -219,13 +219,16 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         t1 = t0 + 60;
     utc_min(t0, t0s);
     utc_min(t1, t1s);
-    snprintf(sub, sizeof sub, "%s, %s .. %s UTC, %zu passages", site, t0s, t1s, n);
+    if (n)
+        snprintf(sub, sizeof sub, "%s, %s .. %s UTC, %zu passages", site, t0s, t1s, n);
+    else
+        snprintf(sub, sizeof sub, "%s, no passages in the store", site);
 
     /* passages.dat: t gvw_t status speed_kmh */
     if (!(f = open_data(dir, "passages.dat", err, errlen)))
         goto out;
     fprintf(f, "# time_s gvw_t status(0 ok,1 gap,2 late,3 overload,4 multiple,5 invalid,6 error) speed_kmh\n");
-    size_t n_ok = 0, n_sp = 0;
+    size_t n_ok = 0, n_sp = 0, n_gvw = 0;
     ok = malloc((n + 1) * sizeof *ok);
     sp = malloc((n + 1) * sizeof *sp);
     if (!ok || !sp) {
@@ -237,6 +240,8 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         const pas *p = &pv.v[k];
         fprintf(f, "%.3f %.4f %d %.3f\n", p->t, isnan(p->gvw) ? NAN : p->gvw / 1000,
                 p->status, isnan(p->speed) ? NAN : p->speed * 3.6);
+        if (!isnan(p->gvw))
+            n_gvw++;
         if (p->status == 0 && !isnan(p->gvw))
             ok[n_ok++] = p->gvw / 1000;
         if (!isnan(p->speed))
@@ -392,7 +397,7 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         "o = '%s/'\n"
         "set grid\n"
         "set key outside right top box opaque\n"
-        "set xdata time\nset timefmt '%%s'\nset format x \"%%H:%%M\\n%%d %%b %%Y\"\n"
+        "set xdata time\nset timefmt '%%s'\nset format x \"%%H:%%M\\n%%d %%b\"\n"
         "set xlabel 'time (UTC, data time)'\n"
         "set xrange [%.3f:%.3f]\n",
         dir, dir, dir, t0 - 0.01 * (t1 - t0), t1 + 0.01 * (t1 - t0));
@@ -401,11 +406,15 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         "set output o.'gvw.png'\n"
         "set title \"Inferred gross vehicle weight per passage\\n%s\"\n"
         "set ylabel 'GVW (t)'\n"
+        "%s"
         "plot d.'band.dat' using 1:2:3 with filledcurves fc rgb '#b0d0b0' fs transparent solid 0.5 title 'baseline mean +/- 2 STD', \\\n"
         "     d.'band.dat' using 1:4 with lines lw 2 lc rgb '#2ca02c' title 'baseline mean', \\\n"
         "     d.'passages.dat' using 1:($3==0?$2:NaN) with points pt 7 ps 0.4 lc rgb '#1f77b4' title 'ok', \\\n"
-        "     d.'passages.dat' using 1:($3!=0?$2:NaN) with points pt 2 ps 0.6 lc rgb '#d62728' title 'not ok (solved)'\n",
-        sub);
+        "     d.'passages.dat' using 1:($3!=0?$2:NaN) with points pt 2 ps 0.6 lc rgb '#d62728' title 'not ok (solved)'\n"
+        "unset label 99\nset autoscale y\n",
+        sub,
+        /* gnuplot refuses a plot without one valid point: a fixed range and a word */
+        n_gvw ? "" : "set yrange [0:60]\nset label 99 'no passage with an inferred GVW in this store' at graph 0.5, graph 0.5 center\n");
     /* 2: trend, three panels with the alerts as vertical lines */
     fprintf(f, "set terminal pngcairo size 960,800\nset output o.'trend.png'\n"
                "unset arrow\n");
@@ -416,6 +425,7 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     fprintf(f,
         "set multiplot layout 3,1 title \"Damage indicator trend (%s)\\n%d indicator rows, %d alerts: red solid = raised, green dashed = cleared\"\n"
         "unset title\nset format x ''\nunset xlabel\n"
+        "set lmargin at screen 0.09\nset rmargin at screen 0.72\n"
         "set ylabel 'STD ratio (window / baseline)'\n"
         "plot d.'indicators.dat' using 1:2 with linespoints pt 7 ps 0.3 lc rgb '#1f77b4' title 'STD ratio', \\\n"
         "     %.4g with lines dt 1 lc rgb '#d62728' title 'raise at >= %.4g', %.4g with lines dt 2 lc rgb '#2ca02c' title 'clear below %.4g', \\\n"
@@ -424,11 +434,11 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         "plot d.'indicators.dat' using 1:($3>0?$3:NaN) with linespoints pt 7 ps 0.3 lc rgb '#9467bd' title 'p (STD test)', \\\n"
         "     %.4g with lines dt 1 lc rgb '#d62728' title 'raise at p <= %.4g'\n"
         "unset logscale y\nset format y '%%g'\n"
-        "set format x \"%%H:%%M\\n%%d %%b %%Y\"\nset xlabel 'time (UTC, data time)'\n"
+        "set format x \"%%H:%%M\\n%%d %%b\"\nset xlabel 'time (UTC, data time)'\n"
         "set ylabel 'mean ratio (window / baseline)'\n"
         "plot d.'indicators.dat' using 1:4 with linespoints pt 7 ps 0.3 lc rgb '#ff7f0e' title 'mean ratio', \\\n"
         "     %.4g with lines dt 1 lc rgb '#d62728' title 'mean alert %.4g and 1/%.4g', %.4g with lines dt 1 lc rgb '#d62728' notitle\n"
-        "unset multiplot\nunset arrow\nset terminal pngcairo size 960,540\n",
+        "unset multiplot\nunset arrow\nset lmargin\nset rmargin\nset terminal pngcairo size 960,540\n",
         sub, n_ind, n_al, ip->std_alert_ratio, ip->std_alert_ratio,
         ip->std_clear_ratio, ip->std_clear_ratio, ip->std_alert_p, ip->std_alert_p,
         ip->mean_alert_ratio, ip->mean_alert_ratio, ip->mean_alert_ratio,
@@ -446,7 +456,7 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     /* 4: passages per hour by status */
     fprintf(f,
         "set output o.'passages_per_hour.png'\n"
-        "set xdata time\nset format x \"%%H:%%M\\n%%d %%b %%Y\"\nset xrange [%.3f:%.3f]\n"
+        "set xdata time\nset format x \"%%H:%%M\\n%%d %%b\"\nset xrange [%.3f:%.3f]\n"
         "set title \"Passages per hour by status (buckets of %.0f min)\\n%s\"\n"
         "set xlabel 'time (UTC, data time)'\nset ylabel 'passages per hour'\n"
         "set style fill solid 0.8 border lc rgb 'black'\nset boxwidth %.0f\nset yrange [0:*]\n"
@@ -462,9 +472,11 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         "set title \"Speed distribution (%zu passages with a speed)\\n%s\"\n"
         "set xlabel 'speed (km/h), bins of 2 km/h'\nset ylabel 'passages'\n"
         "set style fill solid 0.7 border lc rgb 'black'\nset boxwidth 1.8\n"
+        "%s"
         "plot d.'speed.dat' using 1:2 with boxes lc rgb '#1f77b4' title 'passages'\n"
         "set output\n",
-        n_sp, sub);
+        n_sp, sub,
+        n_sp ? "" : "set xrange [0:150]\nset yrange [0:1]\nset label 99 'no passage with a speed in this store' at graph 0.5, graph 0.5 center\n");
     if (close_data(f, dir, "plots.gp", err, errlen) != 0)
         goto out;
     f = NULL;
