@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_export.c: the passage listing of reports (amfi-report --passages,
  * --plot): every passage in a time range, optionally of one status, with

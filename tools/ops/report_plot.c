@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * report_plot.c: amfi-report --plot DIR: the store drawn for a bridge
  * engineer. Reads every passage, indicator and alert through the store's

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * report_plot.h: amfi-report --plot: PNGs of a store drawn with gnuplot
  * (report_plot.c). Single-threaded, the caller's thread; the store handle
