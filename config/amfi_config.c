@@ -9,6 +9,7 @@
  *   section_solver.c             sensors:, solver:
  *   section_daemon.c             daemon:
  *   section_simulation.c         simulation:
+ *   section_site.c               site:
  *   model_check.c                the bridge built, the solver's workspace bounded
  *
  * and holds the defaults, the order of the checks that run once the whole
@@ -27,12 +28,14 @@
 #include "amfi_config_keys.h"
 #include "sections.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* The top level of a site file. */
 static const field top_fields[] = {
+    {.key = "site", .kind = &K_MAP, .aux = site_fields},
     {.key = "bridge", .kind = &K_MAP, .aux = bridge_fields},
     {.key = "sensors", .kind = &K_SENSORS, .aux = &sensors_list},
     {.key = "solver", .kind = &K_MAP, .aux = solver_fields},
@@ -49,7 +52,7 @@ static int check_site(ctx *x, void *base)
     amfi_site_config *c = base;
 
     if (bridge_check(x, c) || sensors_check(x, c) || solver_check(x, c) ||
-        daemon_check(x, c) || sim_check(x, c))
+        daemon_check(x, c) || sim_check(x, c) || site_check(x, c))
         return -1;
     return model_check(x, c);
 }
@@ -58,6 +61,10 @@ void amfi_config_defaults(amfi_site_config *c)
 {
     memset(c, 0, sizeof *c);
     memcpy(c->name, "paper-20m", sizeof "paper-20m");
+    memcpy(c->site.id, "local", sizeof "local");
+    memcpy(c->site.name, "paper-20m", sizeof "paper-20m");
+    c->site.latitude = NAN;
+    c->site.longitude = NAN;
     amfi_bridge_params_paper20(&c->bridge);
     amfi_solver_params_default(&c->solver, c->bridge.span_m);
     /* The site recommendation (docs/results/paper.md): the bridge may still

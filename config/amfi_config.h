@@ -98,7 +98,20 @@ typedef struct amfi_sim_config {
                                s, [0, 60] */
 } amfi_sim_config;
 
+/* site.*: which bridge this is (section_site.c). */
+typedef struct amfi_site_identity {
+    char id[64];      /* site.id: [A-Za-z0-9_.-], 1 .. 63 bytes; stored in the store
+                         at first start, carried by amfid's output messages */
+    char name[128];   /* site.name: 1 .. 127 bytes; default bridge.name */
+    double latitude;  /* site.latitude, degrees WGS 84, [-90, 90]; NaN unknown */
+    double longitude; /* site.longitude, degrees, [-180, 180]; NaN unknown */
+} amfi_site_identity;
+
+/* 1 when s is a valid site.id ([A-Za-z0-9_.-], 1 .. 63 bytes), else 0. */
+int amfi_site_id_valid(const char *s);
+
 typedef struct amfi_site_config {
+    amfi_site_identity site;   /* site.* */
     char name[64];             /* bridge.name: 1 .. 63 bytes, NUL-terminated */
     amfi_bridge_params bridge; /* bridge.* */
     amfi_solver_params solver; /* solver.* and the sensor list (positions,

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * sections.h: the four sections of a site file (internal to config/), each
+ * sections.h: the sections of a site file (internal to config/), each
  * in its own file: its key tables for the walker (yaml_walk.h), its value
  * kinds that need more than a number or a name, and the checks that involve
  * several of its keys. amfi_config.c puts them under one top-level table and
@@ -11,6 +11,7 @@
  *                         and the bound on the solver's workspace
  *   section_daemon.c      daemon:      amfid's bus, store, threads, indicators
  *   section_simulation.c  simulation:  sim_publisher's settings
+ *   section_site.c        site:        which bridge (id, name, position)
  *
  * Every function runs on the loader's (caller's) thread.
  */
@@ -37,6 +38,7 @@ extern const list_schema sensors_list;
 extern const field solver_fields[]; /* solver: */
 extern const field daemon_fields[]; /* daemon: */
 extern const field sim_fields[];    /* simulation: */
+extern const field site_fields[];   /* site: */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */
 int bridge_free_dofs(const amfi_bridge_params *b);
@@ -48,6 +50,7 @@ int sensors_check(ctx *x, amfi_site_config *c);
 int solver_check(ctx *x, amfi_site_config *c);
 int daemon_check(ctx *x, amfi_site_config *c);
 int sim_check(ctx *x, amfi_site_config *c);
+int site_check(ctx *x, amfi_site_config *c);
 
 /* The model itself: the bridge built with libamfi (its refusals reported at
  * the line of the bridge key or section that caused them) and the solver's

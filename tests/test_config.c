@@ -17,6 +17,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -96,6 +97,32 @@ static void test_defaults(void **state)
     assert_int_equal(100, c.sim.block);
     assert_true(c.sim.start_utime == 1767225600000000LL);
     assert_true(c.sim.detector_lead_s == 1.0);
+}
+
+/* site: the id and name as given; the name follows bridge.name when left
+ * out; coordinates both or none. */
+static void test_site_section(void **state)
+{
+    amfi_site_config c;
+    char err[ERRLEN];
+
+    (void)state;
+    amfi_config_defaults(&c);
+    assert_string_equal("local", c.site.id);
+    assert_string_equal("paper-20m", c.site.name);
+    assert_true(isnan(c.site.latitude) && isnan(c.site.longitude));
+    assert_int_equal(0, load_text("bridge:\n  name: sava-42\nsite:\n  id: si.sava-42_N\n",
+                                  &c, err));
+    assert_string_equal("si.sava-42_N", c.site.id);
+    assert_string_equal("sava-42", c.site.name);
+    assert_int_equal(0, load_text("site:\n  id: x\n  name: \"Most čez Savo, km 42\"\n"
+                                  "  latitude: 46.05\n  longitude: -14.5\n", &c, err));
+    assert_string_equal("Most čez Savo, km 42", c.site.name);
+    assert_true(c.site.latitude == 46.05 && c.site.longitude == -14.5);
+    assert_true(amfi_site_id_valid("a-b.c_9"));
+    assert_false(amfi_site_id_valid(""));
+    assert_false(amfi_site_id_valid("a b"));
+    assert_false(amfi_site_id_valid(NULL));
 }
 
 static void test_shipped_file_is_the_defaults(void **state)
@@ -480,7 +507,25 @@ static const bad_case bad_cases[] = {
     {"unknown_key", "solver:\n  calc_rate_hz: 5000\n  lamda: 1e-9\n", 3, "solver.lamda",
      "unknown key"},
     {"unknown_section", "bridge: {}\nmonitor:\n  bus: udpm://\n", 2, "monitor",
-     "unknown key (known: bridge, sensors, solver, daemon, simulation)"},
+     "unknown key (known: site, bridge, sensors, solver, daemon, simulation)"},
+    {"site_id_empty", "site:\n  id: ''\n", 2, "site.id", "must be 1 .. 63 bytes of A-Z"},
+    {"site_id_space", "site:\n  id: my bridge\n", 2, "site.id",
+     "must be 1 .. 63 bytes of A-Z a-z 0-9 _ . -, got 'my bridge'"},
+    {"site_id_slash", "site:\n  id: a/b\n", 2, "site.id", "got 'a/b'"},
+    {"site_id_long", "site:\n  id: "
+     "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\n", 2, "site.id",
+     "1 .. 63 bytes"},
+    {"site_id_list", "site:\n  id: [a]\n", 2, "site.id", "expected a site id"},
+    {"site_name_control", "site:\n  name: \"a\\tb\"\n", 2, "site.name",
+     "must not contain control characters"},
+    {"site_lat_range", "site:\n  latitude: 91\n  longitude: 0\n", 2, "site.latitude",
+     "[-90, 90]"},
+    {"site_lon_text", "site:\n  latitude: 1\n  longitude: east\n", 3, "site.longitude",
+     "expected a finite number, got 'east'"},
+    {"site_lat_alone", "\nsite:\n  latitude: 46\n", 3, "site.latitude",
+     "give both site.latitude and site.longitude"},
+    {"site_unknown", "site:\n  idd: x\n", 2, "site.idd",
+     "unknown key (known: id, name, latitude, longitude)"},
     {"sim_not_map", "simulation: 10\n", 1, "simulation", "expected a mapping"},
     {"sim_unknown_key", "simulation:\n  vehicles: 5\n  vehicle: 5\n", 3,
      "simulation.vehicle", "unknown key (known: population, vehicles, first"},
@@ -866,6 +911,7 @@ int main(void)
 {
     static const struct CMUnitTest fixed[] = {
         cmocka_unit_test(test_defaults),
+        cmocka_unit_test(test_site_section),
         cmocka_unit_test(test_shipped_file_is_the_defaults),
         cmocka_unit_test(test_shipped_sim_file_is_the_defaults),
         cmocka_unit_test(test_other_shipped_files_load),

@@ -1,0 +1,152 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * section_site.c: the site: section of a site file, the identity of the
+ * bridge a store and a bus belong to (amfi_site_identity): site.id, the
+ * key amfid writes into the store at first start and refuses to open a
+ * store under another one with, and that amfid's output messages and the
+ * fleet's central database carry; site.name for people; optional
+ * coordinates. Runs on the loader's thread.
+ */
+#include "sections.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define ID_CAP sizeof(((amfi_site_identity *)0)->id)
+#define NAME_CAP sizeof(((amfi_site_identity *)0)->name)
+
+int amfi_site_id_valid(const char *s)
+{
+    size_t n = s ? strlen(s) : 0;
+
+    if (n == 0 || n >= ID_CAP)
+        return 0;
+    for (size_t i = 0; i < n; i++) {
+        char ch = s[i];
+        if (!((ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+              (ch >= '0' && ch <= '9') || ch == '_' || ch == '.' || ch == '-'))
+            return 0;
+    }
+    return 1;
+}
+
+/* site.id: [A-Za-z0-9_.-], 1 .. 63 bytes */
+static int p_id(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    amfi_site_config *c = base;
+    const char *s = scalar(x, v, path, "a site id", 1);
+
+    (void)f;
+    if (!s)
+        return -1;
+    if (!amfi_site_id_valid(s)) {
+        char shown[SHOW_LEN + 8];
+        return fail(x, line_of(v), path,
+                    "must be 1 .. %zu bytes of A-Z a-z 0-9 _ . -, got '%s'", ID_CAP - 1,
+                    show(shown, sizeof shown, v));
+    }
+    memset(c->site.id, 0, ID_CAP);
+    memcpy(c->site.id, s, strlen(s));
+    return 0;
+}
+
+static void d_id(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "1 .. %zu bytes of A-Z a-z 0-9 _ . -", ID_CAP - 1);
+}
+
+static void v_id(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    snprintf(buf, DOC_LEN, "%s", ((const amfi_site_config *)base)->site.id);
+}
+
+/* site.name: free text, no control characters; absent: bridge.name */
+static int p_sname(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    amfi_site_config *c = base;
+    const char *s = scalar(x, v, path, "a name", 1);
+    size_t n;
+
+    (void)f;
+    if (!s)
+        return -1;
+    n = strlen(s);
+    if (n == 0 || n >= NAME_CAP)
+        return fail(x, line_of(v), path, "must be 1 .. %zu bytes long, got %zu",
+                    NAME_CAP - 1, n);
+    for (size_t i = 0; i < n; i++)
+        if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
+            return fail(x, line_of(v), path, "must not contain control characters");
+    memset(c->site.name, 0, NAME_CAP);
+    memcpy(c->site.name, s, n);
+    return 0;
+}
+
+static void d_sname(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "1 .. %zu bytes, no control characters", NAME_CAP - 1);
+}
+
+static void v_sname(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "bridge.name");
+}
+
+/* site.latitude / site.longitude: degrees (WGS 84); absent: unknown (NaN) */
+static int p_coord(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    return K_DOUBLE.parse(x, v, path, f, base);
+}
+
+static void d_coord(const field *f, const void *base, char *buf)
+{
+    (void)base;
+    describe_interval(f, buf);
+}
+
+static void v_coord(const field *f, const void *base, char *buf)
+{
+    double d;
+
+    memcpy(&d, (const char *)base + f->off, sizeof d);
+    if (isnan(d))
+        snprintf(buf, DOC_LEN, "none");
+    else
+        snprintf(buf, DOC_LEN, "%g", d);
+}
+
+static const kind K_SITE_ID = {"string", p_id, d_id, v_id, NEST_NONE};
+static const kind K_SITE_NAME = {"string", p_sname, d_sname, v_sname, NEST_NONE};
+static const kind K_COORD = {"number", p_coord, d_coord, v_coord, NEST_NONE};
+
+const field site_fields[] = {
+    {.key = "id", .kind = &K_SITE_ID},
+    {.key = "name", .kind = &K_SITE_NAME},
+    {.key = "latitude", .kind = &K_COORD, .off = SC(site.latitude), .lo = -90, .hi = 90},
+    {.key = "longitude", .kind = &K_COORD, .off = SC(site.longitude), .lo = -180,
+     .hi = 180},
+    {.key = NULL}};
+
+/* site.name follows bridge.name when not given (bridge_check runs first);
+ * a latitude without a longitude (or the reverse) is half a position. */
+int site_check(ctx *x, amfi_site_config *c)
+{
+    if (!noted(x, "site.name")) {
+        memset(c->site.name, 0, NAME_CAP);
+        memcpy(c->site.name, c->name, sizeof c->name);
+    }
+    if (isnan(c->site.latitude) != isnan(c->site.longitude)) {
+        int line = first_noted(x, "site.latitude", "site.longitude", NULL);
+        return fail(x, line, isnan(c->site.latitude) ? "site.longitude" : "site.latitude",
+                    "give both site.latitude and site.longitude, or neither");
+    }
+    return 0;
+}
