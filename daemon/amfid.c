@@ -33,6 +33,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <stdarg.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -109,6 +110,58 @@ static int start_config(daemon_s *d, const amfid_options *o)
     return 0;
 }
 
+/* The store belongs to one bridge: at its first start amfid writes the
+ * configuration's site.id (and name, position) into the store's meta table;
+ * later starts refuse a store that holds another site.id, so two bridges'
+ * passages never mix in one store (or in a fleet's central database, which
+ * keys rows by site). A changed site.name or position is written over the
+ * stored one. 0, or 1 after a logged error. */
+static int claim_site(daemon_s *d)
+{
+    const amfi_site_identity *site = &d->cfg.site;
+    char err[512], stored[AMFI_STORE_META_VALUE_MAX + 1];
+    int found = 0;
+
+    if (amfi_store_meta_get(d->store, "site.id", stored, sizeof stored, &found, err,
+                            sizeof err)) {
+        LOG_ERR("store %s: %s", d->cfg.daemon.db_path, err);
+        return 1;
+    }
+    if (found && strcmp(stored, site->id) != 0) {
+        LOG_ERR("store %s belongs to site '%s', but %s configures site.id '%s': refusing "
+                "to mix two sites in one store (give this site its own daemon.store.path, "
+                "or correct site.id)",
+                d->cfg.daemon.db_path, stored, d->config_path, site->id);
+        return 1;
+    }
+    if (!found)
+        LOG_INFO("store %s: first start of site '%s' (%s)", d->cfg.daemon.db_path, site->id,
+                 site->name);
+    struct {
+        const char *key, *val;
+    } kv[4] = {{"site.id", site->id}, {"site.name", site->name}, {NULL, NULL}, {NULL, NULL}};
+    char lat[32], lon[32];
+    if (!isnan(site->latitude)) {
+        snprintf(lat, sizeof lat, "%.7f", site->latitude);
+        snprintf(lon, sizeof lon, "%.7f", site->longitude);
+        kv[2].key = "site.latitude", kv[2].val = lat;
+        kv[3].key = "site.longitude", kv[3].val = lon;
+    }
+    for (int i = 0; i < 4 && kv[i].key; i++) {
+        if (amfi_store_meta_get(d->store, kv[i].key, stored, sizeof stored, &found, err,
+                                sizeof err) ||
+            ((!found || strcmp(stored, kv[i].val)) &&
+             amfi_store_meta_set(d->store, kv[i].key, kv[i].val, err, sizeof err))) {
+            LOG_ERR("store %s: %s", d->cfg.daemon.db_path, err);
+            return 1;
+        }
+        if (found && strcmp(stored, kv[i].val) && i > 0)
+            LOG_INFO("store %s: %s changed from '%s' to '%s'", d->cfg.daemon.db_path,
+                     kv[i].key, stored, kv[i].val);
+    }
+    return 0;
+}
+
 /* The store, the tracker, the bus and the solver threads: 0, or 1. */
 static int start_runtime(daemon_s *d)
 {
@@ -129,6 +182,8 @@ static int start_runtime(daemon_s *d)
         LOG_ERR("store %s: %s", d->cfg.daemon.db_path, err);
         return 1;
     }
+    if (claim_site(d))
+        return 1;
     char abs[PATH_MAX];
     const char *cfg_path = realpath(d->config_path, abs) ? abs : d->config_path;
     if (amfi_store_add_run(d->store, amfi_version(), cfg_path, NULL, err, sizeof err)) {

@@ -118,6 +118,7 @@ void heartbeat(daemon_s *d)
     m.passages_held = d->held_n;
     m.state = (char *)d->state;
     m.last_error = d->last_error;
+    m.site_id = d->cfg.site.id;
     amfi_status_t_publish(d->lcm, d->cfg.daemon.ch_status, &m);
     sd_notifyf(0, "STATUS=%s: %lld passages stored (%lld ok), %d queued, %lld blocks",
                d->state, (long long)d->passages_stored, (long long)d->passages_ok,
@@ -139,6 +140,9 @@ void reload(daemon_s *d)
         memcmp(&n.solver, &d->cfg.solver, sizeof n.solver) ||
         memcmp(n.sensor_id, d->cfg.sensor_id, sizeof n.sensor_id))
         LOG_WARN("reload: bridge, sensors and solver changes take effect at the next start");
+    if (strcmp(n.site.id, d->cfg.site.id) || strcmp(n.site.name, d->cfg.site.name))
+        LOG_WARN("reload: site.id and site.name take effect at the next start (a store "
+                 "that holds another site.id is then refused)");
     if (strcmp(n.daemon.ch_accel, d->cfg.daemon.ch_accel) ||
         strcmp(n.daemon.ch_vehicle, d->cfg.daemon.ch_vehicle) ||
         strcmp(n.daemon.ch_truth, d->cfg.daemon.ch_truth) ||

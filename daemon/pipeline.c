@@ -50,6 +50,7 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id)
     m.residual_rms = j->solved ? j->residual_rms : NAN;
     m.formulation = (char *)amfi_formulation_name(d->cfg.solver.formulation);
     m.solve_ms = j->solve_ms;
+    m.site_id = d->cfg.site.id;
     amfi_passage_t_publish(d->lcm, d->cfg.daemon.ch_passage, &m);
 }
 
@@ -88,7 +89,7 @@ static void feed_indicators(daemon_s *d, const job *j)
             set_error(d, "store: %s", err);
         amfi_indicator_t m = {j->w.v.utime, ind_id, ev.n, ev.mean_kg, ev.std_kg,
                               ev.baseline_mean_kg, ev.baseline_std_kg, ev.std_ratio,
-                              ev.p_value, (char *)ev.state};
+                              ev.p_value, (char *)ev.state, d->cfg.site.id};
         amfi_indicator_t_publish(d->lcm, d->cfg.daemon.ch_indicator, &m);
     }
     for (int i = 0; (bits & AMFI_IND_ALERT) && i < n_al; i++) {
@@ -97,7 +98,7 @@ static void feed_indicators(daemon_s *d, const job *j)
                                  ind_id, al[i].raised, &aid, err, sizeof err))
             set_error(d, "store: %s", err);
         amfi_alert_t m = {j->w.v.utime, aid, (char *)al[i].level, (char *)al[i].kind,
-                          al[i].message, ind_id, (int8_t)al[i].raised};
+                          al[i].message, ind_id, (int8_t)al[i].raised, d->cfg.site.id};
         amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
         if (al[i].raised)
             LOG_WARN("ALERT %s (%s): %s", al[i].kind, al[i].level, al[i].message);
@@ -144,7 +145,7 @@ static int store_now(daemon_s *d, job *j)
 static void publish_store_alert(daemon_s *d, int raised, const char *msg)
 {
     amfi_alert_t m = {d->newest_utime, 0, (char *)"warning", (char *)"store_degraded",
-                      (char *)msg, 0, (int8_t)raised};
+                      (char *)msg, 0, (int8_t)raised, d->cfg.site.id};
     amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
     if (raised)
         LOG_ERR("ALERT store_degraded (warning): %s", msg);

@@ -3,9 +3,11 @@
  * lcm_passages: print the passages an LCM log recorded on AMFI_PASSAGE, one
  * line each, "PASSAGE_ID VEHICLE_ID STATUS", for tests/daemon_kill9.sh (what
  * amfid acknowledged: it publishes a passage only after its commit). Every
- * message is checked before it is decoded.
+ * message is checked before it is decoded. With --site, one line
+ * "CHANNEL SITE_ID" per passage, indicator, alert and status message instead
+ * (tests/daemon_site.sh).
  *
- *   lcm_passages LOG
+ *   lcm_passages [--site] LOG
  */
 #include <lcm/eventlog.h>
 #include <stdio.h>
@@ -14,16 +16,72 @@
 #include "amfi_messages.h"
 #include "amfi_msg_check.h"
 
+/* --site: one line "CHANNEL site_id" per amfid output message of the log
+ * (passage, indicator, alert, status), each decoded through the checker. */
+static int print_sites(lcm_eventlog_t *in)
+{
+    static const struct {
+        const char *channel;
+        amfi_msg_type type;
+    } outs[] = {{AMFI_CHANNEL_PASSAGE, AMFI_MSG_PASSAGE_T},
+                {AMFI_CHANNEL_INDICATOR, AMFI_MSG_INDICATOR_T},
+                {AMFI_CHANNEL_ALERT, AMFI_MSG_ALERT_T},
+                {AMFI_CHANNEL_STATUS, AMFI_MSG_STATUS_T}};
+    lcm_eventlog_event_t *e;
+    int bad = 0;
+
+    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
+        for (size_t k = 0; k < sizeof outs / sizeof outs[0]; k++) {
+            if (strcmp(e->channel, outs[k].channel))
+                continue;
+            union {
+                amfi_passage_t p;
+                amfi_indicator_t i;
+                amfi_alert_t a;
+                amfi_status_t s;
+            } m;
+            char why[160];
+            if (amfi_msg_decode_checked(outs[k].type, e->data, (size_t)e->datalen, &m, why,
+                                        sizeof why) != AMFI_MSG_OK) {
+                fprintf(stderr, "lcm_passages: event %lld: %s\n", (long long)e->eventnum, why);
+                bad = 1;
+                continue;
+            }
+            const char *site = k == 0   ? m.p.site_id
+                               : k == 1 ? m.i.site_id
+                               : k == 2 ? m.a.site_id
+                                        : m.s.site_id;
+            printf("%s %s\n", e->channel, site);
+            if (k == 0)
+                amfi_passage_t_decode_cleanup(&m.p);
+            else if (k == 1)
+                amfi_indicator_t_decode_cleanup(&m.i);
+            else if (k == 2)
+                amfi_alert_t_decode_cleanup(&m.a);
+            else
+                amfi_status_t_decode_cleanup(&m.s);
+        }
+        lcm_eventlog_free_event(e);
+    }
+    return bad;
+}
+
 int main(int argc, char **argv)
 {
-    if (argc != 2) {
-        fprintf(stderr, "usage: lcm_passages LOG\n");
+    int sites = argc == 3 && strcmp(argv[1], "--site") == 0;
+    if (argc != 2 && !sites) {
+        fprintf(stderr, "usage: lcm_passages [--site] LOG\n");
         return 2;
     }
-    lcm_eventlog_t *in = lcm_eventlog_create(argv[1], "r");
+    lcm_eventlog_t *in = lcm_eventlog_create(argv[argc - 1], "r");
     if (!in) {
-        fprintf(stderr, "lcm_passages: cannot open %s\n", argv[1]);
+        fprintf(stderr, "lcm_passages: cannot open %s\n", argv[argc - 1]);
         return 1;
+    }
+    if (sites) {
+        int bad = print_sites(in);
+        lcm_eventlog_destroy(in);
+        return bad;
     }
     lcm_eventlog_event_t *e;
     int bad = 0;

@@ -125,6 +125,7 @@ static void round_make(struct round *r, int i)
     r->passage.residual_rms = 0.0041;
     r->passage.formulation = "modal";
     r->passage.solve_ms = 14.5 + 0.25 * (i % 8);
+    r->passage.site_id = "selftest-site";
 
     r->unsolved = r->passage;
     r->unsolved.passage_id = 100000 + i;
@@ -148,6 +149,7 @@ static void round_make(struct round *r, int i)
     r->indicator.std_ratio = r->indicator.std_kg / r->indicator.baseline_std_kg;
     r->indicator.p_value = 0.274;
     r->indicator.state = "normal";
+    r->indicator.site_id = "selftest-site";
 
     snprintf(r->alert_message, sizeof r->alert_message,
              "GVW spread %.2f x baseline over %d passages", 1.32, 200);
@@ -158,6 +160,7 @@ static void round_make(struct round *r, int i)
     r->alert.message = r->alert_message;
     r->alert.indicator_id = r->indicator.indicator_id;
     r->alert.raised = (int8_t)(i % 2 == 0);
+    r->alert.site_id = "selftest-site";
 
     r->status.utime = t + (N_SAMPLES - 1) * 1000;
     r->status.wall_utime = t + 123456;
@@ -173,6 +176,7 @@ static void round_make(struct round *r, int i)
     r->status.datagrams_dropped = i / 2;
     r->status.passages_held = i % 4;
     r->status.state = "running";
+    r->status.site_id = "selftest-site";
     r->status.last_error = i % 5 == 4 ? "AMFI_VEHICLE: lane 7 not in the site configuration" : "";
 }
 
@@ -253,7 +257,8 @@ static void print_round(const struct round *r)
     put_d("lambda", p->lambda, ";");
     put_d("residual_rms", p->residual_rms, ";");
     put_s("formulation", p->formulation, ";");
-    put_d("solve_ms", p->solve_ms, "\n");
+    put_d("solve_ms", p->solve_ms, ";");
+    put_s("site_id", p->site_id, "\n");
 
     const amfi_indicator_t *d = &r->indicator;
     printf("%s\tamfi.indicator_t\t", AMFI_CHANNEL_INDICATOR);
@@ -266,7 +271,8 @@ static void print_round(const struct round *r)
     put_d("baseline_std_kg", d->baseline_std_kg, ";");
     put_d("std_ratio", d->std_ratio, ";");
     put_d("p_value", d->p_value, ";");
-    put_s("state", d->state, "\n");
+    put_s("state", d->state, ";");
+    put_s("site_id", d->site_id, "\n");
 
     const amfi_alert_t *l = &r->alert;
     printf("%s\tamfi.alert_t\t", AMFI_CHANNEL_ALERT);
@@ -276,7 +282,8 @@ static void print_round(const struct round *r)
     put_s("kind", l->kind, ";");
     put_s("message", l->message, ";");
     put_i("indicator_id", l->indicator_id, ";");
-    put_i("raised", l->raised, "\n");
+    put_i("raised", l->raised, ";");
+    put_s("site_id", l->site_id, "\n");
 
     const amfi_status_t *s = &r->status;
     printf("%s\tamfi.status_t\t", AMFI_CHANNEL_STATUS);
@@ -294,7 +301,8 @@ static void print_round(const struct round *r)
     put_i("datagrams_dropped", s->datagrams_dropped, ";");
     put_i("passages_held", s->passages_held, ";");
     put_s("state", s->state, ";");
-    put_s("last_error", s->last_error, "\n");
+    put_s("last_error", s->last_error, ";");
+    put_s("site_id", s->site_id, "\n");
 }
 
 /* ---- publishing ---- */

@@ -143,14 +143,16 @@ static enc random_message(amfi_msg_type t, int big)
     case AMFI_MSG_PASSAGE_T: {
         amfi_passage_t m = {(int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(), (int16_t)rnd(),
                             rnd_double(), NULL, NULL, rnd_double(), 0, NULL, rnd_double(),
-                            rnd_double(), NULL, rnd_double()};
+                            rnd_double(), NULL, rnd_double(), NULL};
         m.status = rnd_string(AMFI_MSG_MAX_PASSAGE_STATUS);
+        m.site_id = rnd_string(AMFI_MSG_MAX_PASSAGE_SITE_ID);
         m.reason = rnd_string(AMFI_MSG_MAX_PASSAGE_REASON);
         m.n_axles = (int16_t)(big ? AMFI_MSG_MAX_PASSAGE_N_AXLES
                                   : rnd_int(0, AMFI_MSG_MAX_PASSAGE_N_AXLES));
         m.axle_kg = rnd_doubles(m.n_axles);
         m.formulation = rnd_string(AMFI_MSG_MAX_PASSAGE_FORMULATION);
         ENCODE(passage_t, m);
+        free(m.site_id);
         free(m.status);
         free(m.reason);
         free(m.axle_kg);
@@ -160,19 +162,23 @@ static enc random_message(amfi_msg_type t, int big)
     case AMFI_MSG_INDICATOR_T: {
         amfi_indicator_t m = {(int64_t)rnd(), (int64_t)rnd(), (int32_t)rnd(), rnd_double(),
                               rnd_double(), rnd_double(), rnd_double(), rnd_double(),
-                              rnd_double(), NULL};
+                              rnd_double(), NULL, NULL};
         m.state = rnd_string(AMFI_MSG_MAX_INDICATOR_STATE);
+        m.site_id = rnd_string(AMFI_MSG_MAX_INDICATOR_SITE_ID);
         ENCODE(indicator_t, m);
         free(m.state);
+        free(m.site_id);
         break;
     }
     case AMFI_MSG_ALERT_T: {
         amfi_alert_t m = {(int64_t)rnd(), (int64_t)rnd(), NULL, NULL, NULL, (int64_t)rnd(),
-                          (int8_t)rnd()};
+                          (int8_t)rnd(), NULL};
         m.level = rnd_string(AMFI_MSG_MAX_ALERT_LEVEL);
+        m.site_id = rnd_string(AMFI_MSG_MAX_ALERT_SITE_ID);
         m.kind = rnd_string(AMFI_MSG_MAX_ALERT_KIND);
         m.message = rnd_string(AMFI_MSG_MAX_ALERT_MESSAGE);
         ENCODE(alert_t, m);
+        free(m.site_id);
         free(m.level);
         free(m.kind);
         free(m.message);
@@ -182,10 +188,12 @@ static enc random_message(amfi_msg_type t, int big)
         amfi_status_t m = {(int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(),
                            (int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(),
                            (int64_t)rnd(), (int32_t)rnd(), (int64_t)rnd(), (int64_t)rnd(),
-                           (int32_t)rnd(), NULL, NULL};
+                           (int32_t)rnd(), NULL, NULL, NULL};
         m.state = rnd_string(AMFI_MSG_MAX_STATUS_STATE);
+        m.site_id = rnd_string(AMFI_MSG_MAX_STATUS_SITE_ID);
         m.last_error = rnd_string(AMFI_MSG_MAX_STATUS_LAST_ERROR);
         ENCODE(status_t, m);
+        free(m.site_id);
         free(m.state);
         free(m.last_error);
         break;
@@ -453,7 +461,7 @@ static enc empty_arrays(amfi_msg_type t)
     }
     case AMFI_MSG_PASSAGE_T: {
         amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
-                            1e-3, 0.1, (char *)"modal", 5.0};
+                            1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1"};
         ENCODE(passage_t, m);
         break;
     }
