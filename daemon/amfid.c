@@ -14,9 +14,10 @@
  * takes it), speaks sd_notify (READY, STATUS, WATCHDOG). Time is the data's
  * time (message utimes): replaying a log at any speed stores the same rows.
  *
- * This file: main, start-up, the loop and shutdown, on the main thread.
+ * This file: start-up, the loop and shutdown, on the main thread (main()
+ * is in main.c, so that fuzz/fuzz_intake.c can drive the same daemon).
  * Start-up builds the daemon in dependency order; whatever happens, one
- * function (stop) tears down whatever was built, in reverse. The other
+ * function (amfid_stop) tears down whatever was built, in reverse. The other
  * files and who owns what: amfid.h.
  *
  * Signals: SIGTERM/SIGINT stop reading the bus, let the solver threads
@@ -41,13 +42,16 @@
 
 #include "amfid.h"
 
+FILE *amfid_log_stream;
+
 void amfid_log(const char *prefix, const char *fmt, ...)
 {
+    FILE *f = amfid_log_stream ? amfid_log_stream : stderr;
     va_list ap;
     va_start(ap, fmt);
-    fputs(prefix, stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    fputs(prefix, f);
+    vfprintf(f, fmt, ap);
+    fputc('\n', f);
     va_end(ap);
 }
 
@@ -221,7 +225,7 @@ static int start_runtime(daemon_s *d)
 
 /* Read the bus until a signal or its end, then drain: every pending
  * passage is stored, solved or with its reason. 0, or 1. */
-static int run(daemon_s *d)
+int amfid_run(daemon_s *d)
 {
     int rc = 0;
     d->state = "running";
@@ -277,6 +281,13 @@ static int run(daemon_s *d)
             last_wd = now;
         }
     }
+    int drc = amfid_drain(d);
+    return rc ? rc : drc;
+}
+
+int amfid_drain(daemon_s *d)
+{
+    int rc = 0;
     d->state = "draining";
     sd_notify(0, "STOPPING=1");
     release_windows(d, 1);
@@ -299,7 +310,7 @@ static int run(daemon_s *d)
 }
 
 /* The one tear-down: whatever start_* built, in reverse; NULL-safe. */
-static void stop(daemon_s *d)
+void amfid_stop(daemon_s *d)
 {
     for (; d->held && d->held_n > 0; d->held_n--) { /* only left on an early error */
         job_free(d->held[d->held_head]);
@@ -322,17 +333,14 @@ static void stop(daemon_s *d)
     amfi_bridge_destroy(d->bridge);
 }
 
-int main(int argc, char **argv)
+int amfid_start(daemon_s *d, const amfid_options *o)
 {
-    amfid_options o;
-    amfid_parse_options(argc, argv, &o);
-    static daemon_s d; /* large; zeroed */
-    int rc = start_config(&d, &o);
-    if (rc == 0 && o.check_only)
-        printf("amfid: %s: ok (bridge %s, %d sensor(s), %d worker(s), store %s)\n", o.config,
-               d.cfg.name, d.cfg.solver.n_sensors, d.cfg.daemon.workers, d.cfg.daemon.db_path);
-    else if (rc == 0 && (rc = start_runtime(&d)) == 0)
-        rc = run(&d);
-    stop(&d);
+    int rc = start_config(d, o);
+    if (rc == 0 && o->check_only)
+        printf("amfid: %s: ok (bridge %s, %d sensor(s), %d worker(s), store %s)\n", o->config,
+               d->cfg.name, d->cfg.solver.n_sensors, d->cfg.daemon.workers,
+               d->cfg.daemon.db_path);
+    else if (rc == 0)
+        rc = start_runtime(d);
     return rc;
 }

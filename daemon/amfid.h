@@ -19,6 +19,7 @@
 
 #include <lcm/lcm.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <systemd/sd-daemon.h>
 
 #include "amfi/amfi.h"
@@ -38,6 +39,9 @@
 /* ---- logging (stderr, journald reads the <N> prefixes) ----------------- */
 
 void amfid_log(const char *prefix, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Where amfid_log writes: NULL (the default) is stderr; the fuzz target
+ * points it at /dev/null so that only sanitizer reports reach stderr. */
+extern FILE *amfid_log_stream;
 #define LOG_INFO(...) amfid_log(SD_INFO "amfid: ", __VA_ARGS__)
 #define LOG_WARN(...) amfid_log(SD_WARNING "amfid: ", __VA_ARGS__)
 #define LOG_ERR(...) amfid_log(SD_ERR "amfid: ", __VA_ARGS__)
@@ -108,6 +112,23 @@ typedef struct daemon_s {
 } daemon_s;
 
 void set_error(daemon_s *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* ---- life cycle (amfid.c), main thread ----------------------------------- */
+
+/* d zeroed. The configuration (with o's overrides) and what it builds; with
+ * o->check_only print the result and stop there; else the store (site
+ * claimed), the tracker, the bus (subscribed) and the solver threads.
+ * 0, 1 (runtime) or 2 (configuration), reported. */
+int amfid_start(daemon_s *d, const amfid_options *o);
+/* The loop: read the bus until SIGTERM/SIGINT or the end of a replayed log,
+ * then amfid_drain. 0, or 1. */
+int amfid_run(daemon_s *d);
+/* Stop reading: release every window, let the solvers finish, store every
+ * pending passage (retrying a refusing store for up to 20 s). 0, or 1 when
+ * a passage could not be stored. */
+int amfid_drain(daemon_s *d);
+/* Tear down whatever amfid_start built, in reverse; NULL-safe. */
+void amfid_stop(daemon_s *d);
 
 /* ---- the bus (bus.c), main thread ----------------------------------------- */
 

@@ -50,6 +50,23 @@ sed '2s/8003/9000/' "$c/traffic/valid.csv" >"$c/traffic/gvw-mismatch.csv"
 head -1 "$c/traffic/valid.csv" >"$c/traffic/header-only.csv"
 sed '1s/axle2_kg/axle3_kg/' "$c/traffic/valid.csv" >"$c/traffic/axle-hole.csv"
 
+# --- intake: sim_publisher traffic as fuzz_intake records (tests/lcm_intake_seed) ---
+mkdir -p "$c/intake"
+tmpd=$(mktemp -d)
+trap 'rm -rf "$tmpd"' EXIT
+sim="$build/sim_publisher/sim_publisher"
+export AMFI_DATA_DIR="${AMFI_DATA_DIR:-$top/sim_publisher/data}"
+# two vehicles at 1000 Hz, blocks of 160 samples
+"$sim" --lcm-url none --log "$tmpd/a.lcmlog" --vehicles 2 --headway 2.5 --speedup max --seed 3 \
+  --block 160 2>/dev/null
+"$build/tests/lcm_intake_seed" "$tmpd/a.lcmlog" "$c/intake/two-vehicles"
+# the same cut after its first 12 events (vehicles whose data never comes)
+"$build/tests/lcm_intake_seed" "$tmpd/a.lcmlog" "$c/intake/cut-short" 12
+# a dozen vehicles sampled at 200 Hz: enough for the baseline and a window
+"$sim" --lcm-url none --log "$tmpd/b.lcmlog" --vehicles 12 --headway 2.5 --speedup max --seed 4 \
+  --block 160 --scan-rate 200 2>/dev/null
+"$build/tests/lcm_intake_seed" "$tmpd/b.lcmlog" "$c/intake/twelve-at-200hz"
+
 # --- msg_TYPE: encoded by lcm-gen (test_msg_check --corpus) ---
 "$build/tests/test_msg_check" --corpus "$c"
 echo "make_corpus: $(find "$c" -type f | wc -l) files, $(du -sk "$c" | cut -f1) kB in $c"
