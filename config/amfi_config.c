@@ -88,6 +88,7 @@ void amfi_config_defaults(amfi_site_config *c)
     d->workers = 2;
     d->queue_size = 256;
     d->recv_buf_bytes = 4194304;
+    d->bus_queue = 20000;
     d->ring_s = 60.0;
     d->margin_s = 0.05;
     d->max_wait_s = 10.0;

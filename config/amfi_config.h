@@ -39,6 +39,8 @@ typedef struct amfi_daemon_config {
     int queue_size;           /* daemon.queue_size: passages waiting, 1 .. 100000 */
     int recv_buf_bytes;       /* daemon.recv_buf_bytes: UDP receive buffer asked of LCM
                                  (recv_buf_size), 0 (kernel default) .. 1 GiB */
+    int bus_queue;            /* daemon.bus_queue: messages LCM keeps per input channel
+                                 between its receive thread and amfid, 30 .. 1000000 */
     double ring_s;            /* daemon.ring_s: seconds of samples kept per sensor */
     double margin_s;          /* daemon.window_margin_s: data around the solver window */
     double max_wait_s;        /* daemon.max_wait_s: data time to wait for a window */

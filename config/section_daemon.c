@@ -65,6 +65,7 @@ const field daemon_fields[] = {
     {.key = "queue_size", .kind = &K_INT, .off = DC(queue_size), .lo = 1, .hi = 100000},
     {.key = "recv_buf_bytes", .kind = &K_INT, .off = DC(recv_buf_bytes), .lo = 0,
      .hi = 1073741824},
+    {.key = "bus_queue", .kind = &K_INT, .off = DC(bus_queue), .lo = 30, .hi = 1000000},
     {.key = "ring_s", .kind = &K_DOUBLE, .off = DC(ring_s), .lo = 5, .hi = 3600},
     {.key = "window_margin_s", .kind = &K_DOUBLE, .off = DC(margin_s), .lo = 0, .hi = 5},
     {.key = "max_wait_s", .kind = &K_DOUBLE, .off = DC(max_wait_s), .lo = 0, .hi = 3600,

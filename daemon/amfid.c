@@ -214,7 +214,8 @@ static int start_runtime(daemon_s *d)
         LOG_ERR("cannot open the LCM bus '%s'", url);
         return 1;
     }
-    intake_subscribe(d);
+    if (intake_subscribe(d))
+        return 1;
     if (pool_start(&d->pool, d->bridge, &d->cfg.solver, d->cfg.daemon.workers,
                    d->cfg.daemon.queue_size, err, sizeof err)) {
         LOG_ERR("%s", err);
@@ -258,6 +259,12 @@ int amfid_run(daemon_s *d)
             d->messages_malformed++;
             set_error(d, "LCM receive error on '%s'", d->cfg.daemon.lcm_url);
         }
+        /* A live bus: every message already queued, up to a bound that
+         * keeps the heartbeat and the watchdog going in a flood; one at a
+         * time (one poll round each) left LCM's queues to overflow. */
+        for (int k = 0; !replay && pr > 0 && (pf[0].revents & POLLIN) && k < 512; k++)
+            if (lcm_handle_timeout(d->lcm, 0) <= 0)
+                break;
         if (pr > 0 && (pf[0].revents & (POLLHUP | POLLERR | POLLNVAL))) {
             LOG_INFO("the bus closed");
             break;
@@ -301,10 +308,11 @@ int amfid_drain(daemon_s *d)
     reject_final(d);
     if (d->passages_lost > 0)
         rc = 1; /* acknowledged passages are safe; these never were */
-    LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld blocks, "
-             "%lld vehicles, %lld rejected messages",
+    LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld messages received: "
+             "%lld blocks, %lld vehicles, %lld rejected messages",
              (long long)d->passages_stored, (long long)d->passages_ok,
-             (long long)d->passages_lost, (long long)d->blocks_received, (long long)d->vehicles_received,
+             (long long)d->passages_lost, (long long)d->messages_in,
+             (long long)d->blocks_received, (long long)d->vehicles_received,
              (long long)(d->blocks_rejected + d->vehicles_rejected + d->messages_malformed));
     return rc;
 }

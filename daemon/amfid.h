@@ -97,6 +97,7 @@ typedef struct daemon_s {
     /* counters (status_t) */
     int64_t blocks_received, blocks_rejected, vehicles_received, vehicles_rejected;
     int64_t messages_malformed, passages_stored, passages_ok, truth_received;
+    int64_t messages_in;           /* every message the three inputs handed over */
     int64_t newest_utime;
     int64_t udp_drops, udp_drops_logged; /* kernel drops on our sockets */
     reject_state rej;
@@ -152,7 +153,9 @@ const char *reject_reason_name(int reason);
 
 /* ---- bus intake (intake.c), main thread ---------------------------------- */
 
-void intake_subscribe(daemon_s *d);
+/* Subscribe the three inputs with queues of daemon.bus_queue messages:
+ * 0, or −1 (logged). */
+int intake_subscribe(daemon_s *d);
 /* Windows the tracker has decided: to the solvers, or straight to the store. */
 void release_windows(daemon_s *d, int flush);
 

@@ -434,6 +434,7 @@ typedef struct bus {
     lcm_t *lcm;          /* NULL: not publishing */
     lcm_eventlog_t *log; /* NULL: no log */
     int64_t eventnum;
+    int64_t sent;        /* messages emitted (bus and/or log) */
     unsigned char *buf;
     int cap;
 } bus;
@@ -449,6 +450,7 @@ static int emit(bus *b, const char *channel, int64_t utime, const void *data, in
         if (lcm_eventlog_write_event(b->log, &ev) != 0)
             return -1;
     }
+    b->sent++;
     return 0;
 }
 
@@ -646,8 +648,9 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             }
         }
     }
-    fprintf(stderr, "%s: %ld vehicles streamed over %.1f s of data%s\n", PROG, left,
-            amfi_sim_time(sim), stream_stop ? " (stopped by a signal)" : "");
+    fprintf(stderr, "%s: %ld vehicles streamed over %.1f s of data in %lld messages%s\n", PROG,
+            left, amfi_sim_time(sim), (long long)b.sent,
+            stream_stop ? " (stopped by a signal)" : "");
     rc = 0;
     gsl_rng_free(noise);
 out:

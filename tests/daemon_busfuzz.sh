@@ -51,4 +51,9 @@ echo "bus fuzz ($mode): $(cat "$dir/fuzzlog.txt"); amfid exit 0 after $(echo "$t
   "$refused refused; real vehicles: $rows rows, $ok ok of $nveh; rows of mutated vehicles that passed validation: $forged; kernel drops ${drops:-0};" \
   "log lines $(wc -l < "$dir/amfid.log")"
 sed -n 's/.*refused since start: //p' "$dir/amfid.log" | sed 's/^/  refused: /'
+got=$(sed -n 's/.*stopped: .* \([0-9]*\) messages received.*/\1/p' "$dir/amfid.log")
+sent=$(sed -n 's/^\([0-9]*\) real events, \([0-9]*\) mutated.*/\1 \2/p' "$dir/fuzzlog.txt" | awk '{print $1 + $2}')
+echo "  messages: $sent sent, $got reached amfid's handlers, kernel drops ${drops:-0}"
+grep "stopped:" "$dir/amfid.log" | sed "s/^/  /"
+echo "  real vehicles by status: $(sqlite3 "$dir/a.db" "SELECT group_concat(s, ', ') FROM (SELECT status || ' ' || count(*) || ' (' || substr(min(reason), 1, 60) || ')' s FROM passages WHERE vehicle_id BETWEEN 1 AND $nveh GROUP BY status)")"
 [ "$rows" -eq "$nveh" ] || fail "$rows of $nveh real vehicles have rows"
