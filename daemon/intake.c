@@ -49,7 +49,9 @@ void release_windows(daemon_s *d, int flush)
         j->gvw_kg = NAN;
         /* everything the solver thread reads travels with the job */
         j->lambda = d->cfg.lambda;
-        j->scan_rate_hz = amfi_ring_rate(d->rings[0]);
+        /* an ok window has data from every sensor; the others (gap: a
+         * sensor that never sent a block) may have no ring at all */
+        j->scan_rate_hz = d->rings[0] ? amfi_ring_rate(d->rings[0]) : 0.0;
         snprintf(j->status, sizeof j->status, "%s", w.status);
         snprintf(j->reason, sizeof j->reason, "%s", w.reason);
         if (strcmp(w.status, "ok") == 0) {

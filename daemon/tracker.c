@@ -114,6 +114,7 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
     out->status = "ok";
     /* Decide: all data present, data gone, or waited long enough. */
     int complete = 1, gone = 0, jumping = 0;
+    const amfi_ring *gone_ring = NULL; /* a ring whose data left before t0 */
     int64_t restart_utime = 0;
     double newest_us = -INFINITY;
     int n = -1;
@@ -131,8 +132,10 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
         newest_us = fmax(newest_us, amfi_ring_utime(r, amfi_ring_newest(r)));
         if (amfi_ring_newest(r) < k1)
             complete = 0;
-        if (k0 < amfi_ring_oldest(r))
+        if (k0 < amfi_ring_oldest(r)) {
             gone = 1;
+            gone_ring = r;
+        }
         jumping |= amfi_ring_jump_pending(r);
         const amfi_ring_stats *st = amfi_ring_stats_of(r);
         if (st->restarts > 0 && st->restart_utime > restart_utime)
@@ -154,7 +157,7 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
         snprintf(out->reason, sizeof out->reason,
                  "the data for this passage had left the ring (window starts %.3f s before "
                  "the oldest sample held)",
-                 1e-6 * (amfi_ring_utime(rings[0], amfi_ring_oldest(rings[0])) - t0));
+                 1e-6 * (amfi_ring_utime(gone_ring, amfi_ring_oldest(gone_ring)) - t0));
     } else if (!complete) {
         out->status = "gap";
         snprintf(out->reason, sizeof out->reason, "%s",

@@ -62,6 +62,9 @@ export AMFI_DATA_DIR="${AMFI_DATA_DIR:-$top/sim_publisher/data}"
 "$build/tests/lcm_intake_seed" "$tmpd/a.lcmlog" "$c/intake/two-vehicles"
 # the same cut after its first 12 events (vehicles whose data never comes)
 "$build/tests/lcm_intake_seed" "$tmpd/a.lcmlog" "$c/intake/cut-short" 12
+# its vehicles without any sensor data (found by fuzz_intake: amfid crashed at shutdown)
+"$build/tests/lcm_inject" --vehicles-only "$tmpd/a.lcmlog" "$tmpd/v.lcmlog"
+"$build/tests/lcm_intake_seed" "$tmpd/v.lcmlog" "$c/intake/vehicles-without-data"
 # a dozen vehicles sampled at 200 Hz: enough for the baseline and a window
 "$sim" --lcm-url none --log "$tmpd/b.lcmlog" --vehicles 12 --headway 2.5 --speedup max --seed 4 \
   --block 160 --scan-rate 200 2>/dev/null

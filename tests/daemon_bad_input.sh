@@ -27,3 +27,14 @@ sqlite3 "$dir/a.db" "SELECT status FROM passages WHERE vehicle_id = 424242" | gr
 [ "$(sqlite3 "$dir/a.db" "SELECT count(*) FROM passages WHERE status = 'ok'")" -eq 3 ] ||
   fail "the three real vehicles are not all ok"
 echo "bad input: $(grep -c 'rejected' "$dir/amfid.log") rejections logged, 3 vehicles ok, 1 invalid stored"
+
+# Vehicles and no sensor data at all (the DAQ is down): each vehicle is
+# stored as gap with its reason, and amfid stops cleanly (it used to crash
+# at shutdown reading the sample rate of a sensor that never sent a block).
+"$inject" --vehicles-only "$dir/clean.log" "$dir/novdata.log" || fail "lcm_inject --vehicles-only"
+"$amfid" --config "$config" --db "$dir/b.db" --lcm-url "file://$dir/novdata.log?speed=0" \
+  2> "$dir/amfid.log"; rc=$?
+[ $rc -eq 0 ] || fail "amfid on vehicles without data: exit status $rc"
+[ "$(sqlite3 "$dir/b.db" "SELECT count(*) FROM passages WHERE status = 'gap' AND reason <> ''")" -eq 3 ] ||
+  fail "vehicles without data: $(sqlite3 "$dir/b.db" "SELECT status, reason FROM passages")"
+echo "vehicles without sensor data: 3 stored as gap, clean stop"

@@ -8,6 +8,12 @@
  *   from sensor 99; the 60th and 61st accel events swapped (out of order).
  *
  *   lcm_inject IN.log OUT.log
+ *
+ * With --vehicles-only, OUT.log gets IN.log's AMFI_VEHICLE events and
+ * nothing else: vehicles whose sensor data never comes (a DAQ that is down;
+ * fuzz_intake found amfid crashing on it at shutdown).
+ *
+ *   lcm_inject --vehicles-only IN.log OUT.log
  */
 #include <lcm/eventlog.h>
 #include <stdio.h>
@@ -22,10 +28,39 @@ static int put(lcm_eventlog_t *out, int64_t *num, int64_t ts, const char *ch, vo
     return lcm_eventlog_write_event(out, &e);
 }
 
+static int vehicles_only(const char *inp, const char *outp)
+{
+    lcm_eventlog_t *in = lcm_eventlog_create(inp, "r");
+    lcm_eventlog_t *out = lcm_eventlog_create(outp, "w");
+    if (!in || !out) {
+        fprintf(stderr, "lcm_inject: cannot open the logs\n");
+        return 1;
+    }
+    lcm_eventlog_event_t *e;
+    int64_t num = 0;
+    int rc = 0, n = 0;
+    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
+        if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0) {
+            rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
+            n++;
+        }
+        lcm_eventlog_free_event(e);
+    }
+    lcm_eventlog_destroy(in);
+    lcm_eventlog_destroy(out);
+    if (rc || n == 0) {
+        fprintf(stderr, "lcm_inject: %s\n", rc ? "write failed" : "no vehicle in the log");
+        return 1;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 4 && strcmp(argv[1], "--vehicles-only") == 0)
+        return vehicles_only(argv[2], argv[3]);
     if (argc != 3) {
-        fprintf(stderr, "usage: lcm_inject IN.log OUT.log\n");
+        fprintf(stderr, "usage: lcm_inject [--vehicles-only] IN.log OUT.log\n");
         return 2;
     }
     lcm_eventlog_t *in = lcm_eventlog_create(argv[1], "r");
