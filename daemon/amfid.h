@@ -108,6 +108,8 @@ typedef struct daemon_s {
     int64_t passages_lost;         /* held queue overflowed (each logged) */
     double retry_at, retry_wait;   /* amfid_mono_s() of the next try; backoff */
     int degraded;
+    int64_t degraded_utime;        /* data time the store_degraded alert was raised */
+    char degraded_msg[1024];       /* its message, stored once the store writes again */
     char last_error[256];
     const char *state;
 } daemon_s;

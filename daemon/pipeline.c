@@ -142,9 +142,26 @@ static int store_now(daemon_s *d, job *j)
     return 0;
 }
 
+/* The store_degraded alert. Raised, it cannot be stored (that is what it
+ * says): it is published and logged, and its time and text are kept; once
+ * the store takes writes again, the raise and the clear are both written to
+ * the alerts table, so that the store's history shows the outage. */
 static void publish_store_alert(daemon_s *d, int raised, const char *msg)
 {
-    amfi_alert_t m = {d->newest_utime, 0, (char *)"warning", (char *)"store_degraded",
+    int64_t aid = 0;
+    int64_t now = d->newest_utime > 0 ? d->newest_utime : 0;
+    if (raised) {
+        d->degraded_utime = now;
+        snprintf(d->degraded_msg, sizeof d->degraded_msg, "%s", msg);
+    } else {
+        char err[256];
+        if (amfi_store_add_alert(d->store, d->degraded_utime, "warning", "store_degraded",
+                                 d->degraded_msg, 0, 1, NULL, err, sizeof err) ||
+            amfi_store_add_alert(d->store, now, "warning", "store_degraded", msg, 0, 0, &aid,
+                                 err, sizeof err))
+            set_error(d, "store: the store_degraded alert: %s", err);
+    }
+    amfi_alert_t m = {now, aid, (char *)"warning", (char *)"store_degraded",
                       (char *)msg, 0, (int8_t)raised, d->cfg.site.id};
     amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
     if (raised)
@@ -155,7 +172,7 @@ static void publish_store_alert(daemon_s *d, int raised, const char *msg)
 
 static void set_degraded(daemon_s *d, int on)
 {
-    char msg[1200];
+    char msg[1000];
     if (on && !d->degraded) {
         d->degraded = 1;
         d->state = "degraded";

@@ -36,6 +36,8 @@ wait $pid; rc=$?
 [ "$rc" -eq 0 ] || fail "amfid exit status $rc"
 grep -q "ALERT store_degraded" "$dir/amfid.log" || fail "no store_degraded alert (disk free $full kB when full)"
 grep -q "alert cleared store_degraded" "$dir/amfid.log" || fail "the store_degraded alert was not cleared"
+al=$(sqlite3 "$dir/mnt/a.db" "SELECT group_concat(raised, '') FROM (SELECT raised FROM alerts WHERE kind = 'store_degraded' ORDER BY id)")
+[ "$al" = 10 ] || fail "the alerts table should hold the store_degraded raise and clear (raised column '10'), got '$al'"
 n=$(sqlite3 "$dir/mnt/a.db" "SELECT count(*) FROM passages")
 [ "$n" -eq 16 ] || fail "$n of 16 vehicles stored"
 [ "$(sqlite3 "$dir/mnt/a.db" "PRAGMA integrity_check")" = ok ] || fail "integrity_check"
