@@ -10,6 +10,7 @@
  *   section_daemon.c             daemon:
  *   section_simulation.c         simulation:
  *   section_site.c               site:
+ *   section_ops.c                alerts:, metrics:
  *   model_check.c                the bridge built, the solver's workspace bounded
  *
  * and holds the defaults, the order of the checks that run once the whole
@@ -41,6 +42,8 @@ static const field top_fields[] = {
     {.key = "solver", .kind = &K_MAP, .aux = solver_fields},
     {.key = "daemon", .kind = &K_MAP, .aux = daemon_fields},
     {.key = "simulation", .kind = &K_MAP, .aux = sim_fields},
+    {.key = "alerts", .kind = &K_MAP, .aux = alerts_fields},
+    {.key = "metrics", .kind = &K_MAP, .aux = metrics_fields},
     {.key = NULL}};
 
 /* Checks that involve several keys, once the whole file is read; each finds
@@ -52,7 +55,7 @@ static int check_site(ctx *x, void *base)
     amfi_site_config *c = base;
 
     if (bridge_check(x, c) || sensors_check(x, c) || solver_check(x, c) ||
-        daemon_check(x, c) || sim_check(x, c) || site_check(x, c))
+        daemon_check(x, c) || sim_check(x, c) || site_check(x, c) || ops_check(x, c))
         return -1;
     return model_check(x, c);
 }
@@ -93,6 +96,9 @@ void amfi_config_defaults(amfi_site_config *c)
     d->margin_s = 0.05;
     d->max_wait_s = 10.0;
     d->status_period_s = 1.0;
+    d->alert_timeout_s = 30.0;
+    d->alert_max_running = 4;
+    d->metrics_interval_s = 15.0;
     /* The engine's defaults (docs/indicators.md has the simulation behind
      * each value); set field by field, so the padding stays zero. */
     amfi_indicator_params_default(&d->indicators);

@@ -45,6 +45,12 @@ typedef struct amfi_daemon_config {
     double margin_s;          /* daemon.window_margin_s: data around the solver window */
     double max_wait_s;        /* daemon.max_wait_s: data time to wait for a window */
     double status_period_s;   /* daemon.status_period_s: heartbeat, wall time */
+    char alert_command[512];  /* alerts.command: run for each raised and cleared alert;
+                                 "" none */
+    double alert_timeout_s;   /* alerts.command_timeout_s: killed after, (0, 3600] */
+    int alert_max_running;    /* alerts.command_max_running: at once, 1 .. 64 */
+    char metrics_path[512];   /* metrics.textfile: Prometheus text file; "" off */
+    double metrics_interval_s; /* metrics.interval_s: rewritten every, [1, 3600] */
     /* daemon.indicators.*: the indicator engine's own parameters
      * (indicators.h, docs/indicators.md), its defaults from
      * amfi_indicator_params_default() and checked, at load, by

@@ -12,6 +12,7 @@
  *   section_daemon.c      daemon:      amfid's bus, store, threads, indicators
  *   section_simulation.c  simulation:  sim_publisher's settings
  *   section_site.c        site:        which bridge (id, name, position)
+ *   section_ops.c         alerts:, metrics:  notices and health metrics
  *
  * Every function runs on the loader's (caller's) thread.
  */
@@ -39,6 +40,8 @@ extern const field solver_fields[]; /* solver: */
 extern const field daemon_fields[]; /* daemon: */
 extern const field sim_fields[];    /* simulation: */
 extern const field site_fields[];   /* site: */
+extern const field alerts_fields[]; /* alerts: */
+extern const field metrics_fields[]; /* metrics: */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */
 int bridge_free_dofs(const amfi_bridge_params *b);
@@ -51,6 +54,7 @@ int solver_check(ctx *x, amfi_site_config *c);
 int daemon_check(ctx *x, amfi_site_config *c);
 int sim_check(ctx *x, amfi_site_config *c);
 int site_check(ctx *x, amfi_site_config *c);
+int ops_check(ctx *x, amfi_site_config *c);
 
 /* The model itself: the bridge built with libamfi (its refusals reported at
  * the line of the bridge key or section that caused them) and the solver's

@@ -188,6 +188,7 @@ static int start_runtime(daemon_s *d)
     }
     if (claim_site(d))
         return 1;
+    d->metrics.start_wall = (double)time(NULL);
     char abs[PATH_MAX];
     const char *cfg_path = realpath(d->config_path, abs) ? abs : d->config_path;
     if (amfi_store_add_run(d->store, amfi_version(), cfg_path, NULL, err, sizeof err)) {
@@ -283,6 +284,8 @@ int amfid_run(daemon_s *d)
             reject_tick(d);
             last_beat = now;
         }
+        notify_tick(d);
+        metrics_tick(d, 0);
         if (wd && now - last_wd >= 0.5e-6 * (double)wd_usec) {
             sd_notify(0, "WATCHDOG=1");
             last_wd = now;
@@ -306,6 +309,8 @@ int amfid_drain(daemon_s *d)
     }
     heartbeat(d);
     reject_final(d);
+    notify_finish(d);
+    metrics_tick(d, 1);
     if (d->passages_lost > 0)
         rc = 1; /* acknowledged passages are safe; these never were */
     LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld messages received: "
@@ -320,6 +325,7 @@ int amfid_drain(daemon_s *d)
 /* The one tear-down: whatever start_* built, in reverse; NULL-safe. */
 void amfid_stop(daemon_s *d)
 {
+    notify_free(d);
     for (; d->held && d->held_n > 0; d->held_n--) { /* only left on an early error */
         job_free(d->held[d->held_head]);
         d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;

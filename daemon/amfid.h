@@ -78,6 +78,41 @@ typedef struct reject_state {
     double period_start;                                    /* amfid_mono_s() */
 } reject_state;
 
+/* Alert notices (notify.c). */
+#define NOTIFY_MAX_RUNNING 64 /* alerts.command_max_running's upper bound */
+#define NOTIFY_QUEUE 256      /* notices waiting; beyond: dropped, counted */
+struct notice;
+typedef struct notify_state {
+    int pid[NOTIFY_MAX_RUNNING];        /* running children, 0: free slot */
+    double started[NOTIFY_MAX_RUNNING]; /* amfid_mono_s() at spawn */
+    int term_sent[NOTIFY_MAX_RUNNING];  /* SIGTERM sent (timed out) */
+    int running;
+    struct notice *queue[NOTIFY_QUEUE];
+    int qhead, queued;
+    int64_t started_total, ok, failed, timeouts, dropped;
+} notify_state;
+
+/* What the metrics file reports beyond the status counters (metrics.c). */
+#define SOLVE_BUCKETS 12
+#define SOLVE_RECENT 1024
+#define OPEN_KINDS 8
+typedef struct metrics_state {
+    int64_t by_status[16];        /* stored passages per amfi_store_status_name(k) */
+    int64_t solve_le[SOLVE_BUCKETS]; /* solves of at most metrics_solve_bucket(i) s */
+    int64_t solve_count;
+    double solve_sum_s;
+    double recent_s[SOLVE_RECENT]; /* the newest solve times, a ring */
+    int recent_n, recent_at;
+    int have_indicator;
+    double std_ratio, p_value, mean_ratio; /* the newest evaluation */
+    char open_kind[OPEN_KINDS][32];      /* alert kinds seen, and whether open */
+    int open[OPEN_KINDS];
+    double start_wall;            /* time(NULL) at start */
+    double last_write;            /* amfid_mono_s() of the last write */
+    int64_t write_errors;
+    int failing;                  /* the last write failed (logged once) */
+} metrics_state;
+
 typedef struct daemon_s {
     amfi_site_config cfg;
     const char *config_path;
@@ -112,6 +147,8 @@ typedef struct daemon_s {
     char degraded_msg[1024];       /* its message, stored once the store writes again */
     char last_error[256];
     const char *state;
+    notify_state notify;
+    metrics_state metrics;
 } daemon_s;
 
 void set_error(daemon_s *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -175,6 +212,28 @@ void pipeline_drain_results(daemon_s *d);
 void pipeline_retry(daemon_s *d, double final);
 /* The held-queue bound: passages kept while the store cannot write. */
 #define STORE_HOLD_MAX 20000
+
+/* ---- alert notices (notify.c), main thread -------------------------------- */
+
+/* Run (or queue) alerts.command for one raised or cleared alert; no-op
+ * when alerts.command is not set. Never waits. */
+void notify_alert(daemon_s *d, int64_t utime, int64_t alert_id, const char *level,
+                  const char *kind, const char *message, int64_t indicator_id, int raised);
+/* From the loop: reap children, SIGTERM/SIGKILL overdue ones, start queued. */
+void notify_tick(daemon_s *d);
+/* At stop: let running and queued notices finish (each within its timeout). */
+void notify_finish(daemon_s *d);
+/* Tear-down: free the queue, kill what still runs. */
+void notify_free(daemon_s *d);
+
+/* ---- health metrics (metrics.c), main thread ------------------------------- */
+
+/* Account one stored passage (status, solve time) and one alert raise/clear. */
+void metrics_passage(daemon_s *d, const char *status, int solved, double solve_ms);
+void metrics_indicator(daemon_s *d, double std_ratio, double p_value, double mean_ratio);
+void metrics_alert(daemon_s *d, const char *kind, int raised);
+/* Rewrite metrics.textfile when metrics.interval_s has passed (force: now). */
+void metrics_tick(daemon_s *d, int force);
 
 /* ---- configuration, state, heartbeat, reload (control.c), main thread ----- */
 

@@ -75,6 +75,8 @@ void restore_indicator_state(daemon_s *d)
     int open_std = last_alert_raised(d->store, "std_increase");
     int open_mean = last_alert_raised(d->store, "mean_shift");
     amfi_indicators_set_alerted(d->ind, open_std, open_mean);
+    metrics_alert(d, "std_increase", open_std);
+    metrics_alert(d, "mean_shift", open_mean);
     if (open_std || open_mean)
         LOG_INFO("open alerts restored from the store:%s%s", open_std ? " std_increase" : "",
                  open_mean ? " mean_shift" : "");

@@ -91,6 +91,8 @@ static void feed_indicators(daemon_s *d, const job *j)
                               ev.baseline_mean_kg, ev.baseline_std_kg, ev.std_ratio,
                               ev.p_value, (char *)ev.state, d->cfg.site.id};
         amfi_indicator_t_publish(d->lcm, d->cfg.daemon.ch_indicator, &m);
+        metrics_indicator(d, ev.std_ratio, ev.p_value,
+                          ev.baseline_mean_kg > 0 ? ev.mean_kg / ev.baseline_mean_kg : NAN);
     }
     for (int i = 0; (bits & AMFI_IND_ALERT) && i < n_al; i++) {
         int64_t aid = 0;
@@ -100,6 +102,9 @@ static void feed_indicators(daemon_s *d, const job *j)
         amfi_alert_t m = {j->w.v.utime, aid, (char *)al[i].level, (char *)al[i].kind,
                           al[i].message, ind_id, (int8_t)al[i].raised, d->cfg.site.id};
         amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
+        metrics_alert(d, al[i].kind, al[i].raised);
+        notify_alert(d, j->w.v.utime, aid, al[i].level, al[i].kind, al[i].message, ind_id,
+                     al[i].raised);
         if (al[i].raised)
             LOG_WARN("ALERT %s (%s): %s", al[i].kind, al[i].level, al[i].message);
         else
@@ -134,6 +139,7 @@ static int store_now(daemon_s *d, job *j)
         return -1;
     }
     d->passages_stored++;
+    metrics_passage(d, j->status, j->solved, j->solve_ms);
     publish_passage(d, j, id);
     if (j->solved) {
         d->passages_ok++;
@@ -164,6 +170,8 @@ static void publish_store_alert(daemon_s *d, int raised, const char *msg)
     amfi_alert_t m = {now, aid, (char *)"warning", (char *)"store_degraded",
                       (char *)msg, 0, (int8_t)raised, d->cfg.site.id};
     amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
+    metrics_alert(d, "store_degraded", raised);
+    notify_alert(d, now, aid, "warning", "store_degraded", msg, 0, raised);
     if (raised)
         LOG_ERR("ALERT store_degraded (warning): %s", msg);
     else

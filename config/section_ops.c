@@ -1,0 +1,67 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * section_ops.c: the alerts: and metrics: sections of a site file, what
+ * amfid tells the people and programs that watch it: a program run for
+ * every raised and cleared alert (alerts.command, like smartd's -M exec),
+ * and its counters in Prometheus' text format for node-exporter's textfile
+ * collector (metrics.textfile). Both are off by default. Runs on the
+ * loader's thread.
+ */
+#include "sections.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define OPS(m) offsetof(amfi_site_config, daemon.m)
+#define OPS_CAP(m) sizeof(((amfi_daemon_config *)0)->m)
+
+const field alerts_fields[] = {
+    {.key = "command", .kind = &K_PATH, .off = OPS(alert_command), .hi = OPS_CAP(alert_command)},
+    {.key = "command_timeout_s", .kind = &K_DOUBLE, .off = OPS(alert_timeout_s), .lo = 0,
+     .hi = 3600, .flags = F_LO_OPEN},
+    {.key = "command_max_running", .kind = &K_INT, .off = OPS(alert_max_running), .lo = 1,
+     .hi = 64},
+    {.key = NULL}};
+
+const field metrics_fields[] = {
+    {.key = "textfile", .kind = &K_PATH, .off = OPS(metrics_path), .hi = OPS_CAP(metrics_path)},
+    {.key = "interval_s", .kind = &K_DOUBLE, .off = OPS(metrics_interval_s), .lo = 1,
+     .hi = 3600},
+    {.key = NULL}};
+
+/* The command must be a program amfid can run now (absolute: amfid runs
+ * from / under systemd); the metrics file must be an absolute path whose
+ * folder exists (node-exporter reads *.prom files there). */
+int ops_check(ctx *x, amfi_site_config *c)
+{
+    const char *cmd = c->daemon.alert_command;
+    const char *prom = c->daemon.metrics_path;
+    struct stat st;
+
+    if (cmd[0]) {
+        int line = noted(x, "alerts.command");
+        if (cmd[0] != '/')
+            return fail(x, line, "alerts.command", "must be an absolute path, got '%s'", cmd);
+        if (stat(cmd, &st) != 0 || !S_ISREG(st.st_mode))
+            return fail(x, line, "alerts.command", "'%s' is not a file", cmd);
+        if (access(cmd, X_OK) != 0)
+            return fail(x, line, "alerts.command", "'%s' is not executable", cmd);
+    }
+    if (prom[0]) {
+        int line = noted(x, "metrics.textfile");
+        const char *slash = strrchr(prom, '/');
+        char dir[sizeof c->daemon.metrics_path];
+        if (prom[0] != '/')
+            return fail(x, line, "metrics.textfile", "must be an absolute path, got '%s'", prom);
+        size_t n = (size_t)(slash - prom);
+        memcpy(dir, prom, n ? n : 1);
+        dir[n ? n : 1] = '\0';
+        if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+            return fail(x, line, "metrics.textfile", "the folder '%s' does not exist", dir);
+        if (!slash[1])
+            return fail(x, line, "metrics.textfile", "'%s' names a folder, not a file", prom);
+    }
+    return 0;
+}

@@ -1,0 +1,246 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * metrics.c: amfid's health in Prometheus' text exposition format (version
+ * 0.0.4), written to metrics.textfile for node-exporter's textfile collector
+ * (amfid.yaml(5), section metrics; docs/daemon.md, "Health metrics"):
+ * passages by status, refused messages by input and reason, messages
+ * received, queue depth, held and lost passages, solve times (a histogram
+ * and the quantiles of the newest 1024), the newest indicator values, open
+ * alerts by kind, notices, uptime and the build. The file is written whole
+ * to a temporary file in the same folder, synced and renamed over the old
+ * one, so a reader never sees half of it; a failed write is logged once
+ * (until a write succeeds again) and counted.
+ *
+ * Thread: the main thread only; the counters it reads are the main thread's.
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "amfid.h"
+
+/* Upper bounds of the solve-time histogram, s. */
+static const double bucket_s[SOLVE_BUCKETS] = {0.002, 0.005, 0.01, 0.02, 0.05, 0.1,
+                                               0.2,   0.5,   1.0,  2.0,  5.0,  10.0};
+
+void metrics_passage(daemon_s *d, const char *status, int solved, double solve_ms)
+{
+    metrics_state *m = &d->metrics;
+    for (int k = 0; k < AMFI_STORE_N_STATUS; k++)
+        if (strcmp(status, amfi_store_status_name(k)) == 0)
+            m->by_status[k]++;
+    if (!solved || !(solve_ms >= 0))
+        return;
+    double s = 1e-3 * solve_ms;
+    for (int i = 0; i < SOLVE_BUCKETS; i++)
+        if (s <= bucket_s[i])
+            m->solve_le[i]++;
+    m->solve_count++;
+    m->solve_sum_s += s;
+    m->recent_s[m->recent_at] = s;
+    m->recent_at = (m->recent_at + 1) % SOLVE_RECENT;
+    if (m->recent_n < SOLVE_RECENT)
+        m->recent_n++;
+}
+
+void metrics_indicator(daemon_s *d, double std_ratio, double p_value, double mean_ratio)
+{
+    metrics_state *m = &d->metrics;
+    m->have_indicator = 1;
+    m->std_ratio = std_ratio;
+    m->p_value = p_value;
+    m->mean_ratio = mean_ratio;
+}
+
+void metrics_alert(daemon_s *d, const char *kind, int raised)
+{
+    metrics_state *m = &d->metrics;
+    for (int i = 0; i < OPEN_KINDS; i++) {
+        if (!m->open_kind[i][0])
+            snprintf(m->open_kind[i], sizeof m->open_kind[i], "%s", kind);
+        if (strcmp(m->open_kind[i], kind) == 0) {
+            m->open[i] = raised != 0;
+            return;
+        }
+    }
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* A label value as the format wants it: \ " and newline escaped. */
+static void put_label(FILE *f, const char *s)
+{
+    for (; *s; s++) {
+        if (*s == '\\' || *s == '"')
+            fputc('\\', f), fputc(*s, f);
+        else if (*s == '\n')
+            fputs("\\n", f);
+        else
+            fputc(*s, f);
+    }
+}
+
+static void head(FILE *f, const char *name, const char *type, const char *help)
+{
+    fprintf(f, "# HELP %s %s\n# TYPE %s %s\n", name, help, name, type);
+}
+
+/* The value of a sample line (after its name and labels), NaN spelt as
+ * the format wants it. */
+static void put_value(FILE *f, double v)
+{
+    if (isnan(v))
+        fputs("NaN\n", f);
+    else
+        fprintf(f, "%.17g\n", v);
+}
+
+static void sample(FILE *f, const char *name, double v)
+{
+    fprintf(f, "%s ", name);
+    put_value(f, v);
+}
+
+static void write_all(daemon_s *d, FILE *f)
+{
+    const metrics_state *m = &d->metrics;
+    head(f, "amfi_build_info", "gauge", "amfid's version and site (value 1).");
+    fputs("amfi_build_info{version=\"", f);
+    put_label(f, amfi_version());
+    fputs("\",site=\"", f);
+    put_label(f, d->cfg.site.id);
+    fputs("\"} 1\n", f);
+    head(f, "amfi_start_time_seconds", "gauge", "Start of this amfid, Unix time.");
+    sample(f, "amfi_start_time_seconds", m->start_wall);
+    head(f, "amfi_uptime_seconds", "gauge", "Seconds since this amfid started.");
+    sample(f, "amfi_uptime_seconds", (double)time(NULL) - m->start_wall);
+    head(f, "amfi_state", "gauge", "amfid's state (the status message's), 1 for the current one.");
+    static const char *const states[] = {"starting", "running", "degraded", "draining"};
+    for (int i = 0; i < 4; i++)
+        fprintf(f, "amfi_state{state=\"%s\"} %d\n", states[i],
+                d->state && strcmp(d->state, states[i]) == 0);
+
+    head(f, "amfi_passages_total", "counter", "Passages stored since start, by status.");
+    for (int k = 0; k < AMFI_STORE_N_STATUS; k++)
+        fprintf(f, "amfi_passages_total{status=\"%s\"} %lld\n", amfi_store_status_name(k),
+                (long long)m->by_status[k]);
+    head(f, "amfi_passages_lost_total", "counter",
+         "Passages not stored (held queue full, or the store refused at shutdown).");
+    fprintf(f, "amfi_passages_lost_total %lld\n", (long long)d->passages_lost);
+    head(f, "amfi_passages_held", "gauge", "Passages held because the store cannot write.");
+    fprintf(f, "amfi_passages_held %d\n", d->held_n);
+    head(f, "amfi_queue_depth", "gauge", "Passages waiting for a solver thread.");
+    fprintf(f, "amfi_queue_depth %d\n", queue_depth(&d->pool.jobs));
+
+    head(f, "amfi_messages_received_total", "counter",
+         "Bus messages the input channels handed to amfid.");
+    fprintf(f, "amfi_messages_received_total %lld\n", (long long)d->messages_in);
+    head(f, "amfi_messages_refused_total", "counter",
+         "Bus messages refused, by input and reason.");
+    static const char *const inputs[REJECT_NINPUTS] = {"accel", "vehicle", "truth"};
+    for (int i = 0; i < REJECT_NINPUTS; i++)
+        for (int k = 0; k < REJECT_NREASONS; k++)
+            if (d->rej.count[i][k] > 0)
+                fprintf(f, "amfi_messages_refused_total{input=\"%s\",reason=\"%s\"} %lld\n",
+                        inputs[i], reject_reason_name(k), (long long)d->rej.count[i][k]);
+    head(f, "amfi_datagrams_dropped_total", "counter",
+         "UDP datagrams the kernel dropped on amfid's sockets.");
+    fprintf(f, "amfi_datagrams_dropped_total %lld\n",
+            (long long)(d->udp_drops > 0 ? d->udp_drops : 0));
+
+    head(f, "amfi_solve_seconds", "histogram", "Wall time of the solves since start.");
+    for (int i = 0; i < SOLVE_BUCKETS; i++)
+        fprintf(f, "amfi_solve_seconds_bucket{le=\"%g\"} %lld\n", bucket_s[i],
+                (long long)m->solve_le[i]);
+    fprintf(f, "amfi_solve_seconds_bucket{le=\"+Inf\"} %lld\n", (long long)m->solve_count);
+    fprintf(f, "amfi_solve_seconds_sum %.9g\n", m->solve_sum_s);
+    fprintf(f, "amfi_solve_seconds_count %lld\n", (long long)m->solve_count);
+    head(f, "amfi_solve_recent_seconds", "summary",
+         "Quantiles of the newest 1024 solve times.");
+    double q[SOLVE_RECENT];
+    double sum = 0;
+    for (int i = 0; i < m->recent_n; i++)
+        sum += (q[i] = m->recent_s[i]);
+    qsort(q, (size_t)m->recent_n, sizeof q[0], cmp_double);
+    static const double qs[] = {0.5, 0.9, 0.99};
+    for (int i = 0; i < 3; i++) {
+        fprintf(f, "amfi_solve_recent_seconds{quantile=\"%g\"} ", qs[i]);
+        put_value(f, m->recent_n ? q[(int)floor(qs[i] * (m->recent_n - 1) + 0.5)] : NAN);
+    }
+    fprintf(f, "amfi_solve_recent_seconds_sum %.9g\n", sum);
+    fprintf(f, "amfi_solve_recent_seconds_count %d\n", m->recent_n);
+
+    head(f, "amfi_indicator_std_ratio", "gauge",
+         "Window STD over baseline STD at the newest evaluation (NaN: none yet).");
+    sample(f, "amfi_indicator_std_ratio", m->have_indicator ? m->std_ratio : NAN);
+    head(f, "amfi_indicator_p_value", "gauge",
+         "Variance-ratio test p-value at the newest evaluation (NaN: none yet).");
+    sample(f, "amfi_indicator_p_value", m->have_indicator ? m->p_value : NAN);
+    head(f, "amfi_indicator_mean_ratio", "gauge",
+         "Window mean over baseline mean at the newest evaluation (NaN: none yet).");
+    sample(f, "amfi_indicator_mean_ratio", m->have_indicator ? m->mean_ratio : NAN);
+    head(f, "amfi_alert_open", "gauge", "1 while an alert of this kind is raised.");
+    for (int i = 0; i < OPEN_KINDS && m->open_kind[i][0]; i++)
+        fprintf(f, "amfi_alert_open{kind=\"%s\"} %d\n", m->open_kind[i], m->open[i]);
+
+    head(f, "amfi_notices_total", "counter", "Alert notices (alerts.command) by result.");
+    const notify_state *ns = &d->notify;
+    fprintf(f, "amfi_notices_total{result=\"ok\"} %lld\n", (long long)ns->ok);
+    fprintf(f, "amfi_notices_total{result=\"failed\"} %lld\n", (long long)ns->failed);
+    fprintf(f, "amfi_notices_total{result=\"timeout\"} %lld\n", (long long)ns->timeouts);
+    fprintf(f, "amfi_notices_total{result=\"dropped\"} %lld\n", (long long)ns->dropped);
+    head(f, "amfi_notices_running", "gauge", "Alert notices running now.");
+    fprintf(f, "amfi_notices_running %d\n", ns->running);
+    head(f, "amfi_metrics_write_errors_total", "counter",
+         "Failed writes of this file (the previous file stays).");
+    fprintf(f, "amfi_metrics_write_errors_total %lld\n", (long long)m->write_errors);
+}
+
+void metrics_tick(daemon_s *d, int force)
+{
+    metrics_state *m = &d->metrics;
+    const char *path = d->cfg.daemon.metrics_path;
+    if (!path[0])
+        return;
+    double now = amfid_mono_s();
+    if (!force && m->last_write > 0 && now - m->last_write < d->cfg.daemon.metrics_interval_s)
+        return;
+    m->last_write = now;
+    char tmp[sizeof d->cfg.daemon.metrics_path + 32];
+    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
+    FILE *f = fopen(tmp, "w");
+    int ok = f != NULL;
+    if (ok) {
+        /* node-exporter runs as another user (prometheus); the unit's
+         * UMask=0027 would hide the file from it */
+        fchmod(fileno(f), 0644);
+        write_all(d, f);
+        ok = fflush(f) == 0 && fsync(fileno(f)) == 0;
+        ok = (fclose(f) == 0) && ok;
+        ok = ok && rename(tmp, path) == 0;
+    }
+    if (ok) {
+        if (m->failing)
+            LOG_INFO("metrics: %s written again", path);
+        m->failing = 0;
+        return;
+    }
+    int e = errno;
+    if (f)
+        unlink(tmp);
+    m->write_errors++;
+    if (!m->failing)
+        LOG_ERR("metrics: cannot write %s: %s (retried every %.0f s; logged once)", path,
+                strerror(e), d->cfg.daemon.metrics_interval_s);
+    m->failing = 1;
+}

@@ -1,0 +1,217 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * notify.c: alert notices: alerts.command run for every raised and cleared
+ * alert (amfid.yaml(5), section alerts; like smartd's -M exec), with the
+ * alert in its environment, never blocking the pipeline: posix_spawn without
+ * a shell, at most alerts.command_max_running at once, the rest queued (256,
+ * beyond: dropped and counted), children reaped from the loop with waitpid
+ * (WNOHANG), SIGTERM at alerts.command_timeout_s and SIGKILL 5 s later; every
+ * failure (exit status, signal, timeout, spawn error) logged and counted.
+ *
+ * Thread: the main thread only (the pipeline raises alerts there; the loop
+ * calls notify_tick). Owns the queued environments and the child table.
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+
+#include "amfid.h"
+
+#define KILL_AFTER_S 5.0 /* SIGKILL this long after SIGTERM */
+
+struct notice {
+    char *envp[16];
+    char text[2048 + 1024]; /* the strings envp points into */
+};
+
+/* One environment string "NAME=value" appended to n; control characters
+ * of the value (a message is free text) become spaces. */
+static void put_env(struct notice *n, int *k, size_t *used, const char *name, const char *val)
+{
+    size_t cap = sizeof n->text - *used;
+    int w = snprintf(n->text + *used, cap, "%s=%s", name, val ? val : "");
+    if (w < 0 || (size_t)w >= cap || *k >= 15)
+        return;
+    char *s = n->text + *used;
+    for (char *p = s + strlen(name) + 1; *p; p++)
+        if ((unsigned char)*p < 0x20)
+            *p = ' ';
+    n->envp[(*k)++] = s;
+    n->envp[*k] = NULL;
+    *used += (size_t)w + 1;
+}
+
+static int start_child(daemon_s *d, struct notice *n)
+{
+    notify_state *ns = &d->notify;
+    char *argv[] = {d->cfg.daemon.alert_command, NULL};
+    posix_spawn_file_actions_t fa;
+    pid_t pid;
+    int rc;
+
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    rc = posix_spawn(&pid, argv[0], &fa, NULL, argv, n->envp);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0) {
+        ns->failed++;
+        LOG_ERR("alert notice: cannot run %s: %s", argv[0], strerror(rc));
+        return -1;
+    }
+    for (int i = 0; i < NOTIFY_MAX_RUNNING; i++)
+        if (ns->pid[i] == 0) {
+            ns->pid[i] = pid;
+            ns->started[i] = amfid_mono_s();
+            ns->term_sent[i] = 0;
+            ns->running++;
+            ns->started_total++;
+            return 0;
+        }
+    return 0; /* not reached: callers keep running < the table's size */
+}
+
+void notify_alert(daemon_s *d, int64_t utime, int64_t alert_id, const char *level,
+                  const char *kind, const char *message, int64_t indicator_id, int raised)
+{
+    notify_state *ns = &d->notify;
+    if (!d->cfg.daemon.alert_command[0])
+        return;
+    struct notice *n = calloc(1, sizeof *n);
+    if (!n) {
+        ns->dropped++;
+        LOG_ERR("alert notice: out of memory; %s %s not notified", kind,
+                raised ? "raise" : "clear");
+        return;
+    }
+    char num[32], iso[40];
+    int k = 0;
+    size_t used = 0;
+    time_t sec = (time_t)(utime / 1000000);
+    struct tm tm;
+    gmtime_r(&sec, &tm);
+    strftime(iso, sizeof iso, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    snprintf(num, sizeof num, "%lld", (long long)alert_id);
+    put_env(n, &k, &used, "AMFI_ALERT_ID", num);
+    put_env(n, &k, &used, "AMFI_ALERT_KIND", kind);
+    put_env(n, &k, &used, "AMFI_ALERT_LEVEL", level);
+    put_env(n, &k, &used, "AMFI_ALERT_RAISED", raised ? "1" : "0");
+    put_env(n, &k, &used, "AMFI_ALERT_MESSAGE", message);
+    snprintf(num, sizeof num, "%lld", (long long)utime);
+    put_env(n, &k, &used, "AMFI_ALERT_UTIME", num);
+    put_env(n, &k, &used, "AMFI_ALERT_TIME", iso);
+    snprintf(num, sizeof num, "%lld", (long long)indicator_id);
+    put_env(n, &k, &used, "AMFI_ALERT_INDICATOR_ID", num);
+    put_env(n, &k, &used, "AMFI_SITE_ID", d->cfg.site.id);
+    put_env(n, &k, &used, "AMFI_SITE_NAME", d->cfg.site.name);
+    put_env(n, &k, &used, "AMFI_DB", d->cfg.daemon.db_path);
+    const char *path = getenv("PATH");
+    put_env(n, &k, &used, "PATH", path ? path : "/usr/sbin:/usr/bin:/sbin:/bin");
+    if (ns->running < d->cfg.daemon.alert_max_running && ns->queued == 0) {
+        start_child(d, n);
+        free(n);
+        return;
+    }
+    if (ns->queued >= NOTIFY_QUEUE) {
+        ns->dropped++;
+        LOG_ERR("alert notice: %d notices waiting; %s %s (alert %lld) dropped", NOTIFY_QUEUE,
+                kind, raised ? "raise" : "clear", (long long)alert_id);
+        free(n);
+        return;
+    }
+    ns->queue[(ns->qhead + ns->queued) % NOTIFY_QUEUE] = n;
+    ns->queued++;
+}
+
+/* A child ended: count and log how. */
+static void ended(daemon_s *d, int i, int status)
+{
+    notify_state *ns = &d->notify;
+    const char *cmd = d->cfg.daemon.alert_command;
+    if (ns->term_sent[i]) {
+        ns->timeouts++;
+        LOG_ERR("alert notice: %s killed after %.0f s (alerts.command_timeout_s)", cmd,
+                d->cfg.daemon.alert_timeout_s);
+    } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+        ns->ok++;
+    } else {
+        ns->failed++;
+        if (WIFEXITED(status))
+            LOG_ERR("alert notice: %s exited %d", cmd, WEXITSTATUS(status));
+        else
+            LOG_ERR("alert notice: %s ended by signal %d", cmd,
+                    WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    }
+    ns->pid[i] = 0;
+    ns->running--;
+}
+
+void notify_tick(daemon_s *d)
+{
+    notify_state *ns = &d->notify;
+    if (ns->running == 0 && ns->queued == 0)
+        return;
+    double now = amfid_mono_s();
+    for (int i = 0; i < NOTIFY_MAX_RUNNING; i++) {
+        if (ns->pid[i] == 0)
+            continue;
+        int status = 0;
+        pid_t r = waitpid(ns->pid[i], &status, WNOHANG);
+        if (r == ns->pid[i] || (r < 0 && errno == ECHILD)) {
+            ended(d, i, status);
+            continue;
+        }
+        double age = now - ns->started[i];
+        if (!ns->term_sent[i] && age > d->cfg.daemon.alert_timeout_s) {
+            kill(ns->pid[i], SIGTERM);
+            ns->term_sent[i] = 1;
+        } else if (ns->term_sent[i] && age > d->cfg.daemon.alert_timeout_s + KILL_AFTER_S) {
+            kill(ns->pid[i], SIGKILL);
+        }
+    }
+    while (ns->queued > 0 && ns->running < d->cfg.daemon.alert_max_running) {
+        struct notice *n = ns->queue[ns->qhead];
+        ns->queue[ns->qhead] = NULL;
+        ns->qhead = (ns->qhead + 1) % NOTIFY_QUEUE;
+        ns->queued--;
+        start_child(d, n);
+        free(n);
+    }
+}
+
+void notify_finish(daemon_s *d)
+{
+    notify_state *ns = &d->notify;
+    if (ns->running == 0 && ns->queued == 0)
+        return;
+    LOG_INFO("waiting for %d alert notice(s) (%d queued), at most %.0f s", ns->running,
+             ns->queued, d->cfg.daemon.alert_timeout_s + KILL_AFTER_S);
+    while (ns->running > 0 || ns->queued > 0) {
+        notify_tick(d);
+        struct timespec ts = {0, 20000000};
+        nanosleep(&ts, NULL);
+    }
+}
+
+void notify_free(daemon_s *d)
+{
+    notify_state *ns = &d->notify;
+    for (; ns->queued > 0; ns->queued--) {
+        free(ns->queue[ns->qhead]);
+        ns->queue[ns->qhead] = NULL;
+        ns->qhead = (ns->qhead + 1) % NOTIFY_QUEUE;
+    }
+    for (int i = 0; i < NOTIFY_MAX_RUNNING; i++)
+        if (ns->pid[i] > 0) {
+            kill(ns->pid[i], SIGKILL);
+            waitpid(ns->pid[i], NULL, 0);
+            ns->pid[i] = 0;
+        }
+    ns->running = 0;
+}
