@@ -112,29 +112,50 @@ static void feed_indicators(daemon_s *d, const job *j)
     }
 }
 
+/* The row of a job. */
+static void job_row(const daemon_s *d, const job *j, amfi_passage_row *r)
+{
+    memset(r, 0, sizeof *r);
+    r->vehicle_id = j->w.v.vehicle_id;
+    r->utime = j->w.v.utime;
+    r->lane = j->w.v.lane;
+    r->speed_mps = j->w.v.speed_mps;
+    r->n_axles = j->w.v.n_axles;
+    for (int a = 0; a + 1 < r->n_axles; a++)
+        r->spacing_m[a] = j->w.v.spacing_m[a];
+    for (int a = 0; a < r->n_axles; a++)
+        r->axle_kg[a] = j->solved ? j->axle_kg[a] : NAN;
+    r->gvw_kg = j->solved ? j->gvw_kg : NAN;
+    r->status = j->status;
+    r->reason = j->reason;
+    r->lambda = j->solved ? j->lambda_used : NAN;
+    r->residual_rms = j->solved ? j->residual_rms : NAN;
+    r->formulation = amfi_formulation_name(d->cfg.solver.formulation);
+    r->solve_ms = j->solve_ms;
+}
+
 static int store_now(daemon_s *d, job *j)
 {
     amfi_passage_row r;
-    memset(&r, 0, sizeof r);
-    r.vehicle_id = j->w.v.vehicle_id;
-    r.utime = j->w.v.utime;
-    r.lane = j->w.v.lane;
-    r.speed_mps = j->w.v.speed_mps;
-    r.n_axles = j->w.v.n_axles;
-    for (int a = 0; a + 1 < r.n_axles; a++)
-        r.spacing_m[a] = j->w.v.spacing_m[a];
-    for (int a = 0; a < r.n_axles; a++)
-        r.axle_kg[a] = j->solved ? j->axle_kg[a] : NAN;
-    r.gvw_kg = j->solved ? j->gvw_kg : NAN;
-    r.status = j->status;
-    r.reason = j->reason;
-    r.lambda = j->solved ? j->lambda_used : NAN;
-    r.residual_rms = j->solved ? j->residual_rms : NAN;
-    r.formulation = amfi_formulation_name(d->cfg.solver.formulation);
-    r.solve_ms = j->solve_ms;
+    job_row(d, j, &r);
     int64_t id = 0;
     char err[256];
-    if (amfi_store_add_passage(d->store, &r, &id, err, sizeof err)) {
+    int rc = amfi_store_add_passage(d->store, &r, &id, err, sizeof err);
+    if (rc == AMFI_EINVAL && strcmp(j->status, "error") != 0) {
+        /* A value the store cannot hold (a solver result beyond the
+         * schema's ranges: garbage samples within the intake's limits can
+         * give one) is the passage's fault, not the store's: holding it
+         * would block every passage behind it. It is stored as an error
+         * with the store's reason and without the values. */
+        snprintf(j->reason, sizeof j->reason, "result not storable: %.160s", err);
+        snprintf(j->status, sizeof j->status, "error");
+        j->solved = 0;
+        job_row(d, j, &r);
+        set_error(d, "store: passage of vehicle %lld stored as error: %s",
+                  (long long)r.vehicle_id, err);
+        rc = amfi_store_add_passage(d->store, &r, &id, err, sizeof err);
+    }
+    if (rc) {
         set_error(d, "store: passage of vehicle %lld: %s", (long long)r.vehicle_id, err);
         return -1;
     }
@@ -249,8 +270,10 @@ void pipeline_retry(daemon_s *d, double final)
     while (d->held_n > 0) {
         double now = amfid_mono_s();
         if (now < d->retry_at) {
-            if (final <= 0 || now >= until)
+            if (final <= 0)
                 return;
+            if (now >= until)
+                break; /* stopping, and out of time: counted below */
             double w = fmin(d->retry_at - now, until - now);
             struct timespec ts = {(time_t)w, (long)(1e9 * (w - floor(w)))};
             nanosleep(&ts, NULL);

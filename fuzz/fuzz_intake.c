@@ -49,7 +49,9 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     (void)argv;
     const char *tmp = getenv("TMPDIR");
     snprintf(db, sizeof db, "%s/fuzz_intake.%ld.db", tmp && *tmp ? tmp : "/tmp", (long)getpid());
-    amfid_log_stream = fopen("/dev/null", "w");
+    /* FUZZ_INTAKE_LOG=1: amfid's log on stderr, to study a finding */
+    const char *log = getenv("FUZZ_INTAKE_LOG");
+    amfid_log_stream = log && *log == '1' ? stderr : fopen("/dev/null", "w");
     if (!amfid_log_stream)
         abort();
     atexit(remove_store);

@@ -38,3 +38,15 @@ echo "bad input: $(grep -c 'rejected' "$dir/amfid.log") rejections logged, 3 veh
 [ "$(sqlite3 "$dir/b.db" "SELECT count(*) FROM passages WHERE status = 'gap' AND reason <> ''")" -eq 3 ] ||
   fail "vehicles without data: $(sqlite3 "$dir/b.db" "SELECT status, reason FROM passages")"
 echo "vehicles without sensor data: 3 stored as gap, clean stop"
+
+# Samples within the intake's limits but far beyond a real bridge's (x 5000):
+# the solver's weights are beyond the store's ranges. Each passage is stored
+# as error with the reason; the store is not "degraded", nothing is held.
+"$inject" --scale-accel 5000 "$dir/clean.log" "$dir/huge.log" || fail "lcm_inject --scale-accel"
+"$amfid" --config "$config" --db "$dir/c.db" --lcm-url "file://$dir/huge.log?speed=0" \
+  2> "$dir/amfid.log"; rc=$?
+[ $rc -eq 0 ] || fail "amfid on absurd samples: exit status $rc"
+n=$(sqlite3 "$dir/c.db" "SELECT count(*) FROM passages WHERE status = 'error' AND reason LIKE 'result not storable: %out of range%'")
+[ "$n" -eq 3 ] || fail "absurd samples: $(sqlite3 "$dir/c.db" "SELECT status, reason FROM passages")"
+grep -q "store_degraded" "$dir/amfid.log" && fail "absurd samples made the store degraded"
+echo "absurd samples: 3 passages stored as error (result not storable), store never degraded"

@@ -7,7 +7,10 @@
 #     store_degraded alert is raised and cleared, every vehicle ends as a row,
 #     integrity_check ok, exit 0;
 # (2) a store left with its WAL (amfid killed with -9) on a mount that is now
-#     read-only: amfid refuses to start (non-zero exit, never "running").
+#     read-only: amfid refuses to start (non-zero exit, never "running");
+# (3) the disk stays full until SIGTERM: after up to 20 s of retries every
+#     held passage is logged as NOT STORED and amfid exits 1 (it used to
+#     give up silently, exit 0, when its retry wait ran past the 20 s).
 # Usage: daemon_store_full.sh AMFID SIM_PUBLISHER CONFIG
 set -u
 amfid=$1 sim=$2 config=$3
@@ -58,5 +61,28 @@ mount -o remount,ro "$dir/mnt" || fail "remount read-only"
 [ "$rc" -ne 0 ] || fail "amfid started on a store it cannot write (exit 0)"
 grep -q running "$dir/amfid.log" && fail "amfid reported running on a read-only store"
 echo "read-only store with a leftover WAL: refused (exit $rc): $(grep -m1 store "$dir/amfid.log" | sed 's/^<[0-9]>//')"
+mount -o remount,rw "$dir/mnt" || fail "remount read-write"
+rm -f "$dir/mnt/b.db"*
+# (3) full until the end
+"$amfid" --config "$config" --db "$dir/mnt/c.db" --lcm-url "file://$dir/traffic.log?speed=4" \
+  2> "$dir/c.log" &
+pid=$!
+for i in $(seq 100); do grep -q running "$dir/c.log" && break; sleep 0.1; done
+sleep 2
+dd if=/dev/zero of="$dir/mnt/filler" bs=64k 2>/dev/null
+for i in $(seq 200); do grep -q "ALERT store_degraded" "$dir/c.log" && break; sleep 0.1; done
+grep -q "ALERT store_degraded" "$dir/c.log" || { kill -9 $pid; fail "(3) the store never refused"; }
+t0=$(date +%s)
+kill -TERM $pid; wait $pid; rc=$?
+t1=$(date +%s)
+[ "$rc" -eq 1 ] || fail "(3) amfid exit status $rc with passages it could not store, expected 1"
+stored=$(sqlite3 "$dir/mnt/c.db" "SELECT count(*) FROM passages" 2>/dev/null || echo 0)
+lost=$(grep -c "NOT STORED" "$dir/c.log")
+[ "$lost" -ge 1 ] || fail "(3) no NOT STORED line"
+lostc=$(sed -n 's/.*stopped: .* \([0-9]*\) not stored,.*/\1/p' "$dir/c.log")
+[ "$lostc" = "$lost" ] || fail "(3) $lost NOT STORED lines, stop line says '$lostc'"
+[ $((t1 - t0)) -le 40 ] || fail "(3) the stop took $((t1 - t0)) s"
+echo "disk full until SIGTERM: $stored stored, $lost logged NOT STORED and counted, exit 1 after $((t1 - t0)) s"
+rm -f "$dir/mnt/filler"
 umount "$dir/mnt"
 INNER

@@ -14,6 +14,13 @@
  * fuzz_intake found amfid crashing on it at shutdown).
  *
  *   lcm_inject --vehicles-only IN.log OUT.log
+ *
+ * With --scale-accel F, every accel sample is multiplied by F (kept within
+ * the intake's ±1000 m/s²): a solver result beyond the store's ranges
+ * (fuzz_intake found amfid holding such a passage as if the store had
+ * failed, blocking every passage behind it).
+ *
+ *   lcm_inject --scale-accel F IN.log OUT.log
  */
 #include <lcm/eventlog.h>
 #include <stdio.h>
@@ -55,8 +62,45 @@ static int vehicles_only(const char *inp, const char *outp)
     return 0;
 }
 
+static int scale_accel(double f, const char *inp, const char *outp)
+{
+    lcm_eventlog_t *in = lcm_eventlog_create(inp, "r");
+    lcm_eventlog_t *out = lcm_eventlog_create(outp, "w");
+    if (!in || !out) {
+        fprintf(stderr, "lcm_inject: cannot open the logs\n");
+        return 1;
+    }
+    lcm_eventlog_event_t *e;
+    int64_t num = 0;
+    int rc = 0;
+    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
+        amfi_accel_block_t m;
+        if (strcmp(e->channel, AMFI_CHANNEL_ACCEL) == 0 &&
+            amfi_accel_block_t_decode(e->data, 0, e->datalen, &m) >= 0) {
+            for (int i = 0; i < m.n; i++) {
+                double v = m.accel[i] * f;
+                m.accel[i] = v > 999 ? 999 : v < -999 ? -999 : v;
+            }
+            unsigned char b[4096];
+            int n = amfi_accel_block_t_encode(b, 0, sizeof b, &m);
+            rc |= n < 0 || put(out, &num, e->timestamp, e->channel, b, n);
+            amfi_accel_block_t_decode_cleanup(&m);
+        } else {
+            rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
+        }
+        lcm_eventlog_free_event(e);
+    }
+    lcm_eventlog_destroy(in);
+    lcm_eventlog_destroy(out);
+    if (rc)
+        fprintf(stderr, "lcm_inject: write failed\n");
+    return rc ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 5 && strcmp(argv[1], "--scale-accel") == 0)
+        return scale_accel(atof(argv[2]), argv[3], argv[4]);
     if (argc == 4 && strcmp(argv[1], "--vehicles-only") == 0)
         return vehicles_only(argv[2], argv[3]);
     if (argc != 3) {
