@@ -44,6 +44,7 @@ static const field top_fields[] = {
     {.key = "simulation", .kind = &K_MAP, .aux = sim_fields},
     {.key = "alerts", .kind = &K_MAP, .aux = alerts_fields},
     {.key = "metrics", .kind = &K_MAP, .aux = metrics_fields},
+    {.key = "report", .kind = &K_MAP, .aux = report_fields},
     {.key = NULL}};
 
 /* Checks that involve several keys, once the whole file is read; each finds
@@ -99,6 +100,11 @@ void amfi_config_defaults(amfi_site_config *c)
     d->alert_timeout_s = 30.0;
     d->alert_max_running = 4;
     d->metrics_interval_s = 15.0;
+    /* EU Directive 96/53/EC, Annex I: 40 t for a vehicle combination
+     * (2.2.2), 11.5 t for a driving axle (3.2); the site may set its own. */
+    c->report.gvw_limit_kg = 40000.0;
+    c->report.axle_limit_kg = 11500.0;
+    c->report.bin_kg = 2000.0;
     /* The engine's defaults (docs/indicators.md has the simulation behind
      * each value); set field by field, so the padding stays zero. */
     amfi_indicator_params_default(&d->indicators);

@@ -118,6 +118,13 @@ typedef struct amfi_site_identity {
 /* 1 when s is a valid site.id ([A-Za-z0-9_.-], 1 .. 63 bytes), else 0. */
 int amfi_site_id_valid(const char *s);
 
+/* report.*: what amfi-report holds passages against (section_ops.c). */
+typedef struct amfi_report_config {
+    double gvw_limit_kg;   /* report.limits.gvw_kg: legal GVW, (0, 1e6] */
+    double axle_limit_kg;  /* report.limits.axle_kg: legal load of any axle, (0, 1e6] */
+    double bin_kg;         /* report.histogram_bin_kg: GVW histogram bins, [100, 1e5] */
+} amfi_report_config;
+
 typedef struct amfi_site_config {
     amfi_site_identity site;   /* site.* */
     char name[64];             /* bridge.name: 1 .. 63 bytes, NUL-terminated */
@@ -130,6 +137,7 @@ typedef struct amfi_site_config {
                                         −1 past solver.n_sensors */
     amfi_daemon_config daemon;       /* daemon.* */
     amfi_sim_config sim;             /* simulation.* */
+    amfi_report_config report;       /* report.* */
 } amfi_site_config;
 
 /* Fill `c` (not NULL) with the paper-20m defaults: amfi_bridge_params_paper20,

@@ -12,7 +12,8 @@
  *   section_daemon.c      daemon:      amfid's bus, store, threads, indicators
  *   section_simulation.c  simulation:  sim_publisher's settings
  *   section_site.c        site:        which bridge (id, name, position)
- *   section_ops.c         alerts:, metrics:  notices and health metrics
+ *   section_ops.c         alerts:, metrics:, report:  notices, health metrics,
+ *                         and what amfi-report holds passages against
  *
  * Every function runs on the loader's (caller's) thread.
  */
@@ -42,6 +43,7 @@ extern const field sim_fields[];    /* simulation: */
 extern const field site_fields[];   /* site: */
 extern const field alerts_fields[]; /* alerts: */
 extern const field metrics_fields[]; /* metrics: */
+extern const field report_fields[]; /* report: */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */
 int bridge_free_dofs(const amfi_bridge_params *b);

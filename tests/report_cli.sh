@@ -8,12 +8,13 @@
 # database or command line must fail cleanly: status 1 (data) or 2 (usage),
 # never a crash, one line on stderr, nothing on stdout.
 #
-# usage: report_cli.sh PATH/TO/amfi-report PATH/TO/docs/schema.md
+# usage: report_cli.sh PATH/TO/amfi-report PATH/TO/docs/schema.md [PATH/TO/json_check]
 # Exit 77 (skipped) without the sqlite3 program.
 set -u
 
 bin=${1:?usage: report_cli.sh AMFI_REPORT SCHEMA_MD}
 doc=${2:?usage: report_cli.sh AMFI_REPORT SCHEMA_MD}
+jcheck=${3:-}
 [ -x "$bin" ] || { echo "report_cli.sh: $bin: not executable" >&2; exit 1; }
 [ -r "$doc" ] || { echo "report_cli.sh: $doc: not readable" >&2; exit 1; }
 command -v sqlite3 > /dev/null || { echo "report_cli.sh: no sqlite3 program: skipped"; exit 77; }
@@ -191,6 +192,115 @@ if ok help --help; then
     has '^usage: amfi-report --db PATH'
 fi
 
+# ---- records and exports (issue 11) -------------------------------------------
+# A copy of the fixture on two lanes (every third passage on lane 2), three
+# passages made overloads (GVW 45 t; an axle of 12 t; both), and its site id.
+ex=$tmp/exports.db
+cp "$tmp/pristine.db" "$ex"
+q "$ex" "UPDATE passages SET lane = 2 WHERE id % 3 = 0;
+         UPDATE passages SET gvw_kg = 45000 WHERE id = 1;
+         UPDATE axles SET load_kg = 27000 WHERE passage_id = 1 AND idx = 2;
+         UPDATE axles SET load_kg = 14000 WHERE passage_id = 2 AND idx = 2;
+         UPDATE passages SET gvw_kg = 50000 WHERE id = 4;
+         UPDATE axles SET load_kg = 30000 WHERE passage_id = 4 AND idx = 2;
+         INSERT INTO meta (key, value) VALUES ('site.id', 'fixture-1'), ('site.name', 'Fixture bridge');"
+exsum0=$(md5sum < "$ex")
+
+if ok passages-all --db "$ex" --passages; then
+    has '^== passages$'
+    has '^\(40 passages\)$'
+    has '^2025-11-22T10:00:00Z +10 +10 +1 +25\.00 +2 +- +-/- +gap +12 samples missing in the window$'
+    has '^2025-11-22T03:00:00Z +3 +3 +2 +25\.00 +2 +18000 +7200/10800 +ok'
+fi
+if ok passages-filtered --db "$ex" --passages --from 2025-11-22T05:00 --to 2025-11-22 --status ok --lane 2; then
+    want=$(q "$ex" "SELECT count(*) FROM passages WHERE utime BETWEEN 1763787600000000 AND 1763855999999999 AND status = 'ok' AND lane = 2")
+    has "^\\($want passages\\)\$"
+    hasnt ' gap '
+fi
+if ok passages-csv --db "$ex" --passages --format csv --status gap; then
+    n=$(($(wc -l < "$tmp/out") - 1))
+    [ "$n" -eq 4 ] || problem "$n CSV rows of gap passages, expected 4"
+    hdr=$(head -1 "$tmp/out")
+    [ "$(echo "$hdr" | awk -F, '{print NF}')" -eq 33 ] || problem "CSV header has $(echo "$hdr" | awk -F, '{print NF}') columns"
+    bad_rows=$(awk -F, 'NR > 1 && NF != 33' "$tmp/out" | wc -l)
+    [ "$bad_rows" -eq 0 ] || problem "$bad_rows CSV rows without 33 columns"
+    has '^2025-11-22T10:00:00Z,1763805600000000,10,10,1,25\.000,2,,,,'
+    has ',gap,12 samples missing in the window$'
+fi
+if ok passages-csv-values --db "$ex" --passages --format csv --from 2025-11-22T03:00:00Z --to 2025-11-22T03:00:00Z; then
+    row=$(sed -n 2p "$tmp/out")
+    [ "$(echo "$row" | cut -d, -f8,9,10)" = "18000.0,7200.0,10800.0" ] || problem "passage 3: '$row'"
+    [ "$(echo "$row" | cut -d, -f21)" = "4.500" ] || problem "passage 3 spacing: '$row'"
+fi
+if ok passages-json --db "$ex" --passages --format json --lane 1; then
+    n=$(grep -o '"passage_id":' "$tmp/out" | wc -l)
+    want=$(q "$ex" "SELECT count(*) FROM passages WHERE lane = 1")
+    [ "$n" -eq "$want" ] || problem "$n JSON passages on lane 1, expected $want"
+    [ -z "$jcheck" ] || "$jcheck" site_id=fixture-1 < "$tmp/out" || problem "JSON does not parse, or site_id"
+fi
+if ok histogram --db "$ex" --histogram --bin-kg 5000; then
+    has '^== GVW histogram of ok passages, 5000 kg bins$'
+    has '^GVW kg +lane 1 +lane 2 +all$'
+    for lane in 1 2; do
+        for lo in 15000 20000 45000; do
+            want=$(q "$ex" "SELECT count(*) FROM passages WHERE status = 'ok' AND lane = $lane AND gvw_kg >= $lo AND gvw_kg < $lo + 5000")
+            col=$((lane + 3))
+            got=$(awk -v lo="$lo" '$1 == lo && $2 == ".." {print $'$col'}' "$tmp/out")
+            [ "${got:-0}" -eq "$want" ] || problem "lane $lane, bin $lo: $got, expected $want"
+        done
+    done
+    all=$(q "$ex" "SELECT count(*) FROM passages WHERE status = 'ok'")
+    has "^total +[0-9]+ +[0-9]+ +$all\$"
+fi
+if ok histogram-csv --db "$ex" --histogram --format csv --lane 2; then
+    has '^gvw_from_kg,gvw_to_kg,lane_2,all$'
+    sum=$(awk -F, 'NR > 1 {s += $3} END {print s}' "$tmp/out")
+    want=$(q "$ex" "SELECT count(*) FROM passages WHERE status = 'ok' AND lane = 2")
+    [ "$sum" -eq "$want" ] || problem "lane 2 histogram sums to $sum, expected $want"
+fi
+printf 'report:\n  limits:\n    gvw_kg: 40000\n    axle_kg: 13000\n' > "$tmp/limits.yaml"
+if ok overloads --db "$ex" --overloads --config "$tmp/limits.yaml"; then
+    want=$(q "$ex" "SELECT count(*) FROM passages p WHERE status = 'ok' AND (gvw_kg > 40000 OR
+                    EXISTS (SELECT 1 FROM axles a WHERE a.passage_id = p.id AND a.load_kg > 13000))")
+    [ "$want" -eq 3 ] || problem "fixture: $want overloads in sqlite3, expected 3"
+    has "^checked 36 ok passages: 2 over the GVW limit, $want with an axle over the axle limit, $want overloaded in all"
+    has '^2025-11-22T01:00:00Z +1 +1 +1 +45000 +\+12\.5 % +27000 \(axle 2\) +\+107\.7 % +gvw\+axle$'
+    has '^2025-11-22T02:00:00Z +2 +2 +1 +[0-9]+ +-[0-9.]+ % +14000 \(axle 2\) +\+7\.7 % +axle$'
+fi
+printf 'report:\n  limits:\n    gvw_kg: 48000\n    axle_kg: 40000\n' > "$tmp/limits2.yaml"
+if ok overloads-json --db "$ex" --overloads --format json --config "$tmp/limits2.yaml"; then
+    has '"over_gvw":1,'
+    has '"overloaded":1,'
+    has '"passage_id":4,'
+    [ -z "$jcheck" ] || "$jcheck" < "$tmp/out" || problem "JSON does not parse"
+fi
+for sec in summary trend alerts errors; do
+    if ok "$sec-csv" --db "$ex" --$sec --format csv; then
+        bad_rows=$(awk -F, -v h="$(head -1 "$tmp/out" | awk -F, '{print NF}')" 'NR > 1 && NF < h' "$tmp/out" | wc -l)
+        [ "$(wc -l < "$tmp/out")" -ge 2 ] || problem "no CSV rows"
+    fi
+done
+if ok trend-csv-rows --db "$ex" --trend --format csv; then
+    [ "$(($(wc -l < "$tmp/out") - 1))" -eq 25 ] || problem "$(($(wc -l < "$tmp/out") - 1)) indicator rows, expected all 25"
+fi
+if ok alerts-csv-quoted --db "$ex" --alerts --format csv; then
+    has '^3,2025-11-23T09:00:00Z,[0-9]+,warning,std_increase,raised,22,STD of GVW 1\.23 x baseline \(p = 0\.023\)$'
+fi
+if ok summary-csv-values --db "$ex" --summary --format csv; then
+    has '^passages,40$'
+    has '^passages_gap,4$'
+    has '^baseline_n,30$'
+fi
+if ok all-json --db "$ex" --summary --trend --alerts --errors --histogram --format json; then
+    [ -z "$jcheck" ] || "$jcheck" site_id=fixture-1 < "$tmp/out" || problem "JSON does not parse"
+    for k in summary trend alerts errors histogram; do has "\"$k\":"; done
+    has '"by_status":\{"ok":36,"gap":4,'
+    has '"ok_matched":36,'
+fi
+name="exports are read-only"
+cases=$((cases + 1))
+[ "$exsum0" = "$(md5sum < "$ex")" ] || problem "the export modes changed the file"
+
 # ---- failures -------------------------------------------------------------
 
 # bad NAME WANT_STATUS PATTERN ARGS...: one stderr line matching PATTERN
@@ -215,6 +325,17 @@ bad() {
 }
 
 bad no-db 2 '^amfi-report: --db: missing' --summary
+bad from-bad 2 "^amfi-report: --from: '2025-13-01' is not a UTC time" --db "$db" --passages --from 2025-13-01
+bad to-bad 2 "^amfi-report: --to: 'yesterday' is not a UTC time" --db "$db" --passages --to yesterday
+bad feb30 2 "^amfi-report: --from: '2025-02-30' is not a UTC time" --db "$db" --passages --from 2025-02-30
+bad from-after-to 2 '^amfi-report: --from: after --to' --db "$db" --passages --from 2025-11-23 --to 2025-11-22
+bad status-bad 2 "^amfi-report: --status: 'fine' is not a status" --db "$db" --passages --status fine
+bad status-alone 2 '^amfi-report: --status: only with --passages' --db "$db" --histogram --status ok
+bad lane-bad 2 "^amfi-report: --lane: 'x' is not a lane number" --db "$db" --passages --lane x
+bad bin-bad 2 "^amfi-report: --bin-kg: '10' is not a bin width" --db "$db" --histogram --bin-kg 10
+bad format-bad 2 "^amfi-report: --format: 'xml' is not table, csv or json" --db "$db" --summary --format xml
+bad csv-two 2 '^amfi-report: --format: csv takes one section at a time \(2 given\)' --db "$db" --summary --trend --format csv
+bad csv-check 2 '^amfi-report: --format: csv and json are for the report sections' --db "$db" --check --format json
 bad empty-db 2 '^amfi-report: --db: empty value' --db ''
 bad unknown 2 '^amfi-report: --bogus: unknown option' --db "$db" --bogus
 bad stray 2 '^amfi-report: stray: unexpected argument' --db "$db" stray

@@ -3,6 +3,9 @@
  * amfi-report: what amfid's store holds, for people.
  *
  *   amfi-report --db PATH [--summary] [--trend] [--alerts] [--errors]
+ *               [--passages] [--histogram] [--overloads]
+ *               [--from T] [--to T] [--status S] [--lane N] [--bin-kg W]
+ *               [--format table|csv|json] [--config FILE] [--plot DIR]
  *               [--set-baseline-last N | --set-baseline MEAN_KG,STD_KG,N]
  *               [--note TEXT] [--check]
  *
@@ -11,8 +14,11 @@
  * indicators as a compact table), the alerts, and the errors of the
  * inferred GVW against the truth (simulations); sets a manual baseline from
  * the last N ok passages or from explicit values; checks the file's
- * integrity. With no option: summary, trend and alerts. It ends with the
- * sqlite3 queries one would type next. Schema: docs/schema.md.
+ * integrity; lists passages (filtered by time, status, lane), the GVW
+ * histogram per lane and the overloads against legal limits (report_export.c).
+ * Every section prints as a table, CSV (one section at a time) or one JSON
+ * document. With no option: summary, trend and alerts. The table format ends
+ * with the sqlite3 queries one would type next. Schema: docs/schema.md.
  *
  * The database is opened read-only (amfid may be writing it: WAL readers
  * never block the writer); only --set-baseline* opens it read-write, for
@@ -36,6 +42,8 @@
 
 #include "amfi_cli.h"
 #include "amfi_config.h"
+#include "amfi_json.h"
+#include "report_export.h"
 #include "report_plot.h"
 #include "store.h"
 
@@ -56,6 +64,10 @@ typedef struct options {
     const char *note;    /* NULL: empty */
     const char *plot_dir;   /* --plot DIR, NULL: none */
     const char *config;     /* --config FILE, NULL: none */
+    int passages, histogram, overloads;
+    int format;             /* FMT_* */
+    export_opts ex;         /* --from --to --status --lane --bin-kg, limits */
+    int bin_given;
 } options;
 
 static const char *g_db = "?"; /* for messages */
@@ -78,7 +90,10 @@ static void usage(FILE *f)
             "[--errors]\n"
             "       [--set-baseline-last N | --set-baseline MEAN_KG,STD_KG,N] "
             "[--note TEXT] [--check]\n"
-            "       [--plot DIR] [--config FILE]\n"
+            "       [--passages] [--histogram] [--overloads] [--from T] [--to T] "
+            "[--status S]\n"
+            "       [--lane N] [--bin-kg W] [--format table|csv|json] [--plot DIR] "
+            "[--config FILE]\n"
             "\n"
             "Reports on amfid's SQLite store (schema: docs/schema.md).\n"
             "  -d, --db PATH                the store (must exist)\n"
@@ -97,10 +112,25 @@ static void usage(FILE *f)
             "(<= 127 bytes)\n"
             "  -k, --check                  PRAGMA integrity_check and "
             "foreign_key_check\n"
+            "  -P, --passages               one line per passage: time, lane, speed, "
+            "axles, GVW,\n"
+            "                               axle loads, status, reason\n"
+            "  -H, --histogram              GVW histogram of the ok passages per lane\n"
+            "  -O, --overloads              ok passages over the legal GVW or axle "
+            "limit (--config)\n"
+            "  -f, --from T, -T, --to T     only passages in [T, T]: YYYY-MM-DD or "
+            "YYYY-MM-DDTHH:MM[:SS], UTC\n"
+            "  -S, --status S               only passages of status S (--passages)\n"
+            "  -l, --lane N                 only lane N (--passages, --histogram, "
+            "--overloads)\n"
+            "  -w, --bin-kg W               histogram bin width, kg (default "
+            "report.histogram_bin_kg)\n"
+            "  -F, --format F               table (default), csv (one section) or "
+            "json (one document)\n"
             "  -p, --plot DIR               draw PNGs into DIR (gnuplot): GVW, "
             "trend, histogram, per hour, speed\n"
             "  -c, --config FILE            the site's amfid.yaml: alert "
-            "thresholds and site name\n"
+            "thresholds, site name, legal limits\n"
             "  -h, --help                   this help\n"
             "  -V, --version                print the version\n"
             "With no option: --summary --trend --alerts.\n"
@@ -185,8 +215,19 @@ static int parse_args(int argc, char **argv, options *o)
         {"check", no_argument, NULL, 'k'},
         {"plot", required_argument, NULL, 'p'},
         {"config", required_argument, NULL, 'c'},
+        {"passages", no_argument, NULL, 'P'},
+        {"histogram", no_argument, NULL, 'H'},
+        {"overloads", no_argument, NULL, 'O'},
+        {"from", required_argument, NULL, 'f'},
+        {"to", required_argument, NULL, 'T'},
+        {"status", required_argument, NULL, 'S'},
+        {"lane", required_argument, NULL, 'l'},
+        {"bin-kg", required_argument, NULL, 'w'},
+        {"format", required_argument, NULL, 'F'},
         AMFI_CLI_END};
     memset(o, 0, sizeof *o);
+    o->ex.from = 0;
+    o->ex.to = AMFI_STORE_MAX_UTIME;
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
     for (int k; (k = amfi_cli_next(&c)) != -1;) {
@@ -207,6 +248,54 @@ static int parse_args(int argc, char **argv, options *o)
             if (!*val)
                 return usage_error(opt, "empty value");
             *(k == 'p' ? &o->plot_dir : &o->config) = val;
+            break;
+        case 'P': o->passages = 1; break;
+        case 'H': o->histogram = 1; break;
+        case 'O': o->overloads = 1; break;
+        case 'f':
+        case 'T':
+            if (export_parse_time(val, k == 'T', k == 'f' ? &o->ex.from : &o->ex.to) != 0)
+                return usage_error(opt, "'%s' is not a UTC time YYYY-MM-DD, "
+                                   "YYYY-MM-DDTHH:MM or YYYY-MM-DDTHH:MM:SS",
+                                   amfi_cli_shown(val));
+            break;
+        case 'S': {
+            int found = 0;
+            for (int i = 0; i < AMFI_STORE_N_STATUS; i++)
+                if (strcmp(val, amfi_store_status_name(i)) == 0) {
+                    o->ex.status = amfi_store_status_name(i);
+                    found = 1;
+                }
+            if (!found)
+                return usage_error(opt, "'%s' is not a status (%s)", amfi_cli_shown(val),
+                                   AMFI_STORE_STATUSES);
+            break;
+        }
+        case 'l':
+            if (parse_int(val, -32768, 32767, &o->ex.lane) != 0)
+                return usage_error(opt, "'%s' is not a lane number in [-32768, 32767]",
+                                   amfi_cli_shown(val));
+            o->ex.lane_given = 1;
+            break;
+        case 'w': {
+            char *end = NULL;
+            double w = strtod(val, &end);
+            if (!*val || *end || !(w >= 100 && w <= 1e5))
+                return usage_error(opt, "'%s' is not a bin width in [100, 100000] kg",
+                                   amfi_cli_shown(val));
+            o->ex.bin_kg = w;
+            o->bin_given = 1;
+            break;
+        }
+        case 'F':
+            if (strcmp(val, "table") == 0)
+                o->format = FMT_TABLE;
+            else if (strcmp(val, "csv") == 0)
+                o->format = FMT_CSV;
+            else if (strcmp(val, "json") == 0)
+                o->format = FMT_JSON;
+            else
+                return usage_error(opt, "'%s' is not table, csv or json", amfi_cli_shown(val));
             break;
         case 'B':
             if (parse_int(val, 2, MAX_BASELINE_N, &o->baseline_last) != 0)
@@ -232,9 +321,23 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->note && !o->baseline_last && !o->baseline_given)
         return usage_error("--note", "only with --set-baseline-last or "
                            "--set-baseline");
+    if (o->ex.from > o->ex.to)
+        return usage_error("--from", "after --to");
     if (!o->summary && !o->trend && !o->alerts && !o->errors && !o->check
-        && !o->plot_dir && !o->baseline_last && !o->baseline_given)
+        && !o->plot_dir && !o->baseline_last && !o->baseline_given && !o->passages
+        && !o->histogram && !o->overloads)
         o->summary = o->trend = o->alerts = 1;
+    if (o->ex.status && !o->passages)
+        return usage_error("--status", "only with --passages");
+    if (o->format != FMT_TABLE) {
+        int n = o->summary + o->trend + o->alerts + o->errors + o->passages + o->histogram
+                + o->overloads;
+        if (o->check || o->plot_dir || o->baseline_last || o->baseline_given)
+            return usage_error("--format", "csv and json are for the report sections, not "
+                               "--check, --plot or --set-baseline*");
+        if (o->format == FMT_CSV && n != 1)
+            return usage_error("--format", "csv takes one section at a time (%d given)", n);
+    }
     return 0;
 }
 
@@ -571,6 +674,81 @@ static void print_next(const options *o)
                "id DESC LIMIT 5\"\n", w);
 }
 
+/* The export sections (report_export.c) in the table format, through
+ * run_section: they read the options from here. */
+static const options *g_opt;
+static int section_passages(amfi_store *s)
+{
+    char err[512];
+    return export_passages(s, &g_opt->ex, FMT_TABLE, g_out, NULL, err, sizeof err)
+               ? data_error("%s", err) : 0;
+}
+static int section_histogram(amfi_store *s)
+{
+    char err[512];
+    return export_histogram(s, &g_opt->ex, FMT_TABLE, g_out, NULL, err, sizeof err)
+               ? data_error("%s", err) : 0;
+}
+static int section_overloads(amfi_store *s)
+{
+    char err[512];
+    return export_overloads(s, &g_opt->ex, FMT_TABLE, g_out, NULL, err, sizeof err)
+               ? data_error("%s", err) : 0;
+}
+
+/* --format csv|json: the chosen sections as one CSV table or one JSON
+ * document ({"site": ..., "summary": {...}, "passages": [...], ...}),
+ * printed only when complete. */
+static int export_all(const options *o, amfi_store *s)
+{
+    char err[512];
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    json_t *root = json_object();
+    if (!f || !root) {
+        if (f)
+            fclose(f);
+        free(buf);
+        json_decref(root);
+        return data_error("out of memory");
+    }
+    char site[256] = "";
+    int found = 0;
+    int rc = amfi_store_meta_get(s, "site.id", site, sizeof site, &found, err, sizeof err);
+    json_object_set_new(root, "site_id", found ? json_string(site) : json_null());
+    const int fmt = o->format;
+    const export_opts *x = &o->ex;
+    if (rc == 0 && o->summary)
+        rc = export_summary(s, fmt, f, root, err, sizeof err);
+    if (rc == 0 && o->trend)
+        rc = export_trend(s, fmt, f, root, err, sizeof err);
+    if (rc == 0 && o->alerts)
+        rc = export_alerts(s, fmt, f, root, err, sizeof err);
+    if (rc == 0 && o->errors)
+        rc = export_errors(s, fmt, f, root, err, sizeof err);
+    if (rc == 0 && o->passages)
+        rc = export_passages(s, x, fmt, f, root, err, sizeof err);
+    if (rc == 0 && o->histogram)
+        rc = export_histogram(s, x, fmt, f, root, err, sizeof err);
+    if (rc == 0 && o->overloads)
+        rc = export_overloads(s, x, fmt, f, root, err, sizeof err);
+    fclose(f);
+    if (rc == 0) {
+        if (fmt == FMT_CSV) {
+            fwrite(buf, 1, len, stdout);
+            json_decref(root);
+        } else if (amfi_json_print(stdout, root) != 0) {
+            rc = data_error("cannot write the JSON document");
+        }
+    } else {
+        json_decref(root);
+        rc = data_error("%s", err);
+    }
+    free(buf);
+    return rc;
+}
+
 /* Render one section in memory and print it only when it is complete: a
  * damaged row gives its error line, not half a table. Sections are
  * separated by a blank line. */
@@ -597,7 +775,7 @@ static int run_section(int (*fn)(amfi_store *), amfi_store *s, int *printed)
 /* --plot: site name from the store's meta (site.name), else the config's
  * bridge.name, else the database's file name; thresholds from --config or
  * the indicator defaults. */
-static int plot(const options *o, amfi_store *s)
+static int plot(const options *o, const amfi_site_config *c, amfi_store *s)
 {
     char site[256], err[1024];
     int found = 0;
@@ -606,21 +784,12 @@ static int plot(const options *o, amfi_store *s)
     if (amfi_store_meta_get(s, "site.name", site, sizeof site, &found, err,
                             sizeof err) != 0)
         return data_error("%s", err);
-    if (o->config) {
-        amfi_site_config *c = malloc(sizeof *c);
-        if (!c)
-            return data_error("out of memory");
-        if (amfi_config_load(o->config, c, err, sizeof err) != 0) {
-            free(c);
-            fprintf(stderr, PROG ": --config: %s\n", err);
-            return -1;
-        }
+    if (c) {
         ip = c->daemon.indicators;
         if (!found) {
-            snprintf(site, sizeof site, "%s", c->name);
+            snprintf(site, sizeof site, "%s", c->site.name);
             found = 1;
         }
-        free(c);
     }
     if (!found) {
         const char *b = strrchr(o->db, '/');
@@ -643,14 +812,39 @@ int main(int argc, char **argv)
     if (parse_args(argc, argv, &o) != 0)
         return EXIT_USAGE;
     g_db = o.db;
+    g_opt = &o;
+    /* --config: thresholds, names, legal limits; else the defaults */
+    amfi_site_config *cfg = malloc(sizeof *cfg);
+    if (!cfg) {
+        fprintf(stderr, PROG ": out of memory\n");
+        return EXIT_DATA;
+    }
+    amfi_config_defaults(cfg);
+    if (o.config && amfi_config_load(o.config, cfg, err, sizeof err) != 0) {
+        fprintf(stderr, PROG ": --config: %s\n", err);
+        free(cfg);
+        return EXIT_DATA;
+    }
+    o.ex.gvw_limit_kg = cfg->report.gvw_limit_kg;
+    o.ex.axle_limit_kg = cfg->report.axle_limit_kg;
+    if (!o.bin_given)
+        o.ex.bin_kg = cfg->report.bin_kg;
     /* read-only first: refuses a missing file, a non-SQLite file, a foreign
      * or newer database, before anything could write to it */
     if (amfi_store_open_readonly(o.db, &s, err, sizeof err) != 0) {
         /* the store's message starts with the path already */
         fprintf(stderr, PROG ": %s\n", err);
+        free(cfg);
         return EXIT_DATA;
     }
     g_out = stdout;
+    if (o.format != FMT_TABLE) {
+        rc = export_all(&o, s);
+        amfi_store_close(s);
+        free(cfg);
+        fflush(stdout);
+        return rc == 0 ? 0 : EXIT_DATA;
+    }
     if (o.baseline_last || o.baseline_given) {
         rc = set_baseline(&o);
         printed = rc == 0;
@@ -663,10 +857,16 @@ int main(int argc, char **argv)
         rc = run_section(section_alerts, s, &printed);
     if (rc == 0 && o.errors)
         rc = run_section(section_errors, s, &printed);
+    if (rc == 0 && o.passages)
+        rc = run_section(section_passages, s, &printed);
+    if (rc == 0 && o.histogram)
+        rc = run_section(section_histogram, s, &printed);
+    if (rc == 0 && o.overloads)
+        rc = run_section(section_overloads, s, &printed);
     if (rc == 0 && o.plot_dir) {
         if (printed)
             printf("\n");
-        rc = plot(&o, s);
+        rc = plot(&o, o.config ? cfg : NULL, s);
         printed = 1;
     }
     if (rc == 0 && o.check) {
@@ -683,6 +883,7 @@ int main(int argc, char **argv)
                     || o.baseline_last || o.baseline_given))
         print_next(&o);
     amfi_store_close(s);
+    free(cfg);
     fflush(stdout);
     return rc == 0 ? 0 : EXIT_DATA;
 }

@@ -1,0 +1,51 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * report_export.h: amfi-report's sections as records for spreadsheets and
+ * scripts (--format csv|json), and the sections that list or count
+ * passages (--passages, --histogram, --overloads) in all three formats.
+ * CSV is RFC 4180 (a header line, fields with a comma, a quote or a line
+ * break quoted, quotes doubled); JSON goes through libjansson into one
+ * document per run (report_export_json_*). Times are ISO 8601 UTC and, in
+ * CSV and JSON, also µs since 1970 (utime). Single-threaded; the store is
+ * read through store/ only.
+ */
+#ifndef REPORT_EXPORT_H
+#define REPORT_EXPORT_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include <jansson.h>
+
+#include "store.h"
+
+enum { FMT_TABLE, FMT_CSV, FMT_JSON };
+
+typedef struct export_opts {
+    int64_t from, to;      /* utime range, µs, inclusive */
+    const char *status;    /* NULL: every status */
+    int lane, lane_given;  /* --lane */
+    double bin_kg;         /* histogram bin width, kg */
+    double gvw_limit_kg;   /* legal limits for --overloads, kg */
+    double axle_limit_kg;
+} export_opts;
+
+/* One section, written to f (table, csv) or added to root under its name
+ * (json). 0, or −1 with the store's message in err. */
+int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_t errlen);
+int export_trend(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_t errlen);
+int export_alerts(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_t errlen);
+int export_errors(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_t errlen);
+int export_passages(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_t *root,
+                    char *err, size_t errlen);
+int export_histogram(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_t *root,
+                     char *err, size_t errlen);
+int export_overloads(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_t *root,
+                     char *err, size_t errlen);
+
+/* "2025-11-22", "2025-11-22T13:05", "2025-11-22 13:05:09", with an optional
+ * trailing Z: UTC, µs; end_of = 1 makes a date alone its last µs (for
+ * --to). 0, or −1 when s is none of these. */
+int export_parse_time(const char *s, int end_of, int64_t *utime);
+
+#endif /* REPORT_EXPORT_H */
