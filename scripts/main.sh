@@ -4,7 +4,8 @@
 # network namespace of its own: nothing leaves this machine) amfid listens
 # while sim_publisher streams 500 vehicles, one every 2 s of data at 25 times
 # real time, the bridge losing 20 % of its stiffness from vehicle 251 on (half way).
-# Ends with what amfid stored: passages, indicator trend, alerts.
+# Ends with what amfid stored: passages, indicator trend, alerts, and the
+# plots of them (PNG files next to the database, named at the end).
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 bash "$top/scripts/install-deps.sh"
@@ -35,3 +36,6 @@ OPENBLAS_NUM_THREADS=1 unshare --net bash -c '
 grep -E "ALERT|alert cleared|baseline" "$out/amfid.log" | sed 's/^<[0-9]>//' || true
 echo
 "$bin/tools/ops/amfi-report" --db "$out/demo.db" --summary --trend --alerts --errors
+echo
+echo "== plots of the stored results (amfi-report --plot), next to the database"
+"$bin/tools/ops/amfi-report" --db "$out/demo.db" --plot "$out/plots" --config "$config"
