@@ -191,7 +191,7 @@ static int start_runtime(daemon_s *d)
     d->metrics.start_wall = (double)time(NULL);
     char abs[PATH_MAX];
     const char *cfg_path = realpath(d->config_path, abs) ? abs : d->config_path;
-    if (amfi_store_add_run(d->store, amfi_version(), cfg_path, NULL, err, sizeof err)) {
+    if (amfi_store_add_run(d->store, amfi_version(), cfg_path, &d->run_id, err, sizeof err)) {
         LOG_ERR("store %s: %s", d->cfg.daemon.db_path, err);
         return 1;
     }
@@ -286,6 +286,8 @@ int amfid_run(daemon_s *d)
         }
         notify_tick(d);
         metrics_tick(d, 0);
+        if (!d->degraded)
+            record_intake(d, 0);
         if (wd && now - last_wd >= 0.5e-6 * (double)wd_usec) {
             sd_notify(0, "WATCHDOG=1");
             last_wd = now;
@@ -311,6 +313,8 @@ int amfid_drain(daemon_s *d)
     reject_final(d);
     notify_finish(d);
     metrics_tick(d, 1);
+    if (!d->degraded)
+        record_intake(d, 1);
     if (d->passages_lost > 0)
         rc = 1; /* acknowledged passages are safe; these never were */
     LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld messages received: "

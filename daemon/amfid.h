@@ -149,6 +149,9 @@ typedef struct daemon_s {
     const char *state;
     notify_state notify;
     metrics_state metrics;
+    int64_t run_id;                /* this start's row in the store's runs table */
+    int64_t samples_missing;       /* as of the last heartbeat */
+    double intake_recorded;        /* amfid_mono_s() of the last record_intake */
 } daemon_s;
 
 void set_error(daemon_s *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -242,6 +245,11 @@ void indicator_params(const amfi_daemon_config *dc, amfi_indicator_params *p);
 /* The baseline, the window's GVWs and the open alerts from the store. */
 void restore_indicator_state(daemon_s *d);
 void heartbeat(daemon_s *d);
+/* The intake counters of this run into the store's meta table (intake.*:
+ * run, messages received and refused, kernel drops, samples missing,
+ * passages not stored, as of when), for amfi-report: every 60 s from the
+ * loop (force: now, at stop). A failure is logged, never fatal. */
+void record_intake(daemon_s *d, int force);
 /* SIGHUP: apply what can change while running, report the rest. */
 void reload(daemon_s *d);
 

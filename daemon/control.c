@@ -82,6 +82,44 @@ void restore_indicator_state(daemon_s *d)
                  open_mean ? " mean_shift" : "");
 }
 
+/* ---- the intake in the store (for amfi-report) ------------------------------ */
+
+#define INTAKE_PERIOD_S 60.0
+
+void record_intake(daemon_s *d, int force)
+{
+    double now = amfid_mono_s();
+    if (!force && d->intake_recorded > 0 && now - d->intake_recorded < INTAKE_PERIOD_S)
+        return;
+    d->intake_recorded = now;
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    struct tm tm;
+    char when[32];
+    time_t sec = ts.tv_sec;
+    gmtime_r(&sec, &tm);
+    strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    struct {
+        const char *key;
+        long long v;
+    } kv[] = {{"intake.run", (long long)d->run_id},
+              {"intake.messages_received", (long long)d->messages_in},
+              {"intake.messages_refused", (long long)d->rej.total},
+              {"intake.datagrams_dropped", (long long)(d->udp_drops > 0 ? d->udp_drops : 0)},
+              {"intake.samples_missing", (long long)d->samples_missing},
+              {"intake.passages_lost", (long long)d->passages_lost}};
+    char err[256], val[32];
+    int rc = 0;
+    for (size_t i = 0; rc == 0 && i < sizeof kv / sizeof kv[0]; i++) {
+        snprintf(val, sizeof val, "%lld", kv[i].v);
+        rc = amfi_store_meta_set(d->store, kv[i].key, val, err, sizeof err);
+    }
+    if (rc == 0)
+        rc = amfi_store_meta_set(d->store, "intake.as_of", when, err, sizeof err);
+    if (rc)
+        LOG_WARN("store: the intake counters: %s", err);
+}
+
 /* ---- heartbeat ---------------------------------------------------------- */
 
 void heartbeat(daemon_s *d)
@@ -100,6 +138,7 @@ void heartbeat(daemon_s *d)
     m.blocks_received = d->blocks_received;
     m.blocks_rejected = d->blocks_rejected + rejected_ring + d->messages_malformed;
     m.samples_missing = missing;
+    d->samples_missing = missing;
     m.vehicles_received = d->vehicles_received;
     m.vehicles_rejected = d->vehicles_rejected;
     m.passages_stored = d->passages_stored;

@@ -11,13 +11,15 @@
 # per-channel queue, 30 messages by default, used to lose most of such a
 # burst without a trace: daemon.bus_queue), and with no kernel drop every
 # vehicle is weighed.
-# Usage: daemon_drops.sh AMFID SIM_PUBLISHER CONFIG
+# The drops are also in the store (meta intake.*) and in amfi-report's
+# summary ("bus ... kernel drops").
+# Usage: daemon_drops.sh AMFID SIM_PUBLISHER CONFIG AMFI_REPORT
 set -u
 if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
   exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
     AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
 fi
-amfid=$1 sim=$2 config=$3
+amfid=$1 sim=$2 config=$3 report=$4
 dir=$(mktemp -d)
 pids=""
 cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
@@ -50,6 +52,9 @@ n=$(sed -n 's/.*the kernel dropped \([0-9]*\) UDP datagrams.*/\1/p' "$dir/amfid.
 [ -n "$n" ] && [ "$n" -gt 0 ] || fail "no drops reported after a pause with a 4 kB buffer"
 [ -s "$dir/status.lcmlog" ] || fail "no status message recorded"
 rows=$(sqlite3 "$dir/a.db" "SELECT count(*) FROM passages")
+"$report" --db "$dir/a.db" --summary > "$dir/report.txt" || fail "amfi-report"
+grep -q "^bus .* [0-9]* messages received, [0-9]* refused, $n kernel drops, " "$dir/report.txt" ||
+  fail "amfi-report does not show the $n kernel drops: $(grep '^bus' "$dir/report.txt")"
 echo "paused with a 4 kB receive buffer: the kernel dropped $n datagrams, reported in the log (status_t.datagrams_dropped carries the same count); $rows of 4 vehicles reached amfid"
 
 # (3) the shipped buffer and LCM queue: a burst after a pause loses nothing silently

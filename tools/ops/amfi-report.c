@@ -452,6 +452,13 @@ static int section_summary(amfi_store *s)
                percentile(g, ng, 50), g[ng - 1]);
     }
     free(g);
+    report_intake in;
+    if (export_read_intake(s, &in, err, sizeof err) != 0)
+        return data_error("%s", err);
+    if (in.found)
+        out("bus          run %lld (as of %s): %lld messages received, %lld refused, "
+            "%lld kernel drops, %lld samples missing, %lld passages not stored\n",
+            in.run, in.as_of, in.received, in.refused, in.dropped, in.missing, in.lost);
     return print_baseline(s);
 }
 

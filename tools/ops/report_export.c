@@ -102,6 +102,37 @@ int export_parse_time(const char *s, int end_of, int64_t *utime)
     return 0;
 }
 
+/* ---- amfid's intake counters (meta intake.*) ----------------------------------- */
+
+int export_read_intake(amfi_store *s, report_intake *in, char *err, size_t errlen)
+{
+    struct {
+        const char *key;
+        long long *v;
+    } kv[] = {{"intake.run", &in->run},           {"intake.messages_received", &in->received},
+              {"intake.messages_refused", &in->refused}, {"intake.datagrams_dropped", &in->dropped},
+              {"intake.samples_missing", &in->missing},  {"intake.passages_lost", &in->lost}};
+    char val[64];
+    int found = 0;
+    memset(in, 0, sizeof *in);
+    for (size_t i = 0; i < sizeof kv / sizeof kv[0]; i++) {
+        if (amfi_store_meta_get(s, kv[i].key, val, sizeof val, &found, err, errlen))
+            return -1;
+        if (!found)
+            return 0;
+        char *end = NULL;
+        *kv[i].v = strtoll(val, &end, 10);
+        if (end == val || *end || *kv[i].v < 0) {
+            snprintf(err, errlen, "meta: %s is '%s', not a count", kv[i].key, val);
+            return -1;
+        }
+    }
+    if (amfi_store_meta_get(s, "intake.as_of", in->as_of, sizeof in->as_of, &found, err, errlen))
+        return -1;
+    in->found = 1;
+    return 0;
+}
+
 /* ---- summary, trend, alerts, errors: csv and json ------------------------------ */
 
 int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_t errlen)
@@ -111,10 +142,14 @@ int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, siz
     int found = 0;
     double *g = NULL;
     size_t ng = 0;
+    report_intake in;
     if (amfi_store_passage_summary(s, &sum, err, errlen) ||
         amfi_store_all_ok_gvw(s, &g, &ng, err, errlen) ||
-        amfi_store_get_baseline(s, &b, &found, err, errlen))
+        amfi_store_get_baseline(s, &b, &found, err, errlen) ||
+        export_read_intake(s, &in, err, errlen)) {
+        free(g);
         return -1;
+    }
     double mean = NAN, std = NAN, mn = NAN, mx = NAN, sumg = 0, q = 0;
     for (size_t k = 0; k < ng; k++) {
         sumg += g[k];
@@ -147,6 +182,11 @@ int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, siz
         fprintf(f, "baseline_std_kg,"), csv_num(f, found ? b.std_kg : NAN, "%.1f"),
             fputc('\n', f);
         fprintf(f, "baseline_n,%d\n", found ? b.n : 0);
+        if (in.found)
+            fprintf(f, "intake_run,%lld\nintake_as_of,%s\nintake_messages_received,%lld\n"
+                       "intake_messages_refused,%lld\nintake_datagrams_dropped,%lld\n"
+                       "intake_samples_missing,%lld\nintake_passages_lost,%lld\n",
+                    in.run, in.as_of, in.received, in.refused, in.dropped, in.missing, in.lost);
         return 0;
     }
     json_t *o = json_object(), *st = json_object();
@@ -173,6 +213,19 @@ int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, siz
         json_object_set_new(o, "baseline", bl);
     } else {
         json_object_set_new(o, "baseline", json_null());
+    }
+    if (in.found) {
+        json_t *it = json_object();
+        json_object_set_new(it, "run", json_integer(in.run));
+        json_object_set_new(it, "as_of", jstr(in.as_of));
+        json_object_set_new(it, "messages_received", json_integer(in.received));
+        json_object_set_new(it, "messages_refused", json_integer(in.refused));
+        json_object_set_new(it, "datagrams_dropped", json_integer(in.dropped));
+        json_object_set_new(it, "samples_missing", json_integer(in.missing));
+        json_object_set_new(it, "passages_lost", json_integer(in.lost));
+        json_object_set_new(o, "intake", it);
+    } else {
+        json_object_set_new(o, "intake", json_null());
     }
     json_object_set_new(root, "summary", o);
     return 0;

@@ -43,6 +43,14 @@ int export_histogram(amfi_store *s, const export_opts *o, int fmt, FILE *f, json
 int export_overloads(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_t *root,
                      char *err, size_t errlen);
 
+/* amfid's intake counters of its newest run (meta intake.*), if any. */
+typedef struct report_intake {
+    int found;
+    long long run, received, refused, dropped, missing, lost;
+    char as_of[40];
+} report_intake;
+int export_read_intake(amfi_store *s, report_intake *in, char *err, size_t errlen);
+
 /* "2025-11-22", "2025-11-22T13:05", "2025-11-22 13:05:09", with an optional
  * trailing Z: UTC, µs; end_of = 1 makes a date alone its last µs (for
  * --to). 0, or −1 when s is none of these. */
