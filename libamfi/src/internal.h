@@ -6,6 +6,7 @@
  * back into one that calls it; tests/libamfi_calls.sh (ctest libamfi_calls)
  * reads the library with nm, fails on a cycle and fails when this list
  * differs from the code:
+ *   speed.c -> solver.c status.c sweep.c
  *   solver.c -> bridge.c discretise.c lcurve.c status.c sweep.c sweep_modal.c sweep_nodal.c
  *   lcurve.c -> sweep.c
  *   sweep.c -> sweep_modal.c sweep_nodal.c

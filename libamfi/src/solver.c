@@ -293,10 +293,10 @@ static void resample(struct amfi_solver *s, const amfi_passage *ps)
     }
 }
 
-int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
-               amfi_result *res, char *err, size_t errlen)
+int amfi_solve_begin(struct amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
+                     double window_speed, char *err, size_t errlen)
 {
-    if (!s || !ps || !lam || !res)
+    if (!s || !ps || !lam)
         return amfi_fail(err, errlen, AMFI_EINVAL, "solve: NULL argument");
     const double L = s->b->p.span_m;
 #define REQ(cond, st, ...)                                                \
@@ -331,8 +331,10 @@ int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
         "lambda reference rate must be > 0");
 
     /* Window: entry − pre_roll .. last axle's exit + post_roll. */
+    if (!(isfinite(window_speed) && window_speed > 0))
+        window_speed = ps->speed_mps;
     const amfi_passage_times win = amfi_passage_window(
-        L, ps->speed_mps, ps->n_axles, ps->axle_spacing_m, s->p.pre_roll_s, s->p.post_roll_s);
+        L, window_speed, ps->n_axles, ps->axle_spacing_m, s->p.pre_roll_s, s->p.post_roll_s);
     const double t_start = win.start_s, t_end = win.end_s;
     const double t_last = ps->t_first_s + (ps->n_samples - 1) / ps->scan_rate_hz;
     const double tol = 1e-9 + 1e-6 / ps->scan_rate_hz;
@@ -353,18 +355,31 @@ int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
     for (int a = 1; a < ps->n_axles; a++)
         s->off[a] = s->off[a - 1] + ps->axle_spacing_m[a - 1];
     resample(s, ps);
-
-    const double scale = amfi_lambda_scale(s, lam);
-    double lam_h = lam->lambda_ref * scale;
-    int n_solves = 0, rc;
     s->lc_n = 0;
+    return AMFI_OK;
+}
+
+int amfi_solve_lambda(struct amfi_solver *s, const amfi_lambda *lam, double *lam_h,
+                      int *n_solves, char *err, size_t errlen)
+{
+    const double scale = amfi_lambda_scale(s, lam);
+    *lam_h = lam->lambda_ref * scale;
     if (lam->automatic) {
-        rc = amfi_lcurve(s, lam, scale, &lam_h, &n_solves);
+        int rc = amfi_lcurve(s, lam, scale, lam_h, n_solves);
         if (rc)
             return amfi_fail(err, errlen, rc, "L-curve search failed: %s", amfi_strerror(rc));
     }
+    return AMFI_OK;
+}
+
+int amfi_solve_end(struct amfi_solver *s, const amfi_lambda *lam, double lam_h, int n_solves,
+                   amfi_result *res, char *err, size_t errlen)
+{
+    const double L = s->b->p.span_m;
+    const int N = s->N;
+    const double scale = amfi_lambda_scale(s, lam);
     double rn, sn;
-    rc = amfi_sweep(s, lam_h, &rn, &sn);
+    int rc = amfi_sweep(s, lam_h, &rn, &sn);
     n_solves++;
     if (rc)
         return amfi_fail(err, errlen, rc, "sweep failed: %s", amfi_strerror(rc));
@@ -374,7 +389,7 @@ int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
     res->lambda_ref = lam_h / scale;
     res->h_s = s->h;
     res->n_steps = N;
-    res->t0_s = t_start;
+    res->t0_s = s->t0;
     res->n_axles = s->na;
     res->force_N = s->force;
     res->model_accel = s->y;
@@ -412,4 +427,19 @@ int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
     if (!isfinite(res->gvw_kg))
         return amfi_fail(err, errlen, AMFI_ENUM, "the solution is not finite");
     return AMFI_OK;
+}
+
+int amfi_solve(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
+               amfi_result *res, char *err, size_t errlen)
+{
+    if (!res)
+        return amfi_fail(err, errlen, AMFI_EINVAL, "solve: NULL argument");
+    int rc = amfi_solve_begin(s, ps, lam, ps ? ps->speed_mps : 0.0, err, errlen);
+    if (rc)
+        return rc;
+    double lam_h;
+    int n_solves = 0;
+    if ((rc = amfi_solve_lambda(s, lam, &lam_h, &n_solves, err, errlen)) != 0)
+        return rc;
+    return amfi_solve_end(s, lam, lam_h, n_solves, res, err, errlen);
 }

@@ -86,4 +86,19 @@ static inline double amfi_lambda_scale(const struct amfi_solver *s, const amfi_l
 int amfi_lcurve(struct amfi_solver *s, const amfi_lambda *l, double scale, double *lam_h,
                 int *n_solves);
 
+/* amfi_solve in three steps, so that a search (speed.c) can run several
+ * sweeps over one window (solver.c):
+ *   begin: validate the passage, set the window for window_speed (the
+ *     passage's own speed when <= 0; a slower one gives a longer window),
+ *     resample the data; s->speed is the passage's speed;
+ *   lambda: the per-step λ (the L-curve at s->speed when automatic);
+ *   end: one sweep at s->speed and λ_h, and the result (n_solves counts the
+ *     sweeps run before it). */
+int amfi_solve_begin(struct amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
+                     double window_speed, char *err, size_t errlen);
+int amfi_solve_lambda(struct amfi_solver *s, const amfi_lambda *lam, double *lam_h,
+                      int *n_solves, char *err, size_t errlen);
+int amfi_solve_end(struct amfi_solver *s, const amfi_lambda *lam, double lam_h, int n_solves,
+                   amfi_result *res, char *err, size_t errlen);
+
 #endif

@@ -294,6 +294,59 @@ size_t amfi_solver_workspace_bytes(const amfi_solver *s);
 const char *amfi_formulation_name(amfi_formulation f);
 int amfi_formulation_parse(const char *name, amfi_formulation *f); /* 0 ok */
 
+/* ---- speed estimation (issue 12, libamfi/src/speed.c; docs/solver.md) ---- */
+
+/* What the speed search minimises over the trial speed v (the window, λ and
+ * data fixed; the detector's speed v0 with relative SD σ as a Gaussian prior):
+ *   J(v) = n_eff·ln C(v) + ((v − v0)/(σ·v0))²,
+ * the profile log-likelihood of Gaussian residuals of unknown variance plus
+ * the prior, n_eff = data samples in the window × sensors. C(v) is: */
+typedef enum amfi_speed_criterion {
+    AMFI_SPEED_REGULARISED = 0, /* ‖y − d‖²_W + λ‖r‖²: the A-MFI fit's own cost */
+    AMFI_SPEED_RESIDUAL = 1     /* ‖y − d‖²_W alone */
+} amfi_speed_criterion;
+
+typedef struct amfi_speed_prior {
+    double rel_sd;   /* σ: the detector's relative standard deviation, 0 < σ < 1 */
+    double range_sd; /* search v0·(1 ± range_sd·σ), > 0, range_sd·σ < 0.5 */
+    double grid_rel; /* grid step / v0, 1e-4 .. range_sd·σ: below the cost's dip width */
+    double tol_rel;  /* Brent stops when its bracket is below tol_rel·v0, 0 < tol < 0.01 */
+    int brent_evals; /* Brent iterations (sweeps) after the grid, 0 .. 100 */
+    amfi_speed_criterion criterion;
+} amfi_speed_prior;
+
+/* σ 3 %, ±3 σ, grid 0.2 %, tol 0.02 %, 6 Brent sweeps, regularised cost. */
+void amfi_speed_prior_default(amfi_speed_prior *p);
+
+/* Check a prior (and the detector's speed v0): 0, or AMFI_EINVAL with a
+ * message naming the bad field. */
+int amfi_speed_prior_check(const amfi_speed_prior *p, double speed_mps, char *err,
+                           size_t errlen);
+
+typedef struct amfi_speed_result {
+    double speed_given_mps; /* v0, the passage's speed */
+    double speed_mps;       /* the estimate: the speed the result was solved with */
+    double lo_mps, hi_mps;  /* the range searched (the low end raised to what the data covers) */
+    int at_bound;           /* 1: the minimum lay at an end of the range */
+    int n_evals;            /* sweeps of the search (the final solve's apart) */
+    double j_given, j_best; /* J at v0 and at the estimate */
+} amfi_speed_result;
+
+/* Estimate the passage's speed (p->speed_mps is the detector's, the prior
+ * mean): J on a grid, then a Brent search (GSL gsl_min) between the best
+ * grid point's neighbours, then solve at the
+ * estimate as amfi_solve does: `res` is amfi_solve's result at speed_mps
+ * (res->n_solves counts every sweep, search included). λ is fixed during
+ * the search (the L-curve's at v0 when lam is automatic). The axle spacings
+ * are kept as measured. The data must cover the window at the given speed;
+ * the search's low end is raised to the slowest speed they cover. */
+int amfi_solve_speed(amfi_solver *s, const amfi_passage *p, const amfi_lambda *lam,
+                     const amfi_speed_prior *prior, amfi_result *res,
+                     amfi_speed_result *sr, char *err, size_t errlen);
+
+const char *amfi_speed_criterion_name(amfi_speed_criterion c);
+int amfi_speed_criterion_parse(const char *name, amfi_speed_criterion *c); /* 0 ok */
+
 #ifdef __cplusplus
 }
 #endif
