@@ -77,6 +77,10 @@ void amfi_config_defaults(amfi_site_config *c)
     c->solver.free_initial_state = 1;
     c->solver.pre_roll_s = 0.3;
     amfi_lambda_default(&c->lambda);
+    /* Speed estimation stays off by default: it costs ~100 sweeps a passage
+     * and lets a 10 % stiffness loss into the speed (docs/results/speed-estimation.md). */
+    c->speed_estimate = 0;
+    amfi_speed_prior_default(&c->speed_prior);
     for (int i = 0; i < AMFI_MAX_SENSORS; i++)
         c->sensor_id[i] = i < c->solver.n_sensors ? i : -1;
     amfi_daemon_config *d = &c->daemon;

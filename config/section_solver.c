@@ -4,7 +4,8 @@
  * sensor list and the rest of libamfi's amfi_solver_params, and the λ
  * policy amfi_lambda): their keys and the checks between them (sensors on
  * the span, mode counts within the model's DOFs, the L-curve grid, the
- * initial force and state). Runs on the loader's thread.
+ * initial force and state, the speed search of amfi_solve_speed). Runs on the
+ * loader's thread.
  */
 #include "sections.h"
 
@@ -236,6 +237,15 @@ static const enum_name coords_names[] = {
 /* solver.initial_force -> fix_initial_force */
 static const enum_name initial_force_names[] = {{"free", 0}, {"zero", 1}, {NULL, 0}};
 
+/* solver.speed -> speed_estimate */
+static const enum_name speed_names[] = {{"measured", 0}, {"estimate", 1}, {NULL, 0}};
+
+/* solver.speed_criterion -> speed_prior.criterion */
+_Static_assert(sizeof(amfi_speed_criterion) == sizeof(int),
+               "amfi_speed_criterion is written as an int");
+static const enum_name speed_criterion_names[] = {
+    {"regularised", AMFI_SPEED_REGULARISED}, {"residual", AMFI_SPEED_RESIDUAL}, {NULL, 0}};
+
 /* solver.initial_state -> free_initial_state */
 static const enum_name initial_state_names[] = {{"rest", 0}, {"free", 1}, {NULL, 0}};
 
@@ -273,6 +283,15 @@ const field solver_fields[] = {
     {.key = "lambda_ref_rate_hz", .kind = &K_DOUBLE, .off = SC(lambda.ref_rate_hz),
      .lo = 0, .hi = MAX_RATE_HZ, .flags = F_LO_OPEN},
     {.key = "lcurve", .kind = &K_MAP, .aux = lcurve_fields},
+    {.key = "speed", .kind = &K_ENUM, .off = SC(speed_estimate), .aux = speed_names},
+    {.key = "speed_sd", .kind = &K_DOUBLE, .off = SC(speed_prior.rel_sd), .lo = 0, .hi = 1,
+     .flags = F_LO_OPEN | F_HI_OPEN},
+    {.key = "speed_range_sd", .kind = &K_DOUBLE, .off = SC(speed_prior.range_sd), .lo = 0,
+     .hi = 50, .flags = F_LO_OPEN},
+    {.key = "speed_grid", .kind = &K_DOUBLE, .off = SC(speed_prior.grid_rel), .lo = 1e-4,
+     .hi = 0.05},
+    {.key = "speed_criterion", .kind = &K_ENUM, .off = SC(speed_prior.criterion),
+     .aux = speed_criterion_names},
     {.key = NULL}};
 
 /* Without `sensors` in the file, the one sensor follows bridge.span_m. */
@@ -320,5 +339,17 @@ int solver_check(ctx *x, amfi_site_config *c)
     if (s->free_initial_state && s->coords != AMFI_COORDS_MODAL)
         return fail(x, first_noted(x, "solver.initial_state", "solver.coordinates", NULL),
                     "solver.initial_state", "free needs solver.coordinates: modal");
+
+    /* The speed search: v0·(1 ± range·sd) stays well above 0, the grid within it. */
+    const amfi_speed_prior *sp = &c->speed_prior;
+    if (!(sp->range_sd * sp->rel_sd < 0.5))
+        return fail(x, first_noted(x, "solver.speed_range_sd", "solver.speed_sd", NULL),
+                    "solver.speed_range_sd", "speed_range_sd x speed_sd (%g) must be < 0.5",
+                    sp->range_sd * sp->rel_sd);
+    if (!(sp->grid_rel <= sp->range_sd * sp->rel_sd))
+        return fail(x, first_noted(x, "solver.speed_grid", "solver.speed_range_sd",
+                                   "solver.speed_sd"),
+                    "solver.speed_grid", "%g is wider than the range (speed_range_sd x "
+                    "speed_sd = %g)", sp->grid_rel, sp->range_sd * sp->rel_sd);
     return 0;
 }

@@ -6,11 +6,16 @@
  *              --axle-spacing S1[,S2,...] [--entry-time SEC]
  *              [--lambda auto|VALUE] [--formulation NAME]
  *              [--forces OUT.csv] [--lcurve OUT.csv]
+ *              [--estimate-speed [--speed-sd FRACTION]]
  *
  * Reads a single-sensor passage CSV (tools/accel_csv.h), builds the site's
  * bridge and solver from the configuration (default: the shipped
  * paper-20m.yaml, or the built-in paper-20m defaults when that file is not
  * installed), solves, and prints one JSON object on one line to stdout.
+ * With --estimate-speed (or solver.speed: estimate) --speed is the
+ * detector's value, the prior of amfi_solve_speed, and the passage is
+ * weighed at the estimated speed (JSON speed_mps, speed_given_mps,
+ * speed_estimated; the axle spacings are always the given ones).
  *
  * Exit status: 0 solved; 1 bad data, configuration, solver failure or an
  * output file that cannot be written; 2 bad command line. Every error is one
@@ -54,6 +59,8 @@ typedef struct options {
     const char *formulation; /* NULL: the config's */
     const char *lambda;      /* NULL: the config's; "auto" or a number */
     double speed_mps;        /* NaN until given */
+    int estimate_speed;      /* 1: --estimate-speed; 0: the config's solver.speed */
+    double speed_sd;         /* --speed-sd; NaN: the config's solver.speed_sd */
     double entry_time_s;     /* time of entry on the file's clock, s */
     int n_spacings;          /* 1 .. AMFI_MAX_AXLES − 1, 0 until given */
     double spacing_m[AMFI_MAX_AXLES];
@@ -68,6 +75,7 @@ static void usage(FILE *f)
             "       [--entry-time SEC] [--lambda auto|VALUE] "
             "[--formulation NAME]\n"
             "       [--forces OUT.csv] [--lcurve OUT.csv]\n"
+            "       [--estimate-speed [--speed-sd FRACTION]]\n"
             "\n"
             "Solves one recorded passage (CSV 't,accel', plain or gzip) "
             "and prints a JSON line.\n"
@@ -86,6 +94,10 @@ static void usage(FILE *f)
             "  -f, --formulation F      solver formulation (default: the config's)\n"
             "  -F, --forces FILE        write t,x1,force1_N,... per step\n"
             "  -L, --lcurve FILE        write the L-curve (needs --lambda auto)\n"
+            "      --estimate-speed     estimate the speed from the data, --speed as the\n"
+            "                           detector's value (default: the config's solver.speed)\n"
+            "      --speed-sd FRACTION  the detector's relative SD, 0 < f < 1 (default: the\n"
+            "                           config's solver.speed_sd)\n"
             "  -h, --help               this help\n"
             "  -V, --version            print the version\n"
             "Exit status: 0 ok, 1 data or solver error, 2 usage error.\n",
@@ -141,13 +153,20 @@ static int parse_args(int argc, char **argv, options *o)
         {"formulation", required_argument, NULL, 'f'},
         {"forces", required_argument, NULL, 'F'},
         {"lcurve", required_argument, NULL, 'L'},
+        {"estimate-speed", no_argument, NULL, 'E'},
+        {"speed-sd", required_argument, NULL, 'S'},
         AMFI_CLI_END};
     memset(o, 0, sizeof *o);
     o->speed_mps = NAN;
+    o->speed_sd = NAN;
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
     for (int k; (k = amfi_cli_next(&c)) != -1;) {
         const char *opt = c.opt, *val = optarg;
+        if (k == 'E') { /* the one option without a value */
+            o->estimate_speed = 1;
+            continue;
+        }
         if (val[0] == '\0')
             return usage_error(opt, "empty value");
         double x;
@@ -183,6 +202,12 @@ static int parse_args(int argc, char **argv, options *o)
         case 'f': o->formulation = val; break;
         case 'F': o->forces = val; break;
         case 'L': o->lcurve = val; break;
+        case 'S':
+            if (amfi_cli_double(val, &x) != 0 || !(x > 0 && x < 1))
+                return usage_error(opt, "'%s' must be a fraction in (0, 1)",
+                                   amfi_cli_shown(val));
+            o->speed_sd = x;
+            break;
         }
     }
     if (!o->accel)
@@ -298,7 +323,8 @@ static int write_lcurve(const char *path, const amfi_result *r)
 
 /* The result as one JSON line on stdout (common/amfi_json.h). */
 static int print_json(const amfi_site_config *c, const amfi_result *r,
-                      double scan_rate_hz, double solve_ms)
+                      const amfi_speed_result *sr, int estimated, double scan_rate_hz,
+                      double solve_ms)
 {
     json_t *axle = json_array(), *force = json_array();
     for (int a = 0; a < r->n_axles; a++) {
@@ -317,6 +343,13 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
         "residual_rms", amfi_json_num(r->residual_rms),
         "signal_rms", amfi_json_num(r->signal_rms), "solve_ms", amfi_json_num(solve_ms),
         "lcurve_points", r->lcurve_n);
+    if (o && (json_object_set_new(o, "speed_mps", amfi_json_num(sr->speed_mps)) ||
+              json_object_set_new(o, "speed_given_mps", amfi_json_num(sr->speed_given_mps)) ||
+              json_object_set_new(o, "speed_estimated", json_boolean(estimated)) ||
+              json_object_set_new(o, "n_solves", json_integer(r->n_solves)))) {
+        json_decref(o);
+        o = NULL;
+    }
     return amfi_json_print(stdout, o);
 }
 
@@ -349,6 +382,23 @@ int main(int argc, char **argv)
         fprintf(stderr, PROG ": --lcurve needs --lambda auto\n");
         return EXIT_USAGE;
     }
+    if (o.estimate_speed)
+        cfg.speed_estimate = 1;
+    if (!isnan(o.speed_sd)) {
+        if (!cfg.speed_estimate) {
+            fprintf(stderr, PROG ": --speed-sd needs --estimate-speed (or solver.speed: "
+                            "estimate in the configuration)\n");
+            return EXIT_USAGE;
+        }
+        cfg.speed_prior.rel_sd = o.speed_sd;
+    }
+    if (cfg.speed_estimate) {
+        char perr[256];
+        if (amfi_speed_prior_check(&cfg.speed_prior, o.speed_mps, perr, sizeof perr) != 0) {
+            fprintf(stderr, PROG ": --speed-sd: %s\n", perr);
+            return EXIT_USAGE;
+        }
+    }
 
     int n_axles = o.n_spacings + 1;
     /* the window, relative to entry (amfi.h: entry − pre_roll .. last exit
@@ -364,8 +414,12 @@ int main(int argc, char **argv)
     cfg.solver.n_sensors = 1;
     if (cfg.solver.max_axles < n_axles)
         cfg.solver.max_axles = n_axles;
-    if (cfg.solver.max_duration_s < crossing_s)
-        cfg.solver.max_duration_s = crossing_s;
+    /* the speed search reaches down to v·(1 − range·sd): a longer window */
+    const double slowest = cfg.speed_estimate
+                               ? 1.0 - cfg.speed_prior.range_sd * cfg.speed_prior.rel_sd
+                               : 1.0;
+    if (cfg.solver.max_duration_s < crossing_s / slowest)
+        cfg.solver.max_duration_s = crossing_s / slowest;
 
     int status = EXIT_DATA;
     char err[512];
@@ -400,9 +454,14 @@ int main(int argc, char **argv)
 
     amfi_result res;
     memset(&res, 0, sizeof res);
+    amfi_speed_result sres;
+    memset(&sres, 0, sizeof sres);
+    sres.speed_mps = sres.speed_given_mps = o.speed_mps;
     struct timespec t_a, t_b;
     clock_gettime(CLOCK_MONOTONIC, &t_a);
-    int rc = amfi_solve(solver, &p, &cfg.lambda, &res, err, sizeof err);
+    int rc = cfg.speed_estimate ? amfi_solve_speed(solver, &p, &cfg.lambda, &cfg.speed_prior,
+                                                   &res, &sres, err, sizeof err)
+                                : amfi_solve(solver, &p, &cfg.lambda, &res, err, sizeof err);
     clock_gettime(CLOCK_MONOTONIC, &t_b);
     if (rc == AMFI_ERANGE) {
         double lo = p.t_first_s;
@@ -418,11 +477,12 @@ int main(int argc, char **argv)
                 err[0] ? err : amfi_strerror(rc));
         goto done;
     }
-    if (o.forces && write_forces(o.forces, &res, o.speed_mps) != 0)
+    if (o.forces && write_forces(o.forces, &res, sres.speed_mps) != 0)
         goto done;
     if (o.lcurve && write_lcurve(o.lcurve, &res) != 0)
         goto done;
-    if (print_json(&cfg, &res, csv.rate_hz, elapsed_ms(&t_a, &t_b)) != 0
+    if (print_json(&cfg, &res, &sres, cfg.speed_estimate, csv.rate_hz,
+                   elapsed_ms(&t_a, &t_b)) != 0
         || fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, PROG ": stdout: %s\n", strerror(errno));
         goto done;

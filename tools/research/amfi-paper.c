@@ -67,6 +67,8 @@ static const double levels[N_LEVELS] = {0.0, 0.025, 0.05, 0.075, 0.10};
 typedef struct opts {
     const char *out, *config, *population;
     int quick, vehicles, reps, threads, batch_lcurve, plots, batches_only;
+    int speed_batch;      /* > 0: only the speed-estimation batch, this many vehicles */
+    double speed_grid;    /* its grid step (fraction of the given speed) */
     int free_state;       /* -1: as configured; 0 rest; 1 free */
     double pre_roll;      /* < 0: as configured */
     double lambda_ref;
@@ -107,7 +109,7 @@ static void usage(FILE *f)
             "usage: %s [--out DIR] [--quick] [--vehicles N] [--reps R] [--threads T]\n"
             "       [--lambda-ref VALUE] [--batch-lcurve] [--batches-only]\n"
             "       [--initial-state rest|free] [--pre-roll SEC] [--config FILE.yaml]\n"
-            "       [--population FILE.csv] [--no-plots]\n"
+            "       [--population FILE.csv] [--no-plots] [--speed-batch N [--speed-grid F]]\n"
             "  -o, --out DIR                   report, CSVs and plots (default docs/results)\n"
             "  -q, --quick                     the test-suite version (30 vehicles per level)\n"
             "  -n, --vehicles N                vehicles per batch, 3 .. 5000\n"
@@ -121,6 +123,9 @@ static void usage(FILE *f)
             "  -c, --config FILE               site configuration (default paper-20m.yaml)\n"
             "  -p, --population FILE           vehicle list (default population.csv)\n"
             "      --no-plots                  no gnuplot PNGs\n"
+            "      --speed-batch N             only the speed-estimation batch (issue 12):\n"
+            "                                  N vehicles per condition, into speed-estimation.md\n"
+            "      --speed-grid F              its search grid step, fraction of the speed\n"
             "  -h, --help                      this help\n"
             "  -V, --version                   print the version\n"
             "Default files from the first of %s.\n",
@@ -130,7 +135,7 @@ static void usage(FILE *f)
 static void parse(int argc, char **argv, opts *o)
 {
     enum { O_LAMBDA_REF = 256, O_BATCH_LCURVE, O_BATCHES_ONLY, O_INITIAL_STATE, O_PRE_ROLL,
-           O_NO_PLOTS };
+           O_NO_PLOTS, O_SPEED_BATCH, O_SPEED_GRID };
     static const struct option longopts[] = {
         {"out", required_argument, NULL, 'o'},
         {"quick", no_argument, NULL, 'q'},
@@ -145,9 +150,11 @@ static void parse(int argc, char **argv, opts *o)
         {"config", required_argument, NULL, 'c'},
         {"population", required_argument, NULL, 'p'},
         {"no-plots", no_argument, NULL, O_NO_PLOTS},
+        {"speed-batch", required_argument, NULL, O_SPEED_BATCH},
+        {"speed-grid", required_argument, NULL, O_SPEED_GRID},
         AMFI_CLI_END};
     *o = (opts){.out = "docs/results", .vehicles = 500, .reps = 3, .threads = 2, .plots = 1,
-                .lambda_ref = 7.94e-9, .free_state = -1, .pre_roll = -1};
+                .lambda_ref = 7.94e-9, .free_state = -1, .pre_roll = -1, .speed_grid = 0.002};
     int vehicles_set = 0;
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -174,6 +181,8 @@ static void parse(int argc, char **argv, opts *o)
             o->free_state = !strcmp(v, "free");
             break;
         case O_PRE_ROLL: o->pre_roll = amfi_cli_num(&c, v, 0, 0.5); break;
+        case O_SPEED_BATCH: o->speed_batch = (int)amfi_cli_num(&c, v, 3, 5000); break;
+        case O_SPEED_GRID: o->speed_grid = amfi_cli_num(&c, v, 1e-4, 0.05); break;
         }
     }
     if (o->quick && !vehicles_set)
@@ -906,6 +915,253 @@ static void single_vehicle(ctx *c)
     fflush(c->md);
 }
 
+/* ---- speed estimation (issue 12) ---------------------------------------- */
+
+#define SPD_CONDS 4
+static const char *const spd_cond_name[SPD_CONDS] = {
+    "table5, healthy", "table5, -5 % stiffness", "table5, -10 % stiffness",
+    "table5 but speed error U(-8 %, +8 %), healthy"};
+static const int spd_level[SPD_CONDS] = {0, 2, 4, 0}; /* index into levels[] */
+
+typedef struct spd_item {
+    double gvw_true, v_true, v_given;
+    double gvw_exact, gvw_given, gvw_reg, v_reg, gvw_res, v_res; /* kg, m/s */
+    int n_reg, at_bound;
+    double ms_given, ms_reg;
+} spd_item;
+
+typedef struct spd_job {
+    const ctx *c;
+    amfi_profile *prof;
+    spd_item *items;
+    long n_items, next;
+    pthread_mutex_t lock;
+    int failed;
+} spd_job;
+
+static void *spd_thread(void *arg)
+{
+    spd_job *j = arg;
+    const ctx *c = j->c;
+    worker w;
+    if (worker_init(c, &w, c->cfg.solver.calc_rate_hz)) {
+        j->failed = 1;
+        return NULL;
+    }
+    amfi_lambda fixed = c->cfg.lambda;
+    fixed.automatic = 0;
+    fixed.lambda_ref = c->o.lambda_ref;
+    amfi_speed_prior prior;
+    amfi_speed_prior_default(&prior);
+    prior.grid_rel = c->o.speed_grid;
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        long it = j->next++;
+        pthread_mutex_unlock(&j->lock);
+        if (it >= j->n_items || j->failed)
+            break;
+        const int cond = (int)(it / c->o.speed_batch), i = (int)(it % c->o.speed_batch);
+        spd_item *out = &j->items[it];
+        seed3(w.rng, 4000 + cond, 0, (unsigned long)i);
+        const amfi_vehicle_rec *rec = &c->recs[gsl_rng_uniform_int(w.rng, c->n_recs)];
+        amfi_passage_spec spec, ps;
+        char err[256];
+        if (amfi_passage_spec_from_rec(rec, &c->dist, j->prof, 2.0, w.rng, &spec, err,
+                                       sizeof err) ||
+            amfi_passage_spec_from_rec(&c->recs[gsl_rng_uniform_int(w.rng, c->n_recs)],
+                                       &c->dist, j->prof, 2.0, w.rng, &ps, err, sizeof err)) {
+            fprintf(stderr, "%s: %s\n", PROG, err);
+            j->failed = 1;
+            break;
+        }
+        spec.pre_s = 0.5;
+        spec.post_s = 0.3;
+        spec.preceding = 1;
+        spec.prec_car = ps.car;
+        spec.prec_speed_mps = ps.speed_mps;
+        spec.prec_track = ps.track;
+        spec.gap_s = 0.5 + 1.5 * gsl_rng_uniform(w.rng);
+        amfi_measure m = {0};
+        m.noise_frac = 0.03;
+        m.speed_err_std = cond == 3 ? 0.0 : 0.03;
+        const double v_used = cond == 3 ? spec.speed_mps * (1 + gsl_rng_uniform(w.rng) * 0.16 - 0.08)
+                                        : 0.0;
+        amfi_passage_rec pr;
+        amfi_result res;
+        double t = now_s();
+        if (run_passage(c, &w, c->damaged[spd_level[cond]], j->prof, &spec, &m, v_used, &fixed,
+                        &pr, &res)) {
+            j->failed = 1;
+            break;
+        }
+        out->ms_given = 1e3 * (now_s() - t);
+        out->gvw_true = rec->axle_kg[0] + rec->axle_kg[1];
+        out->v_true = spec.speed_mps;
+        out->v_given = v_used > 0 ? v_used : pr.speed_measured_mps;
+        out->gvw_given = res.gvw_kg;
+        amfi_passage p;
+        memset(&p, 0, sizeof p);
+        p.n_samples = pr.n;
+        p.scan_rate_hz = c->sp.scan_rate_hz;
+        p.t_first_s = pr.t_first_s;
+        p.accel[0] = w.acc;
+        p.n_axles = 2;
+        p.axle_spacing_m[0] = spec.car.D1_m + spec.car.D2_m;
+        p.speed_mps = spec.speed_mps;
+        int rc = amfi_solve(w.solver, &p, &fixed, &res, err, sizeof err);
+        out->gvw_exact = res.gvw_kg;
+        amfi_speed_result sr;
+        p.speed_mps = out->v_given;
+        t = now_s();
+        if (!rc) {
+            prior.criterion = AMFI_SPEED_REGULARISED;
+            rc = amfi_solve_speed(w.solver, &p, &fixed, &prior, &res, &sr, err, sizeof err);
+        }
+        out->ms_reg = 1e3 * (now_s() - t);
+        out->gvw_reg = res.gvw_kg;
+        out->v_reg = sr.speed_mps;
+        out->n_reg = res.n_solves;
+        out->at_bound = sr.at_bound;
+        out->gvw_res = out->v_res = NAN;
+        if (!rc && cond == 0) { /* the second criterion, on the first condition */
+            prior.criterion = AMFI_SPEED_RESIDUAL;
+            rc = amfi_solve_speed(w.solver, &p, &fixed, &prior, &res, &sr, err, sizeof err);
+            out->gvw_res = res.gvw_kg;
+            out->v_res = sr.speed_mps;
+        }
+        if (rc) {
+            fprintf(stderr, "%s: speed batch: %s\n", PROG, err);
+            j->failed = 1;
+            break;
+        }
+    }
+    worker_fini(&w);
+    return NULL;
+}
+
+/* mean, STD and max |.| of x[0..n) */
+static void spd_stats(const double *x, int n, double *mean, double *sd, double *worst)
+{
+    *mean = gsl_stats_mean(x, 1, n);
+    *sd = gsl_stats_sd(x, 1, n);
+    *worst = 0;
+    for (int i = 0; i < n; i++)
+        if (fabs(x[i]) > *worst)
+            *worst = fabs(x[i]);
+}
+
+static double spd_rms(const double *x, int n)
+{
+    double s = 0;
+    for (int i = 0; i < n; i++)
+        s += x[i] * x[i];
+    return sqrt(s / n);
+}
+
+static void speed_batch(ctx *c)
+{
+    const int n = c->o.speed_batch;
+    spd_job j;
+    memset(&j, 0, sizeof j);
+    j.c = c;
+    j.n_items = (long)SPD_CONDS * n;
+    j.items = calloc((size_t)j.n_items, sizeof *j.items);
+    pthread_mutex_init(&j.lock, NULL);
+    char err[256];
+    amfi_profile_params pp;
+    amfi_profile_params_default(&pp); /* class A */
+    pp.seed = 7777;
+    pp.length_m = c->sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + c->cfg.bridge.span_m + 100.0;
+    if (!j.items || amfi_profile_create(&pp, &j.prof, err, sizeof err))
+        die("speed batch: %s%s", j.items ? err : "out of memory", "");
+    pthread_t th[64];
+    for (int t = 0; t < c->o.threads; t++)
+        pthread_create(&th[t], NULL, spd_thread, &j);
+    for (int t = 0; t < c->o.threads; t++)
+        pthread_join(th[t], NULL);
+    if (j.failed)
+        die("speed batch failed%s%s", "", "");
+    char path[4096];
+    snprintf(path, sizeof path, "%s/speed_vehicles.csv", c->o.out);
+    FILE *csv = fopen(path, "w");
+    if (!csv)
+        die("%s: %s", path, strerror(errno));
+    fprintf(csv, "condition,i,gvw_true_kg,v_true,v_given,gvw_exact_kg,gvw_given_kg,gvw_reg_kg,"
+                 "v_reg,gvw_res_kg,v_res,n_solves_reg,at_bound,ms_given,ms_reg\n");
+    double *a = malloc(sizeof(double) * n), *b = malloc(sizeof(double) * n),
+           *e = malloc(sizeof(double) * n), *g = malloc(sizeof(double) * n),
+           *vr = malloc(sizeof(double) * n), *vs = malloc(sizeof(double) * n),
+           *vg = malloc(sizeof(double) * n);
+    double growth_exact[SPD_CONDS], growth_reg[SPD_CONDS];
+    fprintf(c->md, "## Speed estimation (issue 12)\n\nEach condition: %d vehicles from the "
+                   "population, class A carpet, 3 %% noise, a preceding vehicle 0.5-2 s "
+                   "before; fixed λ %.3g; prior SD 3 %%, search ±3 SD on a %.2g %% grid + Brent."
+                   " Per-vehicle errors (inferred − true)/true, mean ± STD (worst |.|).\n\n"
+                   "| condition | GVW, exact speed | GVW, given speed | GVW, estimated (regularised) | "
+                   "speed given: RMS | estimated: bias, RMS | GVW, estimated (residual) | speed (residual): bias, RMS | sweeps | ms given / estimated |\n"
+                   "|---|---|---|---|---|---|---|---|---|---|\n",
+            n, c->o.lambda_ref, 100 * c->o.speed_grid);
+    for (int k = 0; k < SPD_CONDS; k++) {
+        double nsum = 0, msg = 0, msr = 0, at = 0;
+        for (int i = 0; i < n; i++) {
+            const spd_item *it = &j.items[(long)k * n + i];
+            fprintf(csv, "%d,%d,%.3f,%.5f,%.5f,%.3f,%.3f,%.3f,%.5f,%.3f,%.5f,%d,%d,%.2f,%.2f\n", k,
+                    i, it->gvw_true, it->v_true, it->v_given, it->gvw_exact, it->gvw_given,
+                    it->gvw_reg, it->v_reg, it->gvw_res, it->v_res, it->n_reg, it->at_bound,
+                    it->ms_given, it->ms_reg);
+            a[i] = 100 * (it->gvw_exact / it->gvw_true - 1);
+            b[i] = 100 * (it->gvw_given / it->gvw_true - 1);
+            e[i] = 100 * (it->gvw_reg / it->gvw_true - 1);
+            g[i] = 100 * (it->gvw_res / it->gvw_true - 1);
+            vg[i] = 100 * (it->v_given / it->v_true - 1);
+            vr[i] = 100 * (it->v_reg / it->v_true - 1);
+            vs[i] = 100 * (it->v_res / it->v_true - 1);
+            nsum += it->n_reg;
+            msg += it->ms_given;
+            msr += it->ms_reg;
+            at += it->at_bound;
+        }
+        double m1, s1, w1, m2, s2, w2, m3, s3, w3, m4, s4, w4, mv, sv, wv;
+        spd_stats(a, n, &m1, &s1, &w1);
+        spd_stats(b, n, &m2, &s2, &w2);
+        spd_stats(e, n, &m3, &s3, &w3);
+        spd_stats(vr, n, &mv, &sv, &wv);
+        growth_exact[k] = m1;
+        growth_reg[k] = m3;
+        fprintf(c->md,
+                "| %s | %+.2f ± %.2f %% (%.1f) | %+.2f ± %.2f %% (%.1f) | %+.2f ± %.2f %% (%.1f) "
+                "| %.2f %% | %+.3f %%, %.3f %% | ",
+                spd_cond_name[k], m1, s1, w1, m2, s2, w2, m3, s3, w3, spd_rms(vg, n), mv,
+                spd_rms(vr, n));
+        if (k == 0) {
+            spd_stats(g, n, &m4, &s4, &w4);
+            double mvs = gsl_stats_mean(vs, 1, n);
+            fprintf(c->md, "%+.2f ± %.2f %% (%.1f) | %+.3f %%, %.3f %% | ", m4, s4, w4, mvs,
+                    spd_rms(vs, n));
+        } else {
+            fprintf(c->md, "– | – | ");
+        }
+        fprintf(c->md, "%.1f (%.0f at a bound) | %.0f / %.0f |\n", nsum / n, at, msg / n,
+                msr / n);
+    }
+    fprintf(c->md, "\nDamage: mean inferred GVW relative to the healthy batch (the same draws "
+                   "of vehicles), against 1/(1 − δ):\n\n| δ | 1/(1 − δ) − 1 | exact speed | "
+                   "estimated speed |\n|---|---|---|---|\n");
+    for (int k = 1; k <= 2; k++) {
+        double d = levels[spd_level[k]];
+        fprintf(c->md, "| %.0f %% | %+.2f %% | %+.2f %% | %+.2f %% |\n", 100 * d,
+                100 * (1 / (1 - d) - 1),
+                100 * ((1 + growth_exact[k] / 100) / (1 + growth_exact[0] / 100) - 1),
+                100 * ((1 + growth_reg[k] / 100) / (1 + growth_reg[0] / 100) - 1));
+    }
+    fprintf(c->md, "\nPer vehicle: speed_vehicles.csv.\n\n");
+    fclose(csv);
+    free(a), free(b), free(e), free(g), free(vr), free(vs), free(vg);
+    free(j.items);
+    amfi_profile_destroy(j.prof);
+    pthread_mutex_destroy(&j.lock);
+}
+
 static void batch_plots(const ctx *c)
 {
     plot(c, "fig10_trends",
@@ -966,7 +1222,10 @@ int main(int argc, char **argv)
         die("%s: %s", c.o.out, strerror(errno));
     char path[4096];
     snprintf(path, sizeof path, "%s/%s", c.o.out,
-             c.o.quick ? "paper-quick.md" : c.o.batches_only ? "batches.md" : "paper.md");
+             c.o.speed_batch   ? "speed-estimation.md"
+             : c.o.quick       ? "paper-quick.md"
+             : c.o.batches_only ? "batches.md"
+                               : "paper.md");
     c.md = fopen(path, "w");
     if (!c.md)
         die("%s: %s", path, strerror(errno));
@@ -980,10 +1239,17 @@ int main(int argc, char **argv)
             c.o.quick ? " --quick" : "", c.cfg.name, c.cfg.bridge.span_m,
             c.cfg.bridge.n_elements, c.sp.sensor_x_m[0], c.sp.scan_rate_hz,
             c.cfg.solver.calc_rate_hz);
-    if (!c.o.quick && !c.o.batches_only)
-        single_vehicle(&c);
-    int trend = batches(&c);
-    if (!c.o.quick)
+    int trend = 0;
+    if (c.o.speed_batch) {
+        speed_batch(&c);
+        fprintf(c.md, "Made by `amfi-paper --speed-batch %d --speed-grid %g -j %d`.\n",
+                c.o.speed_batch, c.o.speed_grid, c.o.threads);
+    } else {
+        if (!c.o.quick && !c.o.batches_only)
+            single_vehicle(&c);
+        trend = batches(&c);
+    }
+    if (!c.o.quick && !c.o.speed_batch)
         batch_plots(&c);
     fprintf(c.md, "Total run time %.0f s.\n", now_s() - t0);
     fclose(c.md);
