@@ -135,12 +135,13 @@ static void v_formulation(const field *f, const void *base, char *buf)
              amfi_formulation_name(((const amfi_site_config *)base)->solver.formulation));
 }
 
-/* solver.modes: all | observable | N (the N lowest observable modes) */
+/* solver.modes: all | observable | resolved (observable below calc_rate_hz / 2) |
+ * N (the N lowest observable modes) */
 static int p_modes(ctx *x, yaml_node_t *v, const char *path, const field *f,
                    void *base)
 {
     amfi_solver_params *p = &((amfi_site_config *)base)->solver;
-    const char *want = "all, observable or a positive mode count";
+    const char *want = "all, observable, resolved or a positive mode count";
     char buf[SHOW_LEN];
     const char *s = scalar(x, v, path, want, 1);
     long n = 0;
@@ -148,8 +149,10 @@ static int p_modes(ctx *x, yaml_node_t *v, const char *path, const field *f,
     (void)f;
     if (!s)
         return -1;
-    if (strcmp(s, "all") == 0 || strcmp(s, "observable") == 0) {
-        p->modes = s[0] == 'a' ? AMFI_MODES_ALL : AMFI_MODES_OBSERVABLE;
+    if (strcmp(s, "all") == 0 || strcmp(s, "observable") == 0 || strcmp(s, "resolved") == 0) {
+        p->modes = s[0] == 'a' ? AMFI_MODES_ALL
+                   : s[0] == 'o' ? AMFI_MODES_OBSERVABLE
+                                 : AMFI_MODES_RESOLVED;
         p->n_modes = 0;
         return 0;
     }
@@ -193,7 +196,7 @@ static void d_modes(const field *f, const void *base, char *buf)
 {
     (void)f;
     (void)base;
-    snprintf(buf, DOC_LEN, "all, observable or a count 1 .. %d", MAX_MODE_NO);
+    snprintf(buf, DOC_LEN, "all, observable, resolved or a count 1 .. %d", MAX_MODE_NO);
 }
 
 static void v_modes(const field *f, const void *base, char *buf)
@@ -204,7 +207,10 @@ static void v_modes(const field *f, const void *base, char *buf)
     if (p->modes == AMFI_MODES_COUNT)
         snprintf(buf, DOC_LEN, "%d", p->n_modes);
     else
-        snprintf(buf, DOC_LEN, "%s", p->modes == AMFI_MODES_ALL ? "all" : "observable");
+        snprintf(buf, DOC_LEN, "%s",
+                 p->modes == AMFI_MODES_ALL        ? "all"
+                 : p->modes == AMFI_MODES_RESOLVED ? "resolved"
+                                                   : "observable");
 }
 
 static void d_lambda(const field *f, const void *base, char *buf)

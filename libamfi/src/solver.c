@@ -56,7 +56,7 @@ static int check_params(const amfi_bridge *b, const amfi_solver_params *p, char 
     REQ(p->formulation == AMFI_FORM_PAPER, "unknown formulation %d", (int)p->formulation);
     REQ(p->coords == AMFI_COORDS_MODAL || p->coords == AMFI_COORDS_NODAL,
         "unknown coordinates %d", (int)p->coords);
-    REQ(p->modes >= AMFI_MODES_ALL && p->modes <= AMFI_MODES_COUNT, "unknown modes policy");
+    REQ(p->modes >= AMFI_MODES_ALL && p->modes <= AMFI_MODES_RESOLVED, "unknown modes policy");
     REQ(p->modes != AMFI_MODES_COUNT || p->n_modes >= 1, "n_modes must be >= 1");
     REQ(isfinite(p->calc_rate_hz) && p->calc_rate_hz > 0 && p->calc_rate_hz <= 1e6,
         "calc_rate_hz must be in (0, 1e6]");
@@ -140,6 +140,9 @@ static int setup_modal(struct amfi_solver *s, char *err, size_t errlen)
         for (int si = 0; si < ns; si++)
             if (fabs(call[si * n + k]) > 1e-9 * cmax)
                 obs = 1;
+        /* resolved: below the Nyquist frequency of the calculation rate */
+        if (s->p.modes == AMFI_MODES_RESOLVED && b->omega[k] >= 3.14159265358979323846 * s->p.calc_rate_hz)
+            obs = 0;
         if (s->p.modes == AMFI_MODES_ALL || obs)
             keep[m++] = k;
     }

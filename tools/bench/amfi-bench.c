@@ -6,7 +6,9 @@
  * paper bridge), recorded at 1000 Hz by the independent Newmark integrator,
  * solved at 5000 Hz: milliseconds per fixed-λ solve for each formulation ×
  * coordinates × modes, the L-curve solve, the workspace and the process's
- * peak resident memory. Each timing is the minimum and median over repeats.
+ * peak resident memory; and the cost of a passage whose speed is estimated
+ * (amfi_solve_speed, issue 12) from a detector speed 4 % high, in sweeps
+ * (fixed-λ solves) and ms. Each timing is the minimum and median over repeats.
  * OpenBLAS runs single-threaded (the daemon parallelises across passages).
  *
  *   amfi-bench [--repeat N] [--no-nodal]
@@ -47,6 +49,7 @@ typedef struct row {
     amfi_modes m;
     int k;
     int automatic;
+    int estimate; /* 1: amfi_solve_speed from a detector speed 4 % high */
 } row;
 
 static void usage(FILE *f)
@@ -83,7 +86,7 @@ int main(int argc, char **argv)
         return 1;
     }
     const double scan = 1000.0, off[2] = {0.0, 5.0}, xs = 10.0;
-    const int n = (int)(1.05 * scan) + 1;
+    const int n = (int)(1.2 * scan) + 1; /* the speed search's slowest window too */
     double *acc = malloc(sizeof(double) * n);
     if (!acc || amfi_forward_newmark(b, 25.0, 2, off, force, NULL, 1, &xs, 2e-5, scan, n, acc,
                                      err, sizeof err)) {
@@ -101,12 +104,15 @@ int main(int argc, char **argv)
     const double true_gvw = (102000.0 + 74600.0) / AMFI_GRAVITY;
 
     const row rows[] = {
-        {"modal", "all", AMFI_COORDS_MODAL, AMFI_MODES_ALL, 0, 0},
-        {"modal", "observable", AMFI_COORDS_MODAL, AMFI_MODES_OBSERVABLE, 0, 0},
-        {"modal", "10", AMFI_COORDS_MODAL, AMFI_MODES_COUNT, 10, 0},
-        {"modal", "5", AMFI_COORDS_MODAL, AMFI_MODES_COUNT, 5, 0},
-        {"nodal", "all", AMFI_COORDS_NODAL, AMFI_MODES_ALL, 0, 0},
-        {"modal", "observable", AMFI_COORDS_MODAL, AMFI_MODES_OBSERVABLE, 0, 1},
+        {"modal", "all", AMFI_COORDS_MODAL, AMFI_MODES_ALL, 0, 0, 0},
+        {"modal", "observable", AMFI_COORDS_MODAL, AMFI_MODES_OBSERVABLE, 0, 0, 0},
+        {"modal", "10", AMFI_COORDS_MODAL, AMFI_MODES_COUNT, 10, 0, 0},
+        {"modal", "resolved", AMFI_COORDS_MODAL, AMFI_MODES_RESOLVED, 0, 0, 0},
+        {"modal", "5", AMFI_COORDS_MODAL, AMFI_MODES_COUNT, 5, 0, 0},
+        {"nodal", "all", AMFI_COORDS_NODAL, AMFI_MODES_ALL, 0, 0, 0},
+        {"modal", "observable", AMFI_COORDS_MODAL, AMFI_MODES_OBSERVABLE, 0, 1, 0},
+        {"modal", "observable", AMFI_COORDS_MODAL, AMFI_MODES_OBSERVABLE, 0, 0, 1},
+        {"modal", "10", AMFI_COORDS_MODAL, AMFI_MODES_COUNT, 10, 0, 1},
     };
     printf("amfi-bench: 1 s passage, 2 axles, data %.0f Hz, calculation 5000 Hz, "
            "OpenBLAS 1 thread, %d repeats\n\n",
@@ -133,11 +139,17 @@ int main(int argc, char **argv)
         amfi_lambda lam;
         amfi_lambda_default(&lam);
         lam.automatic = r->automatic;
-        int reps = r->c == AMFI_COORDS_NODAL ? (repeat < 3 ? repeat : 3) : repeat;
+        int reps = r->c == AMFI_COORDS_NODAL || r->estimate ? (repeat < 3 ? repeat : 3) : repeat;
         amfi_result res;
+        amfi_speed_prior prior;
+        amfi_speed_prior_default(&prior);
+        amfi_speed_result sres;
+        amfi_passage pe = p;
+        pe.speed_mps = 26.0;
         for (int k = 0; k < reps; k++) {
             double t0 = now_ms();
-            if (amfi_solve(s, &p, &lam, &res, err, sizeof err)) {
+            if (r->estimate ? amfi_solve_speed(s, &pe, &lam, &prior, &res, &sres, err, sizeof err)
+                            : amfi_solve(s, &p, &lam, &res, err, sizeof err)) {
                 fprintf(stderr, "amfi-bench: %s\n", err);
                 return 1;
             }
@@ -145,8 +157,12 @@ int main(int argc, char **argv)
         }
         qsort(t, reps, sizeof *t, cmp);
         printf("%-10s %-6s %-11s %-8s %6d %9.2f %9.2f %12.2f %+10.3f %8d\n", "paper", r->coords,
-               r->modes, r->automatic ? "L-curve" : "fixed", res.n_modes, t[0], t[reps / 2],
+               r->modes, r->automatic ? "L-curve" : r->estimate ? "speed" : "fixed", res.n_modes, t[0], t[reps / 2],
                res.gvw_kg, 100 * (res.gvw_kg / true_gvw - 1), res.n_solves);
+        if (r->estimate)
+            printf("    speed estimated from 26 m/s (true 25): %.4f m/s (%+.3f %%), one passage = "
+                   "%d fixed-lambda solves\n",
+                   sres.speed_mps, 100 * (sres.speed_mps / 25.0 - 1), res.n_solves);
         if (r->c == AMFI_COORDS_MODAL && r->m == AMFI_MODES_ALL) {
             t_modal_all = t[0];
             gvw_modal_all = res.gvw_kg;

@@ -168,7 +168,10 @@ typedef enum amfi_coords {
 typedef enum amfi_modes {
     AMFI_MODES_ALL = 0,        /* every mode */
     AMFI_MODES_OBSERVABLE = 1, /* modes some sensor sees (|ψ(x_s)| > 1e-9·max) */
-    AMFI_MODES_COUNT = 2       /* the n_modes lowest observable modes */
+    AMFI_MODES_COUNT = 2,      /* the n_modes lowest observable modes */
+    AMFI_MODES_RESOLVED = 3    /* observable modes the calculation step resolves:
+                                  f_k < calc_rate_hz / 2 (issue 12: same GVW to
+                                  0.1 kg as all observable, several times faster) */
 } amfi_modes;
 
 typedef struct amfi_solver_params {
