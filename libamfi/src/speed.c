@@ -77,6 +77,9 @@ int amfi_speed_prior_check(const amfi_speed_prior *p, double speed_mps, char *er
         return amfi_fail(err, errlen, AMFI_EINVAL,
                          "speed prior: grid step %g must be in [1e-4, range x SD = %g]",
                          p->grid_rel, p->range_sd * p->rel_sd);
+    if (!(isfinite(p->data_dof) && p->data_dof >= 0 && p->data_dof <= 1e9))
+        return amfi_fail(err, errlen, AMFI_EINVAL,
+                         "speed prior: data_dof %g must be in [0, 1e9]", p->data_dof);
     if (p->brent_evals < 0 || p->brent_evals > 100)
         return amfi_fail(err, errlen, AMFI_EINVAL,
                          "speed prior: brent_evals %d must be 0..100", p->brent_evals);
@@ -179,7 +182,7 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
     double data_steps = s->N * (ps->scan_rate_hz < s->p.calc_rate_hz
                                     ? ps->scan_rate_hz / s->p.calc_rate_hz
                                     : 1.0);
-    q.n_eff = data_steps * s->ns;
+    q.n_eff = pr->data_dof > 0 ? pr->data_dof : data_steps * s->ns;
 
     /* Grid: v0 + i·grid_rel·v0 over [lo, hi]. The cost has a narrow dip at
      * the true speed (about ±0.25 % wide: the entry and exit transients of

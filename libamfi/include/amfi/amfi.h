@@ -303,7 +303,8 @@ int amfi_formulation_parse(const char *name, amfi_formulation *f); /* 0 ok */
  * data fixed; the detector's speed v0 with relative SD σ as a Gaussian prior):
  *   J(v) = n_eff·ln C(v) + ((v − v0)/(σ·v0))²,
  * the profile log-likelihood of Gaussian residuals of unknown variance plus
- * the prior, n_eff = data samples in the window × sensors. C(v) is: */
+ * the prior, n_eff = data samples in the window × sensors (or data_dof
+ * below). C(v) is: */
 typedef enum amfi_speed_criterion {
     AMFI_SPEED_REGULARISED = 0, /* ‖y − d‖²_W + λ‖r‖²: the A-MFI fit's own cost */
     AMFI_SPEED_RESIDUAL = 1     /* ‖y − d‖²_W alone */
@@ -315,6 +316,9 @@ typedef struct amfi_speed_prior {
     double grid_rel; /* grid step / v0, 1e-4 .. range_sd·σ: below the cost's dip width */
     double tol_rel;  /* Brent stops when its bracket is below tol_rel·v0, 0 < tol < 0.01 */
     int brent_evals; /* Brent iterations (sweeps) after the grid, 0 .. 100 */
+    double data_dof; /* n_eff in J; 0: the data samples in the window (the
+                        residuals as independent); a small value tempers the
+                        data against the prior (model error is correlated) */
     amfi_speed_criterion criterion;
 } amfi_speed_prior;
 
