@@ -236,6 +236,23 @@ static void seed3(gsl_rng *r, unsigned long a, unsigned long b, unsigned long c)
     gsl_rng_set(r, (unsigned long)((h ^ (h >> 32)) & 0xffffffffu) | 1u);
 }
 
+/* The passage the worker's accelerometer recorded (one sensor:
+ * c->sp.n_sensors = 1), at speed_mps, with the vehicle's axle spacing. */
+static amfi_passage recorded_passage(const ctx *c, const worker *w, const amfi_passage_rec *pr,
+                                     const amfi_passage_spec *spec, double speed_mps)
+{
+    amfi_passage p;
+    memset(&p, 0, sizeof p);
+    p.n_samples = pr->n;
+    p.scan_rate_hz = c->sp.scan_rate_hz;
+    p.t_first_s = pr->t_first_s;
+    p.accel[0] = w->acc;
+    p.speed_mps = speed_mps;
+    p.n_axles = 2;
+    p.axle_spacing_m[0] = spec->car.D1_m + spec->car.D2_m;
+    return p;
+}
+
 /* Simulate spec on bridge `b`, then solve with the speed the detector
  * reports (or speed_used when > 0). */
 static int run_passage(const ctx *c, worker *w, const amfi_bridge *b, const amfi_profile *prof,
@@ -248,15 +265,8 @@ static int run_passage(const ctx *c, worker *w, const amfi_bridge *b, const amfi
         fprintf(stderr, "%s: simulation: %s\n", PROG, err);
         return -1;
     }
-    amfi_passage p;
-    memset(&p, 0, sizeof p);
-    p.n_samples = pr->n;
-    p.scan_rate_hz = c->sp.scan_rate_hz;
-    p.t_first_s = pr->t_first_s;
-    p.accel[0] = w->acc; /* one accelerometer (c->sp.n_sensors = 1) */
-    p.speed_mps = speed_used > 0 ? speed_used : pr->speed_measured_mps;
-    p.n_axles = 2;
-    p.axle_spacing_m[0] = spec->car.D1_m + spec->car.D2_m;
+    amfi_passage p = recorded_passage(c, w, pr, spec,
+                                      speed_used > 0 ? speed_used : pr->speed_measured_mps);
     if (amfi_solve(w->solver, &p, lam, res, err, sizeof err)) {
         fprintf(stderr, "%s: solve: %s\n", PROG, err);
         return -1;
@@ -284,24 +294,42 @@ static long idx(const ctx *c, int rep, int lev, int i)
     return ((long)rep * N_LEVELS + lev) * c->o.vehicles + i;
 }
 
+/* A batch thread's worker at the site's calculation rate and the fixed λ
+ * (the site policy, --lambda-ref); sets *failed and returns −1 on error. */
+static int batch_worker(const ctx *c, worker *w, amfi_lambda *fixed, int *failed)
+{
+    if (worker_init(c, w, c->cfg.solver.calc_rate_hz)) {
+        *failed = 1;
+        return -1;
+    }
+    *fixed = c->cfg.lambda;
+    fixed->automatic = 0;
+    fixed->lambda_ref = c->o.lambda_ref;
+    return 0;
+}
+
+/* The next item of a job shared by threads, or −1 when none is left or one
+ * thread failed. */
+static long take_item(pthread_mutex_t *lock, long *next, long n_items, const int *failed)
+{
+    pthread_mutex_lock(lock);
+    long it = *next < n_items && !*failed ? (*next)++ : -1;
+    pthread_mutex_unlock(lock);
+    return it;
+}
+
 static void *batch_thread(void *arg)
 {
     batch_job *j = arg;
     const ctx *c = j->c;
     worker w;
-    if (worker_init(c, &w, c->cfg.solver.calc_rate_hz)) {
-        j->failed = 1;
+    amfi_lambda fixed, lc = c->cfg.lambda;
+    if (batch_worker(c, &w, &fixed, &j->failed))
         return NULL;
-    }
-    amfi_lambda fixed = c->cfg.lambda, lc = c->cfg.lambda;
-    fixed.automatic = 0;
-    fixed.lambda_ref = c->o.lambda_ref;
     lc.automatic = 1;
     for (;;) {
-        pthread_mutex_lock(&j->lock);
-        long it = j->next++;
-        pthread_mutex_unlock(&j->lock);
-        if (it >= j->n_items || j->failed)
+        long it = take_item(&j->lock, &j->next, j->n_items, &j->failed);
+        if (it < 0)
             break;
         const int i = (int)(it % c->o.vehicles);
         const int lev = (int)((it / c->o.vehicles) % N_LEVELS);
@@ -346,16 +374,8 @@ static void *batch_thread(void *arg)
         j->gvw_true[it] = rec->axle_kg[0] + rec->axle_kg[1];
         j->gvw_fixed[it] = res.gvw_kg;
         if (c->o.batch_lcurve) {
-            amfi_passage p;
-            memset(&p, 0, sizeof p);
             /* the same measured data, solved again */
-            p.n_samples = pr.n;
-            p.scan_rate_hz = c->sp.scan_rate_hz;
-            p.t_first_s = pr.t_first_s;
-            p.accel[0] = w.acc;
-            p.speed_mps = pr.speed_measured_mps;
-            p.n_axles = 2;
-            p.axle_spacing_m[0] = spec.car.D1_m + spec.car.D2_m;
+            amfi_passage p = recorded_passage(c, &w, &pr, &spec, pr.speed_measured_mps);
             if (amfi_solve(w.solver, &p, &lc, &res, err, sizeof err)) {
                 fprintf(stderr, "%s: solve: %s\n", PROG, err);
                 j->failed = 1;
@@ -948,22 +968,16 @@ static void *spd_thread(void *arg)
     spd_job *j = arg;
     const ctx *c = j->c;
     worker w;
-    if (worker_init(c, &w, c->cfg.solver.calc_rate_hz)) {
-        j->failed = 1;
+    amfi_lambda fixed;
+    if (batch_worker(c, &w, &fixed, &j->failed))
         return NULL;
-    }
-    amfi_lambda fixed = c->cfg.lambda;
-    fixed.automatic = 0;
-    fixed.lambda_ref = c->o.lambda_ref;
     amfi_speed_prior prior;
     amfi_speed_prior_default(&prior);
     prior.grid_rel = c->o.speed_grid;
     prior.data_dof = c->o.speed_dof;
     for (;;) {
-        pthread_mutex_lock(&j->lock);
-        long it = j->next++;
-        pthread_mutex_unlock(&j->lock);
-        if (it >= j->n_items || j->failed)
+        long it = take_item(&j->lock, &j->next, j->n_items, &j->failed);
+        if (it < 0)
             break;
         const int cond = (int)(it / c->o.speed_batch), i = (int)(it % c->o.speed_batch);
         spd_item *out = &j->items[it];
@@ -1006,15 +1020,7 @@ static void *spd_thread(void *arg)
         out->v_true = spec.speed_mps;
         out->v_given = v_used > 0 ? v_used : pr.speed_measured_mps;
         out->gvw_given = res.gvw_kg;
-        amfi_passage p;
-        memset(&p, 0, sizeof p);
-        p.n_samples = pr.n;
-        p.scan_rate_hz = c->sp.scan_rate_hz;
-        p.t_first_s = pr.t_first_s;
-        p.accel[0] = w.acc;
-        p.n_axles = 2;
-        p.axle_spacing_m[0] = spec.car.D1_m + spec.car.D2_m;
-        p.speed_mps = spec.speed_mps;
+        amfi_passage p = recorded_passage(c, &w, &pr, &spec, spec.speed_mps);
         int rc = amfi_solve(w.solver, &p, &fixed, &res, err, sizeof err);
         out->gvw_exact = res.gvw_kg;
         amfi_speed_result sr;
