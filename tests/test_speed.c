@@ -95,17 +95,21 @@ static void recovers_biased_speed(void **state)
     amfi_solver *s = solver();
     amfi_lambda lam;
     amfi_lambda_default(&lam);
-    const double noise[2] = {0.0, 0.03}, bias[2] = {-0.04, 0.04};
-    for (int k = 0; k < 2; k++) {
+    /* (noise, bias, criterion): the residual criterion once (it is the
+     * weaker one, docs/results/speed-estimation.md); kept short for ASan */
+    const struct { double noise, bias; int c; } cases[] = {
+        {0.0, -0.04, 0}, {0.03, -0.04, 0}, {0.03, 0.04, 0}, {0.03, -0.04, 1}};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         int n;
-        double *acc = record(noise[k], &n);
-        for (int b = 0; b < 2; b++)
-            for (int c = 0; c < 2; c++) {
+        double *acc = record(cases[k].noise, &n);
+        {
+                const double bias[1] = {cases[k].bias}, noise[1] = {cases[k].noise};
+                const int b = 0, c = cases[k].c;
                 amfi_passage p = passage(acc, n, TRUE_SPEED * (1 + bias[b]));
                 amfi_speed_prior pr;
                 amfi_speed_prior_default(&pr);
                 pr.criterion = (amfi_speed_criterion)c;
-                pr.range_sd = 2.0; /* ±6 %: holds the ±4 % bias, 61 grid sweeps */
+                pr.range_sd = 1.5; /* ±4.5 %: holds the ±4 % bias, 46 grid sweeps */
                 amfi_result plain, est;
                 amfi_speed_result sr;
                 char err[256];
@@ -117,7 +121,7 @@ static void recovers_biased_speed(void **state)
                 double ve = sr.speed_mps / TRUE_SPEED - 1, ge = est.gvw_kg / true_gvw_kg - 1;
                 print_message("noise %.0f%% given %+.0f%% %-11s: speed %+.3f%% in %d sweeps, "
                               "GVW %+.2f%% (given speed: %+.2f%%)\n",
-                              100 * noise[k], 100 * bias[b], amfi_speed_criterion_name(pr.criterion),
+                              100 * noise[b], 100 * bias[b], amfi_speed_criterion_name(pr.criterion),
                               100 * ve, est.n_solves, 100 * ge,
                               100 * (gvw_plain / true_gvw_kg - 1));
                 assert_true(fabs(ve) < 0.005);
