@@ -1109,12 +1109,12 @@ static void speed_batch(ctx *c)
     fprintf(c->md, "## Speed estimation (issue 12)\n\nEach condition: %d vehicles from the "
                    "population, class A carpet, 3 %% noise, a preceding vehicle 0.5-2 s "
                    "before; fixed λ %.3g; prior SD 3 %%, search ±3 SD on a %.2g %% grid + Brent."
-                   " Per-vehicle errors (inferred − true)/true, mean ± STD (worst |.|).\n\n"
+                   " Per-vehicle errors (inferred − true)/true, mean ± STD (worst |.|). Data "
+                   "weight n_eff: %s.\n\n"
                    "| condition | GVW, exact speed | GVW, given speed | GVW, estimated (regularised) | "
                    "speed given: RMS | estimated: bias, RMS | GVW, estimated (residual) | speed (residual): bias, RMS | sweeps | ms given / estimated |\n"
                    "|---|---|---|---|---|---|---|---|---|---|\n",
-            n, c->o.lambda_ref, 100 * c->o.speed_grid);
-    fprintf(c->md, "Data weight n_eff: %s.\n\n",
+            n, c->o.lambda_ref, 100 * c->o.speed_grid,
             c->o.speed_dof > 0 ? "as given by --speed-dof" : "the samples in the window");
     for (int k = 0; k < SPD_CONDS; k++) {
         double nsum = 0, msg = 0, msr = 0, at = 0;
