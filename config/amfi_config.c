@@ -122,6 +122,8 @@ void amfi_config_defaults(amfi_site_config *c)
     m->damage_step_at = -1;
     m->profile_class = 'A';
     m->track_std = 2.0;
+    m->environment = 0;
+    m->time_compression = 1.0;
     m->scan_rate_hz = 1000.0;
     m->noise = 0.0;
     m->speed_err_mean = 0.0;

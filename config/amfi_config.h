@@ -90,6 +90,11 @@ typedef struct amfi_sim_config {
     double pre_s, post_s;   /* simulation.pre_s, post_s: record before entry /
                                after exit (--out), s, [0, 30] */
     double dt_s;            /* simulation.dt_s: integration step, s, [1e-6, 1e-3] */
+    int environment;        /* simulation.environment: 0 none (constant modulus,
+                               the population's mix), 1 site (climate-driven
+                               modulus, drifting mix; docs/simulator.md) */
+    double time_compression; /* simulation.time_compression: site time / data
+                               time of the climate and the mix, [1, 1e6] */
     /* simulation.stream.* (streaming, without --out) */
     char lcm_url[256];      /* lcm_url: "" = LCM's default; "none" = publish nothing */
     char log[512];          /* log: LCM log file to write; "" = none (relative

@@ -208,6 +208,9 @@ static const enum_name profile_names[] = {
     {"A", 'A'}, {"B", 'B'}, {"C", 'C'}, {"D", 'D'}, {"E", 'E'},
     {"F", 'F'}, {"G", 'G'}, {"H", 'H'}, {"smooth", 0}, {NULL, 0}};
 
+/* simulation.environment -> environment */
+static const enum_name environment_names[] = {{"none", 0}, {"site", 1}, {NULL, 0}};
+
 static const field speed_error_fields[] = {
     {.key = "mean", .kind = &K_DOUBLE, .off = SIM(speed_err_mean), .lo = -0.5, .hi = 0.5},
     {.key = "std", .kind = &K_DOUBLE, .off = SIM(speed_err_std), .lo = 0, .hi = 0.5},
@@ -247,6 +250,9 @@ const field sim_fields[] = {
     {.key = "pre_s", .kind = &K_DOUBLE, .off = SIM(pre_s), .lo = 0, .hi = 30},
     {.key = "post_s", .kind = &K_DOUBLE, .off = SIM(post_s), .lo = 0, .hi = 30},
     {.key = "dt_s", .kind = &K_DOUBLE, .off = SIM(dt_s), .lo = 1e-6, .hi = 1e-3},
+    {.key = "environment", .kind = &K_ENUM, .off = SIM(environment), .aux = environment_names},
+    {.key = "time_compression", .kind = &K_DOUBLE, .off = SIM(time_compression), .lo = 1,
+     .hi = 1e6},
     {.key = "stream", .kind = &K_MAP, .aux = stream_fields},
     {.key = NULL}};
 

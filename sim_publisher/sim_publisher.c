@@ -47,6 +47,12 @@
  * file:// provider; --lcm-url none publishes nothing. Vehicles follow each
  * other --headway seconds apart (default: the population's timestamps);
  * --damage-step-at K switches the bridge to --damage from vehicle K on.
+ * --environment site (streaming only) drives the bridge's modulus with the
+ * deck temperature of a simulated site climate, set as each vehicle is
+ * added, and draws each vehicle from the population's loaded or empty class
+ * with a share that drifts with the weekday and the season (site.h,
+ * docs/simulator.md "Environment"); --time-compression C runs the climate
+ * and the calendar C times faster than the data clock.
  *
  *   sim_publisher [--lcm-url URL|none] [--log FILE] [--speedup X|max]
  *                 [--vehicles N] [--headway SEC] [--damage FRACTION]
@@ -77,6 +83,7 @@
 #include "amfi_messages.h"
 #include "passage.h"
 #include "profile.h"
+#include "site.h"
 #include "traffic.h"
 #include "vbi.h"
 #include "vehicle.h"
@@ -109,6 +116,8 @@ typedef struct opts {
     int block;
     long long start_utime;
     double detector_lead;
+    int environment;      /* 0 none, 1 site */
+    double time_compression;
 } opts;
 
 static void usage(FILE *f)
@@ -150,6 +159,8 @@ static void usage(FILE *f)
             "      --block N                  samples per accelerometer message\n"
             "      --start-utime US           data time of the start, µs\n"
             "      --detector-lead SEC        vehicle message this long before entry\n"
+            "      --environment none|site    streaming: site climate and drifting mix\n"
+            "      --time-compression C       site time / data time, 1 .. 1000000\n"
             "  -h, --help                     this help\n"
             "  -V, --version                  print the version\n"
             "Settings: built-in defaults < the configuration file's simulation: section\n"
@@ -161,7 +172,8 @@ static void usage(FILE *f)
 enum {
     O_FIRST = 256, O_PROFILE, O_TRACK_STD, O_SCAN_RATE, O_NOISE, O_SPEED_ERROR,
     O_PRECEDING_GAP, O_PRE, O_POST, O_DT, O_SPEEDUP, O_HEADWAY, O_DAMAGE_STEP_AT,
-    O_NOISE_MS2, O_BLOCK, O_START_UTIME, O_DETECTOR_LEAD
+    O_NOISE_MS2, O_BLOCK, O_START_UTIME, O_DETECTOR_LEAD, O_ENVIRONMENT,
+    O_TIME_COMPRESSION
 };
 
 static const struct option longopts[] = {
@@ -190,6 +202,8 @@ static const struct option longopts[] = {
     {"block", required_argument, NULL, O_BLOCK},
     {"start-utime", required_argument, NULL, O_START_UTIME},
     {"detector-lead", required_argument, NULL, O_DETECTOR_LEAD},
+    {"environment", required_argument, NULL, O_ENVIRONMENT},
+    {"time-compression", required_argument, NULL, O_TIME_COMPRESSION},
     AMFI_CLI_END};
 
 /* "A" or "A,B" */
@@ -272,6 +286,8 @@ static void opts_from_config(opts *o, const amfi_sim_config *c, const char *file
     o->block = c->block;
     o->start_utime = c->start_utime;
     o->detector_lead = c->detector_lead_s;
+    o->environment = c->environment;
+    o->time_compression = c->time_compression;
 }
 
 /* The flags over the values already in *o; exits 0 after --help, 2 after a
@@ -334,6 +350,13 @@ static void apply_flags(int argc, char **argv, opts *o)
         case O_BLOCK: o->block = (int)amfi_cli_num(&c, v, 1, 160); break;
         case O_START_UTIME: o->start_utime = (long long)amfi_cli_num(&c, v, 1, 4e15); break;
         case O_DETECTOR_LEAD: o->detector_lead = amfi_cli_num(&c, v, 0, 60); break;
+        case O_ENVIRONMENT:
+            if (!strcmp(v, "none") || !strcmp(v, "site"))
+                o->environment = !strcmp(v, "site");
+            else
+                amfi_cli_fail(&c, "'%s' is not none or site", amfi_cli_shown(v));
+            break;
+        case O_TIME_COMPRESSION: o->time_compression = amfi_cli_num(&c, v, 1, 1e6); break;
         }
     }
     if (o->speed_err_std < 0) {
@@ -477,15 +500,40 @@ static double wall_s(void)
 }
 
 typedef struct planned {
-    amfi_sim_vehicle v;  /* id = population record + 1 */
+    amfi_sim_vehicle v;  /* id = first + index in the plan + 1 */
+    int rec;             /* its population record (first + index without
+                            --environment site) */
     double entry_s;      /* sim time */
     int added, announced;
     double spacing;
 } planned;
 
-static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
-                  const amfi_vehicle_rec *recs, const char *ppath)
+/* --environment site: before vehicle `id` is added at data time now, put
+ * the bridge of the current deck temperature (and damage) under the
+ * traffic; *cur is the bridge simulated so far. 0, or 1 after a message. */
+static int site_update(amfi_site *site, amfi_sim *sim, double now, double damage,
+                       const amfi_bridge **cur, double deck_range[2])
 {
+    char err[512];
+    const amfi_bridge *b = amfi_site_bridge_at(site, now, damage, err, sizeof err);
+    if (!b || (b != *cur && amfi_sim_set_bridge(sim, b, err, sizeof err))) {
+        fprintf(stderr, "%s: environment: %s\n", PROG, err);
+        return 1;
+    }
+    *cur = b;
+    if (site->env.deck_c < deck_range[0])
+        deck_range[0] = site->env.deck_c;
+    if (site->env.deck_c > deck_range[1])
+        deck_range[1] = site->env.deck_c;
+    return 0;
+}
+
+static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
+                  const amfi_vehicle_rec *recs, int n_recs, const char *ppath)
+{
+    amfi_site site = {0};
+    const amfi_bridge *cur = w->bridge;
+    double deck_range[2] = {1e9, -1e9};
     char err[512];
     int rc = 1;
     bus b = {0};
@@ -495,6 +543,12 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
     double *acc = NULL;
     if (!plan || !rng)
         goto out;
+    if (o->environment &&
+        amfi_site_init(&site, &cfg->bridge, recs, n_recs, o->start_utime, o->time_compression,
+                       o->seed, err, sizeof err)) {
+        fprintf(stderr, "%s: %s: %s\n", PROG, ppath, err);
+        goto out;
+    }
     if (!o->lcm_url || strcmp(o->lcm_url, "none")) {
         b.lcm = lcm_create(o->lcm_url);
         if (!b.lcm) {
@@ -520,21 +574,28 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
      * the first after its full approach. */
     double t = 0.0;
     for (long i = 0; i < o->vehicles; i++) {
-        const amfi_vehicle_rec *rec = &recs[o->first + i];
+        /* the clock follows the population's records in order; with
+         * --environment site the vehicle is the mix's draw for that time */
+        const amfi_vehicle_rec *seq = &recs[o->first + i];
+        double gap = o->headway > 0 ? o->headway
+                                    : (i ? seq->timestamp_s - recs[o->first + i - 1].timestamp_s
+                                         : 0.0);
+        const int ri = o->environment ? amfi_site_pick(&site, o->seed, o->first + i,
+                                                       i ? t + gap : 0.0)
+                                      : (int)(o->first + i);
+        const amfi_vehicle_rec *rec = &recs[ri];
         amfi_passage_spec spec;
         seed_vehicle(rng, o->seed, o->first + i);
         if (amfi_passage_spec_from_rec(rec, &w->dist, w->prof, o->track_std, rng, &spec, err,
                                        sizeof err)) {
-            fprintf(stderr, "%s: %s: vehicle %ld: %s\n", PROG, ppath, o->first + i + 1, err);
+            fprintf(stderr, "%s: %s: vehicle %d: %s\n", PROG, ppath, ri + 1, err);
             goto out;
         }
-        double gap = o->headway > 0 ? o->headway
-                                    : (i ? rec->timestamp_s - recs[o->first + i - 1].timestamp_s
-                                         : 0.0);
         t = i ? t + gap : sp.approach_m / spec.speed_mps + 1.0;
         /* a vehicle cannot start its approach before the previous one: keep order */
         plan[i].entry_s = t;
         plan[i].v.id = o->first + i + 1;
+        plan[i].rec = ri;
         plan[i].v.car = spec.car;
         plan[i].v.speed_mps = spec.speed_mps;
         plan[i].v.t_entry_s = t;
@@ -566,6 +627,10 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
                    now + (double)blk / o->scan_rate + 1e-9) {
             if (damaged && !stepped && next_add == o->damage_step_at)
                 break; /* switch the bridge first (next loop turn) */
+            if (o->environment &&
+                site_update(&site, sim, now, damaged && !stepped ? 0.0 : o->damage, &cur,
+                            deck_range))
+                goto out;
             if (amfi_sim_add(sim, &plan[next_add].v, err, sizeof err)) {
                 fprintf(stderr, "%s: vehicle %ld: %s\n", PROG, plan[next_add].v.id, err);
                 goto out;
@@ -582,6 +647,9 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             stepped = 1;
             fprintf(stderr, "%s: damage %.3g from vehicle %ld on (t = %.1f s)\n", PROG, o->damage,
                     plan[next_add].v.id, now);
+            cur = damaged;
+            if (o->environment && site_update(&site, sim, now, o->damage, &cur, deck_range))
+                goto out;
             if (amfi_sim_add(sim, &plan[next_add].v, err, sizeof err)) {
                 fprintf(stderr, "%s: vehicle %ld: %s\n", PROG, plan[next_add].v.id, err);
                 goto out;
@@ -626,7 +694,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         /* the truth of the vehicles that have left */
         amfi_sim_vehicle d;
         while (amfi_sim_pop_done(sim, &d)) {
-            const amfi_vehicle_rec *rec = &recs[d.id - 1];
+            const amfi_vehicle_rec *rec = &recs[plan[d.id - 1 - o->first].rec];
             double axle[2] = {rec->axle_kg[0], rec->axle_kg[1]};
             amfi_truth_t m = {o->start_utime + (int64_t)llround(d.t_entry_s * 1e6), d.id,
                               axle[0] + axle[1], 2, axle, d.mean_force_N, d.speed_mps};
@@ -648,6 +716,10 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             }
         }
     }
+    if (o->environment)
+        fprintf(stderr, "%s: environment site: deck %.1f .. %.1f °C over %.1f site days, "
+                "%d bridge moduli\n", PROG, deck_range[0], deck_range[1],
+                amfi_sim_time(sim) * o->time_compression / 86400.0, site.n_bridges);
     fprintf(stderr, "%s: %ld vehicles streamed over %.1f s of data in %lld messages%s\n", PROG,
             left, amfi_sim_time(sim), (long long)b.sent,
             stream_stop ? " (stopped by a signal)" : "");
@@ -656,6 +728,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
 out:
     free(acc);
     amfi_sim_destroy(sim);
+    amfi_site_free(&site);
     if (b.log)
         lcm_eventlog_destroy(b.log);
     if (b.lcm)
@@ -709,11 +782,14 @@ int main(int argc, char **argv)
         return 1;
     }
     if (!o.out) {
-        int src = stream(&o, &cfg, &w, recs, ppath);
+        int src = stream(&o, &cfg, &w, recs, n_recs, ppath);
         world_free(&w);
         amfi_traffic_free(recs);
         return src;
     }
+    if (o.environment)
+        fprintf(stderr, "%s: --environment site is for streaming; --out simulates without it\n",
+                PROG);
     if (mkdir(o.out, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "%s: %s: cannot create: %s\n", PROG, o.out, strerror(errno));
         world_free(&w);

@@ -85,6 +85,8 @@ static void test_defaults(void **state)
     assert_true(c.sim.damage == 0.0);
     assert_int_equal(-1, c.sim.damage_step_at);
     assert_int_equal('A', c.sim.profile_class);
+    assert_int_equal(0, c.sim.environment);
+    assert_true(c.sim.time_compression == 1.0);
     assert_true(c.sim.track_std == 2.0 && c.sim.scan_rate_hz == 1000.0);
     assert_true(c.sim.noise == 0.0);
     assert_true(c.sim.speed_err_mean == 0.0 && c.sim.speed_err_std == 0.0);
@@ -291,6 +293,8 @@ static const char every_sim_key[] =
     "  pre_s: 0.25\n"
     "  post_s: 1.5\n"
     "  dt_s: 5e-5\n"
+    "  environment: site\n"
+    "  time_compression: 365\n"
     "  stream:\n"
     "    lcm_url: udpm://239.255.76.99:7667?ttl=0\n"
     "    log: out/traffic.lcmlog\n"
@@ -322,6 +326,8 @@ static void test_every_sim_key(void **state)
     assert_int_equal(1, c.sim.preceding);
     assert_true(c.sim.gap_lo_s == -1.5 && c.sim.gap_hi_s == 2.0);
     assert_true(c.sim.pre_s == 0.25 && c.sim.post_s == 1.5 && c.sim.dt_s == 5e-5);
+    assert_int_equal(1, c.sim.environment);
+    assert_true(c.sim.time_compression == 365.0);
     assert_string_equal("udpm://239.255.76.99:7667?ttl=0", c.sim.lcm_url);
     assert_string_equal("out/traffic.lcmlog", c.sim.log); /* not the file's folder */
     assert_true(c.sim.speedup == 25.0 && c.sim.headway_s == 2.0);
@@ -578,6 +584,10 @@ static const bad_case bad_cases[] = {
      "expected one of A, B, C, D, E, F, G, H, smooth; got 'Z'"},
     {"sim_profile_lower", "simulation:\n  profile: a\n", 2, "simulation.profile",
      "got 'a'"},
+    {"sim_environment", "simulation:\n  environment: winter\n", 2, "simulation.environment",
+     "expected one of none, site; got 'winter'"},
+    {"sim_time_compression", "simulation:\n  time_compression: 0.5\n", 2,
+     "simulation.time_compression", "[1, 1e+06]"},
     {"sim_track_std", "simulation:\n  track_std: 101\n", 2, "simulation.track_std",
      "[0, 100]"},
     {"sim_scan_rate", "simulation:\n  scan_rate_hz: 30\n", 2, "simulation.scan_rate_hz",

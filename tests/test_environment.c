@@ -21,6 +21,7 @@
 
 #include "environment.h"
 #include "mix.h"
+#include "site.h"
 #include "traffic.h"
 
 static void modulus_law(void **state)
@@ -211,13 +212,65 @@ static void mix_draw(void **state)
     amfi_traffic_free(recs);
 }
 
+/* The streaming site: calendar from the start utime, the modulus-scaled
+ * bridges (first circular frequency ∝ sqrt(E)) and their cache. */
+static void site_stream(void **state)
+{
+    amfi_vehicle_rec *recs = NULL;
+    int n = 0;
+    char err[256];
+    amfi_site s;
+    amfi_bridge_params bp;
+    (void)state;
+    amfi_bridge_params_paper20(&bp);
+    bp.damage = 0.3; /* ignored: the damage is the caller's */
+    assert_int_equal(amfi_traffic_read(AMFI_SIM_DATA_DIR "/population.csv", &recs, &n, err,
+                                       sizeof err), 0);
+    /* 2026-01-01T12:00Z, a Thursday */
+    assert_int_equal(amfi_site_init(&s, &bp, recs, n, 1767268800000000LL, 365.0, 5, err,
+                                    sizeof err), 0);
+    assert_float_equal(s.day0, 0.5, 1e-12);
+    assert_int_equal(s.mix.day0_weekday, 3);
+    assert_float_equal(amfi_site_day(&s, 86400.0), 365.5, 1e-9);
+    const amfi_bridge *b0 = amfi_site_bridge_at(&s, 0.0, 0.0, err, sizeof err);
+    assert_non_null(b0);
+    assert_float_equal(amfi_bridge_params_of(b0)->damage, 0.0, 0.0); /* damage from the caller */
+    const double f = amfi_env_modulus_factor(&s.env.p, s.env.deck_c);
+    const double E = amfi_bridge_params_of(b0)->E_pa;
+    assert_true(fabs(E / bp.E_pa - f) <= AMFI_SITE_MODULUS_STEP / 2 + 1e-12);
+    /* same instant, same bridge; damaged is another one */
+    assert_ptr_equal(amfi_site_bridge_at(&s, 0.0, 0.0, err, sizeof err), b0);
+    const amfi_bridge *bd = amfi_site_bridge_at(&s, 0.0, 0.1, err, sizeof err);
+    assert_non_null(bd);
+    assert_ptr_not_equal(bd, b0);
+    /* half a year on (compressed: 12 h of data): another modulus, frequency ∝ sqrt(E) */
+    const amfi_bridge *b1 = amfi_site_bridge_at(&s, 0.5 * 86400.0, 0.0, err, sizeof err);
+    assert_non_null(b1);
+    const double E1 = amfi_bridge_params_of(b1)->E_pa;
+    assert_true(E1 != E);
+    assert_float_equal(amfi_bridge_omega(b1)[0] / amfi_bridge_omega(b0)[0], sqrt(E1 / E), 1e-6);
+    /* the draw is reproducible and in range */
+    for (long i = 0; i < 1000; i++) {
+        const int r = amfi_site_pick(&s, 5, i, 60.0 * i);
+        assert_true(r >= 0 && r < n);
+        assert_int_equal(r, amfi_site_pick(&s, 5, i, 60.0 * i));
+    }
+    amfi_site_free(&s);
+    amfi_site_free(&s);
+    /* a compression below 1 is refused */
+    assert_int_equal(amfi_site_init(&s, &bp, recs, n, 1767268800000000LL, 0.5, 5, err,
+                                    sizeof err), AMFI_EINVAL);
+    assert_non_null(strstr(err, "compression"));
+    amfi_traffic_free(recs);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(modulus_law),     cmocka_unit_test(air_mean_cycles),
         cmocka_unit_test(a_year),          cmocka_unit_test(reproducible_and_compressed),
         cmocka_unit_test(deck_lags_air),   cmocka_unit_test(mix_calendar),
-        cmocka_unit_test(mix_draw),
+        cmocka_unit_test(mix_draw),        cmocka_unit_test(site_stream),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
