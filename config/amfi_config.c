@@ -91,6 +91,7 @@ void amfi_config_defaults(amfi_site_config *c)
     strcpy(d->ch_indicator, "AMFI_INDICATOR");
     strcpy(d->ch_alert, "AMFI_ALERT");
     strcpy(d->ch_status, "AMFI_STATUS");
+    strcpy(d->ch_environment, "AMFI_ENVIRONMENT");
     strcpy(d->db_path, "amfi.db");
     d->sync_full = 1;
     d->workers = 2;
@@ -124,6 +125,7 @@ void amfi_config_defaults(amfi_site_config *c)
     m->track_std = 2.0;
     m->environment = 0;
     m->time_compression = 1.0;
+    m->environment_period_s = 60.0;
     m->scan_rate_hz = 1000.0;
     m->noise = 0.0;
     m->speed_err_mean = 0.0;

@@ -33,6 +33,7 @@ typedef struct amfi_daemon_config {
     char lcm_url[256];        /* daemon.lcm_url; "" = LCM's default */
     char ch_accel[64], ch_vehicle[64], ch_truth[64]; /* daemon.channels.* (inputs) */
     char ch_passage[64], ch_indicator[64], ch_alert[64], ch_status[64]; /* outputs */
+    char ch_environment[64]; /* daemon.channels.environment: in, air/deck temperature */
     char db_path[512];        /* daemon.store.path */
     int sync_full;            /* daemon.store.sync: full (1) | normal (0) */
     int workers;              /* daemon.workers: solver threads, 1 .. 64 */
@@ -109,6 +110,9 @@ typedef struct amfi_sim_config {
                                µs since 1970, 1 .. 4e15 */
     double detector_lead_s; /* detector_lead_s: vehicle event before entry,
                                s, [0, 60] */
+    double environment_period_s; /* environment_period_s: environment_t every
+                               this much data time (environment: site), s,
+                               [0.1, 86400] */
 } amfi_sim_config;
 
 /* site.*: which bridge this is (section_site.c). */

@@ -22,7 +22,8 @@ static const field channel_fields[] = {
     STR("accel", ch_accel, 1),     STR("vehicle", ch_vehicle, 1),
     STR("truth", ch_truth, 1),     STR("passage", ch_passage, 1),
     STR("indicator", ch_indicator, 1), STR("alert", ch_alert, 1),
-    STR("status", ch_status, 1),   {.key = NULL}};
+    STR("status", ch_status, 1),   STR("environment", ch_environment, 1),
+    {.key = NULL}};
 
 static const enum_name sync_names[] = {{"normal", 0}, {"full", 1}, {NULL, 0}};
 

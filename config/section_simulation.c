@@ -229,6 +229,8 @@ static const field stream_fields[] = {
      .hi = 4e15},
     {.key = "detector_lead_s", .kind = &K_DOUBLE, .off = SIM(detector_lead_s), .lo = 0,
      .hi = 60},
+    {.key = "environment_period_s", .kind = &K_DOUBLE, .off = SIM(environment_period_s),
+     .lo = 0.1, .hi = 86400},
     {.key = NULL}};
 
 const field sim_fields[] = {

@@ -16,6 +16,7 @@
 
 #include "amfi_accel_block_t.h"
 #include "amfi_alert_t.h"
+#include "amfi_environment_t.h"
 #include "amfi_indicator_t.h"
 #include "amfi_passage_t.h"
 #include "amfi_status_t.h"
@@ -30,6 +31,7 @@
 #define AMFI_CHANNEL_INDICATOR "AMFI_INDICATOR" /* amfi_indicator_t: amfid */
 #define AMFI_CHANNEL_ALERT     "AMFI_ALERT"     /* amfi_alert_t: amfid */
 #define AMFI_CHANNEL_STATUS    "AMFI_STATUS"    /* amfi_status_t: amfid heartbeat */
+#define AMFI_CHANNEL_ENVIRONMENT "AMFI_ENVIRONMENT" /* amfi_environment_t: site sensors or sim_publisher */
 /* lcm_subscribe() regular expression for every amfi channel. */
 #define AMFI_CHANNEL_ALL       "AMFI_.*"
 

@@ -52,7 +52,9 @@
  * added, and draws each vehicle from the population's loaded or empty class
  * with a share that drifts with the weekday and the season (site.h,
  * docs/simulator.md "Environment"); --time-compression C runs the climate
- * and the calendar C times faster than the data clock.
+ * and the calendar C times faster than the data clock; an environment_t
+ * (air and deck temperature) goes out every --environment-period seconds
+ * of data time.
  *
  *   sim_publisher [--lcm-url URL|none] [--log FILE] [--speedup X|max]
  *                 [--vehicles N] [--headway SEC] [--damage FRACTION]
@@ -117,6 +119,7 @@ typedef struct opts {
     long long start_utime;
     double detector_lead;
     int environment;      /* 0 none, 1 site */
+    double environment_period; /* s of data time between environment_t */
     double time_compression;
 } opts;
 
@@ -161,6 +164,7 @@ static void usage(FILE *f)
             "      --detector-lead SEC        vehicle message this long before entry\n"
             "      --environment none|site    streaming: site climate and drifting mix\n"
             "      --time-compression C       site time / data time, 1 .. 1000000\n"
+            "      --environment-period SEC   environment_t every SEC of data time\n"
             "  -h, --help                     this help\n"
             "  -V, --version                  print the version\n"
             "Settings: built-in defaults < the configuration file's simulation: section\n"
@@ -173,7 +177,7 @@ enum {
     O_FIRST = 256, O_PROFILE, O_TRACK_STD, O_SCAN_RATE, O_NOISE, O_SPEED_ERROR,
     O_PRECEDING_GAP, O_PRE, O_POST, O_DT, O_SPEEDUP, O_HEADWAY, O_DAMAGE_STEP_AT,
     O_NOISE_MS2, O_BLOCK, O_START_UTIME, O_DETECTOR_LEAD, O_ENVIRONMENT,
-    O_TIME_COMPRESSION
+    O_TIME_COMPRESSION, O_ENVIRONMENT_PERIOD
 };
 
 static const struct option longopts[] = {
@@ -204,6 +208,7 @@ static const struct option longopts[] = {
     {"detector-lead", required_argument, NULL, O_DETECTOR_LEAD},
     {"environment", required_argument, NULL, O_ENVIRONMENT},
     {"time-compression", required_argument, NULL, O_TIME_COMPRESSION},
+    {"environment-period", required_argument, NULL, O_ENVIRONMENT_PERIOD},
     AMFI_CLI_END};
 
 /* "A" or "A,B" */
@@ -288,6 +293,7 @@ static void opts_from_config(opts *o, const amfi_sim_config *c, const char *file
     o->detector_lead = c->detector_lead_s;
     o->environment = c->environment;
     o->time_compression = c->time_compression;
+    o->environment_period = c->environment_period_s;
 }
 
 /* The flags over the values already in *o; exits 0 after --help, 2 after a
@@ -355,6 +361,9 @@ static void apply_flags(int argc, char **argv, opts *o)
                 o->environment = !strcmp(v, "site");
             else
                 amfi_cli_fail(&c, "'%s' is not none or site", amfi_cli_shown(v));
+            break;
+        case O_ENVIRONMENT_PERIOD:
+            o->environment_period = amfi_cli_num(&c, v, 0.1, 86400);
             break;
         case O_TIME_COMPRESSION: o->time_compression = amfi_cli_num(&c, v, 1, 1e6); break;
         }
@@ -617,6 +626,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
     gsl_rng *noise = gsl_rng_alloc(gsl_rng_mt19937);
     gsl_rng_set(noise, o->seed ^ 0x5eedu);
     int stepped = 0; /* the damage step has happened */
+    double next_env_s = 0.0; /* data time of the next environment_t */
     if (!acc || !noise)
         goto out;
     while (!stream_stop) {
@@ -672,6 +682,19 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
                 goto out;
             }
             next_announce++;
+        }
+        /* the environment, every environment_period of data time */
+        if (o->environment && now + 1e-9 >= next_env_s) {
+            amfi_env_advance(&site.env, now);
+            amfi_environment_t m = {o->start_utime + (int64_t)llround(now * 1e6), site.env.air_c,
+                                    site.env.deck_c};
+            if (EMIT(&b, amfi_environment_t, cfg->daemon.ch_environment, &m)) {
+                fprintf(stderr, "%s: publishing failed\n", PROG);
+                goto out;
+            }
+            do
+                next_env_s += o->environment_period;
+            while (next_env_s <= now + 1e-9);
         }
         /* one block of samples */
         if (amfi_sim_advance(sim, blk, acc, err, sizeof err)) {

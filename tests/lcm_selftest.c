@@ -58,6 +58,7 @@ struct round {
     amfi_indicator_t indicator;
     amfi_alert_t alert;
     amfi_status_t status;
+    amfi_environment_t environment;
     char alert_message[128];
 };
 
@@ -178,6 +179,11 @@ static void round_make(struct round *r, int i)
     r->status.state = "running";
     r->status.site_id = "selftest-site";
     r->status.last_error = i % 5 == 4 ? "AMFI_VEHICLE: lane 7 not in the site configuration" : "";
+
+    /* A frosty morning warming by 0.1 °C a round, the deck lagging. */
+    r->environment.utime = t;
+    r->environment.air_c = -4.25 + 0.1 * i;
+    r->environment.deck_c = -1.5 + 0.05 * i;
 }
 
 /* ---- canonical text (--expect and test_spy.sh) ---- */
@@ -303,6 +309,12 @@ static void print_round(const struct round *r)
     put_s("state", s->state, ";");
     put_s("last_error", s->last_error, ";");
     put_s("site_id", s->site_id, "\n");
+
+    const amfi_environment_t *en = &r->environment;
+    printf("%s\tamfi.environment_t\t", AMFI_CHANNEL_ENVIRONMENT);
+    put_i("utime", en->utime, ";");
+    put_d("air_c", en->air_c, ";");
+    put_d("deck_c", en->deck_c, "\n");
 }
 
 /* ---- publishing ---- */
@@ -321,6 +333,7 @@ static int publish_round(lcm_t *lcm, const struct round *r, int all)
     bad += amfi_indicator_t_publish(lcm, AMFI_CHANNEL_INDICATOR, &r->indicator) != 0;
     bad += amfi_alert_t_publish(lcm, AMFI_CHANNEL_ALERT, &r->alert) != 0;
     bad += amfi_status_t_publish(lcm, AMFI_CHANNEL_STATUS, &r->status) != 0;
+    bad += amfi_environment_t_publish(lcm, AMFI_CHANNEL_ENVIRONMENT, &r->environment) != 0;
     return bad;
 }
 
@@ -480,8 +493,16 @@ static int same_status(const char *c, const amfi_status_t *a, const amfi_status_
            same_s(c, "last_error", a->last_error, b->last_error);
 }
 
+static int same_environment(const char *c, const amfi_environment_t *a,
+                            const amfi_environment_t *b)
+{
+    return same_i(c, "utime", a->utime, b->utime) + same_d(c, "air_c", a->air_c, b->air_c) +
+           same_d(c, "deck_c", a->deck_c, b->deck_c);
+}
+
 /* What the receiver of one round has seen. */
-enum { K_ACCEL, K_VEHICLE, K_TRUTH, K_PASSAGE, K_UNSOLVED, K_INDICATOR, K_ALERT, K_STATUS, K_N };
+enum { K_ACCEL, K_VEHICLE, K_TRUTH, K_PASSAGE, K_UNSOLVED, K_INDICATOR, K_ALERT, K_STATUS, K_ENVIRONMENT,
+       K_N };
 
 struct rx {
     const struct round *want; /* the round being received */
@@ -531,6 +552,8 @@ static void on_amfi(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
         DECODE_CHECK(amfi_alert_t, same_alert, &w->alert, K_ALERT);
     } else if (strcmp(channel, AMFI_CHANNEL_STATUS) == 0) {
         DECODE_CHECK(amfi_status_t, same_status, &w->status, K_STATUS);
+    } else if (strcmp(channel, AMFI_CHANNEL_ENVIRONMENT) == 0) {
+        DECODE_CHECK(amfi_environment_t, same_environment, &w->environment, K_ENVIRONMENT);
     } else {
         fprintf(stderr, "FAIL: message on unexpected channel %s\n", channel);
         rx->failures++;
@@ -598,7 +621,7 @@ static int run_roundtrip(const char *url, int rounds)
         }
         /* Not an amfi channel: the subscription must not see it. */
         lcm_publish(lcm, "NOT_AMFI", "x", 1);
-        while (rx.round_msgs < 8 && lcm_handle_timeout(lcm, 2000) > 0)
+        while (rx.round_msgs < K_N && lcm_handle_timeout(lcm, 2000) > 0)
             ;
         for (int k = 0; k < K_N; k++)
             if (rx.seen[k] != 1) {
@@ -621,7 +644,7 @@ static int run_roundtrip(const char *url, int rounds)
         fprintf(stderr, "messages_roundtrip: %d failures on %s\n", fails, url);
         return 1;
     }
-    printf("messages_roundtrip: %d rounds x 8 messages (7 types) on %s: every field equal; "
+    printf("messages_roundtrip: %d rounds x 9 messages (8 types) on %s: every field equal; "
            "wrong type and short buffers refused\n", rounds, url);
     return 0;
 }

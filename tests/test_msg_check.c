@@ -198,6 +198,11 @@ static enc random_message(amfi_msg_type t, int big)
         free(m.last_error);
         break;
     }
+    case AMFI_MSG_ENVIRONMENT_T: {
+        amfi_environment_t m = {(int64_t)rnd(), rnd_double(), rnd_double()};
+        ENCODE(environment_t, m);
+        break;
+    }
     case AMFI_MSG_NTYPES:
         break;
     }
@@ -244,6 +249,7 @@ static void expect_reason(amfi_msg_type t, const void *buf, size_t len, int want
         amfi_indicator_t i;
         amfi_alert_t al;
         amfi_status_t s;
+        amfi_environment_t en;
     } msg;
     const unsigned char *bytes = (const unsigned char *)&msg;
     memset(&msg, 0xA5, sizeof msg);

@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: GPL-3.0-or-later
 # amfi_spy: tools/ops/amfi-spy (lcm-spy with amfi_types.jar) starts headless under
-# Xvfb, finds the seven amfi types and decodes every AMFI_* channel that
+# Xvfb, finds the eight amfi types and decodes every AMFI_* channel that
 # lcm_selftest publishes on LCM's default UDP multicast URL.
 #
 # Everything runs inside a private network namespace (unshare --net) whose
@@ -273,8 +273,8 @@ echo "== read from lcm-spy:"
 cut -c1-160 "$work/probe.txt" | sed 's/^/   /'
 grep '^SPY-ERROR' "$work/probe.txt" && fail "the probe could not read lcm-spy"
 
-# 1. The classpath scan: seven types, by name.
-grep -qx 'Found 7 LCM types' "$work/spy.log" || fail "lcm-spy did not report 'Found 7 LCM types'"
+# 1. The classpath scan: eight types, by name.
+grep -qx 'Found 8 LCM types' "$work/spy.log" || fail "lcm-spy did not report 'Found 8 LCM types'"
 grep -E 'Spy.messageReceived ex|Bad LCM Type|Class changed|Exception|Error:' "$work/spy.log" &&
   fail "lcm-spy reported errors"
 "$selftest" --expect $((N - 1)) >"$work/expected.txt" || fail "lcm_selftest --expect"
@@ -297,7 +297,7 @@ while IFS="$(printf '\t')" read -r channel type fields; do
   diff "$work/want.$channel" "$work/got.$channel" >"$work/diff.$channel" ||
     { fail "$channel: decoded fields differ from lcm_selftest's (< sent, > lcm-spy):"; cat "$work/diff.$channel"; }
 done <"$work/expected.txt"
-[ "$(wc -l <"$work/expected.txt")" -eq 7 ] || fail "expected 7 channels from lcm_selftest --expect"
+[ "$(wc -l <"$work/expected.txt")" -eq 8 ] || fail "expected 8 channels from lcm_selftest --expect"
 
 [ $failed -eq 0 ] || exit 1
-echo "amfi_spy: lcm-spy found the 7 amfi types and decoded all 7 AMFI_* channels ($N messages each) field for field"
+echo "amfi_spy: lcm-spy found the 8 amfi types and decoded all 8 AMFI_* channels ($N messages each) field for field"
