@@ -36,12 +36,21 @@ void amfi_env_params_site(amfi_env_params *p)
 }
 
 /* splitmix64 and a Box-Muller normal: reproducible without GSL */
-static uint64_t next_u64(uint64_t *x)
+static uint64_t mix64(uint64_t z)
 {
-    uint64_t z = (*x += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     return z ^ (z >> 31);
+}
+
+static uint64_t next_u64(uint64_t *x)
+{
+    return mix64(*x += 0x9e3779b97f4a7c15ull);
+}
+
+double amfi_env_hash_unit(uint64_t key)
+{
+    return (double)(mix64(key + 0x9e3779b97f4a7c15ull) >> 11) / 9007199254740992.0;
 }
 
 static double unit(uint64_t *x) /* (0, 1) */

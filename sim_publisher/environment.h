@@ -69,6 +69,10 @@ void amfi_env_advance(amfi_env_state *s, double t_s);
 /* The deterministic part: air temperature at a site day (no weather). */
 double amfi_env_air_mean(const amfi_env_params *p, double day);
 
+/* A uniform in [0, 1) that depends only on `key` (the splitmix64 step the
+ * weather noise uses), for reproducible per-vehicle draws. */
+double amfi_env_hash_unit(uint64_t key);
+
 /* E(T) / E(ref_c), bilinear with a knee at 0 °C, constant below
  * frost_floor_c. */
 double amfi_env_modulus_factor(const amfi_env_params *p, double deck_c);

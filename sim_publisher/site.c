@@ -65,20 +65,12 @@ double amfi_site_day(const amfi_site *s, double t_s)
     return s->day0 + t_s * s->compression / 86400.0;
 }
 
-static double unit_of(uint64_t x) /* splitmix64 finaliser to [0, 1) */
-{
-    x += 0x9e3779b97f4a7c15ull;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-    x ^= x >> 31;
-    return (double)(x >> 11) / 9007199254740992.0;
-}
-
 int amfi_site_pick(const amfi_site *s, uint64_t seed, long i, double t_s)
 {
     const uint64_t k = seed * 0x100000001b3ull ^ (uint64_t)i * 0x2545f4914f6cdd1dull;
     const double share = amfi_mix_loaded_share(&s->mix, amfi_site_day(s, t_s));
-    return amfi_mix_pick(&s->classes, share, unit_of(k), unit_of(k ^ 0x6d6978ull));
+    return amfi_mix_pick(&s->classes, share, amfi_env_hash_unit(k),
+                         amfi_env_hash_unit(k ^ 0x6d6978ull));
 }
 
 const amfi_bridge *amfi_site_bridge_at(amfi_site *s, double t_s, double damage, char *err,
