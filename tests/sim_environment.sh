@@ -13,35 +13,37 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-# 200 vehicles 4 s apart (about 806 s of data) at compression 36500: 340 site days
-"$sim" --lcm-url none --log "$work/site.log" --speedup max --vehicles 200 --headway 4 \
-  --environment site --time-compression 36500 --environment-period 30 2>"$work/site.err" ||
+# 100 vehicles 4 s apart (about 406 s of data) at compression 73000: 340 site
+# days; a coarser integration step (4 per sample) keeps it quick under ASan
+"$sim" --lcm-url none --log "$work/site.log" --speedup max --vehicles 100 --headway 4 \
+  --dt 2.5e-4 --environment site --time-compression 73000 --environment-period 15 \
+  2>"$work/site.err" ||
   { cat "$work/site.err" >&2; fail "site run"; }
 grep -q 'environment site: deck' "$work/site.err" || fail "no environment summary"
 "$sum" "$work/site.log" >"$work/site.txt"
 cat "$work/site.txt"
 set -- $(sed -n 's/^env //p' "$work/site.txt")
 n=$1 first=$2 last=$3 smin=$4 smax=$5 amin=$6 amax=$7 dmin=$8 dmax=$9
-# one every 30 s of data from the start (2026-01-01T00:00Z) to the end
+# one every 15 s of data from the start (2026-01-01T00:00Z) to the end
 [ "$first" = 1767225600000000 ] || fail "first environment_t at $first"
-[ "$smin" = 30000000 ] && [ "$smax" = 30000000 ] || fail "steps $smin .. $smax µs, not 30 s"
-want=$(( (last - first) / 30000000 + 1 ))
+[ "$smin" = 15000000 ] && [ "$smax" = 15000000 ] || fail "steps $smin .. $smax µs, not 15 s"
+want=$(( (last - first) / 15000000 + 1 ))
 [ "$n" -eq "$want" ] && [ "$n" -ge 26 ] || fail "$n environment_t, expected $want (>= 26)"
 # a year of seasons: frost and summer on the deck and in the air
 awk -v a="$amin" -v b="$amax" -v c="$dmin" -v d="$dmax" 'BEGIN {
   exit !(c < -2 && d > 18 && a < 0 && b > 18 && a > -40 && b < 45) }' ||
   fail "deck $dmin .. $dmax, air $amin .. $amax °C: not a year's range"
 set -- $(sed -n 's/^truth //p' "$work/site.txt")
-[ "$1" = 200 ] || fail "$1 truth messages, expected 200"
+[ "$1" = 100 ] || fail "$1 truth messages, expected 100"
 gsite=$2
 
 # none (the default): no environment_t, the population in order
-"$sim" --lcm-url none --log "$work/none.log" --speedup max --vehicles 200 --headway 4 \
-  2>"$work/none.err" || { cat "$work/none.err" >&2; fail "none run"; }
+"$sim" --lcm-url none --log "$work/none.log" --speedup max --vehicles 100 --headway 4 \
+  --dt 2.5e-4 2>"$work/none.err" || { cat "$work/none.err" >&2; fail "none run"; }
 "$sum" "$work/none.log" >"$work/none.txt"
 grep -q '^env 0 ' "$work/none.txt" || fail "environment_t without --environment site"
 set -- $(sed -n 's/^truth //p' "$work/none.txt")
-[ "$1" = 200 ] || fail "$1 truth messages (none), expected 200"
+[ "$1" = 100 ] || fail "$1 truth messages (none), expected 100"
 [ "$2" != "$gsite" ] || fail "the mix drew the same vehicles as the population in order"
 grep -q 'environment' "$work/none.err" && fail "environment summary without site"
 
