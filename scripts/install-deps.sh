@@ -32,6 +32,8 @@ pkgs=(
   libjansson-dev                 # JSON output of the tools (common/amfi_json.c): escaped strings
   clang                          # libFuzzer builds of fuzz/ (the fuzz_* tests, docs/fuzzing.md)
   libclang-rt-14-dev             # clang 14's libFuzzer and sanitizer runtimes (-fsanitize=fuzzer)
+  libpq-dev                      # libpq: amfi-sync ships site stores to the central PostgreSQL (fleet/)
+  postgresql                     # initdb, pg_ctl: the fleet_* tests start a throwaway server
 )
 missing=()
 for p in "${pkgs[@]}"; do

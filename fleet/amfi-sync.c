@@ -1,0 +1,474 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/* amfi-sync: ships a site store's new rows (passages with axles, indicators,
+ * alerts, baseline, runs) into the central PostgreSQL (issue 15).
+ *
+ * Single-threaded. Reads the SQLite store read-only (SQLITE_OPEN_READONLY; in
+ * WAL mode a reader never blocks amfid's writer) and writes the central
+ * database with libpq. Each batch is one PostgreSQL transaction holding the
+ * rows (COPY) and the table's high-water mark in fleet_sync_state, so a crash
+ * at any moment leaves either the whole batch or none of it. The mark also
+ * keeps a hash of the last shipped row: a store restored from an older backup
+ * (ids going backwards, or a different row at a shipped id) is refused. */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <libpq-fe.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "fleet_schema.h"
+
+enum { BATCH_ROWS = 5000, SITE_ID_MAX = 63 };
+
+/* One shipped site table: its name, the columns copied (id first) and the
+ * child table shipped in the same transaction (axles for passages). */
+struct table {
+    const char *name;
+    const char *cols;          /* SQLite and PostgreSQL column names, id first */
+    const char *child;         /* NULL or child table */
+    const char *child_cols;    /* its columns, parent id first */
+    const char *child_parent;  /* the parent id column in the child */
+};
+static const struct table tables[] = {
+    {"passages",
+     "id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason, lambda, "
+     "residual_rms, formulation, solve_ms, stored_at",
+     "axles", "passage_id, idx, spacing_m, load_kg", "passage_id"},
+    {"indicators",
+     "id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state",
+     NULL, NULL, NULL},
+    {"alerts", "id, utime, level, kind, message, indicator_id, raised", NULL, NULL, NULL},
+    {"baseline", "id, utime_set, n, mean_kg, std_kg, source, note, set_at", NULL, NULL, NULL},
+    {"runs", "id, started_at, version, config_path", NULL, NULL, NULL},
+};
+enum { N_TABLES = (int)(sizeof tables / sizeof tables[0]) };
+
+static volatile sig_atomic_t stop_requested;
+static void on_signal(int sig) { (void)sig; stop_requested = 1; }
+
+/* 64-bit FNV-1a over a row's text form (fields separated by 0x1f). */
+static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) { h ^= b[i]; h *= 0x100000001b3ULL; }
+    return h;
+}
+
+/* Append s to buf (growing) with COPY text escapes; NULL -> \N. */
+struct buf { char *p; size_t n, cap; };
+static int buf_put(struct buf *b, const char *s, size_t n)
+{
+    if (b->n + n + 1 > b->cap) {
+        size_t cap = b->cap ? b->cap * 2 : 65536;
+        while (cap < b->n + n + 1) cap *= 2;
+        char *q = realloc(b->p, cap);
+        if (!q) return -1;
+        b->p = q; b->cap = cap;
+    }
+    memcpy(b->p + b->n, s, n);
+    b->n += n;
+    return 0;
+}
+static int buf_field(struct buf *b, const unsigned char *s, int isnull)
+{
+    if (isnull) return buf_put(b, "\\N", 2);
+    for (; *s; s++) {
+        const char *e = NULL;
+        switch (*s) {
+        case '\\': e = "\\\\"; break;
+        case '\t': e = "\\t"; break;
+        case '\n': e = "\\n"; break;
+        case '\r': e = "\\r"; break;
+        default: break;
+        }
+        if (e ? buf_put(b, e, 2) : buf_put(b, (const char *)s, 1)) return -1;
+    }
+    return 0;
+}
+
+/* Text of the column of the current row; REAL as %.17g so the copy is exact. */
+static const unsigned char *col_text(sqlite3_stmt *st, int i, char tmp[40], int *isnull)
+{
+    int t = sqlite3_column_type(st, i);
+    *isnull = t == SQLITE_NULL;
+    if (t == SQLITE_FLOAT) {
+        snprintf(tmp, 40, "%.17g", sqlite3_column_double(st, i));
+        return (const unsigned char *)tmp;
+    }
+    return *isnull ? (const unsigned char *)"" : sqlite3_column_text(st, i);
+}
+
+static uint64_t row_hash(sqlite3_stmt *st)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    char tmp[40];
+    int isnull;
+    for (int i = 0; i < sqlite3_column_count(st); i++) {
+        const unsigned char *s = col_text(st, i, tmp, &isnull);
+        h = fnv1a(h, isnull ? "\x01N" : (const char *)s, isnull ? 2 : strlen((const char *)s));
+        h = fnv1a(h, "\x1f", 1);
+    }
+    return h;
+}
+
+static int pg_ok(PGresult *r, const char *what)
+{
+    ExecStatusType s = PQresultStatus(r);
+    if (s == PGRES_COMMAND_OK || s == PGRES_TUPLES_OK) return 0;
+    fprintf(stderr, "amfi-sync: PostgreSQL: %s: %s", what, PQresultErrorMessage(r));
+    return -1;
+}
+static int pg_exec(PGconn *pg, const char *sql, const char *what)
+{
+    PGresult *r = PQexec(pg, sql);
+    int rc = pg_ok(r, what);
+    PQclear(r);
+    return rc;
+}
+
+/* Exit codes: 0 done, 1 server or store trouble (retry), 2 usage, 3 refused. */
+enum { EX_RETRY = 1, EX_USAGE = 2, EX_REFUSED = 3 };
+
+/* Apply the central migrations not yet applied (under an advisory lock so
+ * several sites starting at once do not race). */
+static int apply_schema(PGconn *pg)
+{
+    if (pg_exec(pg, "BEGIN", "BEGIN")) return EX_RETRY;
+    if (pg_exec(pg, "SELECT pg_advisory_xact_lock(1095583305)", "schema lock")
+        || pg_exec(pg, "CREATE TABLE IF NOT EXISTS fleet_migrations (version integer PRIMARY KEY, "
+                       "description text NOT NULL, applied_at timestamptz NOT NULL DEFAULT now())",
+                   "fleet_migrations")) {
+        pg_exec(pg, "ROLLBACK", "ROLLBACK");
+        return EX_RETRY;
+    }
+    PGresult *r = PQexec(pg, "SELECT coalesce(max(version), 0) FROM fleet_migrations");
+    if (pg_ok(r, "schema version")) { PQclear(r); pg_exec(pg, "ROLLBACK", "ROLLBACK"); return EX_RETRY; }
+    int have = atoi(PQgetvalue(r, 0, 0));
+    PQclear(r);
+    for (int i = have; i < fleet_n_migrations; i++) {
+        char ins[256];
+        snprintf(ins, sizeof ins, "INSERT INTO fleet_migrations (version, description) VALUES (%d, '%s')",
+                 fleet_migrations[i].version, fleet_migrations[i].description);
+        if (pg_exec(pg, fleet_migrations[i].sql, "migration") || pg_exec(pg, ins, "migration record")) {
+            pg_exec(pg, "ROLLBACK", "ROLLBACK");
+            return EX_RETRY;
+        }
+    }
+    return pg_exec(pg, "COMMIT", "COMMIT") ? EX_RETRY : 0;
+}
+
+static int valid_site_id(const char *s)
+{
+    size_t n = strlen(s);
+    if (n < 1 || n > SITE_ID_MAX) return 0;
+    for (; *s; s++)
+        if (!((*s >= 'A' && *s <= 'Z') || (*s >= 'a' && *s <= 'z') || (*s >= '0' && *s <= '9')
+              || *s == '_' || *s == '.' || *s == '-'))
+            return 0;
+    return 1;
+}
+
+/* COPY the rows of one SELECT into table dst with the site id in front. */
+static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst, const char *cols,
+                     const char *sel, int64_t lo, int64_t hi, int64_t *last_id, uint64_t *last_hash,
+                     long *nrows)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(db, sel, -1, &st, NULL) != SQLITE_OK) {
+        fprintf(stderr, "amfi-sync: store: %s: %s\n", dst, sqlite3_errmsg(db));
+        return EX_RETRY;
+    }
+    sqlite3_bind_int64(st, 1, lo);
+    sqlite3_bind_int64(st, 2, hi);
+    struct buf b = {0};
+    int rc, n = 0;
+    char tmp[40];
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        int isnull;
+        buf_field(&b, (const unsigned char *)site, 0);
+        for (int i = 0; i < sqlite3_column_count(st); i++) {
+            buf_put(&b, "\t", 1);
+            const unsigned char *s = col_text(st, i, tmp, &isnull);
+            if (buf_field(&b, s, isnull)) { rc = SQLITE_NOMEM; break; }
+        }
+        if (buf_put(&b, "\n", 1)) { rc = SQLITE_NOMEM; break; }
+        if (last_id) { *last_id = sqlite3_column_int64(st, 0); *last_hash = row_hash(st); }
+        n++;
+    }
+    if (rc != SQLITE_DONE) {
+        fprintf(stderr, "amfi-sync: store: reading %s: %s\n", dst, sqlite3_errmsg(db));
+        sqlite3_finalize(st); free(b.p);
+        return EX_RETRY;
+    }
+    sqlite3_finalize(st);
+    *nrows = n;
+    if (n == 0) { free(b.p); return 0; }
+    char copy[512];
+    snprintf(copy, sizeof copy, "COPY %s (site_id, %s) FROM STDIN", dst, cols);
+    PGresult *r = PQexec(pg, copy);
+    if (PQresultStatus(r) != PGRES_COPY_IN) { pg_ok(r, copy); PQclear(r); free(b.p); return EX_RETRY; }
+    PQclear(r);
+    int bad = PQputCopyData(pg, b.p, (int)b.n) != 1 || PQputCopyEnd(pg, NULL) != 1;
+    free(b.p);
+    r = PQgetResult(pg);
+    bad |= pg_ok(r, dst) != 0;
+    PQclear(r);
+    while ((r = PQgetResult(pg))) PQclear(r);
+    return bad ? EX_RETRY : 0;
+}
+
+/* Ship one table until it has no more new rows. */
+static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const struct table *t, int check_only,
+                      long *total)
+{
+    char sql[1024];
+    const char *pv[2] = {site, t->name};
+    PGresult *r = PQexecParams(pg, "SELECT hwm, last_hash FROM fleet_sync_state WHERE site_id = $1 AND tbl = $2",
+                               2, NULL, pv, NULL, NULL, 0);
+    if (pg_ok(r, "fleet_sync_state")) { PQclear(r); return EX_RETRY; }
+    int64_t hwm = 0;
+    uint64_t hash = 0;
+    if (PQntuples(r) == 1) {
+        hwm = strtoll(PQgetvalue(r, 0, 0), NULL, 10);
+        hash = strtoull(PQgetvalue(r, 0, 1), NULL, 16);
+    }
+    PQclear(r);
+    /* The row at the mark must still be the one shipped. */
+    if (hwm > 0) {
+        sqlite3_stmt *st = NULL;
+        snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE id = ?1", t->cols, t->name);
+        if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK) {
+            fprintf(stderr, "amfi-sync: store: %s: %s\n", t->name, sqlite3_errmsg(db));
+            return EX_RETRY;
+        }
+        sqlite3_bind_int64(st, 1, hwm);
+        int rc = sqlite3_step(st);
+        uint64_t h = rc == SQLITE_ROW ? row_hash(st) : 0;
+        sqlite3_finalize(st);
+        if (rc != SQLITE_ROW || h != hash) {
+            fprintf(stderr,
+                    "amfi-sync: refused: site '%s' table %s: the central database holds rows up to id %" PRId64
+                    " but the store %s; was the store restored from an older backup? Nothing merged "
+                    "(see docs/fleet.md, 'Restored stores')\n",
+                    site, t->name, hwm, rc == SQLITE_ROW ? "has a different row at that id" : "has no row at that id");
+            return EX_REFUSED;
+        }
+    }
+    if (check_only) return 0;
+    for (;;) {
+        if (stop_requested) return 0;
+        if (pg_exec(pg, "BEGIN", "BEGIN")) return EX_RETRY;
+        int64_t last = hwm;
+        uint64_t lh = hash;
+        long n = 0, nc = 0;
+        snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE id > ?1 AND ?2 > 0 ORDER BY id LIMIT %d",
+                 t->cols, t->name, BATCH_ROWS);
+        int rc = copy_rows(pg, db, site, t->name, t->cols, sql, hwm, 1, &last, &lh, &n);
+        if (!rc && n > 0 && t->child) {
+            snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE %s > ?1 AND %s <= ?2 ORDER BY %s",
+                     t->child_cols, t->child, t->child_parent, t->child_parent, t->child_parent);
+            rc = copy_rows(pg, db, site, t->child, t->child_cols, sql, hwm, last, NULL, NULL, &nc);
+        }
+        if (!rc && n > 0) {
+            char shwm[24], shash[24];
+            snprintf(shwm, sizeof shwm, "%" PRId64, last);
+            snprintf(shash, sizeof shash, "%016" PRIx64, lh);
+            const char *p[4] = {site, t->name, shwm, shash};
+            r = PQexecParams(pg,
+                             "INSERT INTO fleet_sync_state (site_id, tbl, hwm, last_hash) VALUES ($1, $2, $3, $4) "
+                             "ON CONFLICT (site_id, tbl) DO UPDATE SET hwm = EXCLUDED.hwm, "
+                             "last_hash = EXCLUDED.last_hash, synced_at = now()",
+                             4, NULL, p, NULL, NULL, 0);
+            rc = pg_ok(r, "fleet_sync_state") ? EX_RETRY : 0;
+            PQclear(r);
+        }
+        if (rc || n == 0) { pg_exec(pg, "ROLLBACK", "ROLLBACK"); return rc; }
+        if (pg_exec(pg, "COMMIT", "COMMIT")) return EX_RETRY;
+        hwm = last;
+        hash = lh;
+        *total += n + nc;
+    }
+}
+
+/* Local ids lower than the central mark: the store went backwards. */
+static int check_backwards(PGconn *pg, sqlite3 *db, const char *site)
+{
+    for (int i = 0; i < N_TABLES; i++) {
+        const char *pv[2] = {site, tables[i].name};
+        PGresult *r = PQexecParams(pg, "SELECT hwm FROM fleet_sync_state WHERE site_id = $1 AND tbl = $2",
+                                   2, NULL, pv, NULL, NULL, 0);
+        if (pg_ok(r, "fleet_sync_state")) { PQclear(r); return EX_RETRY; }
+        int64_t hwm = PQntuples(r) ? strtoll(PQgetvalue(r, 0, 0), NULL, 10) : 0;
+        PQclear(r);
+        char sql[128];
+        snprintf(sql, sizeof sql, "SELECT coalesce(max(id), 0) FROM %s", tables[i].name);
+        sqlite3_stmt *st = NULL;
+        if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK || sqlite3_step(st) != SQLITE_ROW) {
+            fprintf(stderr, "amfi-sync: store: %s: %s\n", tables[i].name, sqlite3_errmsg(db));
+            sqlite3_finalize(st);
+            return EX_RETRY;
+        }
+        int64_t mx = sqlite3_column_int64(st, 0);
+        sqlite3_finalize(st);
+        if (mx < hwm) {
+            fprintf(stderr,
+                    "amfi-sync: refused: site '%s' table %s: the store's newest id is %" PRId64
+                    " but id %" PRId64 " was already shipped (ids going backwards); was the store restored "
+                    "from an older backup? Nothing merged (see docs/fleet.md, 'Restored stores')\n",
+                    site, tables[i].name, mx, hwm);
+            return EX_REFUSED;
+        }
+    }
+    return 0;
+}
+
+static int store_site_id(sqlite3 *db, char out[SITE_ID_MAX + 1])
+{
+    sqlite3_stmt *st = NULL;
+    int found = 0;
+    if (sqlite3_prepare_v2(db, "SELECT value FROM meta WHERE key = 'site.id'", -1, &st, NULL) == SQLITE_OK
+        && sqlite3_step(st) == SQLITE_ROW) {
+        const char *v = (const char *)sqlite3_column_text(st, 0);
+        if (v && strlen(v) <= SITE_ID_MAX) { strcpy(out, v); found = 1; }
+    }
+    sqlite3_finalize(st);
+    return found;
+}
+
+/* One pass: connect, migrate, check, ship every table. */
+static int sync_once(const char *conninfo, const char *store, const char *site_opt, int init_only, int quiet)
+{
+    PGconn *pg = PQconnectdb(conninfo);
+    if (PQstatus(pg) != CONNECTION_OK) {
+        fprintf(stderr, "amfi-sync: cannot connect to PostgreSQL: %s", PQerrorMessage(pg));
+        PQfinish(pg);
+        return EX_RETRY;
+    }
+    pg_exec(pg, "SET client_min_messages = warning", "SET");
+    int rc = apply_schema(pg);
+    if (rc || init_only) {
+        if (!rc && !quiet)
+            fprintf(stderr, "amfi-sync: central schema at version %d on %s/%s\n", fleet_n_migrations,
+                    PQhost(pg), PQdb(pg));
+        PQfinish(pg);
+        return rc;
+    }
+    sqlite3 *db = NULL;
+    if (sqlite3_open_v2(store, &db, SQLITE_OPEN_READONLY, NULL) != SQLITE_OK) {
+        fprintf(stderr, "amfi-sync: %s: cannot open the store read-only: %s\n", store, sqlite3_errmsg(db));
+        sqlite3_close(db);
+        PQfinish(pg);
+        return EX_RETRY;
+    }
+    sqlite3_busy_timeout(db, 5000);
+    char site[SITE_ID_MAX + 1] = "";
+    if (!store_site_id(db, site)) {
+        if (!site_opt) {
+            fprintf(stderr, "amfi-sync: %s: no meta 'site.id' in the store; give --site ID\n", store);
+            rc = EX_USAGE;
+            goto out;
+        }
+        snprintf(site, sizeof site, "%s", site_opt);
+    } else if (site_opt && strcmp(site, site_opt) != 0) {
+        fprintf(stderr, "amfi-sync: %s: meta 'site.id' is '%s' but --site gives '%s'\n", store, site, site_opt);
+        rc = EX_USAGE;
+        goto out;
+    }
+    if (!valid_site_id(site)) {
+        fprintf(stderr, "amfi-sync: site id '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n", site);
+        rc = EX_USAGE;
+        goto out;
+    }
+    /* One read transaction for the whole pass: a consistent snapshot while
+     * amfid keeps writing (WAL). */
+    sqlite3_exec(db, "BEGIN", NULL, NULL, NULL);
+    rc = check_backwards(pg, db, site);
+    long total = 0;
+    for (int i = 0; !rc && i < N_TABLES; i++) /* every table checked before any is shipped */
+        rc = sync_table(pg, db, site, &tables[i], 1, &total);
+    for (int i = 0; !rc && i < N_TABLES && !stop_requested; i++)
+        rc = sync_table(pg, db, site, &tables[i], 0, &total);
+    sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
+    if (!rc && !quiet && total > 0)
+        fprintf(stderr, "amfi-sync: site '%s': %ld rows shipped to %s/%s\n", site, total, PQhost(pg), PQdb(pg));
+out:
+    sqlite3_close(db);
+    PQfinish(pg);
+    return rc;
+}
+
+static void usage(FILE *f)
+{
+    fputs("usage: amfi-sync --pg CONNINFO --init-schema\n"
+          "       amfi-sync --db STORE --pg CONNINFO [--site ID] [--once] [--interval S] [--quiet]\n"
+          "Ships the site store's new rows to the central PostgreSQL (docs/fleet.md).\n"
+          "CONNINFO is a libpq connection string ('service=amfi', 'host=... dbname=...');\n"
+          "PG* environment variables, ~/.pg_service.conf and ~/.pgpass apply.\n"
+          "Exit: 0 done, 1 server or store unavailable, 2 usage, 3 store refused (restored backup).\n",
+          f);
+}
+
+int main(int argc, char **argv)
+{
+    const char *store = NULL, *conninfo = NULL, *site = NULL;
+    int once = 0, init = 0, quiet = 0;
+    double interval = 10;
+    static const struct option opts[] = {
+        {"db", required_argument, NULL, 'd'},   {"pg", required_argument, NULL, 'p'},
+        {"site", required_argument, NULL, 's'}, {"once", no_argument, NULL, 'o'},
+        {"init-schema", no_argument, NULL, 'I'}, {"interval", required_argument, NULL, 'i'},
+        {"quiet", no_argument, NULL, 'q'},      {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
+    int c;
+    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        switch (c) {
+        case 'd': store = optarg; break;
+        case 'p': conninfo = optarg; break;
+        case 's': site = optarg; break;
+        case 'o': once = 1; break;
+        case 'I': init = 1; break;
+        case 'q': quiet = 1; break;
+        case 'i': {
+            char *end;
+            errno = 0;
+            interval = strtod(optarg, &end);
+            if (errno || *end || !(interval >= 0.1 && interval <= 86400)) {
+                fprintf(stderr, "amfi-sync: --interval: '%s' is not a number of seconds in 0.1..86400\n", optarg);
+                return EX_USAGE;
+            }
+            break;
+        }
+        case 'h': usage(stdout); return 0;
+        default: usage(stderr); return EX_USAGE;
+        }
+    }
+    if (optind < argc || !conninfo || (!init && !store)) { usage(stderr); return EX_USAGE; }
+    if (site && !valid_site_id(site)) {
+        fprintf(stderr, "amfi-sync: --site: '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n", site);
+        return EX_USAGE;
+    }
+    struct sigaction sa = {0};
+    sa.sa_handler = on_signal;
+    sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGINT, &sa, NULL);
+    if (init || once) return sync_once(conninfo, store, site, init, quiet);
+    /* Follow mode: a pass every interval; capped exponential backoff while
+     * the server or the store is away; stops cleanly on SIGTERM. */
+    double backoff = 1;
+    while (!stop_requested) {
+        int rc = sync_once(conninfo, store, site, 0, quiet);
+        if (rc == EX_REFUSED || rc == EX_USAGE) return rc;
+        double wait = rc ? backoff : interval;
+        backoff = rc ? (backoff * 2 > 60 ? 60 : backoff * 2) : 1;
+        struct timespec ts = {(time_t)wait, (long)((wait - (double)(time_t)wait) * 1e9)};
+        while (!stop_requested && nanosleep(&ts, &ts) == -1 && errno == EINTR) {}
+    }
+    return 0;
+}

@@ -1,0 +1,157 @@
+#!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
+# fleet_sync.sh: amfi-sync against a real PostgreSQL server (tests/pg_server.sh):
+# three sites at once; a writer appending while sync reads; kill -9 of
+# amfi-sync 20 times at random moments; the server stopped and restarted while
+# amfi-sync follows; a store restored from an older backup refused. After each
+# case the central counts equal the sites', with no duplicate and no gap.
+# Usage: fleet_sync.sh AMFI_SYNC SCHEMA_MD. Exit 77 without sqlite3/PostgreSQL.
+set -u
+sync=$1 doc=$2
+command -v sqlite3 > /dev/null || { echo "fleet_sync.sh: no sqlite3: skipped"; exit 77; }
+here=$(cd "$(dirname "$0")" && pwd)
+. "$here/pg_server.sh"
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/fleet_sync.XXXXXX") || exit 1
+chmod 755 "$tmp"
+trap 'pg_stop; rm -rf "$tmp"' EXIT INT TERM
+pg_start "$tmp"
+failures=0
+fail() { echo "FAIL $case: $*"; failures=$((failures + 1)); }
+
+awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
+     on && !/^```/' "$doc" > "$tmp/ddl.sql"
+[ -s "$tmp/ddl.sql" ] || { echo "fleet_sync.sh: no DDL block in $doc" >&2; exit 1; }
+
+# add_rows DB N: N passages (2 axles each), an indicator per 10, an alert per 50.
+add_rows() {
+    sqlite3 "$1" <<SQL > /dev/null
+PRAGMA busy_timeout = 5000;
+BEGIN;
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $2)
+INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason,
+                      lambda, residual_rms, formulation, solve_ms)
+SELECT i, 1763769600000000 + ((SELECT count(*) FROM passages) + i) * 40000000, 1, 25.0, 2,
+       CASE WHEN i % 10 = 0 THEN NULL ELSE 15000.0 + 1000 * (i % 7) + 0.1 END,
+       CASE WHEN i % 10 = 0 THEN 'gap' ELSE 'ok' END,
+       CASE WHEN i % 10 = 0 THEN 'tab	and "quote" \\ back' ELSE '' END,
+       7.94e-9, 0.001, 'paper', 15.0 FROM k;
+INSERT INTO axles SELECT id, 1, NULL, 0.4 * gvw_kg FROM passages WHERE id NOT IN (SELECT passage_id FROM axles);
+INSERT INTO axles SELECT id, 2, 4.5, 0.6 * gvw_kg FROM passages p WHERE NOT EXISTS
+  (SELECT 1 FROM axles a WHERE a.passage_id = p.id AND a.idx = 2);
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $2 / 10)
+INSERT INTO indicators (utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state)
+SELECT 1763769600000000 + i, 20, 17800, 1900, 17800, 1900, 1.0, 0.5, 'normal' FROM k;
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $2 / 50)
+INSERT INTO alerts (utime, level, kind, message, indicator_id, raised)
+SELECT 1763769600000000 + i, 'warning', 'std_increase', 'STD up
+two lines', NULL, i % 2 FROM k;
+COMMIT;
+SQL
+}
+# mkstore DB SITE N
+mkstore() {
+    { cat "$tmp/ddl.sql"; echo "PRAGMA journal_mode = WAL;
+INSERT INTO meta (key, value) VALUES ('site.id', '$2');
+INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note) VALUES (0, 30, 17800, 1900, 'auto', '');
+INSERT INTO runs (version, config_path) VALUES ('0.test', '/etc/amfi/amfid.yaml');"; } |
+        sqlite3 "$1" > /dev/null
+    add_rows "$1" "$3"
+}
+# same DB SITE: central rows of the site equal the store's, no gap.
+same() {
+    for t in passages indicators alerts baseline runs; do
+        l=$(sqlite3 "$1" "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t")
+        c=$(pg_q "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t WHERE site_id = '$2'")
+        [ "$l" = "$c" ] || fail "$2 $t: store '$l' central '$c'"
+    done
+    l=$(sqlite3 "$1" "SELECT count(*) || ' ' || total(load_kg) FROM axles")
+    c=$(pg_q "SELECT count(*) || ' ' || coalesce(sum(load_kg), 0) FROM axles WHERE site_id = '$2'")
+    [ "$(echo "$l" | cut -d' ' -f1)" = "$(echo "$c" | cut -d' ' -f1)" ] || fail "$2 axles: store '$l' central '$c'"
+    l=$(sqlite3 "$1" "SELECT reason FROM passages WHERE id = 10")
+    c=$(pg_q "SELECT reason FROM passages WHERE site_id = '$2' AND id = 10")
+    [ "$l" = "$c" ] || fail "$2: text not copied exactly: '$l' vs '$c'"
+}
+
+case=init
+"$sync" --pg "$PG_CONNINFO" --init-schema 2> "$tmp/init.log" || fail "--init-schema: $(cat "$tmp/init.log")"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 1 ] || fail "schema version"
+grep -q password "$tmp/init.log" && fail "log mentions a password"
+
+case=three-sites
+for s in a b c; do mkstore "$tmp/$s.db" "site-$s" 3000; done
+for s in a b c; do "$sync" --db "$tmp/$s.db" --pg "$PG_CONNINFO" --once --quiet & done
+wait
+for s in a b c; do same "$tmp/$s.db" "site-$s"; done
+"$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --once || fail "second --once failed"
+same "$tmp/a.db" site-a
+
+case=writer
+( for i in 1 2 3 4 5 6 7 8; do add_rows "$tmp/b.db" 500; done ) &
+w=$!
+while kill -0 $w 2> /dev/null; do "$sync" --db "$tmp/b.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync during writes"; done
+wait $w
+"$sync" --db "$tmp/b.db" --pg "$PG_CONNINFO" --once --quiet || fail "final sync"
+same "$tmp/b.db" site-b
+
+case=kill9
+# Each round appends 4000 passages and kills amfi-sync 0..0.39 s after its
+# start; most kills land in the middle of a batch.
+mkstore "$tmp/k.db" site-k 4000
+i=0 mid=0
+while [ $i -lt 20 ]; do
+    add_rows "$tmp/k.db" 4000
+    "$sync" --db "$tmp/k.db" --pg "$PG_CONNINFO" --once --quiet 2> /dev/null &
+    p=$!
+    sleep "0.$(od -An -N1 -tu1 /dev/urandom | tr -d ' ' | cut -c1 | tr 456789 012301)$(od -An -N1 -tu1 /dev/urandom | tr -d ' ' | cut -c1)"
+    kill -9 $p 2> /dev/null
+    wait $p 2> /dev/null
+    [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-k'")" -lt "$(sqlite3 "$tmp/k.db" 'SELECT count(*) FROM passages')" ] &&
+        mid=$((mid + 1))
+    i=$((i + 1))
+done
+echo "kill9: $mid of 20 kills left the site partly shipped"
+[ $mid -ge 5 ] || fail "only $mid of 20 kills landed before the end of a sync"
+"$sync" --db "$tmp/k.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync after the kills"
+same "$tmp/k.db" site-k
+
+case=restart
+mkstore "$tmp/r.db" site-r 2000
+"$sync" --db "$tmp/r.db" --pg "$PG_CONNINFO" --interval 0.2 --quiet 2> "$tmp/follow.log" &
+f=$!
+sleep 1
+pg_stop
+add_rows "$tmp/r.db" 2000
+sleep 2
+pg_restart_start
+sleep 3
+kill -TERM $f
+wait $f || fail "follow mode did not stop cleanly on SIGTERM: $?"
+same "$tmp/r.db" site-r
+grep -q "cannot connect" "$tmp/follow.log" || fail "no message while the server was away"
+
+case=restored
+cp "$tmp/c.db" "$tmp/c-backup.db"
+add_rows "$tmp/c.db" 100
+"$sync" --db "$tmp/c.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync c"
+before=$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-c'")
+add_rows "$tmp/c-backup.db" 10   # fewer new rows than shipped: ids go backwards
+"$sync" --db "$tmp/c-backup.db" --pg "$PG_CONNINFO" --once 2> "$tmp/restored.log"
+rc=$?
+[ $rc = 3 ] || fail "restored store: exit $rc, expected 3"
+grep -q "refused: site 'site-c'.*older backup" "$tmp/restored.log" || fail "message: $(cat "$tmp/restored.log")"
+cp "$tmp/c.db" "$tmp/c-backup2.db"
+sqlite3 "$tmp/c-backup2.db" "UPDATE runs SET version = '0.other' WHERE id = 1"
+"$sync" --db "$tmp/c-backup2.db" --pg "$PG_CONNINFO" --once 2> "$tmp/restored2.log"
+[ $? = 3 ] || fail "a different row at a shipped id was not refused"
+add_rows "$tmp/c-backup.db" 500  # ids past the mark, but the row at the mark differs
+"$sync" --db "$tmp/c-backup.db" --pg "$PG_CONNINFO" --once 2> "$tmp/restored3.log"
+[ $? = 3 ] || fail "restored store with more rows: not refused"
+[ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-c'")" = "$before" ] || fail "rows merged"
+same "$tmp/c.db" site-c
+
+case=usage
+"$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --site 'bad id' --once 2> /dev/null
+[ $? = 2 ] || fail "bad --site accepted"
+
+[ $failures = 0 ] && echo "fleet_sync.sh: all cases pass"
+exit $((failures != 0))

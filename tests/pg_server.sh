@@ -1,0 +1,31 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+# pg_server.sh: sourced by the fleet_* tests. pg_start DIR starts a throwaway
+# PostgreSQL server (initdb into DIR/data as the unprivileged user postgres,
+# or nobody; Unix socket in DIR, no TCP port) and sets PG_CONNINFO; pg_stop
+# and pg_restart stop / restart it. The caller's trap runs pg_stop.
+pg_user=postgres
+id "$pg_user" > /dev/null 2>&1 || pg_user=nobody
+pg_as() {
+    if [ "$(id -u)" = 0 ]; then runuser -u "$pg_user" -- env HOME="$PG_DIR" "$@"; else "$@"; fi
+}
+pg_start() {
+    PG_DIR=$1
+    command -v initdb > /dev/null && command -v pg_ctl > /dev/null ||
+        { echo "pg_server.sh: no initdb/pg_ctl (apt-get install postgresql): skipped"; exit 77; }
+    [ "$(id -u)" = 0 ] && chown "$pg_user" "$PG_DIR"
+    pg_as initdb -D "$PG_DIR/data" -U postgres -A trust --no-sync > "$PG_DIR/initdb.log" 2>&1 ||
+        { cat "$PG_DIR/initdb.log" >&2; exit 1; }
+    pg_restart_start
+    PG_CONNINFO="host=$PG_DIR dbname=postgres user=postgres"
+}
+pg_restart_start() {
+    pg_as pg_ctl -D "$PG_DIR/data" -l "$PG_DIR/server.log" -w \
+        -o "-k $PG_DIR -c listen_addresses='' -c fsync=off" start > /dev/null ||
+        { cat "$PG_DIR/server.log" >&2; exit 1; }
+}
+pg_stop() {
+    [ -n "${PG_DIR:-}" ] && [ -f "$PG_DIR/data/postmaster.pid" ] &&
+        pg_as pg_ctl -D "$PG_DIR/data" -m fast -w stop > /dev/null 2>&1
+    return 0
+}
+pg_q() { psql -X -q -At -v ON_ERROR_STOP=1 "$PG_CONNINFO" -c "$1"; }
