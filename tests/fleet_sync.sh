@@ -94,15 +94,19 @@ wait $w
 same "$tmp/b.db" site-b
 
 case=kill9
-# Each round appends 4000 passages and kills amfi-sync 0..0.39 s after its
-# start; most kills land in the middle of a batch.
+# Each round appends 20 000 passages (four batches), starts amfi-sync, waits
+# for its first batch to commit and kills it 0..9 ms later: the kills land in
+# the middle of a sync, at varying points of the next batch.
 mkstore "$tmp/k.db" site-k 4000
 i=0 mid=0
 while [ $i -lt 20 ]; do
-    add_rows "$tmp/k.db" 4000
+    add_rows "$tmp/k.db" 20000
+    n0=$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-k'")
     "$sync" --db "$tmp/k.db" --pg "$PG_CONNINFO" --once --quiet 2> /dev/null &
     p=$!
-    sleep "0.$(od -An -N1 -tu1 /dev/urandom | tr -d ' ' | cut -c1 | tr 456789 012301)$(od -An -N1 -tu1 /dev/urandom | tr -d ' ' | cut -c1)"
+    while kill -0 $p 2> /dev/null &&
+        [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-k'")" = "$n0" ]; do :; done
+    sleep "0.00$(od -An -N1 -tu1 /dev/urandom | tr -d ' ' | cut -c1)"
     kill -9 $p 2> /dev/null
     wait $p 2> /dev/null
     [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-k'")" -lt "$(sqlite3 "$tmp/k.db" 'SELECT count(*) FROM passages')" ] &&
