@@ -315,9 +315,23 @@ int amfi_store_gvw_errors(amfi_store *s, double **pct, size_t *n,
 typedef int (*amfi_store_passage_fn)(void *ctx, int64_t id,
                                      const amfi_passage_row *row);
 
-/* Every passage with from <= utime <= to (µs) and, when status is not NULL,
-   of that status (one of AMFI_STORE_STATUSES), oldest first (utime, id),
-   with its axle rows (spacing_m[k], axle_kg[k]; NaN where NULL). */
+/* Which passages a listing reads; the store turns it into the WHERE clause
+   (no row outside it leaves SQLite). */
+typedef struct amfi_passage_filter {
+    int64_t from, to;      /* from <= utime <= to, µs */
+    const char *status;    /* NULL: any; else one of AMFI_STORE_STATUSES */
+    int lane_given;        /* 1: only passages of lane `lane` */
+    int lane;
+} amfi_passage_filter;
+
+/* Every passage the filter selects, oldest first (utime, id), with its axle
+   rows (spacing_m[k], axle_kg[k]; NaN where NULL). One row in memory at a
+   time. */
+int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
+                                  amfi_store_passage_fn fn, void *ctx,
+                                  char *err, size_t errlen);
+
+/* amfi_store_each_passage_where with from, to, status and any lane. */
 int amfi_store_each_passage(amfi_store *s, int64_t from, int64_t to,
                             const char *status, amfi_store_passage_fn fn,
                             void *ctx, char *err, size_t errlen);

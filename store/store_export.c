@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_export.c: the passage listing of reports (amfi-report --passages,
- * --plot): every passage in a time range, optionally of one status, with
- * its axle loads, oldest first, handed one typed row at a time to the
+ * --histogram, --overloads, --plot): every passage in a time range,
+ * optionally of one status and one lane (filtered in SQL), with its axle
+ * loads, oldest first, handed one typed row at a time to the
  * caller's function. Every value is checked as in store_read.c. The
  * caller's thread; the two statements are prepared and finalized per call
  * (no state kept in the handle).
@@ -17,9 +18,21 @@ int amfi_store_each_passage(amfi_store *s, int64_t from, int64_t to,
                             const char *status, amfi_store_passage_fn fn,
                             void *ctx, char *err, size_t errlen)
 {
+    amfi_passage_filter f = {.from = from, .to = to, .status = status};
+    return amfi_store_each_passage_where(s, &f, fn, ctx, err, errlen);
+}
+
+int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
+                                  amfi_store_passage_fn fn, void *ctx,
+                                  char *err, size_t errlen)
+{
     int rc = st_check_handle(s, 0, err, errlen), src = SQLITE_OK;
-    if (rc == 0 && !fn)
-        rc = st_fail(err, errlen, AMFI_EINVAL, "passages: no function");
+    if (rc == 0 && (!fn || !f))
+        rc = st_fail(err, errlen, AMFI_EINVAL, "passages: no function or filter");
+    if (rc == 0 && f->lane_given && (f->lane < -32768 || f->lane > 32767))
+        rc = st_fail(err, errlen, AMFI_EINVAL,
+                     "passages: lane %d outside [-32768, 32767]", f->lane);
+    const char *status = rc == 0 ? f->status : NULL;
     if (rc == 0 && status
         && st_check_enum("passages: status", status, st_statuses,
                          AMFI_STORE_STATUSES, err, errlen) != 0)
@@ -30,7 +43,8 @@ int amfi_store_each_passage(amfi_store *s, int64_t from, int64_t to,
     src = sqlite3_prepare_v2(s->db,
         "SELECT id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, "
         "reason FROM passages WHERE utime >= ?1 AND utime <= ?2 "
-        "AND (?3 IS NULL OR status = ?3) ORDER BY utime, id", -1, &p, NULL);
+        "AND (?3 IS NULL OR status = ?3) AND (?4 IS NULL OR lane = ?4) "
+        "ORDER BY utime, id", -1, &p, NULL);
     if (src == SQLITE_OK)
         src = sqlite3_prepare_v2(s->db,
             "SELECT idx, spacing_m, load_kg FROM axles WHERE passage_id = ?1 "
@@ -39,8 +53,10 @@ int amfi_store_each_passage(amfi_store *s, int64_t from, int64_t to,
         rc = st_db_fail(s, src, "passages: prepare", err, errlen);
         goto done;
     }
-    sqlite3_bind_int64(p, 1, from);
-    sqlite3_bind_int64(p, 2, to);
+    sqlite3_bind_int64(p, 1, f->from);
+    sqlite3_bind_int64(p, 2, f->to);
+    if (f->lane_given)
+        sqlite3_bind_int(p, 4, f->lane);
     if (status)
         sqlite3_bind_text(p, 3, status, -1, SQLITE_TRANSIENT);
     while (rc == 0 && (src = sqlite3_step(p)) == SQLITE_ROW) {

@@ -704,56 +704,78 @@ static int section_overloads(amfi_store *s)
 }
 
 /* --format csv|json: the chosen sections as one CSV table or one JSON
- * document ({"site": ..., "summary": {...}, "passages": [...], ...}),
- * printed only when complete. */
+ * document ({"site_id": ..., "summary": {...}, ..., "passages": [...]}).
+ * CSV (one section) goes straight to stdout. In JSON, the sections other
+ * than --passages are built first (small: counts, bins, the indicator and
+ * alert rows) and the passage array is streamed last, element by element:
+ * a year of passages is never held in memory. A store error part-way ends
+ * the output short, with the message on stderr and exit 1. */
 static int export_all(const options *o, amfi_store *s)
 {
     char err[512];
-    char *buf = NULL;
-    size_t len = 0;
-    FILE *f = open_memstream(&buf, &len);
-    json_t *root = json_object();
-    if (!f || !root) {
-        if (f)
-            fclose(f);
-        free(buf);
-        json_decref(root);
-        return data_error("out of memory");
+    const int fmt = o->format;
+    const export_opts *x = &o->ex;
+    if (fmt == FMT_CSV) {
+        int rc = 0;
+        if (o->summary)
+            rc = export_summary(s, fmt, stdout, NULL, err, sizeof err);
+        else if (o->trend)
+            rc = export_trend(s, fmt, stdout, NULL, err, sizeof err);
+        else if (o->alerts)
+            rc = export_alerts(s, fmt, stdout, NULL, err, sizeof err);
+        else if (o->errors)
+            rc = export_errors(s, fmt, stdout, NULL, err, sizeof err);
+        else if (o->passages)
+            rc = export_passages(s, x, fmt, stdout, NULL, err, sizeof err);
+        else if (o->histogram)
+            rc = export_histogram(s, x, fmt, stdout, NULL, err, sizeof err);
+        else if (o->overloads)
+            rc = export_overloads(s, x, fmt, stdout, NULL, err, sizeof err);
+        return rc ? data_error("%s", err) : 0;
     }
+    json_t *root = json_object();
+    if (!root)
+        return data_error("out of memory");
     char site[256] = "";
     int found = 0;
     int rc = amfi_store_meta_get(s, "site.id", site, sizeof site, &found, err, sizeof err);
     json_object_set_new(root, "site_id", found ? json_string(site) : json_null());
-    const int fmt = o->format;
-    const export_opts *x = &o->ex;
     if (rc == 0 && o->summary)
-        rc = export_summary(s, fmt, f, root, err, sizeof err);
+        rc = export_summary(s, fmt, NULL, root, err, sizeof err);
     if (rc == 0 && o->trend)
-        rc = export_trend(s, fmt, f, root, err, sizeof err);
+        rc = export_trend(s, fmt, NULL, root, err, sizeof err);
     if (rc == 0 && o->alerts)
-        rc = export_alerts(s, fmt, f, root, err, sizeof err);
+        rc = export_alerts(s, fmt, NULL, root, err, sizeof err);
     if (rc == 0 && o->errors)
-        rc = export_errors(s, fmt, f, root, err, sizeof err);
-    if (rc == 0 && o->passages)
-        rc = export_passages(s, x, fmt, f, root, err, sizeof err);
+        rc = export_errors(s, fmt, NULL, root, err, sizeof err);
     if (rc == 0 && o->histogram)
-        rc = export_histogram(s, x, fmt, f, root, err, sizeof err);
+        rc = export_histogram(s, x, fmt, NULL, root, err, sizeof err);
     if (rc == 0 && o->overloads)
-        rc = export_overloads(s, x, fmt, f, root, err, sizeof err);
-    fclose(f);
-    if (rc == 0) {
-        if (fmt == FMT_CSV) {
-            fwrite(buf, 1, len, stdout);
-            json_decref(root);
-        } else if (amfi_json_print(stdout, root) != 0) {
-            rc = data_error("cannot write the JSON document");
-        }
-    } else {
+        rc = export_overloads(s, x, fmt, NULL, root, err, sizeof err);
+    if (rc != 0) {
         json_decref(root);
-        rc = data_error("%s", err);
+        return data_error("%s", err);
     }
-    free(buf);
-    return rc;
+    if (!o->passages)
+        return amfi_json_print(stdout, root) != 0
+                   ? data_error("cannot write the JSON document") : 0;
+    /* the document without its closing brace, then "passages" streamed */
+    char *head = json_dumps(root, JSON_COMPACT | JSON_PRESERVE_ORDER
+                                      | JSON_REAL_PRECISION(10));
+    json_decref(root);
+    size_t hl = head ? strlen(head) : 0;
+    if (hl < 2 || head[hl - 1] != '}') {
+        free(head);
+        return data_error("cannot write the JSON document");
+    }
+    fwrite(head, 1, hl - 1, stdout);
+    free(head);
+    fputs(",\"passages\":", stdout);
+    if (export_passages(s, x, fmt, stdout, NULL, err, sizeof err) != 0)
+        return data_error("%s", err);
+    if (fputs("}\n", stdout) == EOF || ferror(stdout))
+        return data_error("cannot write the JSON document");
+    return 0;
 }
 
 /* Render one section in memory and print it only when it is complete: a
@@ -864,8 +886,14 @@ int main(int argc, char **argv)
         rc = run_section(section_alerts, s, &printed);
     if (rc == 0 && o.errors)
         rc = run_section(section_errors, s, &printed);
-    if (rc == 0 && o.passages)
-        rc = run_section(section_passages, s, &printed);
+    if (rc == 0 && o.passages) {
+        /* streamed (a year of passages is not rendered in memory first): a
+         * damaged row ends the list with its error line */
+        if (printed)
+            putchar('\n');
+        rc = section_passages(s);
+        printed = 1;
+    }
     if (rc == 0 && o.histogram)
         rc = run_section(section_histogram, s, &printed);
     if (rc == 0 && o.overloads)

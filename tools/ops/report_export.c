@@ -3,8 +3,9 @@
  * report_export.c: amfi-report's records (report_export.h): every section in
  * CSV and JSON, and the passage list, the GVW histogram per lane and the
  * overloads against legal limits in all three formats. Streams the passages
- * (amfi_store_each_passage): a year of traffic is never held in memory,
- * except by --format json, whose one document is built whole.
+ * (amfi_store_each_passage_where, filtered in SQL): a year of traffic is
+ * never held in memory; the passage list is written row by row in every
+ * format (in JSON, element by element into the document's "passages").
  */
 #define _GNU_SOURCE
 #include "report_export.h"
@@ -392,19 +393,27 @@ int export_errors(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size
 
 /* ---- passages ------------------------------------------------------------------ */
 
+/* The passages of o's range and lane and of `status` (NULL: any), read
+ * through the store's filtered iterator: the filter is SQL. */
+static int each(amfi_store *s, const export_opts *o, const char *status,
+                amfi_store_passage_fn fn, void *ctx, char *err, size_t errlen)
+{
+    amfi_passage_filter f = {.from = o->from, .to = o->to, .status = status,
+                             .lane_given = o->lane_given, .lane = o->lane};
+    return amfi_store_each_passage_where(s, &f, fn, ctx, err, errlen);
+}
+
 typedef struct list_ctx {
     const export_opts *o;
     int fmt;
     FILE *f;
-    json_t *arr;
     int64_t n;
+    int werr; /* 1: the output refused a write */
 } list_ctx;
 
 static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
 {
     list_ctx *c = vctx;
-    if (c->o->lane_given && r->lane != c->o->lane)
-        return 0;
     char t[32];
     FILE *f = c->f;
     c->n++;
@@ -463,7 +472,14 @@ static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
         json_object_set_new(o, "spacing_m", spc);
         json_object_set_new(o, "status", jstr(r->status));
         json_object_set_new(o, "reason", jstr(r->reason));
-        json_array_append_new(c->arr, o);
+        /* streamed: one element at a time, never the whole array */
+        if ((c->n > 1 && fputc(',', f) == EOF) ||
+            json_dumpf(o, f, JSON_COMPACT | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10))) {
+            json_decref(o);
+            c->werr = 1;
+            return 1;
+        }
+        json_decref(o);
     }
     return 0;
 }
@@ -471,7 +487,8 @@ static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
 int export_passages(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_t *root,
                     char *err, size_t errlen)
 {
-    list_ctx c = {o, fmt, f, NULL, 0};
+    list_ctx c = {o, fmt, f, 0, 0};
+    (void)root; /* JSON: the array is written to f as it is read */
     if (fmt == FMT_TABLE) {
         fprintf(f, "== passages\n%-20s  %8s  %10s  %4s  %6s  %2s  %8s  %-28s  %-8s  %s\n",
                 "time (UTC)", "id", "vehicle", "lane", "m/s", "ax", "GVW kg",
@@ -484,18 +501,16 @@ int export_passages(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_
             fprintf(f, ",spacing%d_m", a);
         fprintf(f, ",status,reason\n");
     } else {
-        c.arr = json_array();
+        fputc('[', f);
     }
-    int rc = amfi_store_each_passage(s, o->from, o->to, o->status, list_one, &c, err, errlen);
+    int rc = each(s, o, o->status, list_one, &c, err, errlen);
+    if (c.werr)
+        snprintf(err, errlen, "passages: cannot write the output");
     if (fmt == FMT_TABLE && rc == 0)
         fprintf(f, "(%lld passages)\n", (long long)c.n);
-    if (c.arr) {
-        if (rc == 0)
-            json_object_set_new(root, "passages", c.arr);
-        else
-            json_decref(c.arr);
-    }
-    return rc ? -1 : 0;
+    if (fmt == FMT_JSON && rc == 0)
+        fputc(']', f);
+    return rc || ferror(f) ? -1 : 0;
 }
 
 /* ---- histogram per lane ---------------------------------------------------------- */
@@ -513,7 +528,7 @@ static int hist_one(void *vctx, int64_t id, const amfi_passage_row *r)
 {
     hist_ctx *h = vctx;
     (void)id;
-    if ((h->o->lane_given && r->lane != h->o->lane) || !(r->gvw_kg > 0))
+    if (!(r->gvw_kg > 0))
         return 0;
     int li = 0;
     while (li < h->n_lanes && h->lanes[li] != r->lane)
@@ -555,7 +570,7 @@ int export_histogram(amfi_store *s, const export_opts *o, int fmt, FILE *f, json
     hist_ctx h;
     memset(&h, 0, sizeof h);
     h.o = o;
-    int rc = amfi_store_each_passage(s, o->from, o->to, "ok", hist_one, &h, err, errlen);
+    int rc = each(s, o, "ok", hist_one, &h, err, errlen);
     if (h.oom) {
         snprintf(err, errlen, "out of memory for the histogram");
         rc = -1;
@@ -655,8 +670,6 @@ typedef struct over_ctx {
 static int over_one(void *vctx, int64_t id, const amfi_passage_row *r)
 {
     over_ctx *c = vctx;
-    if (c->o->lane_given && r->lane != c->o->lane)
-        return 0;
     c->checked++;
     double maxax = -INFINITY;
     int maxi = 0;
@@ -711,7 +724,7 @@ int export_overloads(amfi_store *s, const export_opts *o, int fmt, FILE *f, json
                    "max_axle_kg,max_axle,axle_over_pct,over\n");
     else
         c.arr = json_array();
-    int rc = amfi_store_each_passage(s, o->from, o->to, "ok", over_one, &c, err, errlen);
+    int rc = each(s, o, "ok", over_one, &c, err, errlen);
     if (rc) {
         json_decref(c.arr);
         return -1;

@@ -36,6 +36,9 @@ int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, siz
 int export_trend(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_t errlen);
 int export_alerts(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_t errlen);
 int export_errors(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_t errlen);
+/* The passage list is written to f row by row in every format, JSON
+ * included (a JSON array, element by element; root is not used): no whole
+ * listing is ever held in memory. On an error the output is cut short. */
 int export_passages(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_t *root,
                     char *err, size_t errlen);
 int export_histogram(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_t *root,
