@@ -1184,6 +1184,105 @@ static void test_many_passages(void **state)
     sqlite3_close(db);
 }
 
+/* amfi_store_each_passage_where: 60 passages on lanes 1..3, one a minute,
+ * every fourth a gap: each filter's rows equal a raw sqlite3 count of the
+ * same WHERE, arrive oldest first, carry their axles, and a callback's
+ * nonzero return stops the listing and is returned. */
+typedef struct each_ctx {
+    int n, bad_order, bad_filter, stop_at;
+    int64_t last_utime;
+    const amfi_passage_filter *f;
+} each_ctx;
+
+static int each_count(void *vctx, int64_t id, const amfi_passage_row *r)
+{
+    each_ctx *c = vctx;
+    (void)id;
+    c->n++;
+    if (r->utime < c->last_utime)
+        c->bad_order++;
+    c->last_utime = r->utime;
+    if (r->utime < c->f->from || r->utime > c->f->to
+        || (c->f->status && strcmp(r->status, c->f->status) != 0)
+        || (c->f->lane_given && r->lane != c->f->lane)
+        || r->n_axles != 2 || !(fabs(r->axle_kg[0] + r->axle_kg[1] - r->gvw_kg) < 1e-6))
+        c->bad_filter++;
+    return c->stop_at && c->n == c->stop_at ? 7 : 0;
+}
+
+static void test_each_passage_filtered(void **state)
+{
+    fixture *f = *state;
+    amfi_passage_row r;
+    char err[ERRLEN], sql[256];
+    int64_t id = 0;
+    const int64_t t0 = 5 * DAY_US, min = INT64_C(60000000);
+    for (int k = 0; k < 60; k++) {
+        ok_row(&r, k + 1, t0 + k * min, 20000.0 + 100.0 * k);
+        r.lane = 1 + k % 3;
+        if (k % 4 == 3) {
+            r.status = "gap";
+            r.reason = "test";
+        }
+        assert_int_equal(0, amfi_store_add_passage(f->s, &r, &id, err, sizeof err));
+    }
+    sqlite3 *db = raw_open(f->path);
+    const struct {
+        int64_t from, to;
+        const char *status;
+        int lane_given, lane;
+    } cases[] = {
+        {0, AMFI_STORE_MAX_UTIME, NULL, 0, 0},
+        {0, AMFI_STORE_MAX_UTIME, "ok", 0, 0},
+        {0, AMFI_STORE_MAX_UTIME, NULL, 1, 2},
+        {t0 + 10 * min, t0 + 40 * min, "gap", 1, 1},
+        {t0 + 10 * min, t0 + 40 * min, "ok", 1, 3},
+        {t0 + 59 * min, t0 + 59 * min, NULL, 0, 0},
+        {0, t0 - 1, NULL, 0, 0},
+        {0, AMFI_STORE_MAX_UTIME, NULL, 1, 9},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        amfi_passage_filter flt = {.from = cases[k].from, .to = cases[k].to,
+                                   .status = cases[k].status,
+                                   .lane_given = cases[k].lane_given,
+                                   .lane = cases[k].lane};
+        each_ctx c = {.f = &flt};
+        assert_int_equal(0, amfi_store_each_passage_where(f->s, &flt, each_count, &c,
+                                                          err, sizeof err));
+        char lane[32] = "", st[32] = "";
+        if (flt.lane_given)
+            snprintf(lane, sizeof lane, " AND lane = %d", flt.lane);
+        if (flt.status)
+            snprintf(st, sizeof st, " AND status = '%s'", flt.status);
+        snprintf(sql, sizeof sql,
+                 "SELECT count(*) FROM passages WHERE utime BETWEEN %lld AND %lld%s%s",
+                 (long long)flt.from, (long long)flt.to, st, lane);
+        assert_int_equal(raw_int(db, sql), c.n);
+        assert_int_equal(0, c.bad_order);
+        assert_int_equal(0, c.bad_filter);
+    }
+    /* the four cases with rows are not all the table: the filter filters */
+    assert_int_equal(60, raw_int(db, "SELECT count(*) FROM passages"));
+    assert_int_equal(20, raw_int(db, "SELECT count(*) FROM passages WHERE lane = 2"));
+    sqlite3_close(db);
+    /* a stop, a bad status, a bad lane, no filter */
+    amfi_passage_filter all = {.from = 0, .to = AMFI_STORE_MAX_UTIME};
+    each_ctx c = {.f = &all, .stop_at = 5};
+    assert_int_equal(7, amfi_store_each_passage_where(f->s, &all, each_count, &c, err,
+                                                      sizeof err));
+    assert_int_equal(5, c.n);
+    amfi_passage_filter bad = {.from = 0, .to = 1, .status = "fine"};
+    assert_int_not_equal(0, amfi_store_each_passage_where(f->s, &bad, each_count, &c, err,
+                                                          sizeof err));
+    assert_non_null(strstr(err, "status"));
+    amfi_passage_filter badlane = {.from = 0, .to = 1, .lane_given = 1, .lane = 40000};
+    assert_int_not_equal(0, amfi_store_each_passage_where(f->s, &badlane, each_count, &c,
+                                                          err, sizeof err));
+    assert_non_null(strstr(err, "lane 40000"));
+    assert_int_not_equal(0, amfi_store_each_passage_where(f->s, NULL, each_count, &c, err,
+                                                          sizeof err));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1206,6 +1305,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
         cmocka_unit_test_setup_teardown(test_many_passages, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_each_passage_filtered, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
