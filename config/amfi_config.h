@@ -127,7 +127,7 @@ typedef struct amfi_site_identity {
 /* 1 when s is a valid site.id ([A-Za-z0-9_.-], 1 .. 63 bytes), else 0. */
 int amfi_site_id_valid(const char *s);
 
-/* report.*: what amfi-report holds passages against (section_ops.c). */
+/* report.*: what amfi-report holds passages against (section_report.c). */
 typedef struct amfi_report_config {
     double gvw_limit_kg;   /* report.limits.gvw_kg: legal GVW, (0, 1e6] */
     double axle_limit_kg;  /* report.limits.axle_kg: legal load of any axle, (0, 1e6] */

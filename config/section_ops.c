@@ -4,8 +4,7 @@
  * amfid tells the people and programs that watch it: a program run for
  * every raised and cleared alert (alerts.command, like smartd's -M exec),
  * and its counters in Prometheus' text format for node-exporter's textfile
- * collector (metrics.textfile), both off by default; and the legal limits
- * and histogram bins amfi-report uses (report:). Runs on the loader's
+ * collector (metrics.textfile). Both are off by default. Runs on the loader's
  * thread.
  */
 #include "sections.h"
@@ -30,20 +29,6 @@ const field metrics_fields[] = {
     {.key = "textfile", .kind = &K_PATH, .off = OPS(metrics_path), .hi = OPS_CAP(metrics_path)},
     {.key = "interval_s", .kind = &K_DOUBLE, .off = OPS(metrics_interval_s), .lo = 1,
      .hi = 3600},
-    {.key = NULL}};
-
-#define REP(m) offsetof(amfi_site_config, report.m)
-
-static const field limit_fields[] = {
-    {.key = "gvw_kg", .kind = &K_DOUBLE, .off = REP(gvw_limit_kg), .lo = 0, .hi = 1e6,
-     .flags = F_LO_OPEN},
-    {.key = "axle_kg", .kind = &K_DOUBLE, .off = REP(axle_limit_kg), .lo = 0, .hi = 1e6,
-     .flags = F_LO_OPEN},
-    {.key = NULL}};
-
-const field report_fields[] = {
-    {.key = "limits", .kind = &K_MAP, .aux = limit_fields},
-    {.key = "histogram_bin_kg", .kind = &K_DOUBLE, .off = REP(bin_kg), .lo = 100, .hi = 1e5},
     {.key = NULL}};
 
 /* The command must be a program amfid can run now (absolute: amfid runs

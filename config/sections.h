@@ -12,8 +12,8 @@
  *   section_daemon.c      daemon:      amfid's bus, store, threads, indicators
  *   section_simulation.c  simulation:  sim_publisher's settings
  *   section_site.c        site:        which bridge (id, name, position)
- *   section_ops.c         alerts:, metrics:, report:  notices, health metrics,
- *                         and what amfi-report holds passages against
+ *   section_ops.c         alerts:, metrics:  notices and health metrics
+ *   section_report.c      report:      what amfi-report holds passages against
  *
  * Every function runs on the loader's (caller's) thread.
  */
