@@ -277,6 +277,7 @@ fi
 for sec in summary trend alerts errors; do
     if ok "$sec-csv" --db "$ex" --$sec --format csv; then
         bad_rows=$(awk -F, -v h="$(head -1 "$tmp/out" | awk -F, '{print NF}')" 'NR > 1 && NF < h' "$tmp/out" | wc -l)
+        [ "$bad_rows" -eq 0 ] || problem "$bad_rows CSV rows with fewer columns than the header"
         [ "$(wc -l < "$tmp/out")" -ge 2 ] || problem "no CSV rows"
     fi
 done
@@ -296,6 +297,27 @@ if ok all-json --db "$ex" --summary --trend --alerts --errors --histogram --form
     for k in summary trend alerts errors histogram; do has "\"$k\":"; done
     has '"by_status":\{"ok":36,"gap":4,'
     has '"ok_matched":36,'
+fi
+# --passages in JSON is streamed as the document's last key, after the others
+if ok passages-json-mixed --db "$ex" --summary --overloads --passages --format json --status gap; then
+    [ -z "$jcheck" ] || "$jcheck" site_id=fixture-1 < "$tmp/out" || problem "JSON does not parse"
+    want=$(q "$ex" "SELECT (SELECT count(*) FROM passages WHERE status = 'gap') + (SELECT count(*)
+                    FROM passages p WHERE status = 'ok' AND (gvw_kg > 40000 OR
+                    EXISTS (SELECT 1 FROM axles a WHERE a.passage_id = p.id AND a.load_kg > 11500)))")
+    n=$(grep -o '"passage_id":' "$tmp/out" | wc -l)
+    [ "$n" -eq "$want" ] || problem "$n passage objects, expected $want (gap passages + overloads at the 96/53/EC defaults)"
+    has '"by_status":\{"ok":36,"gap":4,'
+    has ',"passages":\[\{"time_utc":"2025-11-22T10:00:00Z",.*"reason":"12 samples missing in the window"\}.*\]\}$'
+fi
+if ok passages-json-none --db "$ex" --passages --format json --lane 7; then
+    [ -z "$jcheck" ] || "$jcheck" site_id=fixture-1 < "$tmp/out" || problem "JSON does not parse"
+    has '^\{"site_id":"fixture-1","passages":\[\]\}$'
+fi
+if ok passages-lane-sql --db "$ex" --passages --format csv --lane 2 --from 2025-11-22T01:00 --to 2025-11-22T20:00; then
+    want=$(q "$ex" "SELECT count(*) FROM passages WHERE lane = 2 AND utime BETWEEN 1763773200000000 AND 1763841659999999")
+    [ "$(($(wc -l < "$tmp/out") - 1))" -eq "$want" ] || problem "$(($(wc -l < "$tmp/out") - 1)) lane-2 rows, expected $want"
+    bad_lane=$(awk -F, 'NR > 1 && $5 != 2' "$tmp/out" | wc -l)
+    [ "$bad_lane" -eq 0 ] || problem "$bad_lane rows not on lane 2"
 fi
 name="exports are read-only"
 cases=$((cases + 1))
