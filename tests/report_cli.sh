@@ -319,6 +319,17 @@ if ok passages-lane-sql --db "$ex" --passages --format csv --lane 2 --from 2025-
     bad_lane=$(awk -F, 'NR > 1 && $5 != 2' "$tmp/out" | wc -l)
     [ "$bad_lane" -eq 0 ] || problem "$bad_lane rows not on lane 2"
 fi
+# ISO 8601 forms: fractions of a second, a zero offset; --to a minute is its last µs
+if ok time-forms --db "$ex" --passages --format csv --from 2025-11-22T03:00:00.000000Z --to 2025-11-22T03:00:00+00:00; then
+    [ "$(($(wc -l < "$tmp/out") - 1))" -eq 1 ] || problem "not exactly passage 3"
+    has '^2025-11-22T03:00:00Z,1763780400000000,3,'
+fi
+if ok time-to-minute --db "$ex" --passages --format csv --from '2025-11-22 02:59:59.999999' --to 2025-11-22T03:00; then
+    [ "$(($(wc -l < "$tmp/out") - 1))" -eq 1 ] || problem "--to HH:MM is not the whole minute"
+fi
+if ok time-after --db "$ex" --passages --format csv --from 2025-11-22T03:00:00.000001; then
+    hasnt ',1763780400000000,3,'
+fi
 name="exports are read-only"
 cases=$((cases + 1))
 [ "$exsum0" = "$(md5sum < "$ex")" ] || problem "the export modes changed the file"
@@ -349,6 +360,11 @@ bad() {
 bad no-db 2 '^amfi-report: --db: missing' --summary
 bad from-bad 2 "^amfi-report: --from: '2025-13-01' is not a UTC time" --db "$db" --passages --from 2025-13-01
 bad to-bad 2 "^amfi-report: --to: 'yesterday' is not a UTC time" --db "$db" --passages --to yesterday
+bad from-month 2 "^amfi-report: --from: '2025-13-01' is not a UTC time \\(month 13 is not in 1 \\.\\. 12\\)" --db "$db" --passages --from 2025-13-01
+bad from-hour 2 "^amfi-report: --from: '2025-11-22T25:00' is not a UTC time \\(hour 25 " --db "$db" --passages --from 2025-11-22T25:00
+bad from-offset 2 "^amfi-report: --from: '2025-11-22T10:00\\+02:00' is not a UTC time \\(offset \\+02:00: only UTC" --db "$db" --passages --from 2025-11-22T10:00+02:00
+bad to-trailing 2 "^amfi-report: --to: '2025-11-22x' is not a UTC time \\(unexpected 'x'\\)" --db "$db" --passages --to 2025-11-22x
+bad to-no-minutes 2 "^amfi-report: --to: '2025-11-22T10' is not a UTC time \\(no time HH:MM" --db "$db" --passages --to 2025-11-22T10
 bad feb30 2 "^amfi-report: --from: '2025-02-30' is not a UTC time" --db "$db" --passages --from 2025-02-30
 bad from-after-to 2 '^amfi-report: --from: after --to' --db "$db" --passages --from 2025-11-23 --to 2025-11-22
 bad status-bad 2 "^amfi-report: --status: 'fine' is not a status" --db "$db" --passages --status fine

@@ -254,10 +254,14 @@ static int parse_args(int argc, char **argv, options *o)
         case 'O': o->overloads = 1; break;
         case 'f':
         case 'T':
-            if (export_parse_time(val, k == 'T', k == 'f' ? &o->ex.from : &o->ex.to) != 0)
-                return usage_error(opt, "'%s' is not a UTC time YYYY-MM-DD, "
-                                   "YYYY-MM-DDTHH:MM or YYYY-MM-DDTHH:MM:SS",
-                                   amfi_cli_shown(val));
+            {
+                char why[128];
+                if (export_parse_time(val, k == 'T', k == 'f' ? &o->ex.from : &o->ex.to,
+                                      why, sizeof why) != 0)
+                    return usage_error(opt, "'%s' is not a UTC time (%s): use YYYY-MM-DD, "
+                                       "YYYY-MM-DDTHH:MM[:SS[.ffffff]][Z]",
+                                       amfi_cli_shown(val), why);
+            }
             break;
         case 'S': {
             int found = 0;

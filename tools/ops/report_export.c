@@ -58,34 +58,86 @@ static json_t *jstr(const char *s) { return json_string(s ? s : ""); }
 
 /* ---- time ------------------------------------------------------------------ */
 
-int export_parse_time(const char *s, int end_of, int64_t *utime)
+/* n digits at *p into *v; 0, or -1 when fewer digits are there */
+static int digits(const char **p, int n, int *v)
 {
-    struct tm tm;
-    int y, mo, d, h = 0, mi = 0, sec = 0, n = 0;
-    size_t len = strlen(s);
-    char sep = 0;
-
-    if (len && (s[len - 1] == 'Z' || s[len - 1] == 'z'))
-        len--;
-    char buf[40];
-    if (len == 0 || len >= sizeof buf)
-        return -1;
-    memcpy(buf, s, len);
-    buf[len] = '\0';
-    int date_only = 0;
-    if (sscanf(buf, "%4d-%2d-%2d%n", &y, &mo, &d, &n) == 3 && (size_t)n == len) {
-        date_only = 1;
-    } else if (sscanf(buf, "%4d-%2d-%2d%c%2d:%2d%n", &y, &mo, &d, &sep, &h, &mi, &n) == 6 &&
-               (sep == 'T' || sep == ' ') && (size_t)n == len) {
-    } else if (sscanf(buf, "%4d-%2d-%2d%c%2d:%2d:%2d%n", &y, &mo, &d, &sep, &h, &mi, &sec,
-                      &n) == 7 &&
-               (sep == 'T' || sep == ' ') && (size_t)n == len) {
-    } else {
-        return -1;
+    *v = 0;
+    for (int k = 0; k < n; k++, (*p)++) {
+        if (**p < '0' || **p > '9')
+            return -1;
+        *v = *v * 10 + (**p - '0');
     }
-    if (y < 1970 || y > 9999 || mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 ||
-        sec > 60 || h < 0 || mi < 0 || sec < 0)
-        return -1;
+    return 0;
+}
+
+#define WHY(...) (snprintf(why, whylen, __VA_ARGS__), -1)
+
+int export_parse_time(const char *s, int end_of, int64_t *utime, char *why, size_t whylen)
+{
+    const char *p = s;
+    int y, mo, d, h = 0, mi = 0, sec = 0, us = 0, prec = 0; /* prec: 0 day, 1 min, 2 s, 3 µs */
+    if (digits(&p, 4, &y) || *p != '-')
+        return WHY("no year YYYY- at its start");
+    p++;
+    if (digits(&p, 2, &mo) || *p != '-')
+        return WHY("no month MM- after the year");
+    p++;
+    if (digits(&p, 2, &d))
+        return WHY("no day DD after the month");
+    if (*p == 'T' || *p == 't' || (*p == ' ' && p[1])) {
+        p++;
+        if (digits(&p, 2, &h) || *p != ':' || (p++, digits(&p, 2, &mi)))
+            return WHY("no time HH:MM after '%c'", s[10]);
+        prec = 1;
+        if (*p == ':') {
+            p++;
+            if (digits(&p, 2, &sec))
+                return WHY("no seconds SS after HH:MM:");
+            prec = 2;
+            if (*p == '.' || *p == ',') {
+                int n = 0;
+                for (p++; *p >= '0' && *p <= '9'; p++, n++)
+                    if (n < 6)
+                        us = us * 10 + (*p - '0');
+                if (n == 0)
+                    return WHY("no digits after the decimal mark");
+                for (int k = n; k < 6; k++)
+                    us *= 10;
+                prec = 3;
+            }
+        }
+    }
+    /* UTC only: Z, or an offset of zero */
+    if (*p == 'Z' || *p == 'z')
+        p++;
+    else if ((*p == '+' || *p == '-') && prec > 0) {
+        const char *o = p++;
+        int oh = 0, om = 0;
+        int bad = digits(&p, 2, &oh);
+        if (!bad && *p == ':')
+            p++;
+        if (bad || digits(&p, 2, &om))
+            return WHY("'%s' is not a UTC offset", o);
+        if (oh || om)
+            return WHY("offset %.6s: only UTC times (Z or +00:00)", o);
+    }
+    if (*p)
+        return WHY("unexpected '%.20s'", p);
+    if (y < 1970 || y > 9999)
+        return WHY("year %d is not in 1970 .. 9999", y);
+    if (mo < 1 || mo > 12)
+        return WHY("month %d is not in 1 .. 12", mo);
+    static const int mdays[12] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+    int leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+    if (d < 1 || d > mdays[mo - 1] || (mo == 2 && d == 29 && !leap))
+        return WHY("day %d is not in %04d-%02d", d, y, mo);
+    if (h > 23)
+        return WHY("hour %d is not in 0 .. 23", h);
+    if (mi > 59)
+        return WHY("minute %d is not in 0 .. 59", mi);
+    if (sec > 59)
+        return WHY("second %d is not in 0 .. 59", sec);
+    struct tm tm;
     memset(&tm, 0, sizeof tm);
     tm.tm_year = y - 1900;
     tm.tm_mon = mo - 1;
@@ -94,12 +146,14 @@ int export_parse_time(const char *s, int end_of, int64_t *utime)
     tm.tm_min = mi;
     tm.tm_sec = sec;
     time_t t = timegm(&tm);
-    struct tm back;
-    if (t == (time_t)-1 || !gmtime_r(&t, &back) || back.tm_mday != d) /* 2025-02-30 */
-        return -1;
-    *utime = (int64_t)t * 1000000;
-    if (end_of)
-        *utime += date_only ? INT64_C(86400000000) - 1 : (sec || n > 16 ? 999999 : 59999999);
+    if (t == (time_t)-1)
+        return WHY("not a time this system can represent");
+    *utime = (int64_t)t * 1000000 + us;
+    if (end_of) {
+        static const int64_t span[3] = {INT64_C(86400000000), 60000000, 1000000};
+        if (prec < 3)
+            *utime += span[prec] - 1; /* the last µs of that day, minute or second */
+    }
     return 0;
 }
 

@@ -54,9 +54,11 @@ typedef struct report_intake {
 } report_intake;
 int export_read_intake(amfi_store *s, report_intake *in, char *err, size_t errlen);
 
-/* "2025-11-22", "2025-11-22T13:05", "2025-11-22 13:05:09", with an optional
- * trailing Z: UTC, µs; end_of = 1 makes a date alone its last µs (for
- * --to). 0, or −1 when s is none of these. */
-int export_parse_time(const char *s, int end_of, int64_t *utime);
+/* ISO 8601 in UTC: "2025-11-22", "2025-11-22T13:05", "2025-11-22 13:05:09",
+ * "2025-11-22T13:05:09.25", each with an optional Z or zero offset (+00:00):
+ * µs since 1970. end_of = 1 (for --to) makes a date, a minute or a second
+ * its last µs. 0, or −1 with what could not be parsed in why (a missing
+ * part, a field out of range naming it, another offset, trailing text). */
+int export_parse_time(const char *s, int end_of, int64_t *utime, char *why, size_t whylen);
 
 #endif /* REPORT_EXPORT_H */
