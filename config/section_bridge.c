@@ -20,22 +20,9 @@ _Static_assert(sizeof(amfi_coords) == sizeof(int), "amfi_coords is written as an
 static int p_name(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
     amfi_site_config *c = base;
-    const char *s = scalar(x, v, path, "a name", 1);
-    size_t n;
 
     (void)f;
-    if (!s)
-        return -1;
-    n = strlen(s);
-    if (n == 0 || n >= sizeof c->name)
-        return fail(x, line_of(v), path, "must be 1 .. %zu bytes long, got %zu",
-                    sizeof c->name - 1, n);
-    for (size_t i = 0; i < n; i++)
-        if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
-            return fail(x, line_of(v), path, "must not contain control characters");
-    memset(c->name, 0, sizeof c->name);
-    memcpy(c->name, s, n);
-    return 0;
+    return get_name(x, v, path, c->name, sizeof c->name);
 }
 
 /* bridge.damping.modes: [a, b], two distinct 1-based mode numbers */

@@ -68,22 +68,9 @@ static void v_id(const field *f, const void *base, char *buf)
 static int p_sname(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
     amfi_site_config *c = base;
-    const char *s = scalar(x, v, path, "a name", 1);
-    size_t n;
 
     (void)f;
-    if (!s)
-        return -1;
-    n = strlen(s);
-    if (n == 0 || n >= NAME_CAP)
-        return fail(x, line_of(v), path, "must be 1 .. %zu bytes long, got %zu",
-                    NAME_CAP - 1, n);
-    for (size_t i = 0; i < n; i++)
-        if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
-            return fail(x, line_of(v), path, "must not contain control characters");
-    memset(c->site.name, 0, NAME_CAP);
-    memcpy(c->site.name, s, n);
-    return 0;
+    return get_name(x, v, path, c->site.name, NAME_CAP);
 }
 
 static void d_sname(const field *f, const void *base, char *buf)

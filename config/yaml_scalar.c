@@ -33,6 +33,24 @@ int is_plain(const yaml_node_t *v)
 
 /* The text of scalar node v, or NULL after an error saying what was `want`ed.
  * Numbers must be plain (unquoted) scalars: allow_quoted = 0. */
+int get_name(ctx *x, const yaml_node_t *v, const char *path, char *dst, size_t cap)
+{
+    const char *s = scalar(x, v, path, "a name", 1);
+    size_t n;
+
+    if (!s)
+        return -1;
+    n = strlen(s);
+    if (n == 0 || n >= cap)
+        return fail(x, line_of(v), path, "must be 1 .. %zu bytes long, got %zu", cap - 1, n);
+    for (size_t i = 0; i < n; i++)
+        if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
+            return fail(x, line_of(v), path, "must not contain control characters");
+    memset(dst, 0, cap);
+    memcpy(dst, s, n);
+    return 0;
+}
+
 const char *scalar(ctx *x, const yaml_node_t *v, const char *path,
                           const char *want, int allow_quoted)
 {

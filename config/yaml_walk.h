@@ -152,6 +152,9 @@ int to_double(const char *s, double *out);
 int to_llong(const char *s, long long *out);
 int to_long(const char *s, long *out);
 int get_double(ctx *x, const yaml_node_t *v, const char *path, double *out);
+/* A name (quoted or not) of 1 .. cap − 1 bytes without control characters
+ * into dst[cap] (zero-filled); 0, or −1 after fail(). */
+int get_name(ctx *x, const yaml_node_t *v, const char *path, char *dst, size_t cap);
 int get_long(ctx *x, const yaml_node_t *v, const char *path, long *out);
 /* A plain number in scalar v (already checked by scalar()), else "expected
  * `want`" or "number out of range"; 0 or −1 after fail(). */
