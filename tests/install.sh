@@ -22,7 +22,7 @@ for f in "$bindir/amfid" "$bindir/amfi-solve" "$bindir/amfi-report" "$bindir/amf
          "$bindir/sim_publisher" "$sysconfdir/amfid/amfid.yaml" "$unitdir/amfid.service" \
          "$sysusersdir/amfid.conf" "$tmpfilesdir/amfid.conf" "$mandir/man8/amfid.8.gz" \
          "$mandir/man5/amfid.yaml.5.gz" "$mandir/man1/amfi-solve.1.gz" "$mandir/man1/amfi-report.1.gz" \
-         "$mandir/man1/sim_publisher.1.gz" "$datadir/amfi/population.csv" \
+         "$mandir/man1/sim_publisher.1.gz" "$datadir/amfi/population.csv" "$datadir/amfi/amfi-alert-mail" \
          "$docdir/README.md" "$docdir/LICENSE" "$docdir/docs/daemon.md" "$datadir/java/amfi_types.jar"; do
   [ -e "$stage$f" ] || fail "not installed: $f"
 done
