@@ -190,8 +190,11 @@ static void write_all(daemon_s *d, FILE *f)
          "Window mean over baseline mean at the newest evaluation (NaN: none yet).");
     sample(f, "amfi_indicator_mean_ratio", m->have_indicator ? m->mean_ratio : NAN);
     head(f, "amfi_alert_open", "gauge", "1 while an alert of this kind is raised.");
-    for (int i = 0; i < OPEN_KINDS && m->open_kind[i][0]; i++)
-        fprintf(f, "amfi_alert_open{kind=\"%s\"} %d\n", m->open_kind[i], m->open[i]);
+    for (int i = 0; i < OPEN_KINDS && m->open_kind[i][0]; i++) {
+        fputs("amfi_alert_open{kind=\"", f);
+        put_label(f, m->open_kind[i]);
+        fprintf(f, "\"} %d\n", m->open[i]);
+    }
 
     head(f, "amfi_notices_total", "counter", "Alert notices (alerts.command) by result.");
     const notify_state *ns = &d->notify;
@@ -219,23 +222,25 @@ void metrics_tick(daemon_s *d, int force)
     char tmp[sizeof d->cfg.daemon.metrics_path + 32];
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "w");
-    int ok = f != NULL;
-    if (ok) {
+    int e = f ? 0 : (errno ? errno : EIO); /* the first failure's errno */
+    if (f) {
         /* node-exporter runs as another user (prometheus); the unit's
          * UMask=0027 would hide the file from it */
         fchmod(fileno(f), 0644);
         write_all(d, f);
-        ok = fflush(f) == 0 && fsync(fileno(f)) == 0;
-        ok = (fclose(f) == 0) && ok;
-        ok = ok && rename(tmp, path) == 0;
+        if (fflush(f) != 0 || fsync(fileno(f)) != 0)
+            e = errno ? errno : EIO;
+        if (fclose(f) != 0 && !e)
+            e = errno ? errno : EIO;
+        if (!e && rename(tmp, path) != 0)
+            e = errno ? errno : EIO;
     }
-    if (ok) {
+    if (!e) {
         if (m->failing)
             LOG_INFO("metrics: %s written again", path);
         m->failing = 0;
         return;
     }
-    int e = errno;
     if (f)
         unlink(tmp);
     m->write_errors++;

@@ -14,6 +14,9 @@
 #     FILE:LINE.
 #  5. The metrics file is valid text format (tests/prom_check.awk) and its
 #     counters equal the store's.
+#  6. A metrics file that cannot be written (a read-only mount, in a private
+#     mount namespace): logged once with the reason, every passage still
+#     stored, amfid exits 0.
 # Usage: daemon_notify.sh AMFID SIM_PUBLISHER CONFIG PROM_CHECK_AWK
 set -u
 amfid=$1 sim=$2 config=$3 check=$4
@@ -115,3 +118,16 @@ for c in "$dir/missing.sh" "$dir/plain.txt" "relative/notify.sh"; do
   grep -q "^amfid: $dir/bad.yaml:$line: alerts.command: " "$dir/bad.log" || fail "refusal of $c: $(cat "$dir/bad.log")"
 done
 echo "missing, not executable and relative commands refused with FILE:LINE"
+
+# 6. the metrics file on a read-only mount
+mkdir "$dir/ro"
+conf "$dir/fails.sh" 30 | sed "s|^  textfile: .*|  textfile: $dir/ro/amfid.prom|" > "$dir/ro.yaml"
+grep -q "^  textfile: $dir/ro/amfid.prom" "$dir/ro.yaml" || fail "the test's metrics path did not apply"
+unshare --mount sh -c 'mount --make-rprivate / 2>/dev/null; mount -t tmpfs -o ro,size=64k tmpfs "$1/ro" &&
+  "$2" --config "$1/ro.yaml" --db "$1/ro.db" --lcm-url "file://$1/t.lcmlog?speed=0" 2> "$1/amfid.log"' \
+  sh "$dir" "$amfid" || fail "amfid exit $? (metrics on a read-only mount)"
+n=$(grep -c "metrics: cannot write $dir/ro/amfid.prom: Read-only file system" "$dir/amfid.log")
+[ "$n" -eq 1 ] || fail "the write error logged $n times, not once"
+[ "$(q ro "SELECT count(*) FROM passages")" -eq 60 ] || fail "$(q ro "SELECT count(*) FROM passages") of 60 passages"
+[ ! -e "$dir/ro/amfid.prom" ] || fail "a metrics file outside the namespace's mount"
+echo "metrics on a read-only mount: the write error logged once, all 60 passages stored, exit 0"
