@@ -377,31 +377,6 @@ static const char *num(double x, const char *fmt, char buf[32])
     return buf;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* Nearest-rank percentile of sorted v[0 .. n−1], 0 < p <= 100. */
-static double percentile(const double *v, size_t n, double p)
-{
-    size_t k = (size_t)ceil(p / 100.0 * (double)n);
-    return v[k > 0 ? k - 1 : 0];
-}
-
-/* Mean and sample STD (two passes; NaN STD when n < 2). */
-static void mean_std(const double *v, size_t n, double *mean, double *std)
-{
-    double s = 0, q = 0;
-    for (size_t k = 0; k < n; k++)
-        s += v[k];
-    *mean = n ? s / (double)n : NAN;
-    for (size_t k = 0; k < n; k++)
-        q += (v[k] - *mean) * (v[k] - *mean);
-    *std = n > 1 ? sqrt(q / (double)(n - 1)) : NAN;
-}
-
 /* ---- sections ------------------------------------------------------------ */
 
 static int print_baseline(amfi_store *s)
@@ -448,12 +423,12 @@ static int section_summary(amfi_store *s)
     if (ng == 0) {
         out("GVW, ok      (no ok passages)\n");
     } else {
-        qsort(g, ng, sizeof *g, cmp_double);
-        mean_std(g, ng, &mean, &std);
+        report_mean_std(g, ng, &mean, &std);
+        report_sort(g, ng);
         out("GVW, ok      n %zu, mean %.0f kg, STD %s kg, min %.0f, "
                "median %.0f, max %.0f kg\n",
                ng, mean, num(std, "%.0f", a), g[0],
-               percentile(g, ng, 50), g[ng - 1]);
+               report_percentile(g, ng, 50), g[ng - 1]);
     }
     free(g);
     report_intake in;
@@ -560,16 +535,16 @@ static int section_errors(amfi_store *s)
            "matched %lld\n", (long long)n_truth, ne, (long long)not_ok);
     if (ne > 0) {
         double mean, std;
-        mean_std(e, ne, &mean, &std);
+        report_mean_std(e, ne, &mean, &std);
         out("GVW error    mean %+.2f %%, STD %s %%\n", mean,
                num(std, "%.2f", b[0]));
         for (size_t k = 0; k < ne; k++)
             e[k] = fabs(e[k]);
-        qsort(e, ne, sizeof *e, cmp_double);
+        report_sort(e, ne);
         out("|GVW error|  median %.2f %%, 90 %% %.2f %%, 95 %% %.2f %%, "
                "99 %% %.2f %%, max %.2f %%\n",
-               percentile(e, ne, 50), percentile(e, ne, 90),
-               percentile(e, ne, 95), percentile(e, ne, 99),
+               report_percentile(e, ne, 50), report_percentile(e, ne, 90),
+               report_percentile(e, ne, 95), report_percentile(e, ne, 99),
                e[ne - 1]);
     }
     free(e);
@@ -600,7 +575,7 @@ static int set_baseline(const options *o)
             rc = data_error("only %d ok passages stored, --set-baseline-last "
                             "asked for %d", n, o->baseline_last);
         if (rc == 0) {
-            mean_std(g, (size_t)n, &b.mean_kg, &b.std_kg);
+            report_mean_std(g, (size_t)n, &b.mean_kg, &b.std_kg);
             b.n = n;
         }
     } else {

@@ -157,6 +157,39 @@ int export_parse_time(const char *s, int end_of, int64_t *utime, char *why, size
     return 0;
 }
 
+/* ---- statistics shared with amfi-report's tables ---------------------------------- */
+
+void report_mean_std(const double *v, size_t n, double *mean, double *std)
+{
+    double s = 0, q = 0;
+    for (size_t k = 0; k < n; k++)
+        s += v[k];
+    *mean = n ? s / (double)n : NAN;
+    for (size_t k = 0; k < n; k++)
+        q += (v[k] - *mean) * (v[k] - *mean);
+    *std = n > 1 ? sqrt(q / (double)(n - 1)) : NAN;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+void report_sort(double *v, size_t n)
+{
+    if (n > 1)
+        qsort(v, n, sizeof *v, cmp_double);
+}
+
+double report_percentile(const double *v, size_t n, double p)
+{
+    if (n == 0)
+        return NAN;
+    size_t k = (size_t)ceil(p / 100.0 * (double)n);
+    return v[k > 0 ? k - 1 : 0];
+}
+
 /* ---- amfid's intake counters (meta intake.*) ----------------------------------- */
 
 int export_read_intake(amfi_store *s, report_intake *in, char *err, size_t errlen)
@@ -205,18 +238,10 @@ int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, siz
         free(g);
         return -1;
     }
-    double mean = NAN, std = NAN, mn = NAN, mx = NAN, sumg = 0, q = 0;
-    for (size_t k = 0; k < ng; k++) {
-        sumg += g[k];
-        mn = k ? fmin(mn, g[k]) : g[k];
-        mx = k ? fmax(mx, g[k]) : g[k];
-    }
-    if (ng) {
-        mean = sumg / (double)ng;
-        for (size_t k = 0; k < ng; k++)
-            q += (g[k] - mean) * (g[k] - mean);
-        std = ng > 1 ? sqrt(q / (double)(ng - 1)) : NAN;
-    }
+    double mean, std;
+    report_mean_std(g, ng, &mean, &std);
+    report_sort(g, ng);
+    double mn = ng ? g[0] : NAN, mx = ng ? g[ng - 1] : NAN;
     free(g);
     char a[32], c[32];
     if (fmt == FMT_CSV) {
@@ -391,12 +416,6 @@ int export_alerts(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size
     return 0;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 int export_errors(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_t errlen)
 {
     int64_t n_truth = 0, not_ok = 0;
@@ -405,22 +424,13 @@ int export_errors(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size
     if (amfi_store_count(s, AMFI_STORE_TRUTH, &n_truth, err, errlen) ||
         (n_truth > 0 && amfi_store_gvw_errors(s, &e, &ne, &not_ok, err, errlen)))
         return -1;
-    double mean = NAN, std = NAN, med = NAN, p95 = NAN, mx = NAN, sum = 0, q = 0;
-    if (ne) {
-        for (size_t k = 0; k < ne; k++)
-            sum += e[k];
-        mean = sum / (double)ne;
-        for (size_t k = 0; k < ne; k++)
-            q += (e[k] - mean) * (e[k] - mean);
-        std = ne > 1 ? sqrt(q / (double)(ne - 1)) : NAN;
-        for (size_t k = 0; k < ne; k++)
-            e[k] = fabs(e[k]);
-        qsort(e, ne, sizeof *e, cmp_double);
-        size_t k50 = (size_t)ceil(0.5 * (double)ne), k95 = (size_t)ceil(0.95 * (double)ne);
-        med = e[k50 ? k50 - 1 : 0];
-        p95 = e[k95 ? k95 - 1 : 0];
-        mx = e[ne - 1];
-    }
+    double mean, std;
+    report_mean_std(e, ne, &mean, &std);
+    for (size_t k = 0; k < ne; k++)
+        e[k] = fabs(e[k]);
+    report_sort(e, ne);
+    double med = report_percentile(e, ne, 50), p95 = report_percentile(e, ne, 95);
+    double mx = ne ? e[ne - 1] : NAN;
     free(e);
     if (fmt == FMT_CSV) {
         fprintf(f, "item,value\ntruth_rows,%lld\nok_matched,%zu\nother_matched,%lld\n",

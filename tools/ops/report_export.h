@@ -46,6 +46,14 @@ int export_histogram(amfi_store *s, const export_opts *o, int fmt, FILE *f, json
 int export_overloads(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_t *root,
                      char *err, size_t errlen);
 
+/* Mean and sample STD of v[0 .. n−1] (two passes; NaN when n is 0, STD
+ * NaN when n < 2). */
+void report_mean_std(const double *v, size_t n, double *mean, double *std);
+/* Sort v[0 .. n−1] in place; then report_percentile gives the nearest-rank
+ * percentile p (0 < p <= 100) of the sorted values (NaN when n is 0). */
+void report_sort(double *v, size_t n);
+double report_percentile(const double *v, size_t n, double p);
+
 /* amfid's intake counters of its newest run (meta intake.*), if any. */
 typedef struct report_intake {
     int found;
