@@ -296,27 +296,18 @@ static void resample(struct amfi_solver *s, const amfi_passage *ps)
     }
 }
 
-int amfi_solve_begin(struct amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
-                     double window_speed, char *err, size_t errlen)
+int amfi_check_samples_lambda(const struct amfi_solver *s, const amfi_passage *ps,
+                              const amfi_lambda *lam, char *err, size_t errlen)
 {
-    if (!s || !ps || !lam)
-        return amfi_fail(err, errlen, AMFI_EINVAL, "solve: NULL argument");
-    const double L = s->b->p.span_m;
 #define REQ(cond, st, ...)                                                \
     do {                                                                  \
         if (!(cond))                                                      \
             return amfi_fail(err, errlen, st, __VA_ARGS__);               \
     } while (0)
-    REQ(isfinite(ps->speed_mps) && ps->speed_mps > 0, AMFI_EINVAL, "speed must be > 0");
-    REQ(ps->n_axles >= 1 && ps->n_axles <= s->na_max, AMFI_EINVAL,
-        "%d axles: the solver was sized for 1..%d", ps->n_axles, s->na_max);
     REQ(ps->n_samples >= 2, AMFI_EINVAL, "need at least 2 samples");
     REQ(isfinite(ps->scan_rate_hz) && ps->scan_rate_hz > 0, AMFI_EINVAL,
         "scan rate must be > 0");
     REQ(isfinite(ps->t_first_s), AMFI_EINVAL, "t_first_s is not finite");
-    for (int a = 0; a + 1 < ps->n_axles; a++)
-        REQ(isfinite(ps->axle_spacing_m[a]) && ps->axle_spacing_m[a] > 0, AMFI_EINVAL,
-            "axle spacing %d must be > 0", a + 1);
     for (int si = 0; si < s->ns; si++)
         REQ(ps->accel[si], AMFI_EINVAL, "sensor %d has no samples", si);
     if (lam->automatic) {
@@ -333,6 +324,79 @@ int amfi_solve_begin(struct amfi_solver *s, const amfi_passage *ps, const amfi_l
     REQ(isfinite(lam->ref_rate_hz) && lam->ref_rate_hz > 0, AMFI_EINVAL,
         "lambda reference rate must be > 0");
 
+#undef REQ
+    return AMFI_OK;
+}
+
+int amfi_solver_grow_axles(struct amfi_solver *s, int na)
+{
+    if (na <= s->na_max)
+        return AMFI_OK;
+    if (na > AMFI_MAX_AXLES)
+        return AMFI_EINVAL;
+    const int old_stride = s->gstride, old_na = s->na_max;
+    const size_t old_len = s->scratch_len;
+    if (s->p.coords == AMFI_COORDS_MODAL) {
+        s->gstride = 2 * s->m + na;
+        s->scratch_len = amfi_sweep_modal_scratch(s->m, na, s->ns) +
+                         (size_t)(s->gstride + 1) * s->gstride;
+    } else {
+        s->gstride = 4 * s->n + na;
+        s->scratch_len = amfi_sweep_nodal_scratch(s->n, na, s->ns);
+    }
+    double *sc = realloc(s->scratch, sizeof(double) * s->scratch_len);
+    if (!sc) {
+        s->gstride = old_stride;
+        s->scratch_len = old_len;
+        return AMFI_ENOMEM;
+    }
+    s->scratch = sc;
+    s->bytes += sizeof(double) * (s->scratch_len - old_len);
+    /* the per-step buffers at the same step capacity, for na axles */
+    const int cap = s->cap;
+    s->bytes -= sizeof(double) * (size_t)cap *
+                (2 * (size_t)s->ns + old_na + (size_t)old_na * old_stride + old_na);
+    s->cap = 0;
+    s->na_max = na;
+    return reserve(s, cap);
+}
+
+int amfi_solve_window(struct amfi_solver *s, const amfi_passage *ps, int na, double t_start,
+                      double t_end, char *err, size_t errlen)
+{
+    int N = (int)ceil((t_end - t_start) * s->p.calc_rate_hz - 1e-6);
+    if (N < 2)
+        N = 2;
+    if (N > s->cap && reserve(s, N) != 0)
+        return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory for %d steps", N);
+    s->N = N;
+    s->na = na;
+    s->t0 = t_start;
+    resample(s, ps);
+    s->lc_n = 0;
+    return AMFI_OK;
+}
+
+int amfi_solve_begin(struct amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
+                     double window_speed, char *err, size_t errlen)
+{
+    if (!s || !ps || !lam)
+        return amfi_fail(err, errlen, AMFI_EINVAL, "solve: NULL argument");
+    const double L = s->b->p.span_m;
+#define REQ(cond, st, ...)                                                \
+    do {                                                                  \
+        if (!(cond))                                                      \
+            return amfi_fail(err, errlen, st, __VA_ARGS__);               \
+    } while (0)
+    REQ(isfinite(ps->speed_mps) && ps->speed_mps > 0, AMFI_EINVAL, "speed must be > 0");
+    REQ(ps->n_axles >= 1 && ps->n_axles <= s->na_max, AMFI_EINVAL,
+        "%d axles: the solver was sized for 1..%d", ps->n_axles, s->na_max);
+    for (int a = 0; a + 1 < ps->n_axles; a++)
+        REQ(isfinite(ps->axle_spacing_m[a]) && ps->axle_spacing_m[a] > 0, AMFI_EINVAL,
+            "axle spacing %d must be > 0", a + 1);
+    int rc = amfi_check_samples_lambda(s, ps, lam, err, errlen);
+    if (rc)
+        return rc;
     /* Window: entry − pre_roll .. last axle's exit + post_roll. */
     if (!(isfinite(window_speed) && window_speed > 0))
         window_speed = ps->speed_mps;
@@ -345,21 +409,13 @@ int amfi_solve_begin(struct amfi_solver *s, const amfi_passage *ps, const amfi_l
         "the data spans [%.6g, %.6g] s but the window needs [%.6g, %.6g] s", ps->t_first_s,
         t_last, t_start, t_end);
 #undef REQ
-    int N = (int)ceil((t_end - t_start) * s->p.calc_rate_hz - 1e-6);
-    if (N < 2)
-        N = 2;
-    if (N > s->cap && reserve(s, N) != 0)
-        return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory for %d steps", N);
-    s->N = N;
-    s->na = ps->n_axles;
-    s->t0 = t_start;
     s->speed = ps->speed_mps;
     s->off[0] = 0.0;
     for (int a = 1; a < ps->n_axles; a++)
         s->off[a] = s->off[a - 1] + ps->axle_spacing_m[a - 1];
-    resample(s, ps);
-    s->lc_n = 0;
-    return AMFI_OK;
+    for (int a = 0; a < ps->n_axles; a++)
+        s->vf[a] = 1.0;
+    return amfi_solve_window(s, ps, ps->n_axles, t_start, t_end, err, errlen);
 }
 
 int amfi_solve_lambda(struct amfi_solver *s, const amfi_lambda *lam, double *lam_h,

@@ -39,7 +39,10 @@ struct amfi_solver {
     int N;          /* steps of the current passage */
     double t0;      /* time of step 0 relative to entry, s */
     double speed;   /* m/s */
-    double off[AMFI_MAX_AXLES]; /* axle a at x = speed·t − off[a] */
+    double off[AMFI_MAX_AXLES]; /* axle a at x = speed·vf[a]·t − off[a] */
+    double vf[AMFI_MAX_AXLES];  /* per-axle speed factor: 1 for one vehicle; for
+                                   several (multi.c) speed = 1 and vf[a] = the
+                                   vehicle's speed, off[a] = speed·entry + offset */
     double *d;      /* (cap + 1) × ns: data at the steps */
     double *force;  /* (cap + 1) × na_max */
     double *y;      /* cap × ns: fitted outputs y_1..y_N */
@@ -55,12 +58,12 @@ struct amfi_solver {
     double *lc_lam, *lc_res, *lc_smo, *lc_kap;
 };
 
-/* Position of axle a at step j, m (x = speed·t − off[a], t = t0 + j·h):
+/* Position of axle a at step j, m (x = speed·vf[a]·t − off[a], t = t0 + j·h):
  * inline beside the passage fields it reads, so the sweeps need no call
  * into solver.c. */
 static inline double axle_x(const struct amfi_solver *s, int a, int j)
 {
-    return s->speed * (s->t0 + j * s->h) - s->off[a];
+    return s->speed * s->vf[a] * (s->t0 + j * s->h) - s->off[a];
 }
 
 /* One backward and forward sweep at per-step λ: fills s->force (N + 1 rows),
@@ -98,6 +101,18 @@ int amfi_solve_begin(struct amfi_solver *s, const amfi_passage *ps, const amfi_l
                      double window_speed, char *err, size_t errlen);
 int amfi_solve_lambda(struct amfi_solver *s, const amfi_lambda *lam, double *lam_h,
                       int *n_solves, char *err, size_t errlen);
+/* Shared with amfi_solve_multi (multi.c):
+ *   check_samples_lambda: the samples (count, rate, t_first, a pointer per
+ *     sensor) and λ, as amfi_solve_begin checks them;
+ *   grow_axles: the workspace for na axles (outside any time loop);
+ *     AMFI_EINVAL above AMFI_MAX_AXLES, AMFI_ENOMEM;
+ *   window: na axles over [t_start, t_end] (off[], vf[], speed set by the
+ *     caller): size N, resample the data. */
+int amfi_check_samples_lambda(const struct amfi_solver *s, const amfi_passage *ps,
+                              const amfi_lambda *lam, char *err, size_t errlen);
+int amfi_solver_grow_axles(struct amfi_solver *s, int na);
+int amfi_solve_window(struct amfi_solver *s, const amfi_passage *ps, int na, double t_start,
+                      double t_end, char *err, size_t errlen);
 int amfi_solve_end(struct amfi_solver *s, const amfi_lambda *lam, double lam_h, int n_solves,
                    amfi_result *res, char *err, size_t errlen);
 

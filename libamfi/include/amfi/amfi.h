@@ -354,6 +354,68 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *p, const amfi_lambda *l
 const char *amfi_speed_criterion_name(amfi_speed_criterion c);
 int amfi_speed_criterion_parse(const char *name, amfi_speed_criterion *c); /* 0 ok */
 
+/* ---- several vehicles on the span, solved jointly (multi.c) ------------ */
+
+#define AMFI_MAX_VEHICLES 8
+
+/* One vehicle of an event: its first axle reaches x = 0 at entry_s, on the
+ * samples' clock (the one of amfi_multi_passage.t_first_s). */
+typedef struct amfi_vehicle {
+    double entry_s;                        /* finite */
+    double speed_mps;                      /* > 0 */
+    int n_axles;                           /* >= 1; all vehicles <= AMFI_MAX_AXLES */
+    double axle_spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1 spacings, > 0 */
+} amfi_vehicle;
+
+/* An event: the samples (as in amfi_passage) and the vehicles on the span,
+ * in any order (results come back in the order given). */
+typedef struct amfi_multi_passage {
+    int n_samples;
+    double scan_rate_hz;
+    double t_first_s;
+    const double *accel[AMFI_MAX_SENSORS];
+    int n_vehicles; /* 1 .. AMFI_MAX_VEHICLES */
+    amfi_vehicle vehicle[AMFI_MAX_VEHICLES];
+} amfi_multi_passage;
+
+typedef struct amfi_vehicle_result {
+    int first_axle;   /* index of its first axle in the joint result */
+    int n_axles;
+    double axle_kg[AMFI_MAX_AXLES]; /* mean force of its own axles on the span / g */
+    double gvw_kg;
+    /* Separability of this vehicle's weight from the others': with constant
+     * axle loads as the model, A = Σ_j Gᵀ W G the normal matrix of all axles
+     * (G the sensors' response to unit loads moving with the axles) and u the
+     * vehicle's axle indicator, quality = sqrt(uᵀA⁻¹u / uᵀ(A_vv)⁻¹u): the
+     * factor by which the other vehicles inflate the standard deviation of
+     * this vehicle's weight. 1 = alone or fully separable; large = its axles
+     * trade load with another vehicle's (close axles, one sensor). */
+    double quality;
+    /* σ·sqrt(uᵀA⁻¹u)/g with σ the joint fit's residual RMS: the posterior
+     * standard deviation of the weight under that model, kg */
+    double gvw_sd_kg;
+} amfi_vehicle_result;
+
+typedef struct amfi_multi_result {
+    amfi_result all; /* the joint solve: all axles, vehicle by vehicle in the
+                        order given; t0_s on the samples' clock */
+    int n_vehicles;
+    amfi_vehicle_result vehicle[AMFI_MAX_VEHICLES];
+    double total_gvw_kg; /* Σ of the vehicles' GVW */
+} amfi_multi_result;
+
+/* The event window on the samples' clock: start_s = first entry − pre_roll,
+ * on_span_s = the last exit, end_s = last exit + post_roll. No validation. */
+amfi_passage_times amfi_multi_window(double span_m, const amfi_multi_passage *p,
+                                     double pre_roll_s, double post_roll_s);
+
+/* Solve all vehicles' axles in one sweep. The workspace grows (outside the
+ * time loop) to the event's total axles and duration. Refused: no vehicles,
+ * more than AMFI_MAX_VEHICLES, more than AMFI_MAX_AXLES axles in all
+ * (AMFI_EINVAL); data not covering the window (AMFI_ERANGE). */
+int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lambda *lam,
+                     amfi_multi_result *res, char *err, size_t errlen);
+
 #ifdef __cplusplus
 }
 #endif

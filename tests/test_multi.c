@@ -1,0 +1,367 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * test_multi.c: unit tests of amfi_solve_multi (several vehicles on the span
+ * solved jointly, issue 13) against prescribed constant moving forces put
+ * through the independent Newmark forward integrator, on the paper-20m
+ * bridge, at one sensor (mid-span) and three (quarter, mid, three-quarter).
+ * Each tolerance says why it is what it is.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "amfi/amfi.h"
+
+static amfi_bridge *bridge; /* paper-20m, shared by all tests */
+
+static int setup(void **state)
+{
+    (void)state;
+    amfi_bridge_params p;
+    char err[256];
+    amfi_bridge_params_paper20(&p);
+    return amfi_bridge_create(&p, &bridge, err, sizeof err);
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    amfi_bridge_destroy(bridge);
+    return 0;
+}
+
+#define SPEED 25.0 /* every vehicle (the forward integrator has one speed) */
+#define RATE 1000.0
+
+static const double sensors[3] = {10.0, 5.0, 15.0}; /* mid-span first */
+
+/* An event: vehicles with entry times, spacings and constant axle forces. */
+typedef struct event {
+    amfi_multi_passage p;
+    double force_N[AMFI_MAX_AXLES]; /* all axles, vehicle by vehicle */
+    int na;
+    double *accel[3];
+} event;
+
+static double const_force(double t, int a, void *user)
+{
+    (void)t;
+    return ((const double *)user)[a];
+}
+
+/* Record the event at ns sensors from t = t0 (the bridge at rest, no axle on
+ * it) to the last exit + 0.05 s; the clock of entry_s is shifted by t0. */
+static void record(event *ev, int ns, double t0)
+{
+    double off[AMFI_MAX_AXLES];
+    int i = 0;
+    for (int v = 0; v < ev->p.n_vehicles; v++) {
+        const amfi_vehicle *ve = &ev->p.vehicle[v];
+        double o = SPEED * ve->entry_s;
+        for (int a = 0; a < ve->n_axles; a++, i++) {
+            if (a > 0)
+                o += ve->axle_spacing_m[a - 1];
+            off[i] = o;
+        }
+    }
+    ev->na = i;
+    amfi_passage_times w = amfi_multi_window(20.0, &ev->p, 0.0, 0.0);
+    assert_true(w.start_s >= 0.0);
+    int n = (int)((w.end_s + 0.05) * RATE) + 1;
+    double *all = malloc(sizeof(double) * n * ns);
+    char err[256];
+    assert_int_equal(amfi_forward_newmark(bridge, SPEED, ev->na, off, const_force, ev->force_N,
+                                          ns, sensors, 2e-5, RATE, n, all, err, sizeof err),
+                     0);
+    for (int s = 0; s < ns; s++) {
+        ev->accel[s] = malloc(sizeof(double) * n);
+        for (int k = 0; k < n; k++)
+            ev->accel[s][k] = all[k * ns + s];
+        ev->p.accel[s] = ev->accel[s];
+    }
+    free(all);
+    ev->p.n_samples = n;
+    ev->p.scan_rate_hz = RATE;
+    ev->p.t_first_s = t0;
+    for (int v = 0; v < ev->p.n_vehicles; v++)
+        ev->p.vehicle[v].entry_s += t0;
+}
+
+static void event_free(event *ev)
+{
+    for (int s = 0; s < 3; s++)
+        free(ev->accel[s]);
+}
+
+static void add_vehicle(event *ev, double entry_s, int n_axles, const double *spacing,
+                        const double *force_N)
+{
+    amfi_vehicle *ve = &ev->p.vehicle[ev->p.n_vehicles++];
+    ve->entry_s = entry_s;
+    ve->speed_mps = SPEED;
+    ve->n_axles = n_axles;
+    for (int a = 0; a + 1 < n_axles; a++)
+        ve->axle_spacing_m[a] = spacing[a];
+    for (int a = 0; a < n_axles; a++)
+        ev->force_N[ev->na++] = force_N[a];
+}
+
+static amfi_solver *make_solver(int ns, int max_axles, amfi_coords coords)
+{
+    amfi_solver_params sp;
+    amfi_solver *s = NULL;
+    char err[256];
+    amfi_solver_params_default(&sp, 20.0);
+    sp.n_sensors = ns;
+    for (int i = 0; i < ns; i++) {
+        sp.sensor_x_m[i] = sensors[i];
+        sp.sensor_weight[i] = 1.0;
+    }
+    sp.calc_rate_hz = 5000.0; /* the default: at 1000 Hz one vehicle alone errs by -1.06 % */
+    sp.max_axles = max_axles;
+    sp.coords = coords;
+    assert_int_equal(amfi_solver_create(bridge, &sp, &s, err, sizeof err), 0);
+    return s;
+}
+
+/* Relative GVW errors of each vehicle and of their sum. */
+static double errors(const event *ev, const amfi_multi_result *r, double *err_v)
+{
+    double truth_all = 0.0;
+    int i = 0;
+    for (int v = 0; v < r->n_vehicles; v++) {
+        double truth = 0.0;
+        for (int a = 0; a < r->vehicle[v].n_axles; a++, i++)
+            truth += ev->force_N[i] / AMFI_GRAVITY;
+        truth_all += truth;
+        err_v[v] = r->vehicle[v].gvw_kg / truth - 1.0;
+    }
+    return r->total_gvw_kg / truth_all - 1.0;
+}
+
+static const double sp2[1] = {5.0}, sp3[2] = {4.0, 1.3};
+static const double f2[2] = {102000.0, 74600.0};     /* class A-like two-axle */
+static const double f2b[2] = {60000.0, 90000.0};
+static const double f3[3] = {70000.0, 110000.0, 100000.0};
+
+/* One vehicle through the multi path equals amfi_solve, on a shifted clock,
+ * with quality exactly 1 (nothing to trade load with). */
+static void single_equals_solve(void **state)
+{
+    (void)state;
+    event ev;
+    memset(&ev, 0, sizeof ev);
+    add_vehicle(&ev, 0.0, 2, sp2, f2);
+    ev.na = 0;
+    record(&ev, 1, 0.0);
+    amfi_solver *s = make_solver(1, 2, AMFI_COORDS_MODAL);
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    amfi_passage one;
+    memset(&one, 0, sizeof one);
+    one.n_samples = ev.p.n_samples;
+    one.scan_rate_hz = RATE;
+    one.accel[0] = ev.accel[0];
+    one.speed_mps = SPEED;
+    one.n_axles = 2;
+    one.axle_spacing_m[0] = 5.0;
+    amfi_result r1;
+    assert_int_equal(amfi_solve(s, &one, &lam, &r1, NULL, 0), 0);
+    double gvw1 = r1.gvw_kg;
+    printf("# one vehicle: %+.3f %%\n", 100 * (gvw1 / ((f2[0] + f2[1]) / AMFI_GRAVITY) - 1));
+    /* the same data on a clock starting at 1234.5 s */
+    ev.p.t_first_s = 1234.5;
+    ev.p.vehicle[0].entry_s = 1234.5;
+    amfi_multi_result rm;
+    char err[256];
+    assert_int_equal(amfi_solve_multi(s, &ev.p, &lam, &rm, err, sizeof err), 0);
+    /* the same sweep on the same samples: only the clock's rounding differs */
+    assert_true(fabs(rm.vehicle[0].gvw_kg / gvw1 - 1.0) < 1e-6);
+    assert_true(fabs(rm.all.t0_s - 1234.5) < 1e-9);
+    assert_true(fabs(rm.vehicle[0].quality - 1.0) < 1e-9);
+    assert_true(rm.vehicle[0].gvw_sd_kg >= 0.0);
+    amfi_solver_destroy(s);
+    event_free(&ev);
+}
+
+/* Two vehicles, one mid-span sensor, the second entering at 0.5 s while the
+ * first (on the span 0 .. 1 s) is at mid-span. */
+static void two_vehicles_one_sensor(void **state)
+{
+    (void)state;
+    event ev;
+    memset(&ev, 0, sizeof ev);
+    add_vehicle(&ev, 0.0, 2, sp2, f2);
+    add_vehicle(&ev, 0.5, 3, sp3, f3);
+    ev.na = 0;
+    record(&ev, 1, 0.0);
+    /* sized for 2 axles: the event's 5 grow it */
+    amfi_solver *s = make_solver(1, 2, AMFI_COORDS_MODAL);
+    size_t before = amfi_solver_workspace_bytes(s);
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    amfi_multi_result r;
+    char err[256];
+    assert_int_equal(amfi_solve_multi(s, &ev.p, &lam, &r, err, sizeof err), 0);
+    assert_true(amfi_solver_workspace_bytes(s) > before);
+    assert_int_equal(r.n_vehicles, 2);
+    assert_int_equal(r.all.n_axles, 5);
+    assert_int_equal(r.vehicle[1].first_axle, 2);
+    double e[2];
+    double et = errors(&ev, &r, e);
+    printf("# 2 vehicles, 1 sensor: total %+.3f %%, v1 %+.3f %% (q %.3g), v2 %+.3f %% (q %.3g)\n",
+           100 * et, 100 * e[0], r.vehicle[0].quality, 100 * e[1], r.vehicle[1].quality);
+    /* constant forces, no noise: measured -0.21 % (sum), -0.24 %, -0.19 %; one
+     * vehicle alone errs by -0.21 % here. Bound: 2.5 × that, well inside the
+     * issue's one-sensor targets (sum 2.5 %, each 10 %) */
+    assert_true(fabs(et) < 0.005);
+    assert_true(fabs(e[0]) < 0.006 && fabs(e[1]) < 0.006);
+    for (int v = 0; v < 2; v++)
+        assert_true(r.vehicle[v].quality >= 1.0 && isfinite(r.vehicle[v].quality));
+    amfi_solver_destroy(s);
+    event_free(&ev);
+}
+
+/* Three vehicles in a chain (A-B-C: A and C never meet), at three sensors,
+ * modal and dense nodal paths agree. */
+static void three_vehicles_three_sensors(void **state)
+{
+    (void)state;
+    event ev;
+    memset(&ev, 0, sizeof ev);
+    add_vehicle(&ev, 0.0, 2, sp2, f2);
+    add_vehicle(&ev, 0.6, 3, sp3, f3);
+    add_vehicle(&ev, 1.3, 2, sp2, f2b);
+    ev.na = 0;
+    record(&ev, 3, 0.0);
+    amfi_solver *s = make_solver(3, 7, AMFI_COORDS_MODAL);
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    amfi_multi_result r;
+    char err[256];
+    assert_int_equal(amfi_solve_multi(s, &ev.p, &lam, &r, err, sizeof err), 0);
+    double e[3];
+    double et = errors(&ev, &r, e);
+    printf("# 3 vehicles, 3 sensors: total %+.3f %%, %+.3f %% %+.3f %% %+.3f %% (q %.3g %.3g %.3g)\n",
+           100 * et, 100 * e[0], 100 * e[1], 100 * e[2], r.vehicle[0].quality,
+           r.vehicle[1].quality, r.vehicle[2].quality);
+    /* measured -0.39 % (sum), -0.40 / -0.37 / -0.41 %; the issue's
+     * three-sensor target is 5 % worst: bound at 1 % */
+    for (int v = 0; v < 3; v++)
+        assert_true(fabs(e[v]) < 0.01);
+    assert_true(fabs(et) < 0.01);
+    amfi_solver *sn = make_solver(3, 7, AMFI_COORDS_NODAL);
+    amfi_multi_result rn;
+    assert_int_equal(amfi_solve_multi(sn, &ev.p, &lam, &rn, err, sizeof err), 0);
+    /* the same cost minimised in two coordinate systems (test_libamfi's
+     * modal_vs_nodal bound); qualities from all modes vs the observable ones */
+    for (int v = 0; v < 3; v++) {
+        assert_true(fabs(rn.vehicle[v].gvw_kg / r.vehicle[v].gvw_kg - 1.0) < 1e-3);
+        assert_true(fabs(rn.vehicle[v].quality / r.vehicle[v].quality - 1.0) < 0.05);
+    }
+    amfi_solver_destroy(sn);
+    amfi_solver_destroy(s);
+    event_free(&ev);
+}
+
+/* Three vehicles at one sensor; the first vehicle's quality figure is worse
+ * (larger) when the second follows it closely (1.25 m between axles, most of
+ * the crossing together) than when it enters as the first is about to leave.
+ * Measured: 1.23 against 1.12. */
+static void quality_ranks_close_axles(void **state)
+{
+    (void)state;
+    amfi_solver *s = make_solver(1, 7, AMFI_COORDS_MODAL);
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    double q[2];
+    const double entry2[2] = {0.25, 0.9}; /* 1.25 m gap, 2 s together; 17.5 m gap, 0.1 s */
+    for (int c = 0; c < 2; c++) {
+        event ev;
+        memset(&ev, 0, sizeof ev);
+        add_vehicle(&ev, 0.0, 2, sp2, f2);
+        add_vehicle(&ev, entry2[c], 3, sp3, f3);
+        add_vehicle(&ev, entry2[c] + 0.9, 2, sp2, f2b);
+        ev.na = 0;
+        record(&ev, 1, 0.0);
+        amfi_multi_result r;
+        char err[256];
+        assert_int_equal(amfi_solve_multi(s, &ev.p, &lam, &r, err, sizeof err), 0);
+        double e[3];
+        double et = errors(&ev, &r, e);
+        printf("# chain of 3, entry2 %.2f s: total %+.3f %%, %+.3f %% %+.3f %% %+.3f %% "
+               "(q %.3g %.3g %.3g)\n",
+               entry2[c], 100 * et, 100 * e[0], 100 * e[1], 100 * e[2], r.vehicle[0].quality,
+               r.vehicle[1].quality, r.vehicle[2].quality);
+        assert_true(fabs(et) < 0.01); /* measured -0.23, -0.25 % */
+        q[c] = r.vehicle[0].quality;
+        event_free(&ev);
+    }
+    assert_true(q[0] > q[1]);
+    amfi_solver_destroy(s);
+}
+
+static void rejects_bad_events(void **state)
+{
+    (void)state;
+    event ev;
+    memset(&ev, 0, sizeof ev);
+    add_vehicle(&ev, 0.0, 2, sp2, f2);
+    add_vehicle(&ev, 0.5, 2, sp2, f2b);
+    ev.na = 0;
+    record(&ev, 1, 0.0);
+    amfi_solver *s = make_solver(1, 2, AMFI_COORDS_MODAL);
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    amfi_multi_result r;
+    char err[256];
+    amfi_multi_passage p = ev.p;
+    p.n_vehicles = 0;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
+    p = ev.p;
+    p.vehicle[1].speed_mps = 0.0;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
+    assert_non_null(strstr(err, "vehicle 2"));
+    p = ev.p;
+    p.vehicle[0].axle_spacing_m[0] = -1.0;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
+    p = ev.p;
+    p.vehicle[1].entry_s = NAN;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
+    /* more axles in all than AMFI_MAX_AXLES */
+    p = ev.p;
+    p.vehicle[1].n_axles = AMFI_MAX_AXLES - 1;
+    for (int a = 0; a < AMFI_MAX_AXLES - 2; a++)
+        p.vehicle[1].axle_spacing_m[a] = 1.2;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
+    assert_non_null(strstr(err, "axles in all"));
+    /* the second vehicle leaving after the data ends */
+    p = ev.p;
+    p.vehicle[1].entry_s = 0.9;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_ERANGE);
+    p = ev.p;
+    p.n_vehicles = AMFI_MAX_VEHICLES + 1;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
+    /* a refused event leaves the solver usable */
+    assert_int_equal(amfi_solve_multi(s, &ev.p, &lam, &r, err, sizeof err), 0);
+    amfi_solver_destroy(s);
+    event_free(&ev);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(single_equals_solve),
+        cmocka_unit_test(two_vehicles_one_sensor),
+        cmocka_unit_test(three_vehicles_three_sensors),
+        cmocka_unit_test(quality_ranks_close_axles),
+        cmocka_unit_test(rejects_bad_events),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
