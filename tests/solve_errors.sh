@@ -134,5 +134,26 @@ run bad_config 1 "^$tmp/nope.yaml" --config "$tmp/nope.yaml" --accel "$good" --s
 # shellcheck disable=SC2086
 run forces_unwritable 1 "--forces" $config --accel "$good" --speed 25 --axle-spacing 4 --entry-time 0.5 --forces "$tmp/no/such/dir/f.csv"
 
+# --vehicle ENTRY_S:SPEED_MPS:S1[,S2,...] (several vehicles solved jointly)
+for v in "0:25" "0:25:" "x:25:4" "0:0:4" "0:99:4" "0:25:4,,3" "0:25:-1" "::4"; do
+    # shellcheck disable=SC2086
+    run "vehicle_$v" 2 "--vehicle" $config --accel "$good" --vehicle "$v"
+done
+# shellcheck disable=SC2086
+run vehicle_and_speed 2 "--vehicle: not with" $config --accel "$good" --vehicle 0:25:4 --speed 25
+# shellcheck disable=SC2086
+run vehicle_and_entry 2 "--vehicle: not with" $config --accel "$good" --vehicle 0:25:4 --entry-time 0
+# shellcheck disable=SC2086
+run vehicle_too_many 2 "--vehicle: more than 8" $config --accel "$good" --vehicle 0:25:4 \
+    --vehicle 0:25:4 --vehicle 0:25:4 --vehicle 0:25:4 --vehicle 0:25:4 --vehicle 0:25:4 \
+    --vehicle 0:25:4 --vehicle 0:25:4 --vehicle 0:25:4
+# shellcheck disable=SC2086
+run vehicle_axles 2 "--vehicle: 13 axles in all" $config --accel "$good" \
+    --vehicle 0:25:1,1,1,1,1,1 --vehicle 0.2:25:1,1,1,1,1
+# the second vehicle leaves after the data ends (2 s of data)
+f=$(csv two_s.csv 2000)
+# shellcheck disable=SC2086
+run vehicle_not_covered 1 "passage not covered" $config --accel "$f" --vehicle 0:25:4 --vehicle 1.5:25:4
+
 echo "solve_errors: $cases cases, $failures failed"
 [ "$failures" -eq 0 ]

@@ -4,6 +4,8 @@
  *
  *   amfi-solve [--config FILE.yaml] --accel CASE.csv[.gz] --speed MPS
  *              --axle-spacing S1[,S2,...] [--entry-time SEC]
+ *   amfi-solve ... --vehicle ENTRY_S:SPEED_MPS:S1[,S2,...] (repeated, one per
+ *              vehicle on the span, solved jointly; instead of the three above)
  *              [--lambda auto|VALUE] [--formulation NAME]
  *              [--forces OUT.csv] [--lcurve OUT.csv]
  *              [--estimate-speed [--speed-sd FRACTION]]
@@ -64,6 +66,9 @@ typedef struct options {
     double entry_time_s;     /* time of entry on the file's clock, s */
     int n_spacings;          /* 1 .. AMFI_MAX_AXLES − 1, 0 until given */
     double spacing_m[AMFI_MAX_AXLES];
+    int entry_given;         /* --entry-time seen (not with --vehicle) */
+    int n_vehicles;          /* --vehicle count, 0: the one-vehicle form */
+    amfi_vehicle vehicle[AMFI_MAX_VEHICLES]; /* entry on the file's clock */
 } options;
 
 static void usage(FILE *f)
@@ -76,6 +81,8 @@ static void usage(FILE *f)
             "[--formulation NAME]\n"
             "       [--forces OUT.csv] [--lcurve OUT.csv]\n"
             "       [--estimate-speed [--speed-sd FRACTION]]\n"
+            "   or: " PROG " ... --vehicle ENTRY_S:SPEED_MPS:S1[,S2,...] "
+            "[--vehicle ...] (instead of --speed/--axle-spacing/--entry-time)\n"
             "\n"
             "Solves one recorded passage (CSV 't,accel', plain or gzip) "
             "and prints a JSON line.\n"
@@ -89,6 +96,9 @@ static void usage(FILE *f)
             "(0 < s <= %g)\n"
             "  -e, --entry-time SEC     time on the file's clock when the first "
             "axle enters (default 0)\n"
+            "  -v, --vehicle E:V:S      a vehicle entering at E s (file's clock) at V m/s\n"
+            "                           with axle spacings S (as -x); repeat for each\n"
+            "                           vehicle on the span: all are solved jointly\n"
             "  -l, --lambda L           'auto' (L-curve) or lambda at the config's "
             "lambda reference rate\n"
             "  -f, --formulation F      solver formulation (default: the config's)\n"
@@ -107,12 +117,12 @@ static void usage(FILE *f)
 /* "amfi-solve: OPT: problem" on stderr; returns −1 */
 #define usage_error(opt, ...) (amfi_cli_error(PROG, opt, __VA_ARGS__), -1)
 
-static int parse_spacings(const char *arg, options *o)
+/* Comma-separated axle spacings into out[] (*n of them), for option opt. */
+static int parse_spacings(const char *arg, const char *opt, double *out, int *n_out)
 {
-    const char *opt = "--axle-spacing";
     char buf[64];
     const char *p = arg;
-    o->n_spacings = 0;
+    *n_out = 0;
     for (;;) {
         const char *comma = strchr(p, ',');
         size_t n = comma ? (size_t)(comma - p) : strlen(p);
@@ -122,7 +132,7 @@ static int parse_spacings(const char *arg, options *o)
             return usage_error(opt, "value too long in '%s'", amfi_cli_shown(arg));
         memcpy(buf, p, n);
         buf[n] = '\0';
-        if (o->n_spacings == AMFI_MAX_AXLES - 1)
+        if (*n_out == AMFI_MAX_AXLES - 1)
             return usage_error(opt, "more than %d spacings (at most %d axles)",
                                AMFI_MAX_AXLES - 1, AMFI_MAX_AXLES);
         double s;
@@ -133,11 +143,62 @@ static int parse_spacings(const char *arg, options *o)
         if (s > MAX_SPACING_M)
             return usage_error(opt, "'%s' m is not an axle spacing (max %g m)",
                                amfi_cli_shown(buf), MAX_SPACING_M);
-        o->spacing_m[o->n_spacings++] = s;
+        out[(*n_out)++] = s;
         if (!comma)
             return 0;
         p = comma + 1;
     }
+}
+
+static int check_speed(const char *opt, const char *val, double *out)
+{
+    double x;
+    if (amfi_cli_double(val, &x) != 0)
+        return usage_error(opt, "'%s' is not a number", amfi_cli_shown(val));
+    if (!(x > 0))
+        return usage_error(opt, "'%s' must be > 0 m/s", amfi_cli_shown(val));
+    if (x > MAX_SPEED_MPS)
+        return usage_error(opt, "'%s' m/s is absurd for road traffic "
+                           "(max %g m/s)", amfi_cli_shown(val), MAX_SPEED_MPS);
+    *out = x;
+    return 0;
+}
+
+/* --vehicle ENTRY_S:SPEED_MPS:S1[,S2,...] */
+static int parse_vehicle(const char *arg, options *o)
+{
+    const char *opt = "--vehicle";
+    if (o->n_vehicles == AMFI_MAX_VEHICLES)
+        return usage_error(opt, "more than %d vehicles", AMFI_MAX_VEHICLES);
+    const char *c1 = strchr(arg, ':'), *c2 = c1 ? strchr(c1 + 1, ':') : NULL;
+    if (!c1 || !c2)
+        return usage_error(opt, "'%s' is not ENTRY_S:SPEED_MPS:S1[,S2,...]",
+                           amfi_cli_shown(arg));
+    char buf[64];
+    amfi_vehicle *v = &o->vehicle[o->n_vehicles];
+    memset(v, 0, sizeof *v);
+    size_t n = (size_t)(c1 - arg);
+    if (n == 0 || n >= sizeof buf)
+        return usage_error(opt, "bad entry time in '%s'", amfi_cli_shown(arg));
+    memcpy(buf, arg, n);
+    buf[n] = '\0';
+    if (amfi_cli_double(buf, &v->entry_s) != 0)
+        return usage_error(opt, "entry time '%s' is not a number", amfi_cli_shown(buf));
+    n = (size_t)(c2 - c1 - 1);
+    if (n == 0 || n >= sizeof buf)
+        return usage_error(opt, "bad speed in '%s'", amfi_cli_shown(arg));
+    memcpy(buf, c1 + 1, n);
+    buf[n] = '\0';
+    if (check_speed(opt, buf, &v->speed_mps) != 0)
+        return -1;
+    int ns = 0;
+    if (c2[1] == '\0')
+        return usage_error(opt, "no axle spacings in '%s'", amfi_cli_shown(arg));
+    if (parse_spacings(c2 + 1, opt, v->axle_spacing_m, &ns) != 0)
+        return -1;
+    v->n_axles = ns + 1;
+    o->n_vehicles++;
+    return 0;
 }
 
 /* Options take a value, as "--name VALUE", "--name=VALUE" or "-n VALUE". */
@@ -155,6 +216,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"lcurve", required_argument, NULL, 'L'},
         {"estimate-speed", no_argument, NULL, 'E'},
         {"speed-sd", required_argument, NULL, 'S'},
+        {"vehicle", required_argument, NULL, 'v'},
         AMFI_CLI_END};
     memset(o, 0, sizeof *o);
     o->speed_mps = NAN;
@@ -174,23 +236,22 @@ static int parse_args(int argc, char **argv, options *o)
         case 'c': o->config = val; break;
         case 'a': o->accel = val; break;
         case 's':
-            if (amfi_cli_double(val, &x) != 0)
-                return usage_error(opt, "'%s' is not a number", amfi_cli_shown(val));
-            if (!(x > 0))
-                return usage_error(opt, "'%s' must be > 0 m/s", amfi_cli_shown(val));
-            if (x > MAX_SPEED_MPS)
-                return usage_error(opt, "'%s' m/s is absurd for road traffic "
-                                   "(max %g m/s)", amfi_cli_shown(val), MAX_SPEED_MPS);
-            o->speed_mps = x;
+            if (check_speed(opt, val, &o->speed_mps) != 0)
+                return -1;
             break;
         case 'x':
-            if (parse_spacings(val, o) != 0)
+            if (parse_spacings(val, opt, o->spacing_m, &o->n_spacings) != 0)
+                return -1;
+            break;
+        case 'v':
+            if (parse_vehicle(val, o) != 0)
                 return -1;
             break;
         case 'e':
             if (amfi_cli_double(val, &x) != 0)
                 return usage_error(opt, "'%s' is not a number", amfi_cli_shown(val));
             o->entry_time_s = x;
+            o->entry_given = 1;
             break;
         case 'l':
             if (strcmp(val, "auto") != 0
@@ -212,8 +273,20 @@ static int parse_args(int argc, char **argv, options *o)
     }
     if (!o->accel)
         return usage_error("--accel", "missing (see --help)");
+    if (o->n_vehicles > 0) {
+        if (!isnan(o->speed_mps) || o->n_spacings > 0 || o->entry_given)
+            return usage_error("--vehicle", "not with --speed, --axle-spacing or "
+                               "--entry-time (give each vehicle's in --vehicle)");
+        int total = 0;
+        for (int v = 0; v < o->n_vehicles; v++)
+            total += o->vehicle[v].n_axles;
+        if (total > AMFI_MAX_AXLES)
+            return usage_error("--vehicle", "%d axles in all (at most %d)", total,
+                               AMFI_MAX_AXLES);
+        return 0;
+    }
     if (isnan(o->speed_mps))
-        return usage_error("--speed", "missing (see --help)");
+        return usage_error("--speed", "missing (see --help, or give --vehicle)");
     if (o->n_spacings == 0)
         return usage_error("--axle-spacing", "missing (see --help)");
     return 0;
@@ -277,9 +350,10 @@ static FILE *open_out(const char *what, const char *path)
     return f;
 }
 
-/* One row per step j = 0 .. N: t relative to entry, x of axle 1, forces. */
+/* One row per step j = 0 .. N: t relative to entry (with --vehicle: on the
+ * file's clock), x of axle 1 (first vehicle's, entering at entry_s), forces. */
 static int write_forces(const char *path, const amfi_result *r,
-                        double speed_mps)
+                        double speed_mps, double entry_s)
 {
     FILE *f = open_out("--forces", path);
     if (!f)
@@ -292,7 +366,7 @@ static int write_forces(const char *path, const amfi_result *r,
         double t = r->t0_s + j * r->h_s;
         csv_num(f, t);
         fputc(',', f);
-        csv_num(f, speed_mps * t);
+        csv_num(f, speed_mps * (t - entry_s));
         for (int a = 0; a < r->n_axles; a++) {
             fputc(',', f);
             csv_num(f, r->force_N[(size_t)j * (size_t)r->n_axles + (size_t)a]);
@@ -323,8 +397,8 @@ static int write_lcurve(const char *path, const amfi_result *r)
 
 /* The result as one JSON line on stdout (common/amfi_json.h). */
 static int print_json(const amfi_site_config *c, const amfi_result *r,
-                      const amfi_speed_result *sr, int estimated, double scan_rate_hz,
-                      double solve_ms)
+                      const amfi_speed_result *sr, int estimated,
+                      const amfi_multi_result *m, double scan_rate_hz, double solve_ms)
 {
     json_t *axle = json_array(), *force = json_array();
     for (int a = 0; a < r->n_axles; a++) {
@@ -349,6 +423,20 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
               json_object_set_new(o, "n_solves", json_integer(r->n_solves)))) {
         json_decref(o);
         o = NULL;
+    }
+    if (o && m) { /* --vehicle: one object per vehicle, in the order given */
+        json_t *vs = json_array();
+        for (int v = 0; v < m->n_vehicles; v++) {
+            const amfi_vehicle_result *vr = &m->vehicle[v];
+            json_t *ak = json_array();
+            for (int a = 0; a < vr->n_axles; a++)
+                json_array_append_new(ak, amfi_json_num(vr->axle_kg[a]));
+            json_array_append_new(
+                vs, json_pack("{s:o, s:o, s:o, s:o}", "gvw_kg", amfi_json_num(vr->gvw_kg),
+                              "axle_kg", ak, "quality", amfi_json_num(vr->quality),
+                              "gvw_sd_kg", amfi_json_num(vr->gvw_sd_kg)));
+        }
+        json_object_set_new(o, "vehicles", vs);
     }
     return amfi_json_print(stdout, o);
 }
@@ -382,6 +470,14 @@ int main(int argc, char **argv)
         fprintf(stderr, PROG ": --lcurve needs --lambda auto\n");
         return EXIT_USAGE;
     }
+    if (o.n_vehicles > 0) {
+        if (o.estimate_speed || !isnan(o.speed_sd)) {
+            fprintf(stderr, PROG ": --vehicle: not with --estimate-speed or --speed-sd "
+                            "(the joint solve takes the given speeds)\n");
+            return EXIT_USAGE;
+        }
+        cfg.speed_estimate = 0; /* a configured estimate applies to one vehicle */
+    }
     if (o.estimate_speed)
         cfg.speed_estimate = 1;
     if (!isnan(o.speed_sd)) {
@@ -402,11 +498,26 @@ int main(int argc, char **argv)
 
     int n_axles = o.n_spacings + 1;
     /* the window, relative to entry (amfi.h: entry − pre_roll .. last exit
-     * + post_roll) */
-    const amfi_passage_times win =
-        amfi_passage_window(cfg.bridge.span_m, o.speed_mps, n_axles, o.spacing_m,
-                            cfg.solver.pre_roll_s, cfg.solver.post_roll_s);
-    const double crossing_s = win.on_span_s;
+     * + post_roll); with --vehicle, first entry .. last exit on the file's clock */
+    amfi_multi_passage mp;
+    memset(&mp, 0, sizeof mp);
+    amfi_passage_times win;
+    double crossing_s;
+    if (o.n_vehicles > 0) {
+        mp.n_vehicles = o.n_vehicles;
+        n_axles = 0;
+        for (int v = 0; v < o.n_vehicles; v++) {
+            mp.vehicle[v] = o.vehicle[v];
+            n_axles += o.vehicle[v].n_axles;
+        }
+        win = amfi_multi_window(cfg.bridge.span_m, &mp, cfg.solver.pre_roll_s,
+                                cfg.solver.post_roll_s);
+        crossing_s = win.on_span_s - (win.start_s + cfg.solver.pre_roll_s);
+    } else {
+        win = amfi_passage_window(cfg.bridge.span_m, o.speed_mps, n_axles, o.spacing_m,
+                                  cfg.solver.pre_roll_s, cfg.solver.post_roll_s);
+        crossing_s = win.on_span_s;
+    }
     const double win_lo = win.start_s; /* never "-0" */
     const double win_hi = win.end_s;
 
@@ -452,19 +563,32 @@ int main(int argc, char **argv)
     for (int k = 0; k < o.n_spacings; k++)
         p.axle_spacing_m[k] = o.spacing_m[k];
 
+    mp.n_samples = csv.n;
+    mp.scan_rate_hz = csv.rate_hz;
+    mp.t_first_s = csv.t0_s;
+    mp.accel[0] = csv.accel;
+
     amfi_result res;
     memset(&res, 0, sizeof res);
     amfi_speed_result sres;
     memset(&sres, 0, sizeof sres);
-    sres.speed_mps = sres.speed_given_mps = o.speed_mps;
+    sres.speed_mps = sres.speed_given_mps =
+        o.n_vehicles > 0 ? o.vehicle[0].speed_mps : o.speed_mps;
+    static amfi_multi_result mres;
     struct timespec t_a, t_b;
     clock_gettime(CLOCK_MONOTONIC, &t_a);
-    int rc = cfg.speed_estimate ? amfi_solve_speed(solver, &p, &cfg.lambda, &cfg.speed_prior,
+    int rc;
+    if (o.n_vehicles > 0) {
+        rc = amfi_solve_multi(solver, &mp, &cfg.lambda, &mres, err, sizeof err);
+        res = mres.all;
+    } else {
+        rc = cfg.speed_estimate ? amfi_solve_speed(solver, &p, &cfg.lambda, &cfg.speed_prior,
                                                    &res, &sres, err, sizeof err)
                                 : amfi_solve(solver, &p, &cfg.lambda, &res, err, sizeof err);
+    }
     clock_gettime(CLOCK_MONOTONIC, &t_b);
     if (rc == AMFI_ERANGE) {
-        double lo = p.t_first_s;
+        double lo = o.n_vehicles > 0 ? mp.t_first_s : p.t_first_s;
         double hi = lo + (double)(csv.n - 1) / csv.rate_hz;
         fprintf(stderr,
                 "%s: passage not covered: the data spans [%.6g, %.6g] s but "
@@ -477,11 +601,14 @@ int main(int argc, char **argv)
                 err[0] ? err : amfi_strerror(rc));
         goto done;
     }
-    if (o.forces && write_forces(o.forces, &res, sres.speed_mps) != 0)
+    if (o.forces &&
+        write_forces(o.forces, &res, sres.speed_mps,
+                     o.n_vehicles ? o.vehicle[0].entry_s : 0.0) != 0)
         goto done;
     if (o.lcurve && write_lcurve(o.lcurve, &res) != 0)
         goto done;
-    if (print_json(&cfg, &res, &sres, cfg.speed_estimate, csv.rate_hz,
+    if (print_json(&cfg, &res, &sres, cfg.speed_estimate, o.n_vehicles ? &mres : NULL,
+                   csv.rate_hz,
                    elapsed_ms(&t_a, &t_b)) != 0
         || fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, PROG ": stdout: %s\n", strerror(errno));

@@ -1,0 +1,64 @@
+#!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
+# solve_multi.sh: amfi-solve --vehicle (several vehicles solved jointly).
+# Two two-axle vehicles at 25 m/s, the second entering 0.5 s after the first
+# (12.5 m behind), are the same axle trajectories as one four-axle vehicle
+# with spacings 5, 7.5, 4: amfi-mkcase writes that case, and the joint solve
+# must give the one-vehicle solve's numbers exactly, plus each vehicle's GVW
+# (truth 18000 and 15000 kg) within 1 % and a quality figure >= 1, in the
+# order the vehicles were given.
+#
+# usage: solve_multi.sh AMFI_SOLVE AMFI_MKCASE CONFIG_DIR
+set -u
+solve=${1:?usage: solve_multi.sh AMFI_SOLVE AMFI_MKCASE CONFIG_DIR}
+mkcase=${2:?usage}
+confdir=${3:?usage}
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/solve_multi.XXXXXX") || exit 1
+trap 'rm -rf "$tmp"' EXIT INT TERM
+fail() { echo "FAIL: $*"; exit 1; }
+config="--config $confdir/paper-20m.yaml"
+[ -f "$confdir/paper-20m.yaml" ] || fail "$confdir/paper-20m.yaml missing"
+
+# shellcheck disable=SC2086
+"$mkcase" $config --out "$tmp/two.csv" --speed 25 --axle-loads-kg 10400,7600,9000,6000 \
+    --axle-spacing 5,7.5,4 --pre 0.5 --post 0.5 --scan-rate 1000 > "$tmp/truth" ||
+    fail "amfi-mkcase: exit $?"
+# shellcheck disable=SC2086
+"$solve" $config --accel "$tmp/two.csv" --speed 25 --axle-spacing 5,7.5,4 \
+    --entry-time 0.5 > "$tmp/one.json" || fail "one-vehicle solve: exit $?"
+# shellcheck disable=SC2086
+"$solve" $config --accel "$tmp/two.csv" --vehicle 0.5:25:5 --vehicle 1.0:25:4 \
+    > "$tmp/joint.json" || fail "joint solve: exit $?"
+# shellcheck disable=SC2086
+"$solve" $config --accel "$tmp/two.csv" --vehicle 1.0:25:4 --vehicle 0.5:25:5 \
+    > "$tmp/reversed.json" || fail "reversed joint solve: exit $?"
+echo "one:      $(cat "$tmp/one.json")"
+echo "joint:    $(cat "$tmp/joint.json")"
+echo "reversed: $(cat "$tmp/reversed.json")"
+
+# the keys before solve_ms (the timing) are the same numbers
+head_of() { sed 's/,"solve_ms".*//' "$1"; }
+[ "$(head_of "$tmp/one.json")" = "$(head_of "$tmp/joint.json")" ] ||
+    fail "the joint solve differs from the one-vehicle solve of the same axles"
+
+# "vehicles":[{"gvw_kg":G,...,"quality":Q,...},{...}] -> "G Q" per line
+vehicles() {
+    sed 's/.*"vehicles":\[//' "$1" | tr '}' '\n' |
+        sed -n 's/.*"gvw_kg":\([^,]*\),.*"quality":\([^,]*\),.*/\1 \2/p'
+}
+check() { # FILE TRUTH1 TRUTH2
+    vehicles "$1" | awk -v t1="$2" -v t2="$3" '
+        { n++; g[n] = $1; q[n] = $2 }
+        END {
+            if (n != 2) { print "expected 2 vehicles, got " n; exit 1 }
+            t[1] = t1; t[2] = t2
+            for (i = 1; i <= 2; i++) {
+                e = g[i] / t[i] - 1
+                if (e < -0.01 || e > 0.01) { printf "vehicle %d: GVW %g vs %g\n", i, g[i], t[i]; exit 1 }
+                if (!(q[i] >= 1)) { printf "vehicle %d: quality %s < 1\n", i, q[i]; exit 1 }
+            }
+        }' || fail "$1"
+}
+check "$tmp/joint.json" 18000 15000
+check "$tmp/reversed.json" 15000 18000
+echo "solve_multi: ok"
