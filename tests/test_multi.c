@@ -17,24 +17,7 @@
 #include <cmocka.h>
 
 #include "amfi/amfi.h"
-
-static amfi_bridge *bridge; /* paper-20m, shared by all tests */
-
-static int setup(void **state)
-{
-    (void)state;
-    amfi_bridge_params p;
-    char err[256];
-    amfi_bridge_params_paper20(&p);
-    return amfi_bridge_create(&p, &bridge, err, sizeof err);
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    amfi_bridge_destroy(bridge);
-    return 0;
-}
+#include "paper20_fixture.h"
 
 #define SPEED 25.0 /* every vehicle (the forward integrator has one speed) */
 #define RATE 1000.0
