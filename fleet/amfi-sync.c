@@ -11,7 +11,6 @@
  * (ids going backwards, or a different row at a shipped id) is refused. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
-#include <getopt.h>
 #include <inttypes.h>
 #include <libpq-fe.h>
 #include <signal.h>
@@ -23,6 +22,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <systemd/sd-daemon.h>
+
+#include "amfi_cli.h"
+#include "amfi_config.h"
 #include "fleet_schema.h"
 
 enum { BATCH_ROWS = 5000, SITE_ID_MAX = 63 };
@@ -118,6 +121,27 @@ static uint64_t row_hash(sqlite3_stmt *st)
     return h;
 }
 
+/* Watchdog pings while a long first sync ships batch after batch, and while
+ * follow mode sleeps: at most every half watchdog period (none when systemd
+ * set no watchdog). */
+static uint64_t wd_usec;
+static double wd_last;
+static double mono_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+static void keepalive(void)
+{
+    if (!wd_usec) return;
+    double now = mono_s();
+    if (now - wd_last >= 0.5e-6 * (double)wd_usec) {
+        sd_notify(0, "WATCHDOG=1");
+        wd_last = now;
+    }
+}
+
 static int pg_ok(PGresult *r, const char *what)
 {
     ExecStatusType s = PQresultStatus(r);
@@ -164,16 +188,6 @@ static int apply_schema(PGconn *pg)
     return pg_exec(pg, "COMMIT", "COMMIT") ? EX_RETRY : 0;
 }
 
-static int valid_site_id(const char *s)
-{
-    size_t n = strlen(s);
-    if (n < 1 || n > SITE_ID_MAX) return 0;
-    for (; *s; s++)
-        if (!((*s >= 'A' && *s <= 'Z') || (*s >= 'a' && *s <= 'z') || (*s >= '0' && *s <= '9')
-              || *s == '_' || *s == '.' || *s == '-'))
-            return 0;
-    return 1;
-}
 
 /* COPY the rows of one SELECT into table dst with the site id in front. */
 static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst, const char *cols,
@@ -294,6 +308,7 @@ static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const struct ta
         hwm = last;
         hash = lh;
         *total += n + nc;
+        keepalive();
     }
 }
 
@@ -343,7 +358,12 @@ static int store_site_id(sqlite3 *db, char out[SITE_ID_MAX + 1])
 }
 
 /* One pass: connect, migrate, check, ship every table. */
-static int sync_once(const char *conninfo, const char *store, const char *site_opt, int init_only, int quiet)
+/* One pass: connect, create or migrate the central schema, check and ship
+ * every table. site_opt: the site id the caller expects (site_src names
+ * where it came from, for the messages); *shipped (if not NULL) gets the
+ * rows shipped. Returns 0 or an EX_ code. */
+static int sync_once(const char *conninfo, const char *store, const char *site_opt,
+                     const char *site_src, int init_only, int quiet, long *shipped)
 {
     PGconn *pg = PQconnectdb(conninfo);
     if (PQstatus(pg) != CONNECTION_OK) {
@@ -377,11 +397,12 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         }
         snprintf(site, sizeof site, "%s", site_opt);
     } else if (site_opt && strcmp(site, site_opt) != 0) {
-        fprintf(stderr, "amfi-sync: %s: meta 'site.id' is '%s' but --site gives '%s'\n", store, site, site_opt);
+        fprintf(stderr, "amfi-sync: %s: the store belongs to site '%s' (meta 'site.id') but %s gives '%s'\n",
+                store, site, site_src, site_opt);
         rc = EX_USAGE;
         goto out;
     }
-    if (!valid_site_id(site)) {
+    if (!amfi_site_id_valid(site)) {
         fprintf(stderr, "amfi-sync: site id '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n", site);
         rc = EX_USAGE;
         goto out;
@@ -396,6 +417,7 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
     for (int i = 0; !rc && i < N_TABLES && !stop_requested; i++)
         rc = sync_table(pg, db, site, &tables[i], 0, &total);
     sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
+    if (shipped) *shipped = total;
     if (!rc && !quiet && total > 0)
         fprintf(stderr, "amfi-sync: site '%s': %ld rows shipped to %s/%s\n", site, total, PQhost(pg), PQdb(pg));
 out:
@@ -407,50 +429,78 @@ out:
 static void usage(FILE *f)
 {
     fputs("usage: amfi-sync --pg CONNINFO --init-schema\n"
-          "       amfi-sync --db STORE --pg CONNINFO [--site ID] [--once] [--interval S] [--quiet]\n"
-          "Ships the site store's new rows to the central PostgreSQL (docs/fleet.md).\n"
-          "CONNINFO is a libpq connection string ('service=amfi', 'host=... dbname=...');\n"
-          "PG* environment variables, ~/.pg_service.conf and ~/.pgpass apply.\n"
-          "Exit: 0 done, 1 server or store unavailable, 2 usage, 3 store refused (restored backup).\n",
+          "       amfi-sync [--config FILE] [--db STORE] --pg CONNINFO [--site ID] [--once]\n"
+          "                 [--interval S] [--quiet]\n"
+          "Ships the site store's new rows to the central PostgreSQL (amfi-sync(1),\n"
+          "docs/fleet.md). --config: amfid's YAML (store path and site.id from it;\n"
+          "--db and --site win). CONNINFO is a libpq connection string ('service=amfi',\n"
+          "'host=... dbname=...'); PG* environment variables, ~/.pg_service.conf and\n"
+          "~/.pgpass apply. Exit: 0 done, 1 server or store unavailable, 2 usage or\n"
+          "configuration, 3 store refused (restored backup, other site).\n",
           f);
+}
+
+/* Sleeps s seconds or until a stop is asked, pinging the watchdog. */
+static void pause_s(double s)
+{
+    double end = mono_s() + s;
+    while (!stop_requested) {
+        double left = end - mono_s();
+        if (left <= 0) break;
+        if (wd_usec && left > 0.25e-6 * (double)wd_usec) left = 0.25e-6 * (double)wd_usec;
+        struct timespec ts = {(time_t)left, (long)((left - (double)(time_t)left) * 1e9)};
+        nanosleep(&ts, NULL); /* EINTR: the loop looks at stop_requested */
+        keepalive();
+    }
 }
 
 int main(int argc, char **argv)
 {
-    const char *store = NULL, *conninfo = NULL, *site = NULL;
+    const char *store = NULL, *conninfo = NULL, *site = NULL, *config = NULL;
     int once = 0, init = 0, quiet = 0;
     double interval = 10;
+    enum { O_INIT = 256, O_ONCE, O_INTERVAL };
     static const struct option opts[] = {
         {"db", required_argument, NULL, 'd'},   {"pg", required_argument, NULL, 'p'},
-        {"site", required_argument, NULL, 's'}, {"once", no_argument, NULL, 'o'},
-        {"init-schema", no_argument, NULL, 'I'}, {"interval", required_argument, NULL, 'i'},
-        {"quiet", no_argument, NULL, 'q'},      {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
-    int c;
-    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
-        switch (c) {
+        {"site", required_argument, NULL, 's'}, {"config", required_argument, NULL, 'c'},
+        {"once", no_argument, NULL, O_ONCE},    {"init-schema", no_argument, NULL, O_INIT},
+        {"interval", required_argument, NULL, O_INTERVAL},
+        {"quiet", no_argument, NULL, 'q'},      AMFI_CLI_END};
+    amfi_cli c;
+    amfi_cli_init(&c, "amfi-sync", argc, argv, opts, usage);
+    for (int k; (k = amfi_cli_next(&c)) != -1;) {
+        switch (k) {
         case 'd': store = optarg; break;
         case 'p': conninfo = optarg; break;
         case 's': site = optarg; break;
-        case 'o': once = 1; break;
-        case 'I': init = 1; break;
+        case 'c': config = optarg; break;
+        case O_ONCE: once = 1; break;
+        case O_INIT: init = 1; break;
         case 'q': quiet = 1; break;
-        case 'i': {
-            char *end;
-            errno = 0;
-            interval = strtod(optarg, &end);
-            if (errno || *end || !(interval >= 0.1 && interval <= 86400)) {
-                fprintf(stderr, "amfi-sync: --interval: '%s' is not a number of seconds in 0.1..86400\n", optarg);
-                return EX_USAGE;
-            }
-            break;
-        }
-        case 'h': usage(stdout); return 0;
+        case O_INTERVAL: interval = amfi_cli_num(&c, optarg, 0.1, 86400); break;
         default: usage(stderr); return EX_USAGE;
         }
     }
-    if (optind < argc || !conninfo || (!init && !store)) { usage(stderr); return EX_USAGE; }
-    if (site && !valid_site_id(site)) {
+    /* amfid's configuration: the store it writes and the site it claims.
+     * Explicit options win; the store's own meta is checked against the
+     * site id in sync_once (a different one is refused). */
+    static amfi_site_config cfg;
+    if (config) {
+        char err[1024];
+        if (amfi_config_load(config, &cfg, err, sizeof err) != 0) {
+            fprintf(stderr, "amfi-sync: %s\n", err);
+            return EX_USAGE;
+        }
+        if (!store) store = cfg.daemon.db_path[0] ? cfg.daemon.db_path : NULL;
+        if (!site && cfg.site.id[0]) site = cfg.site.id;
+    }
+    if (!conninfo || (!init && !store)) {
+        amfi_cli_error("amfi-sync", NULL, !conninfo ? "--pg CONNINFO is required"
+                                                    : "no store: give --db STORE or --config FILE");
+        usage(stderr);
+        return EX_USAGE;
+    }
+    if (site && !amfi_site_id_valid(site)) {
         fprintf(stderr, "amfi-sync: --site: '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n", site);
         return EX_USAGE;
     }
@@ -458,17 +508,33 @@ int main(int argc, char **argv)
     sa.sa_handler = on_signal;
     sigaction(SIGTERM, &sa, NULL);
     sigaction(SIGINT, &sa, NULL);
-    if (init || once) return sync_once(conninfo, store, site, init, quiet);
+    char site_src[600] = "--site";
+    if (site && site == cfg.site.id) snprintf(site_src, sizeof site_src, "%s: site.id", config);
+    if (init || once) return sync_once(conninfo, store, site, site_src, init, quiet, NULL);
     /* Follow mode: a pass every interval; capped exponential backoff while
-     * the server or the store is away; stops cleanly on SIGTERM. */
+     * the server or the store is away; stops cleanly on SIGTERM after the
+     * batch in flight. Under systemd (Type=notify): READY after the first
+     * pass, STATUS after each, WATCHDOG pings (keepalive). */
+    if (sd_watchdog_enabled(0, &wd_usec) <= 0) wd_usec = 0;
+    wd_last = mono_s();
     double backoff = 1;
+    int ready = 0, rc = 0;
     while (!stop_requested) {
-        int rc = sync_once(conninfo, store, site, 0, quiet);
-        if (rc == EX_REFUSED || rc == EX_USAGE) return rc;
+        long shipped = 0;
+        rc = sync_once(conninfo, store, site, site_src, 0, quiet, &shipped);
+        if (rc == EX_REFUSED || rc == EX_USAGE) {
+            sd_notifyf(0, "STATUS=refused: see the log (exit %d)", rc);
+            return rc;
+        }
         double wait = rc ? backoff : interval;
+        if (rc)
+            sd_notifyf(0, "STATUS=server or store unavailable, retry in %.0f s", wait);
+        else
+            sd_notifyf(0, "STATUS=%ld rows shipped in the last pass; next in %.0f s", shipped, wait);
+        if (!ready) { sd_notify(0, "READY=1"); ready = 1; }
         backoff = rc ? (backoff * 2 > 60 ? 60 : backoff * 2) : 1;
-        struct timespec ts = {(time_t)wait, (long)((wait - (double)(time_t)wait) * 1e9)};
-        while (!stop_requested && nanosleep(&ts, &ts) == -1 && errno == EINTR) {}
+        pause_s(wait);
     }
+    sd_notify(0, "STOPPING=1");
     return 0;
 }

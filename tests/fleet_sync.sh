@@ -5,9 +5,12 @@
 # amfi-sync 20 times at random moments; the server stopped and restarted while
 # amfi-sync follows; a store restored from an older backup refused. After each
 # case the central counts equal the sites', with no duplicate and no gap.
-# Usage: fleet_sync.sh AMFI_SYNC SCHEMA_MD. Exit 77 without sqlite3/PostgreSQL.
+# Then --config (amfid's YAML: store and site from it) and follow mode under a
+# stand-in systemd notification socket (READY, STATUS, WATCHDOG, STOPPING).
+# Usage: fleet_sync.sh AMFI_SYNC SCHEMA_MD NOTIFY_LISTEN. Exit 77 without
+# sqlite3/PostgreSQL.
 set -u
-sync=$1 doc=$2
+sync=$1 doc=$2 listen=$3
 command -v sqlite3 > /dev/null || { echo "fleet_sync.sh: no sqlite3: skipped"; exit 77; }
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/pg_server.sh"
@@ -156,6 +159,49 @@ same "$tmp/c.db" site-c
 case=usage
 "$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --site 'bad id' --once 2> /dev/null
 [ $? = 2 ] || fail "bad --site accepted"
+
+case=config
+# amfid's configuration names the store and the site: explicit options win,
+# a store of another site is refused, a bad file is named at its line.
+printf 'site:\n  id: site-a\ndaemon:\n  store:\n    path: %s\n' "$tmp/a.db" > "$tmp/a.yaml"
+add_rows "$tmp/a.db" 300
+"$sync" --config "$tmp/a.yaml" --pg "$PG_CONNINFO" --once --quiet || fail "--config: exit $?"
+same "$tmp/a.db" site-a
+printf 'site:\n  id: site-zz\ndaemon:\n  store:\n    path: %s\n' "$tmp/a.db" > "$tmp/zz.yaml"
+"$sync" --config "$tmp/zz.yaml" --pg "$PG_CONNINFO" --once 2> "$tmp/zz.log"
+rc=$?
+[ $rc = 2 ] || fail "a store of another site: exit $rc, expected 2"
+grep -q "belongs to site 'site-a'.*zz.yaml: site.id gives 'site-zz'" "$tmp/zz.log" ||
+    fail "message: $(cat "$tmp/zz.log")"
+"$sync" --config "$tmp/zz.yaml" --site site-a --pg "$PG_CONNINFO" --once --quiet ||
+    fail "--site does not win over the configuration"
+printf 'site:\n  id: site-a\n  idd: x\n' > "$tmp/bad.yaml"
+"$sync" --config "$tmp/bad.yaml" --pg "$PG_CONNINFO" --once 2> "$tmp/bad.log"
+rc=$?
+[ $rc = 2 ] || fail "bad configuration: exit $rc"
+grep -q "bad.yaml:3: site.idd: unknown key" "$tmp/bad.log" || fail "message: $(cat "$tmp/bad.log")"
+
+case=notify
+# Follow mode with a 0.4 s watchdog and a 30 s interval: READY after the
+# first pass, a STATUS line, watchdog pings while it sleeps, STOPPING after
+# SIGTERM, and the rows shipped.
+add_rows "$tmp/a.db" 200
+"$listen" "$tmp/notify.sock" 4 > "$tmp/notify.log" &
+l=$!
+sleep 0.3
+NOTIFY_SOCKET=$tmp/notify.sock WATCHDOG_USEC=400000 \
+    "$sync" --config "$tmp/a.yaml" --pg "$PG_CONNINFO" --interval 30 --quiet &
+f=$!
+sleep 2.5
+kill -TERM $f
+wait $f || fail "follow mode under systemd: exit $?"
+wait $l
+same "$tmp/a.db" site-a
+grep -q " READY=1$" "$tmp/notify.log" || fail "no READY=1: $(cat "$tmp/notify.log")"
+grep -q " STATUS=.*rows shipped" "$tmp/notify.log" || fail "no STATUS: $(cat "$tmp/notify.log")"
+grep -q " STOPPING=1$" "$tmp/notify.log" || fail "no STOPPING=1"
+pings=$(grep -c " WATCHDOG=1$" "$tmp/notify.log")
+[ "$pings" -ge 5 ] || fail "$pings watchdog pings in 2.5 s with a 0.4 s watchdog"
 
 [ $failures = 0 ] && echo "fleet_sync.sh: all cases pass"
 exit $((failures != 0))
