@@ -32,7 +32,7 @@ echo "installed files: ok"
 out=$("$stage$bindir/amfid" --check-config --config "$stage$sysconfdir/amfid/amfid.yaml" 2>&1) ||
   { echo "$out"; fail "installed amfid --check-config on the installed amfid.yaml"; }
 echo "installed amfid --check-config: ok"
-for p in amfid amfi-solve amfi-report sim_publisher amfi-mkcase amfi-bench amfi-population amfi-fleet-bench; do
+for p in amfid amfi-solve amfi-report sim_publisher amfi-mkcase amfi-bench amfi-population amfi-fleet-bench amfi-sync; do
   v=$("$stage$bindir/$p" --version 2>&1) || fail "installed $p --version exited non-zero"
   case "$v" in "$p "[0-9]*) ;; *) fail "installed $p --version said: $v" ;; esac
 done
@@ -45,15 +45,26 @@ grep -qx "ExecStart=$bindir/amfid --config $sysconfdir/amfid/amfid.yaml --db %S/
 for k in '^Type=notify$' '^WatchdogSec=' '^User=amfid$' '^StateDirectory=amfid$' '^Documentation=man:amfid(8)'; do
   grep -q "$k" "$unit" || fail "unit lacks $k"
 done
+# amfi-sync's unit: the installed binary on amfid's configuration and store,
+# the password only as a systemd credential (never in the unit).
+sunit=$stage$unitdir/amfi-sync.service
+grep -qx "ExecStart=$bindir/amfi-sync --config $sysconfdir/amfid/amfid.yaml --db %S/amfid/amfi.db --pg service=amfi --interval 60" "$sunit" ||
+  fail "amfi-sync.service ExecStart: $(grep ^ExecStart= "$sunit" 2>&1)"
+for k in '^Type=notify$' '^WatchdogSec=' '^User=amfid$' '^RestartPreventExitStatus=2 3$' \
+         "^LoadCredential=pgpass:$sysconfdir/amfid/pgpass$" '^Environment=PGPASSFILE=%d/pgpass$' \
+         '^Documentation=man:amfi-sync(1)'; do
+  grep -q "$k" "$sunit" || fail "amfi-sync.service lacks $k"
+done
+grep -v '^#' "$sunit" | grep -qi 'password=' && fail "amfi-sync.service holds a password"
 grep -q "^d $sysconfdir/amfid " "$stage$tmpfilesdir/amfid.conf" || fail "tmpfiles does not create $sysconfdir/amfid"
 grep -q '^u amfid ' "$stage$sysusersdir/amfid.conf" || fail "sysusers does not declare amfid"
 if command -v systemd-analyze >/dev/null && [ "$prefix" != /usr ] && [ "$prefix" != / ]; then
   # Mount the staged prefix over the real one, so the unit is checked exactly
   # as installed (the binary it starts, the man page it documents).
-  v=$(unshare --mount sh -c 'mount --bind "$1$2" "$2" && systemd-analyze verify "$3" 2>&1; echo "rc=$?"' \
-      verify "$stage" "$prefix" "$unit")
+  v=$(unshare --mount sh -c 'mount --bind "$1$2" "$2" && systemd-analyze verify "$3" "$4" 2>&1; echo "rc=$?"' \
+      verify "$stage" "$prefix" "$unit" "$sunit")
   [ "$v" = "rc=0" ] || { echo "$v"; fail "systemd-analyze verify of the installed unit"; }
-  echo "systemd-analyze verify (installed unit, staged prefix mounted on $prefix): ok"
+  echo "systemd-analyze verify (installed units, staged prefix mounted on $prefix): ok"
 else
   fail "cannot verify the unit: no systemd-analyze, or the prefix $prefix cannot be mounted over"
 fi
