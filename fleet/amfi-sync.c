@@ -165,14 +165,25 @@ enum { EX_RETRY = 1, EX_USAGE = 2, EX_REFUSED = 3 };
 static int apply_schema(PGconn *pg)
 {
     if (pg_exec(pg, "BEGIN", "BEGIN")) return EX_RETRY;
-    if (pg_exec(pg, "SELECT pg_advisory_xact_lock(1095583305)", "schema lock")
-        || pg_exec(pg, "CREATE TABLE IF NOT EXISTS fleet_migrations (version integer PRIMARY KEY, "
-                       "description text NOT NULL, applied_at timestamptz NOT NULL DEFAULT now())",
-                   "fleet_migrations")) {
+    if (pg_exec(pg, "SELECT pg_advisory_xact_lock(1095583305)", "schema lock")) {
         pg_exec(pg, "ROLLBACK", "ROLLBACK");
         return EX_RETRY;
     }
-    PGresult *r = PQexec(pg, "SELECT coalesce(max(version), 0) FROM fleet_migrations");
+    /* Look before creating: a writer role without CREATE on the schema
+     * (docs/fleet.md, Roles) must get past an up-to-date schema. */
+    PGresult *r = PQexec(pg, "SELECT to_regclass('fleet_migrations') IS NOT NULL");
+    int exists = !pg_ok(r, "schema lookup") && PQgetvalue(r, 0, 0)[0] == 't';
+    PQclear(r);
+    if (!exists
+        && pg_exec(pg, "CREATE TABLE fleet_migrations (version integer PRIMARY KEY, "
+                       "description text NOT NULL, applied_at timestamptz NOT NULL DEFAULT now())",
+                   "fleet_migrations")) {
+        fprintf(stderr, "amfi-sync: the central database has no amfi schema and this role cannot create "
+                        "it: run 'amfi-sync --init-schema' as the database owner (docs/fleet.md)\n");
+        pg_exec(pg, "ROLLBACK", "ROLLBACK");
+        return EX_RETRY;
+    }
+    r = PQexec(pg, "SELECT coalesce(max(version), 0) FROM fleet_migrations");
     if (pg_ok(r, "schema version")) { PQclear(r); pg_exec(pg, "ROLLBACK", "ROLLBACK"); return EX_RETRY; }
     int have = atoi(PQgetvalue(r, 0, 0));
     PQclear(r);
@@ -181,6 +192,9 @@ static int apply_schema(PGconn *pg)
         snprintf(ins, sizeof ins, "INSERT INTO fleet_migrations (version, description) VALUES (%d, '%s')",
                  fleet_migrations[i].version, fleet_migrations[i].description);
         if (pg_exec(pg, fleet_migrations[i].sql, "migration") || pg_exec(pg, ins, "migration record")) {
+            fprintf(stderr, "amfi-sync: the central schema is at version %d, this program needs %d: "
+                            "run 'amfi-sync --init-schema' as the database owner (docs/fleet.md)\n",
+                    have, fleet_n_migrations);
             pg_exec(pg, "ROLLBACK", "ROLLBACK");
             return EX_RETRY;
         }

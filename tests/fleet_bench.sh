@@ -29,6 +29,8 @@ n=$(pg_q "SELECT count(*) FROM passages") a=$(pg_q "SELECT count(*) FROM axles")
 [ "$n" = 1800 ] && [ "$a" = 3600 ] || { echo "FAIL: central passages $n axles $a, want 1800 3600"; failures=$((failures + 1)); }
 l=$(pg_q "SELECT count(*) FROM fleet_latest_state")
 [ "$l" = 3 ] || { echo "FAIL: fleet_latest_state has $l rows, want 3 (one per site)"; failures=$((failures + 1)); }
+o=$(pg_q "SELECT string_agg(site_id, ' ') FROM fleet_open_alerts")
+[ "$o" = bench-000 ] || { echo "FAIL: open alerts at '$o', want bench-000 (every tenth site)"; failures=$((failures + 1)); }
 d=$(pg_q "SELECT count(*) FROM fleet_daily_trend")
 [ "$d" = 6 ] || { echo "FAIL: fleet_daily_trend has $d rows, want 6"; failures=$((failures + 1)); }
 # a second bench run on the same stores (--keep) ships nothing new

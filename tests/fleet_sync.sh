@@ -7,10 +7,12 @@
 # case the central counts equal the sites', with no duplicate and no gap.
 # Then --config (amfid's YAML: store and site from it) and follow mode under a
 # stand-in systemd notification socket (READY, STATUS, WATCHDOG, STOPPING).
-# Usage: fleet_sync.sh AMFI_SYNC SCHEMA_MD NOTIFY_LISTEN. Exit 77 without
-# sqlite3/PostgreSQL.
+# The roles of docs/fleet.md (its SQL block run as written): the writer role
+# syncs, the analysts' role reads the views and cannot write.
+# Usage: fleet_sync.sh AMFI_SYNC SCHEMA_MD NOTIFY_LISTEN FLEET_MD. Exit 77
+# without sqlite3/PostgreSQL.
 set -u
-sync=$1 doc=$2 listen=$3
+sync=$1 doc=$2 listen=$3 fleetdoc=$4
 command -v sqlite3 > /dev/null || { echo "fleet_sync.sh: no sqlite3: skipped"; exit 77; }
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/pg_server.sh"
@@ -180,6 +182,33 @@ printf 'site:\n  id: site-a\n  idd: x\n' > "$tmp/bad.yaml"
 rc=$?
 [ $rc = 2 ] || fail "bad configuration: exit $rc"
 grep -q "bad.yaml:3: site.idd: unknown key" "$tmp/bad.log" || fail "message: $(cat "$tmp/bad.log")"
+
+case=roles
+awk '/^<!-- roles:begin -->/ { on = 1; next } /^<!-- roles:end -->/ { on = 0 }
+     on && !/^```/' "$fleetdoc" > "$tmp/roles.sql"
+[ -s "$tmp/roles.sql" ] || fail "no roles block in $fleetdoc"
+psql -X -q -v ON_ERROR_STOP=1 "$PG_CONNINFO" -f "$tmp/roles.sql" > "$tmp/roles.log" 2>&1 ||
+    fail "the roles SQL of docs/fleet.md: $(cat "$tmp/roles.log")"
+pg_q "CREATE ROLE analyst LOGIN IN ROLE amfi_reader"
+writer="host=$PG_DIR dbname=postgres user=amfi_sync"
+reader="host=$PG_DIR dbname=postgres user=analyst"
+mkstore "$tmp/w.db" site-w 3000
+"$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the writer role cannot sync"
+"$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the writer role: second pass"
+same "$tmp/w.db" site-w
+[ "$(psql -X -At "$reader" -c "SELECT count(*) FROM fleet_latest_state WHERE site_id = 'site-w'")" = 1 ] ||
+    fail "the reader cannot read fleet_latest_state"
+psql -X -At "$reader" -c "SELECT count(*) FROM fleet_daily_trend" > /dev/null 2>&1 ||
+    fail "the reader cannot read fleet_daily_trend"
+psql -X -At "$reader" -c "DELETE FROM passages WHERE site_id = 'site-w'" > /dev/null 2>&1 &&
+    fail "the reader deleted passages"
+psql -X -At "$writer" -c "DELETE FROM passages WHERE site_id = 'site-w'" > /dev/null 2>&1 &&
+    fail "the writer deleted passages"
+add_rows "$tmp/w.db" 100
+"$sync" --db "$tmp/w.db" --pg "$reader" --once 2> "$tmp/reader.log" && fail "the reader role synced"
+grep -q "permission denied" "$tmp/reader.log" || fail "reader sync: $(cat "$tmp/reader.log")"
+"$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the writer role: after the reader"
+same "$tmp/w.db" site-w
 
 case=notify
 # Follow mode with a 0.4 s watchdog and a 30 s interval: READY after the
