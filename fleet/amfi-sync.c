@@ -30,28 +30,6 @@
 
 enum { BATCH_ROWS = 5000, SITE_ID_MAX = 63 };
 
-/* One shipped site table: its name, the columns copied (id first) and the
- * child table shipped in the same transaction (axles for passages). */
-struct table {
-    const char *name;
-    const char *cols;          /* SQLite and PostgreSQL column names, id first */
-    const char *child;         /* NULL or child table */
-    const char *child_cols;    /* its columns, parent id first */
-    const char *child_parent;  /* the parent id column in the child */
-};
-static const struct table tables[] = {
-    {"passages",
-     "id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason, lambda, "
-     "residual_rms, formulation, solve_ms, stored_at",
-     "axles", "passage_id, idx, spacing_m, load_kg", "passage_id"},
-    {"indicators",
-     "id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state",
-     NULL, NULL, NULL},
-    {"alerts", "id, utime, level, kind, message, indicator_id, raised", NULL, NULL, NULL},
-    {"baseline", "id, utime_set, n, mean_kg, std_kg, source, note, set_at", NULL, NULL, NULL},
-    {"runs", "id, started_at, version, config_path", NULL, NULL, NULL},
-};
-enum { N_TABLES = (int)(sizeof tables / sizeof tables[0]) };
 
 static volatile sig_atomic_t stop_requested;
 static void on_signal(int sig) { (void)sig; stop_requested = 1; }
@@ -253,7 +231,7 @@ static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst,
 }
 
 /* Ship one table until it has no more new rows. */
-static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const struct table *t, int check_only,
+static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const struct fleet_table *t, int check_only,
                       long *total)
 {
     char sql[1024];
@@ -329,18 +307,18 @@ static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const struct ta
 /* Local ids lower than the central mark: the store went backwards. */
 static int check_backwards(PGconn *pg, sqlite3 *db, const char *site)
 {
-    for (int i = 0; i < N_TABLES; i++) {
-        const char *pv[2] = {site, tables[i].name};
+    for (int i = 0; i < fleet_n_tables; i++) {
+        const char *pv[2] = {site, fleet_tables[i].name};
         PGresult *r = PQexecParams(pg, "SELECT hwm FROM fleet_sync_state WHERE site_id = $1 AND tbl = $2",
                                    2, NULL, pv, NULL, NULL, 0);
         if (pg_ok(r, "fleet_sync_state")) { PQclear(r); return EX_RETRY; }
         int64_t hwm = PQntuples(r) ? strtoll(PQgetvalue(r, 0, 0), NULL, 10) : 0;
         PQclear(r);
         char sql[128];
-        snprintf(sql, sizeof sql, "SELECT coalesce(max(id), 0) FROM %s", tables[i].name);
+        snprintf(sql, sizeof sql, "SELECT coalesce(max(id), 0) FROM %s", fleet_tables[i].name);
         sqlite3_stmt *st = NULL;
         if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK || sqlite3_step(st) != SQLITE_ROW) {
-            fprintf(stderr, "amfi-sync: store: %s: %s\n", tables[i].name, sqlite3_errmsg(db));
+            fprintf(stderr, "amfi-sync: store: %s: %s\n", fleet_tables[i].name, sqlite3_errmsg(db));
             sqlite3_finalize(st);
             return EX_RETRY;
         }
@@ -351,7 +329,7 @@ static int check_backwards(PGconn *pg, sqlite3 *db, const char *site)
                     "amfi-sync: refused: site '%s' table %s: the store's newest id is %" PRId64
                     " but id %" PRId64 " was already shipped (ids going backwards); was the store restored "
                     "from an older backup? Nothing merged (see docs/fleet.md, 'Restored stores')\n",
-                    site, tables[i].name, mx, hwm);
+                    site, fleet_tables[i].name, mx, hwm);
             return EX_REFUSED;
         }
     }
@@ -426,10 +404,10 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
     sqlite3_exec(db, "BEGIN", NULL, NULL, NULL);
     rc = check_backwards(pg, db, site);
     long total = 0;
-    for (int i = 0; !rc && i < N_TABLES; i++) /* every table checked before any is shipped */
-        rc = sync_table(pg, db, site, &tables[i], 1, &total);
-    for (int i = 0; !rc && i < N_TABLES && !stop_requested; i++)
-        rc = sync_table(pg, db, site, &tables[i], 0, &total);
+    for (int i = 0; !rc && i < fleet_n_tables; i++) /* every table checked before any is shipped */
+        rc = sync_table(pg, db, site, &fleet_tables[i], 1, &total);
+    for (int i = 0; !rc && i < fleet_n_tables && !stop_requested; i++)
+        rc = sync_table(pg, db, site, &fleet_tables[i], 0, &total);
     sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
     if (shipped) *shipped = total;
     if (!rc && !quiet && total > 0)

@@ -5,6 +5,8 @@
  * per-table high-water mark and the hash of the last shipped row. */
 #include "fleet_schema.h"
 
+#include <stddef.h>
+
 static const char fleet_v1[] =
     "CREATE TABLE passages (\n"
     "  site_id text NOT NULL, id bigint NOT NULL, vehicle_id bigint NOT NULL,\n"
@@ -67,3 +69,17 @@ const struct fleet_migration fleet_migrations[] = {
     {1, "site tables with site_id, fleet_sync_state, fleet views", fleet_v1},
 };
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
+
+const struct fleet_table fleet_tables[] = {
+    {"passages",
+     "id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason, lambda, "
+     "residual_rms, formulation, solve_ms, stored_at",
+     "axles", "passage_id, idx, spacing_m, load_kg", "passage_id"},
+    {"indicators",
+     "id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state",
+     NULL, NULL, NULL},
+    {"alerts", "id, utime, level, kind, message, indicator_id, raised", NULL, NULL, NULL},
+    {"baseline", "id, utime_set, n, mean_kg, std_kg, source, note, set_at", NULL, NULL, NULL},
+    {"runs", "id, started_at, version, config_path", NULL, NULL, NULL},
+};
+const int fleet_n_tables = (int)(sizeof fleet_tables / sizeof fleet_tables[0]);

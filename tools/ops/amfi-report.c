@@ -32,6 +32,7 @@
  * Workload: one run reads the ok GVWs once (8 bytes each: a million
  * passages take 8 MB and well under a second) plus a few indexed queries.
  */
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -39,11 +40,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "amfi_cli.h"
 #include "amfi_config.h"
 #include "amfi_json.h"
 #include "report_export.h"
+#include "report_pg.h"
 #include "report_plot.h"
 #include "store.h"
 
@@ -56,6 +59,8 @@
 
 typedef struct options {
     const char *db;
+    const char *pg;         /* --pg CONNINFO: the central database, NULL: none */
+    const char *site;       /* --site ID (with --pg) */
     int summary, trend, alerts, errors, check;
     int baseline_last;   /* N of --set-baseline-last, 0: not given */
     int baseline_given;  /* --set-baseline MEAN,STD,N given */
@@ -86,7 +91,7 @@ static void out(const char *fmt, ...)
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: " PROG " --db PATH [--summary] [--trend] [--alerts] "
+            "usage: " PROG " --db PATH | --pg CONNINFO [--site ID] [--summary] [--trend] [--alerts] "
             "[--errors]\n"
             "       [--set-baseline-last N | --set-baseline MEAN_KG,STD_KG,N] "
             "[--note TEXT] [--check]\n"
@@ -97,6 +102,11 @@ static void usage(FILE *f)
             "\n"
             "Reports on amfid's SQLite store (schema: docs/schema.md).\n"
             "  -d, --db PATH                the store (must exist)\n"
+            "      --pg CONNINFO            the central PostgreSQL instead (docs/fleet.md): "
+            "the fleet\n"
+            "                               summary, or with --site the report of one "
+            "site\n"
+            "      --site ID                the site, with --pg\n"
             "  -s, --summary                passages by status, GVW of the ok "
             "ones, time span, baseline\n"
             "  -t, --trend                  the last %d indicators\n"
@@ -224,6 +234,8 @@ static int parse_args(int argc, char **argv, options *o)
         {"lane", required_argument, NULL, 'l'},
         {"bin-kg", required_argument, NULL, 'w'},
         {"format", required_argument, NULL, 'F'},
+        {"pg", required_argument, NULL, 'G'},
+        {"site", required_argument, NULL, 'I'},
         AMFI_CLI_END};
     memset(o, 0, sizeof *o);
     o->ex.from = 0;
@@ -248,6 +260,15 @@ static int parse_args(int argc, char **argv, options *o)
             if (!*val)
                 return usage_error(opt, "empty value");
             *(k == 'p' ? &o->plot_dir : &o->config) = val;
+            break;
+        case 'G':
+        case 'I':
+            if (!*val)
+                return usage_error(opt, "empty value");
+            *(k == 'G' ? &o->pg : &o->site) = val;
+            if (k == 'I' && !amfi_site_id_valid(val))
+                return usage_error(opt, "'%s' is not a site id (1 to 63 of A-Z a-z 0-9 _ . -)",
+                                   amfi_cli_shown(val));
             break;
         case 'P': o->passages = 1; break;
         case 'H': o->histogram = 1; break;
@@ -317,8 +338,22 @@ static int parse_args(int argc, char **argv, options *o)
             break;
         }
     }
-    if (!o->db)
+    if (o->db && o->pg)
+        return usage_error("--pg", "give --db or --pg, not both");
+    if (!o->db && !o->pg)
         return usage_error("--db", "missing (see --help)");
+    if (o->site && !o->pg)
+        return usage_error("--site", "only with --pg");
+    if (o->pg && (o->baseline_last || o->baseline_given || o->check))
+        return usage_error("--pg", "the central database is read only here: --set-baseline* and "
+                           "--check work on a site's store (--db)");
+    if (o->pg && !o->site) {
+        if (o->summary || o->trend || o->alerts || o->errors || o->passages || o->histogram
+            || o->overloads || o->plot_dir || o->format != FMT_TABLE)
+            return usage_error("--site", "the report sections need one site: without --site, "
+                               "--pg prints the fleet summary only");
+        return 0;
+    }
     if (o->baseline_last && o->baseline_given)
         return usage_error("--set-baseline", "give --set-baseline-last or "
                            "--set-baseline, not both");
@@ -642,6 +677,20 @@ static void shell_word(const char *s, char *out, size_t len)
 static void print_next(const options *o)
 {
     char w[1100];
+    if (o->pg) {
+        /* the central database; the connection as given to --pg, not
+         * echoed (it may hold a password) */
+        printf("\nNext, with psql on the central database (docs/fleet.md lists the views):\n");
+        printf("  psql -c \"SELECT * FROM fleet_daily_trend WHERE site_id = '%s' ORDER BY day\"\n",
+               o->site);
+        if (o->trend || o->alerts)
+            printf("  psql -c \"SELECT * FROM indicators WHERE site_id = '%s' "
+                   "ORDER BY utime DESC LIMIT 50\"\n", o->site);
+        if (o->summary)
+            printf("  psql -c \"SELECT * FROM fleet_passages_daily WHERE site_id = '%s' "
+                   "AND status <> 'ok'\"\n", o->site);
+        return;
+    }
     shell_word(o->db, w, sizeof w);
     printf("\nNext, with sqlite3 (docs/schema.md lists every table and view):\n");
     printf("  sqlite3 -header -column %s \"SELECT * FROM daily_trend\"\n", w);
@@ -810,16 +859,68 @@ static int plot(const options *o, const amfi_site_config *c, amfi_store *s)
     return 0;
 }
 
+static int report_main(options *op);
+static void remove_tmp(const char *dir, const char *db);
+
 int main(int argc, char **argv)
 {
     options o;
-    amfi_store *s = NULL;
     char err[512];
-    int rc = 0, printed = 0;
+    int rc = 0;
 
     if (parse_args(argc, argv, &o) != 0)
         return EXIT_USAGE;
-    g_db = o.db;
+    if (o.pg && !o.site) {
+        rc = report_pg_fleet(o.pg, stdout, err, sizeof err);
+        if (rc)
+            fprintf(stderr, PROG ": --pg: %s\n", err);
+        return rc ? EXIT_DATA : 0;
+    }
+    /* --pg --site: the site's central rows in a private temporary store,
+     * reported like any store (report_pg.c) */
+    char tmpdir[4096] = "", tmpdb[4200] = "";
+    if (o.pg) {
+        const char *t = getenv("TMPDIR");
+        snprintf(tmpdir, sizeof tmpdir, "%s/amfi-report.XXXXXX", t && *t ? t : "/tmp");
+        if (!mkdtemp(tmpdir)) {
+            fprintf(stderr, PROG ": %s: %s\n", tmpdir, strerror(errno));
+            return EXIT_DATA;
+        }
+        snprintf(tmpdb, sizeof tmpdb, "%s/%s.db", tmpdir, o.site);
+        long rows = 0;
+        rc = report_pg_fetch_site(o.pg, o.site, tmpdb, &rows, err, sizeof err);
+        if (rc) {
+            fprintf(stderr, PROG ": --pg: %s\n", err);
+            remove_tmp(tmpdir, tmpdb);
+            return rc == 2 ? EXIT_USAGE : EXIT_DATA;
+        }
+        o.db = tmpdb;
+    }
+    rc = report_main(&o);
+    if (o.pg)
+        remove_tmp(tmpdir, tmpdb);
+    return rc;
+}
+
+static void remove_tmp(const char *dir, const char *db)
+{
+    char p[4300];
+    unlink(db);
+    snprintf(p, sizeof p, "%s-wal", db);
+    unlink(p);
+    snprintf(p, sizeof p, "%s-shm", db);
+    unlink(p);
+    rmdir(dir);
+}
+
+/* The report of one store (o->db): the sections asked for. */
+static int report_main(options *op)
+{
+    options o = *op;
+    amfi_store *s = NULL;
+    char err[512];
+    int rc = 0, printed = 0;
+    g_db = o.pg ? o.site : o.db;
     g_opt = &o;
     /* --config: thresholds, names, legal limits; else the defaults */
     amfi_site_config *cfg = malloc(sizeof *cfg);

@@ -1,0 +1,91 @@
+#!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
+# report_pg.sh: amfi-report --pg against a throwaway PostgreSQL
+# (tests/pg_server.sh). Two site stores (amfi-fleet-bench, 3 days x 400) are
+# shipped with amfi-sync; then the fleet summary has one line per site with
+# its counts, and the report of one site from the central database equals
+# the report of its store: the default sections, the CSV and JSON exports,
+# the histogram, the plots. An unknown site (exit 2, the sites listed), a
+# central row the store schema refuses (exit 1, named), a stopped server
+# (exit 1) and the options that make no sense centrally (exit 2) are refused.
+# No temporary store is left behind.
+# Usage: report_pg.sh AMFI_REPORT AMFI_SYNC AMFI_FLEET_BENCH. Exit 77 without PostgreSQL.
+set -u
+report=$1 sync=$2 bench=$3
+here=$(cd "$(dirname "$0")" && pwd)
+. "$here/pg_server.sh"
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/report_pg.XXXXXX") || exit 1
+chmod 755 "$tmp"
+trap 'pg_stop; rm -rf "$tmp"' EXIT INT TERM
+pg_start "$tmp"
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+mkdir "$tmp/t"
+export TMPDIR="$tmp/t"
+
+"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "--init-schema"
+"$bench" --pg "$PG_CONNINFO" --sync "$sync" --dir "$tmp/st" --sites 2 --days 3 --per-day 400 \
+    > "$tmp/bench.log" || { cat "$tmp/bench.log"; fail "amfi-fleet-bench"; exit 1; }
+a=$tmp/st/bench-000.db
+
+# the fleet summary: one line per site, passages, open alerts (site 0 has one)
+"$report" --pg "$PG_CONNINFO" > "$tmp/fleet.txt" || fail "fleet summary: exit $?"
+cat "$tmp/fleet.txt"
+grep -q "^fleet  *2 sites" "$tmp/fleet.txt" || fail "fleet summary: no '2 sites' line"
+grep -Eq "^bench-000 +1200 +2025-01-03T..:..Z +baseline +[0-9.]+ +1 " "$tmp/fleet.txt" ||
+    fail "fleet summary: bench-000 line"
+grep -Eq "^bench-001 +1200 .* 0 +[0-9]{4}-" "$tmp/fleet.txt" || fail "fleet summary: bench-001 line"
+
+# one site: the same report as from its store (up to the 'Next' hints,
+# which name sqlite3 and the file there, psql and the views here)
+same() {
+    "$report" --db "$a" "$@" > "$tmp/db.out" 2>&1 || fail "--db $*: exit $?"
+    "$report" --pg "$PG_CONNINFO" --site bench-000 "$@" > "$tmp/pg.out" 2>&1 || fail "--pg $*: exit $?"
+    sed '/^Next, with/,$d' "$tmp/db.out" > "$tmp/db.cut"
+    sed '/^Next, with/,$d' "$tmp/pg.out" > "$tmp/pg.cut"
+    cmp -s "$tmp/db.cut" "$tmp/pg.cut" || { diff "$tmp/db.cut" "$tmp/pg.cut" | head; fail "--pg differs: $*"; }
+    [ -s "$tmp/pg.cut" ] || fail "--pg $*: no output"
+}
+same
+same --passages --format csv
+same --format json
+same --histogram --lane 1
+same --overloads --from 2025-01-02
+"$report" --pg "$PG_CONNINFO" --site bench-000 > "$tmp/pg.out"
+grep -q "^  psql -c \"SELECT \* FROM fleet_daily_trend WHERE site_id = 'bench-000'" "$tmp/pg.out" ||
+    fail "no psql hint"
+grep -q "host=\|dbname=" "$tmp/pg.out" && fail "the connection string is echoed"
+if command -v gnuplot > /dev/null; then
+    "$report" --db "$a" --plot "$tmp/p1" > /dev/null 2>&1 || fail "--db --plot"
+    "$report" --pg "$PG_CONNINFO" --site bench-000 --plot "$tmp/p2" > /dev/null 2>&1 || fail "--pg --plot"
+    [ "$(ls "$tmp/p1")" = "$(ls "$tmp/p2")" ] && [ -n "$(ls "$tmp/p2")" ] ||
+        fail "plots: '$(ls "$tmp/p1" | tr '\n' ' ')' vs '$(ls "$tmp/p2" | tr '\n' ' ')'"
+fi
+
+# refusals
+"$report" --pg "$PG_CONNINFO" --site nope 2> "$tmp/e1"
+rc=$?
+[ $rc = 2 ] || fail "unknown site: exit $rc"
+grep -q "no site 'nope' in the central database (sites: bench-000, bench-001)" "$tmp/e1" ||
+    fail "unknown site: $(cat "$tmp/e1")"
+for args in "--site bench-000" "--pg x --db $a" "--pg x --site bench-000 --set-baseline-last 10" \
+            "--pg x --site bench-000 --check" "--pg x --summary" "--pg x --site 'bad id'"; do
+    eval "\"\$report\" $args" > /dev/null 2>&1
+    rc=$?
+    [ $rc = 2 ] || fail "amfi-report $args: exit $rc, expected 2"
+done
+pg_q "INSERT INTO passages (site_id, id, vehicle_id, utime, lane, n_axles, status, reason, stored_at)
+      VALUES ('bench-001', 99999, 1, 1735776000000000, 99999, 2, 'gap', '', 'x')"
+"$report" --pg "$PG_CONNINFO" --site bench-001 2> "$tmp/e2" > /dev/null
+rc=$?
+[ $rc = 1 ] || fail "a bad central row: exit $rc"
+grep -q "central passages row (site 'bench-001', id 99999) refused by the store schema: CHECK" "$tmp/e2" ||
+    fail "a bad central row: $(cat "$tmp/e2")"
+pg_stop
+"$report" --pg "$PG_CONNINFO" --site bench-000 2> "$tmp/e3" > /dev/null
+rc=$?
+[ $rc = 1 ] || fail "server stopped: exit $rc"
+grep -q "cannot connect to PostgreSQL" "$tmp/e3" || fail "server stopped: $(cat "$tmp/e3")"
+[ -z "$(ls "$tmp/t")" ] || fail "temporary files left: $(ls "$tmp/t")"
+[ $failures = 0 ] && echo "report_pg.sh: all cases pass"
+exit $((failures != 0))

@@ -1,0 +1,22 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/* report_pg.h: amfi-report --pg, the report from the central PostgreSQL
+ * (report_pg.c). CONNINFO goes to PQconnectdb (PG* variables, service file,
+ * password file); the password is never printed. Errors: one line in err,
+ * without the program name. */
+#ifndef AMFI_REPORT_PG_H
+#define AMFI_REPORT_PG_H
+
+#include <stdio.h>
+
+/* The fleet summary on out: one line per site. 0, or 1 (server away,
+ * query failed). */
+int report_pg_fleet(const char *conninfo, FILE *out, char *err, size_t errlen);
+
+/* A new store at path (which must not exist) holding every central row of
+ * site; *rows gets their number. 0; 1 server away or a row the store's
+ * schema refuses (named by table and id); 2 no such site (err lists the
+ * sites there are). */
+int report_pg_fetch_site(const char *conninfo, const char *site, const char *path, long *rows,
+                         char *err, size_t errlen);
+
+#endif
