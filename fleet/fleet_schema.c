@@ -65,8 +65,21 @@ static const char fleet_v1[] =
     "         count(*) AS n\n"
     "  FROM passages GROUP BY 1, 2, 3;\n";
 
+/* Version 2: the site store's window_trend, per site (each indicator with
+ * the alerts it raised or cleared). */
+static const char fleet_v2[] =
+    "CREATE VIEW fleet_window_trend AS\n"
+    "  SELECT i.site_id, i.id AS indicator_id, i.utime,\n"
+    "         to_timestamp(i.utime / 1e6) AS time_utc, i.n, i.mean_kg, i.std_kg,\n"
+    "         i.baseline_mean_kg, i.baseline_std_kg, i.std_ratio, i.p_value, i.state,\n"
+    "         a.id AS alert_id, a.level AS alert_level, a.kind AS alert_kind,\n"
+    "         a.raised AS alert_raised, a.message AS alert_message\n"
+    "  FROM indicators AS i\n"
+    "  LEFT JOIN alerts AS a ON a.site_id = i.site_id AND a.indicator_id = i.id;\n";
+
 const struct fleet_migration fleet_migrations[] = {
     {1, "site tables with site_id, fleet_sync_state, fleet views", fleet_v1},
+    {2, "fleet_window_trend: indicators with their alerts, per site", fleet_v2},
 };
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
 

@@ -79,7 +79,12 @@ same() {
 
 case=init
 "$sync" --pg "$PG_CONNINFO" --init-schema 2> "$tmp/init.log" || fail "--init-schema: $(cat "$tmp/init.log")"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 1 ] || fail "schema version"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 2 ] || fail "schema version"
+# a central database of version 1 migrates on the next contact
+pg_q "DROP VIEW fleet_window_trend; DELETE FROM fleet_migrations WHERE version = 2"
+"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 2"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 2 ] || fail "not migrated to 2"
+pg_q "SELECT count(*) FROM fleet_window_trend" > /dev/null || fail "no fleet_window_trend after migration"
 grep -q password "$tmp/init.log" && fail "log mentions a password"
 
 case=three-sites
@@ -196,6 +201,8 @@ mkstore "$tmp/w.db" site-w 3000
 "$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the writer role cannot sync"
 "$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the writer role: second pass"
 same "$tmp/w.db" site-w
+[ "$(psql -X -At "$reader" -c "SELECT count(*) FROM fleet_window_trend WHERE site_id = 'site-w'")" = \
+  "$(sqlite3 "$tmp/w.db" "SELECT count(*) FROM window_trend")" ] || fail "fleet_window_trend differs from the store's window_trend"
 [ "$(psql -X -At "$reader" -c "SELECT count(*) FROM fleet_latest_state WHERE site_id = 'site-w'")" = 1 ] ||
     fail "the reader cannot read fleet_latest_state"
 psql -X -At "$reader" -c "SELECT count(*) FROM fleet_daily_trend" > /dev/null 2>&1 ||
