@@ -106,6 +106,10 @@ int amfi_store_open_readonly(const char *path, amfi_store **out, char *err,
  * (truncating it) when writable, close. NULL-safe. */
 void amfi_store_close(amfi_store *s);
 
+/* Delete a closed store's files: path and its -wal and -shm (those absent
+ * are fine). For temporary stores (tests, amfi-report --pg). */
+void amfi_store_remove(const char *path);
+
 /* ---- passages ---------------------------------------------------------- */
 
 /* Passage status values, as in the AMFI_PASSAGE message. */

@@ -21,6 +21,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <sys/stat.h>
 
 #include "store_internal.h"
@@ -185,6 +186,16 @@ static void destroy(amfi_store *s, int tidy)
 }
 
 void amfi_store_close(amfi_store *s) { destroy(s, 1); }
+
+void amfi_store_remove(const char *path)
+{
+    char p[4200];
+    unlink(path);
+    snprintf(p, sizeof p, "%s-wal", path);
+    unlink(p);
+    snprintf(p, sizeof p, "%s-shm", path);
+    unlink(p);
+}
 
 /* Is this file an amfi store this code can use? *version gets its
  * user_version. Reads only: a refused file is left untouched. */

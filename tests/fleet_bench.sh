@@ -10,10 +10,7 @@ set -u
 bench=$1 sync=$2
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/pg_server.sh"
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/fleet_bench.XXXXXX") || exit 1
-chmod 755 "$tmp"
-trap 'pg_stop; rm -rf "$tmp"' EXIT INT TERM
-pg_start "$tmp"
+pg_tmp fleet_bench
 "$sync" --pg "$PG_CONNINFO" --init-schema --quiet || { echo "FAIL: --init-schema"; exit 1; }
 out=$("$bench" --pg "$PG_CONNINFO" --sync "$sync" --dir "$tmp/stores" --sites 3 --days 2 \
       --per-day 300 --jobs 2) || { echo "$out"; echo "FAIL: amfi-fleet-bench exit $?"; exit 1; }

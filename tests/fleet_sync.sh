@@ -16,10 +16,7 @@ sync=$1 doc=$2 listen=$3 fleetdoc=$4
 command -v sqlite3 > /dev/null || { echo "fleet_sync.sh: no sqlite3: skipped"; exit 77; }
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/pg_server.sh"
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/fleet_sync.XXXXXX") || exit 1
-chmod 755 "$tmp"
-trap 'pg_stop; rm -rf "$tmp"' EXIT INT TERM
-pg_start "$tmp"
+pg_tmp fleet_sync
 failures=0
 fail() { echo "FAIL $case: $*"; failures=$((failures + 1)); }
 

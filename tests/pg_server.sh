@@ -2,7 +2,8 @@
 # pg_server.sh: sourced by the fleet_* tests. pg_start DIR starts a throwaway
 # PostgreSQL server (initdb into DIR/data as the unprivileged user postgres,
 # or nobody; Unix socket in DIR, no TCP port) and sets PG_CONNINFO; pg_stop
-# and pg_restart stop / restart it. The caller's trap runs pg_stop.
+# and pg_restart stop / restart it. The caller's trap runs pg_stop (pg_tmp
+# sets one up).
 pg_user=postgres
 id "$pg_user" > /dev/null 2>&1 || pg_user=nobody
 pg_as() {
@@ -27,5 +28,13 @@ pg_stop() {
     [ -n "${PG_DIR:-}" ] && [ -f "$PG_DIR/data/postmaster.pid" ] &&
         pg_as pg_ctl -D "$PG_DIR/data" -m fast -w stop > /dev/null 2>&1
     return 0
+}
+# pg_tmp NAME: a new temporary directory in $tmp (NAME.XXXXXX under TMPDIR),
+# removed at exit with the server stopped, and the server started in it.
+pg_tmp() {
+    tmp=$(mktemp -d "${TMPDIR:-/tmp}/$1.XXXXXX") || exit 1
+    chmod 755 "$tmp"
+    trap 'pg_stop; rm -rf "$tmp"' EXIT INT TERM
+    pg_start "$tmp"
 }
 pg_q() { psql -X -q -At -v ON_ERROR_STOP=1 "$PG_CONNINFO" -c "$1"; }

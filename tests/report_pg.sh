@@ -14,10 +14,7 @@ set -u
 report=$1 sync=$2 bench=$3
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/pg_server.sh"
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/report_pg.XXXXXX") || exit 1
-chmod 755 "$tmp"
-trap 'pg_stop; rm -rf "$tmp"' EXIT INT TERM
-pg_start "$tmp"
+pg_tmp report_pg
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 mkdir "$tmp/t"

@@ -62,26 +62,17 @@ static int setup(void **state)
     return 0;
 }
 
-static void remove_db(const char *path)
-{
-    char p[256];
-    unlink(path);
-    snprintf(p, sizeof p, "%s-wal", path);
-    unlink(p);
-    snprintf(p, sizeof p, "%s-shm", path);
-    unlink(p);
-}
 
 static int teardown(void **state)
 {
     fixture *f = *state;
     char p[128];
     amfi_store_close(f->s);
-    remove_db(f->path);
+    amfi_store_remove(f->path);
     snprintf(p, sizeof p, "%s/other.db", f->dir);
-    remove_db(p);
+    amfi_store_remove(p);
     snprintf(p, sizeof p, "%s/doc.db", f->dir);
-    remove_db(p);
+    amfi_store_remove(p);
     snprintf(p, sizeof p, "%s/not-sqlite.db", f->dir);
     unlink(p);
     rmdir(f->dir);

@@ -904,12 +904,7 @@ int main(int argc, char **argv)
 
 static void remove_tmp(const char *dir, const char *db)
 {
-    char p[4300];
-    unlink(db);
-    snprintf(p, sizeof p, "%s-wal", db);
-    unlink(p);
-    snprintf(p, sizeof p, "%s-shm", db);
-    unlink(p);
+    amfi_store_remove(db);
     rmdir(dir);
 }
 
