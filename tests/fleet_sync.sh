@@ -59,16 +59,10 @@ INSERT INTO runs (version, config_path) VALUES ('0.test', '/etc/amfi/amfid.yaml'
         sqlite3 "$1" > /dev/null
     add_rows "$1" "$3"
 }
-# same DB SITE: central rows of the site equal the store's, no gap.
+# same DB SITE: central rows of the site equal the store's, no gap
+# (fleet_same, pg_server.sh), and text copied exactly.
 same() {
-    for t in passages indicators alerts baseline runs; do
-        l=$(sqlite3 "$1" "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t")
-        c=$(pg_q "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t WHERE site_id = '$2'")
-        [ "$l" = "$c" ] || fail "$2 $t: store '$l' central '$c'"
-    done
-    l=$(sqlite3 "$1" "SELECT count(*) || ' ' || total(load_kg) FROM axles")
-    c=$(pg_q "SELECT count(*) || ' ' || coalesce(sum(load_kg), 0) FROM axles WHERE site_id = '$2'")
-    [ "$(echo "$l" | cut -d' ' -f1)" = "$(echo "$c" | cut -d' ' -f1)" ] || fail "$2 axles: store '$l' central '$c'"
+    fleet_same "$1" "$2"
     l=$(sqlite3 "$1" "SELECT reason FROM passages WHERE id = 10")
     c=$(pg_q "SELECT reason FROM passages WHERE site_id = '$2' AND id = 10")
     [ "$l" = "$c" ] || fail "$2: text not copied exactly: '$l' vs '$c'"

@@ -38,3 +38,16 @@ pg_tmp() {
     pg_start "$tmp"
 }
 pg_q() { psql -X -q -At -v ON_ERROR_STOP=1 "$PG_CONNINFO" -c "$1"; }
+# fleet_same DB SITE: the central rows of SITE equal the store DB's, table by
+# table (count and newest id: no gap, no duplicate), axles by count; calls
+# the caller's fail for each difference.
+fleet_same() {
+    for t in passages indicators alerts baseline runs; do
+        l=$(sqlite3 "$1" "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t")
+        c=$(pg_q "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t WHERE site_id = '$2'")
+        [ "$l" = "$c" ] || fail "$2 $t: store '$l' central '$c'"
+    done
+    l=$(sqlite3 "$1" "SELECT count(*) FROM axles")
+    c=$(pg_q "SELECT count(*) FROM axles WHERE site_id = '$2'")
+    [ "$l" = "$c" ] || fail "$2 axles: store '$l' central '$c'"
+}
