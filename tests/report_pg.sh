@@ -7,7 +7,8 @@
 # the report of its store: the default sections, the CSV and JSON exports,
 # the histogram, the plots. An unknown site (exit 2, the sites listed), a
 # central row the store schema refuses (exit 1, named), a stopped server
-# (exit 1) and the options that make no sense centrally (exit 2) are refused.
+# (exit 1, one line, no password) and the options that make no sense
+# centrally (exit 2) are refused.
 # No temporary store is left behind.
 # Usage: report_pg.sh AMFI_REPORT AMFI_SYNC AMFI_FLEET_BENCH. Exit 77 without PostgreSQL.
 set -u
@@ -83,6 +84,13 @@ pg_stop
 rc=$?
 [ $rc = 1 ] || fail "server stopped: exit $rc"
 grep -q "cannot connect to PostgreSQL" "$tmp/e3" || fail "server stopped: $(cat "$tmp/e3")"
+[ "$(wc -l < "$tmp/e3")" = 1 ] || fail "server stopped: not one line: $(cat "$tmp/e3")"
+grep -q "Is the server running" "$tmp/e3" || fail "server stopped: libpq's hint lost: $(cat "$tmp/e3")"
+"$report" --pg "$PG_CONNINFO password=sekret-pw" 2> "$tmp/e4" > "$tmp/o4"
+rc=$?
+[ $rc = 1 ] || fail "fleet summary, server stopped: exit $rc"
+[ "$(wc -l < "$tmp/e4")" = 1 ] || fail "fleet summary, server stopped: not one line: $(cat "$tmp/e4")"
+grep -q sekret "$tmp/e4" "$tmp/o4" && fail "server stopped: the password is printed"
 [ -z "$(ls "$tmp/t")" ] || fail "temporary files left: $(ls "$tmp/t")"
 [ $failures = 0 ] && echo "report_pg.sh: all cases pass"
 exit $((failures != 0))

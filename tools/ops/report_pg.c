@@ -30,6 +30,16 @@ static int fail(char *err, size_t errlen, int rc, const char *fmt, ...)
     va_end(ap);
     size_t n = strlen(err);
     while (n > 0 && err[n - 1] == '\n') err[--n] = 0; /* libpq's messages end in \n */
+    /* and may go on over more lines ("...failed: No such file or directory\n
+     * \tIs the server running locally...?"): one line, as every error of
+     * amfi-report is ("...directory; Is the server ...") */
+    for (size_t k = 0; k < n; k++)
+        if (err[k] == '\n' && err[k + 1] == '\t') {
+            err[k] = ';';
+            err[k + 1] = ' ';
+        } else if (err[k] == '\n' || err[k] == '\r') {
+            err[k] = ' ';
+        }
     return rc;
 }
 
