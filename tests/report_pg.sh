@@ -72,6 +72,31 @@ for args in "--site bench-000" "--pg x --db $a" "--pg x --site bench-000 --set-b
     rc=$?
     [ $rc = 2 ] || fail "amfi-report $args: exit $rc, expected 2"
 done
+# a bad row in the fleet summary's sources: an error naming the site, no table
+pg_q "UPDATE indicators SET state = 'wobbly' WHERE site_id = 'bench-001' AND id =
+      (SELECT indicator_id FROM fleet_latest_state WHERE site_id = 'bench-001')"
+"$report" --pg "$PG_CONNINFO" > "$tmp/o5" 2> "$tmp/e5"
+rc=$?
+[ $rc = 1 ] || fail "fleet summary, bad state: exit $rc"
+grep -q "^amfi-report: --pg: fleet summary: central row 2 (site 'bench-001'): fleet_latest_state.state is not" "$tmp/e5" ||
+    fail "fleet summary, bad state: $(cat "$tmp/e5")"
+[ -s "$tmp/o5" ] && fail "fleet summary, bad state: printed a table"
+pg_q "UPDATE indicators SET state = 'normal', std_ratio = -1 WHERE site_id = 'bench-001' AND id =
+      (SELECT indicator_id FROM fleet_latest_state WHERE site_id = 'bench-001')"
+"$report" --pg "$PG_CONNINFO" > /dev/null 2> "$tmp/e5"
+rc=$?
+[ $rc = 1 ] || fail "fleet summary, negative ratio: exit $rc"
+grep -q "(site 'bench-001'): fleet_latest_state.std_ratio is not a ratio" "$tmp/e5" ||
+    fail "fleet summary, negative ratio: $(cat "$tmp/e5")"
+pg_q "UPDATE indicators SET std_ratio = 1 WHERE site_id = 'bench-001'"
+pg_q "UPDATE fleet_sync_state SET site_id = 'bad site' || chr(10) || 'x' WHERE site_id = 'bench-001'"
+"$report" --pg "$PG_CONNINFO" > /dev/null 2> "$tmp/e5"
+rc=$?
+[ $rc = 1 ] || fail "fleet summary, bad site id: exit $rc"
+[ "$(wc -l < "$tmp/e5")" = 1 ] && grep -q "(site 'bad site?x'): site_id is not a valid site id" "$tmp/e5" ||
+    fail "fleet summary, bad site id: $(cat "$tmp/e5")"
+pg_q "UPDATE fleet_sync_state SET site_id = 'bench-001' WHERE site_id LIKE 'bad site%'"
+"$report" --pg "$PG_CONNINFO" > /dev/null || fail "fleet summary after the repairs: exit $?"
 pg_q "INSERT INTO passages (site_id, id, vehicle_id, utime, lane, n_axles, status, reason, stored_at)
       VALUES ('bench-001', 99999, 1, 1735776000000000, 99999, 2, 'gap', '', 'x')"
 "$report" --pg "$PG_CONNINFO" --site bench-001 2> "$tmp/e2" > /dev/null

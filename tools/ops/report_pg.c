@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amfi_config.h"
 #include "fleet_schema.h"
 #include "store.h"
 
@@ -65,6 +66,51 @@ static void known_sites(PGconn *pg, char *buf, size_t len)
     PQclear(r);
 }
 
+/* s with control characters and non-ASCII bytes as '?', cut to len − 1 */
+static void shown(const char *s, char *buf, size_t len)
+{
+    size_t k = 0;
+    for (; s[k] && k + 1 < len; k++)
+        buf[k] = (s[k] < 0x20 || s[k] > 0x7e) ? '?' : s[k];
+    buf[k] = '\0';
+}
+
+/* v is an integer in [0, INT64_MAX] (text of a bigint) */
+static int count_ok(const char *v)
+{
+    char *end;
+    errno = 0;
+    long long x = strtoll(v, &end, 10);
+    return errno == 0 && end != v && !*end && x >= 0;
+}
+
+/* What is wrong with row i of the fleet summary query, NULL if nothing:
+ * site id as amfid's config allows it, counts, a known state, a ratio. */
+static const char *fleet_row_problem(PGresult *r, int i)
+{
+    static const char *const states[] = {"-", "baseline", "normal", "watch", "alert", NULL};
+    if (PQgetisnull(r, i, 0) || !amfi_site_id_valid(PQgetvalue(r, i, 0)))
+        return "site_id is not a valid site id";
+    if (PQgetisnull(r, i, 1) || !count_ok(PQgetvalue(r, i, 1)))
+        return "fleet_sync_state.hwm is not a count";
+    if (PQgetisnull(r, i, 5) || !count_ok(PQgetvalue(r, i, 5)))
+        return "the open alerts are not a count";
+    int k = 0;
+    while (states[k] && strcmp(states[k], PQgetvalue(r, i, 3)) != 0)
+        k++;
+    if (!states[k])
+        return "fleet_latest_state.state is not baseline, normal, watch or alert";
+    const char *ratio = PQgetvalue(r, i, 4);
+    if (strcmp(ratio, "-") != 0) {
+        char *end;
+        double x = strtod(ratio, &end);
+        /* to_char gives '#' for a value beyond its format */
+        if (end == ratio || *end || !(x >= 0))
+            return "fleet_latest_state.std_ratio is not a ratio in [0, 999.999]";
+    }
+    return NULL;
+}
+
 int report_pg_fleet(const char *conninfo, FILE *out, char *err, size_t errlen)
 {
     PGconn *pg = connect_pg(conninfo, err, errlen);
@@ -90,6 +136,20 @@ int report_pg_fleet(const char *conninfo, FILE *out, char *err, size_t errlen)
         PQclear(r);
         PQfinish(pg);
         return 1;
+    }
+    /* every row checked before anything is printed: a bad one is an error
+     * naming the site, not a broken line in the table */
+    for (int i = 0; i < PQntuples(r); i++) {
+        const char *why = fleet_row_problem(r, i);
+        if (why) {
+            char site[48];
+            shown(PQgetvalue(r, i, 0), site, sizeof site);
+            fail(err, errlen, 1, "fleet summary: central row %d (site '%s'): %s", i + 1, site,
+                 why);
+            PQclear(r);
+            PQfinish(pg);
+            return 1;
+        }
     }
     fprintf(out, "fleet        %d sites on %s/%s\n", PQntuples(r), PQhost(pg), PQdb(pg));
     fprintf(out, "%-24s %10s  %-17s  %-8s %9s  %5s  %-17s\n", "site", "passages", "last passage",
