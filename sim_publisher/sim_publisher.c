@@ -45,7 +45,9 @@
  * max). --log FILE writes the same events to an LCM log (timestamps = data
  * time), replayable with lcm-logplayer and readable by amfid through LCM's
  * file:// provider; --lcm-url none publishes nothing. Vehicles follow each
- * other --headway seconds apart (default: the population's timestamps);
+ * other --headway seconds apart (default: the population's timestamps),
+ * or arrive at random with --flow vehicles/h per lane on --lanes 1 or 2
+ * (at least --min-headway apart within a lane, no overtaking: flow.h);
  * --damage-step-at K switches the bridge to --damage from vehicle K on.
  * --environment site (streaming only) drives the bridge's modulus with the
  * deck temperature of a simulated site climate, set as each vehicle is
@@ -86,6 +88,7 @@
 #include "passage.h"
 #include "profile.h"
 #include "site.h"
+#include "flow.h"
 #include "traffic.h"
 #include "vbi.h"
 #include "vehicle.h"
@@ -113,6 +116,9 @@ typedef struct opts {
     int lcm_url_flag;     /* lcm_url came from --lcm-url (for messages) */
     double speedup;       /* <= 0: as fast as possible */
     double headway;       /* <= 0: the population's timestamps */
+    double flow;          /* > 0: Poisson arrivals, vehicles/h per lane (flow.h) */
+    double min_headway;   /* with flow: per lane, s */
+    int lanes;            /* with flow: 1 or 2 */
     long damage_step_at;  /* < 0: --damage from the start */
     double noise_ms2;
     int block;
@@ -157,6 +163,9 @@ static void usage(FILE *f)
             "  -l, --log FILE                 also write the events to an LCM log\n"
             "      --speedup X|max            pacing: data time / wall time\n"
             "      --headway SEC              time between vehicles\n"
+            "      --flow VEH_PER_H           Poisson arrivals per lane (overrides --headway)\n"
+            "      --min-headway SEC          with --flow: minimum headway per lane (0.5)\n"
+            "      --lanes 1|2                with --flow: number of lanes (1)\n"
             "      --damage-step-at K|none    --damage from vehicle K on\n"
             "      --noise-ms2 STD            noise on the stream, m/s^2\n"
             "      --block N                  samples per accelerometer message\n"
@@ -177,7 +186,7 @@ enum {
     O_FIRST = 256, O_PROFILE, O_TRACK_STD, O_SCAN_RATE, O_NOISE, O_SPEED_ERROR,
     O_PRECEDING_GAP, O_PRE, O_POST, O_DT, O_SPEEDUP, O_HEADWAY, O_DAMAGE_STEP_AT,
     O_NOISE_MS2, O_BLOCK, O_START_UTIME, O_DETECTOR_LEAD, O_ENVIRONMENT,
-    O_TIME_COMPRESSION, O_ENVIRONMENT_PERIOD
+    O_TIME_COMPRESSION, O_ENVIRONMENT_PERIOD, O_FLOW, O_MIN_HEADWAY, O_LANES
 };
 
 static const struct option longopts[] = {
@@ -201,6 +210,9 @@ static const struct option longopts[] = {
     {"log", required_argument, NULL, 'l'},
     {"speedup", required_argument, NULL, O_SPEEDUP},
     {"headway", required_argument, NULL, O_HEADWAY},
+    {"flow", required_argument, NULL, O_FLOW},
+    {"min-headway", required_argument, NULL, O_MIN_HEADWAY},
+    {"lanes", required_argument, NULL, O_LANES},
     {"damage-step-at", required_argument, NULL, O_DAMAGE_STEP_AT},
     {"noise-ms2", required_argument, NULL, O_NOISE_MS2},
     {"block", required_argument, NULL, O_BLOCK},
@@ -286,6 +298,8 @@ static void opts_from_config(opts *o, const amfi_sim_config *c, const char *file
     o->log = c->log[0] ? c->log : NULL;
     o->speedup = c->speedup;
     o->headway = c->headway_s;
+    o->min_headway = 0.5;
+    o->lanes = 1;
     o->damage_step_at = c->damage_step_at;
     o->noise_ms2 = c->noise_ms2;
     o->block = c->block;
@@ -349,6 +363,9 @@ static void apply_flags(int argc, char **argv, opts *o)
             o->speedup = !strcmp(v, "max") ? 0.0 : amfi_cli_num(&c, v, 0.01, 1e6);
             break;
         case O_HEADWAY: o->headway = amfi_cli_num(&c, v, 0.1, 3600); break;
+        case O_FLOW: o->flow = amfi_cli_num(&c, v, 1, 3600); break;
+        case O_MIN_HEADWAY: o->min_headway = amfi_cli_num(&c, v, 0, 60); break;
+        case O_LANES: o->lanes = (int)amfi_cli_num(&c, v, 1, AMFI_FLOW_MAX_LANES); break;
         case O_DAMAGE_STEP_AT:
             o->damage_step_at = !strcmp(v, "none") ? -1 : (long)amfi_cli_num(&c, v, 0, 1e7);
             break;
@@ -515,7 +532,15 @@ typedef struct planned {
     double entry_s;      /* sim time */
     int added, announced;
     double spacing;
+    int lane;            /* 1-based */
+    double start_s;      /* its approach starts (sim time) */
 } planned;
+
+static int by_start(const void *a, const void *b)
+{
+    const planned *p = a, *q = b;
+    return (p->start_s > q->start_s) - (p->start_s < q->start_s);
+}
 
 /* --environment site: before vehicle `id` is added at data time now, put
  * the bridge of the current deck temperature (and damage) under the
@@ -549,8 +574,9 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
     amfi_sim *sim = NULL;
     planned *plan = calloc((size_t)o->vehicles, sizeof *plan);
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng *frng = gsl_rng_alloc(gsl_rng_mt19937); /* --flow arrivals */
     double *acc = NULL;
-    if (!plan || !rng)
+    if (!plan || !rng || !frng)
         goto out;
     if (o->environment &&
         amfi_site_init(&site, &cfg->bridge, recs, n_recs, o->start_utime, o->time_compression,
@@ -582,6 +608,9 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
     /* The plan: entries spaced by the headway (or the population's clock),
      * the first after its full approach. */
     double t = 0.0;
+    amfi_flow fl;
+    if (frng)
+        gsl_rng_set(frng, o->seed ^ 0xf10bu);
     for (long i = 0; i < o->vehicles; i++) {
         /* the clock follows the population's records in order; with
          * --environment site the vehicle is the mix's draw for that time */
@@ -601,6 +630,16 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             goto out;
         }
         t = i ? t + gap : sp.approach_m / spec.speed_mps + 1.0;
+        plan[i].lane = 1;
+        if (o->flow > 0) {
+            if (!i && amfi_flow_init(&fl, o->lanes, 3600.0 / o->flow, o->min_headway,
+                                     cfg->bridge.span_m, sp.approach_m, sp.approach_m + 1.0, frng, err,
+                                     sizeof err)) {
+                fprintf(stderr, "%s: %s\n", PROG, err);
+                goto out;
+            }
+            amfi_flow_next(&fl, spec.speed_mps, frng, &plan[i].lane, &t);
+        }
         /* a vehicle cannot start its approach before the previous one: keep order */
         plan[i].entry_s = t;
         plan[i].v.id = o->first + i + 1;
@@ -608,8 +647,15 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         plan[i].v.car = spec.car;
         plan[i].v.speed_mps = spec.speed_mps;
         plan[i].v.t_entry_s = t;
+        plan[i].start_s = t - sp.approach_m / spec.speed_mps;
         plan[i].v.track = spec.track;
         plan[i].spacing = spec.car.D1_m + spec.car.D2_m;
+    }
+    if (o->flow > 0) {
+        /* the simulator takes vehicles in the order their approach starts */
+        qsort(plan, (size_t)o->vehicles, sizeof *plan, by_start);
+        for (long i = 0; i < o->vehicles; i++)
+            plan[i].v.id = o->first + i + 1;
     }
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -675,7 +721,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
                 speed *= 1.0 + o->speed_err_mean +
                          (o->speed_err_std > 0 ? gsl_ran_gaussian(noise, o->speed_err_std) : 0.0);
             double spacing = p->spacing;
-            amfi_vehicle_t m = {o->start_utime + (int64_t)llround(p->entry_s * 1e6), p->v.id, 1,
+            amfi_vehicle_t m = {o->start_utime + (int64_t)llround(p->entry_s * 1e6), p->v.id, p->lane,
                                 speed, 2, 1, &spacing, PROG};
             if (EMIT(&b, amfi_vehicle_t, cfg->daemon.ch_vehicle, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
@@ -759,6 +805,7 @@ out:
     free(b.buf);
     free(plan);
     gsl_rng_free(rng);
+    gsl_rng_free(frng);
     return rc;
 }
 
