@@ -47,7 +47,8 @@
  * file:// provider; --lcm-url none publishes nothing. Vehicles follow each
  * other --headway seconds apart (default: the population's timestamps),
  * or arrive at random with --flow vehicles/h per lane on --lanes 1 or 2
- * (at least --min-headway apart within a lane, no overtaking: flow.h);
+ * (at least --min-headway apart within a lane, no overtaking: flow.h;
+ * every vehicle of a lane on that lane's road track);
  * --damage-step-at K switches the bridge to --damage from vehicle K on.
  * --environment site (streaming only) drives the bridge's modulus with the
  * deck temperature of a simulated site climate, set as each vehicle is
@@ -639,6 +640,10 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
                 goto out;
             }
             amfi_flow_next(&fl, spec.speed_mps, frng, &plan[i].lane, &t);
+            /* vehicles of one lane run over the same road track: lane 1
+             * the carpet's centre track, lane 2 its first (flow.h) */
+            if (w->prof)
+                spec.track = plan[i].lane == 1 ? amfi_profile_tracks(w->prof) / 2 : 0;
         }
         /* a vehicle cannot start its approach before the previous one: keep order */
         plan[i].entry_s = t;
