@@ -137,6 +137,9 @@ void amfi_config_defaults(amfi_site_config *c)
     m->dt_s = 1e-4;
     m->speedup = 1.0;
     m->headway_s = 0.0;
+    m->flow_veh_h = 0.0;
+    m->min_headway_s = 0.5;
+    m->lanes = 1;
     m->noise_ms2 = 0.0;
     m->block = 100;
     m->start_utime = 1767225600000000LL; /* 2026-01-01T00:00:00Z */

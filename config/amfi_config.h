@@ -104,6 +104,10 @@ typedef struct amfi_sim_config {
                                0 = as fast as possible ("max") */
     double headway_s;       /* headway_s: entry to entry, s, [0.1, 3600];
                                0 = the population's timestamps */
+    double flow_veh_h;      /* flow_veh_h: Poisson arrivals per lane, vehicles/h,
+                               [1, 3600]; 0 = off (headway_s) */
+    double min_headway_s;   /* min_headway_s: with flow, per lane, s, [0, 60] */
+    int lanes;              /* lanes: with flow, 1 .. 2 */
     double noise_ms2;       /* noise_ms2: extra Gaussian noise, m/s², [0, 10] */
     int block;              /* block: samples per accel message, 1 .. 160 */
     long long start_utime;  /* start_utime: data time of the first sample,

@@ -34,8 +34,8 @@ static int p_speedup(ctx *x, yaml_node_t *v, const char *path, const field *f,
     return 0;
 }
 
-/* simulation.stream.headway_s: 0 or null (stored as 0: the population's
- * timestamps) or seconds in the row's range. */
+/* simulation.stream.headway_s and flow_veh_h: 0 or null (stored as 0: the
+ * population's timestamps / no Poisson flow) or a value in the row's range. */
 static int p_headway(ctx *x, yaml_node_t *v, const char *path, const field *f,
                      void *base)
 {
@@ -45,8 +45,9 @@ static int p_headway(ctx *x, yaml_node_t *v, const char *path, const field *f,
         if (get_double(x, v, path, &d))
             return -1;
         if (d != 0.0 && out_of_range(d, f))
-            return fail(x, line_of(v), path, "must be 0 or null (the population's "
-                        "timestamps) or in [%g, %g], got %g", f->lo, f->hi, d);
+            return fail(x, line_of(v), path, "must be 0 or null (%s) or in [%g, %g], got %g",
+                        strcmp(f->key, "headway_s") ? "off" : "the population's timestamps",
+                        f->lo, f->hi, d);
     }
     memcpy((char *)base + f->off, &d, sizeof d);
     return 0;
@@ -223,6 +224,9 @@ static const field stream_fields[] = {
     {.key = "speedup", .kind = &K_SPEEDUP, .off = SIM(speedup), .lo = 0.01, .hi = 1e6},
     {.key = "headway_s", .kind = &K_HEADWAY, .off = SIM(headway_s), .lo = 0.1,
      .hi = 3600},
+    {.key = "flow_veh_h", .kind = &K_HEADWAY, .off = SIM(flow_veh_h), .lo = 1, .hi = 3600},
+    {.key = "min_headway_s", .kind = &K_DOUBLE, .off = SIM(min_headway_s), .lo = 0, .hi = 60},
+    {.key = "lanes", .kind = &K_INT, .off = SIM(lanes), .lo = 1, .hi = 2},
     {.key = "noise_ms2", .kind = &K_DOUBLE, .off = SIM(noise_ms2), .lo = 0, .hi = 10},
     {.key = "block", .kind = &K_INT, .off = SIM(block), .lo = 1, .hi = 160},
     {.key = "start_utime", .kind = &K_LLONG, .off = SIM(start_utime), .lo = 1,

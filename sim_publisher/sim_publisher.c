@@ -299,8 +299,9 @@ static void opts_from_config(opts *o, const amfi_sim_config *c, const char *file
     o->log = c->log[0] ? c->log : NULL;
     o->speedup = c->speedup;
     o->headway = c->headway_s;
-    o->min_headway = 0.5;
-    o->lanes = 1;
+    o->flow = c->flow_veh_h;
+    o->min_headway = c->min_headway_s;
+    o->lanes = c->lanes;
     o->damage_step_at = c->damage_step_at;
     o->noise_ms2 = c->noise_ms2;
     o->block = c->block;

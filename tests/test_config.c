@@ -95,6 +95,7 @@ static void test_defaults(void **state)
     assert_string_equal("", c.sim.lcm_url);
     assert_string_equal("", c.sim.log);
     assert_true(c.sim.speedup == 1.0 && c.sim.headway_s == 0.0);
+    assert_true(c.sim.flow_veh_h == 0.0 && c.sim.min_headway_s == 0.5 && c.sim.lanes == 1);
     assert_true(c.sim.noise_ms2 == 0.0);
     assert_int_equal(100, c.sim.block);
     assert_true(c.sim.start_utime == 1767225600000000LL);
@@ -300,6 +301,9 @@ static const char every_sim_key[] =
     "    log: out/traffic.lcmlog\n"
     "    speedup: 25\n"
     "    headway_s: 2\n"
+    "    flow_veh_h: 1200\n"
+    "    min_headway_s: 0.8\n"
+    "    lanes: 2\n"
     "    noise_ms2: 0.003\n"
     "    block: 160\n"
     "    start_utime: 4000000000000000\n"
@@ -331,6 +335,8 @@ static void test_every_sim_key(void **state)
     assert_string_equal("udpm://239.255.76.99:7667?ttl=0", c.sim.lcm_url);
     assert_string_equal("out/traffic.lcmlog", c.sim.log); /* not the file's folder */
     assert_true(c.sim.speedup == 25.0 && c.sim.headway_s == 2.0);
+    assert_true(c.sim.flow_veh_h == 1200.0 && c.sim.min_headway_s == 0.8);
+    assert_int_equal(2, c.sim.lanes);
     assert_true(c.sim.noise_ms2 == 0.003);
     assert_int_equal(160, c.sim.block);
     assert_true(c.sim.start_utime == 4000000000000000LL);
@@ -635,6 +641,12 @@ static const bad_case bad_cases[] = {
     {"sim_headway", "simulation:\n  stream: {headway_s: 0.05}\n", 2,
      "simulation.stream.headway_s",
      "must be 0 or null (the population's timestamps) or in [0.1, 3600], got 0.05"},
+    {"sim_flow", "simulation:\n  stream: {flow_veh_h: 0.5}\n", 2,
+     "simulation.stream.flow_veh_h", "must be 0 or null (off) or in [1, 3600], got 0.5"},
+    {"sim_min_headway", "simulation:\n  stream: {min_headway_s: -1}\n", 2,
+     "simulation.stream.min_headway_s", "[0, 60]"},
+    {"sim_lanes", "simulation:\n  stream: {lanes: 3}\n", 2, "simulation.stream.lanes",
+     "1 .. 2"},
     {"sim_headway_word", "simulation:\n  stream: {headway_s: population}\n", 2,
      "simulation.stream.headway_s", "'population'"},
     {"sim_noise_ms2", "simulation:\n  stream: {noise_ms2: 11}\n", 2,
