@@ -49,6 +49,8 @@ void release_windows(daemon_s *d, int flush)
         j->gvw_kg = NAN;
         /* everything the solver thread reads travels with the job */
         j->lambda = d->cfg.lambda;
+        j->speed_estimate = d->cfg.speed_estimate;
+        j->speed_prior = d->cfg.speed_prior;
         /* an ok window has data from every sensor; the others (gap: a
          * sensor that never sent a block) may have no ring at all */
         j->scan_rate_hz = d->rings[0] ? amfi_ring_rate(d->rings[0]) : 0.0;

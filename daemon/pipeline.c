@@ -32,6 +32,13 @@
 #include "amfi_passage_t.h"
 #include "amfid.h"
 
+/* The speed the passage was weighed with: the estimate when the solver
+ * estimated it (solver.speed: estimate), else the detector's. */
+static double speed_used(const job *j)
+{
+    return j->speed_estimated ? j->speed_used_mps : j->w.v.speed_mps;
+}
+
 static void publish_passage(daemon_s *d, const job *j, int64_t id)
 {
     amfi_passage_t m;
@@ -40,7 +47,7 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id)
     m.passage_id = id;
     m.vehicle_id = j->w.v.vehicle_id;
     m.lane = (int16_t)j->w.v.lane;
-    m.speed_mps = j->w.v.speed_mps;
+    m.speed_mps = speed_used(j);
     m.status = (char *)j->status;
     m.reason = (char *)j->reason;
     m.gvw_kg = j->solved ? j->gvw_kg : NAN;
@@ -51,6 +58,8 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id)
     m.formulation = (char *)amfi_formulation_name(d->cfg.solver.formulation);
     m.solve_ms = j->solve_ms;
     m.site_id = d->cfg.site.id;
+    m.speed_given_mps = j->w.v.speed_mps;
+    m.speed_estimated = (int8_t)j->speed_estimated;
     amfi_passage_t_publish(d->lcm, d->cfg.daemon.ch_passage, &m);
 }
 
@@ -119,7 +128,9 @@ static void job_row(const daemon_s *d, const job *j, amfi_passage_row *r)
     r->vehicle_id = j->w.v.vehicle_id;
     r->utime = j->w.v.utime;
     r->lane = j->w.v.lane;
-    r->speed_mps = j->w.v.speed_mps;
+    r->speed_mps = speed_used(j);
+    r->speed_given_mps = j->w.v.speed_mps;
+    r->speed_estimated = j->speed_estimated;
     r->n_axles = j->w.v.n_axles;
     for (int a = 0; a + 1 < r->n_axles; a++)
         r->spacing_m[a] = j->w.v.spacing_m[a];

@@ -116,9 +116,12 @@ static void solve_job(amfi_solver *s, job *j)
     for (int a = 0; a + 1 < p.n_axles; a++)
         p.axle_spacing_m[a] = j->w.v.spacing_m[a];
     amfi_result r;
+    amfi_speed_result sr;
     char err[256];
     double t0 = mono_s();
-    int rc = amfi_solve(s, &p, &j->lambda, &r, err, sizeof err);
+    int rc = j->speed_estimate
+                 ? amfi_solve_speed(s, &p, &j->lambda, &j->speed_prior, &r, &sr, err, sizeof err)
+                 : amfi_solve(s, &p, &j->lambda, &r, err, sizeof err);
     j->solve_ms = 1e3 * (mono_s() - t0);
     if (rc != 0) {
         snprintf(j->status, sizeof j->status, "error");
@@ -136,6 +139,10 @@ static void solve_job(amfi_solver *s, job *j)
     }
     j->solved = 1;
     snprintf(j->status, sizeof j->status, "ok");
+    if (j->speed_estimate) {
+        j->speed_used_mps = sr.speed_mps;
+        j->speed_estimated = 1;
+    }
     j->gvw_kg = r.gvw_kg;
     for (int a = 0; a < r.n_axles; a++)
         j->axle_kg[a] = r.axle_kg[a];

@@ -26,8 +26,12 @@ typedef struct job {
     double *accel;           /* n_sensors × w.n, owned */
     amfi_lambda lambda;      /* λ policy at release (a reload changes the next jobs) */
     double scan_rate_hz;     /* sample rate of the window's samples */
+    int speed_estimate;      /* solver.speed at release: 1 estimate (amfi_solve_speed) */
+    amfi_speed_prior speed_prior; /* its prior (solver.speed_sd, ...) at release */
     /* result */
     int solved;
+    double speed_used_mps;   /* the speed weighed with: the estimate, or w.v.speed_mps */
+    int speed_estimated;     /* 1: speed_used_mps is amfi_solve_speed's estimate */
     double gvw_kg, axle_kg[AMFI_MAX_AXLES], lambda_used, residual_rms, solve_ms;
     char status[16];
     char reason[200];

@@ -64,7 +64,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 2
+#define AMFI_STORE_SCHEMA_VERSION 3
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -123,7 +123,9 @@ typedef struct amfi_passage_row {
     int64_t utime;       /* entry of the first axle, data time, µs since 1970
                             UTC, 0 .. AMFI_STORE_MAX_UTIME */
     int lane;            /* −32768 .. 32767 */
-    double speed_mps;    /* 0 .. 150 m/s, or NaN */
+    double speed_mps;    /* the speed weighed with, 0 .. 150 m/s, or NaN */
+    double speed_given_mps; /* the detector's speed, 0 .. 150 m/s, or NaN */
+    int speed_estimated; /* 1: speed_mps was estimated from the data, else 0 */
     int n_axles;         /* 0 (unknown) .. AMFI_MAX_AXLES: axle rows stored */
     double spacing_m[AMFI_MAX_AXLES]; /* spacing_m[k]: axle k to axle k + 1
                             (0-based, as amfi_passage.axle_spacing_m),

@@ -178,10 +178,21 @@ static const char schema_v2[] =
     "  config_path TEXT NOT NULL CHECK (length(CAST(config_path AS BLOB)) BETWEEN 1 AND 4096)  -- file read\n"
     ") STRICT;\n";
 
+/* Version 3 (issue 12): the detector's speed beside the one weighed with
+ * (speed_mps, the estimate when solver.speed is estimate). Rows written
+ * before it were weighed with the detector's speed: it is copied. */
+static const char schema_v3[] =
+    "ALTER TABLE passages ADD COLUMN speed_given_mps REAL\n"
+    "  CHECK (speed_given_mps BETWEEN 0 AND 150);\n"
+    "ALTER TABLE passages ADD COLUMN speed_estimated INTEGER NOT NULL DEFAULT 0\n"
+    "  CHECK (speed_estimated IN (0, 1));\n"
+    "UPDATE passages SET speed_given_mps = speed_mps;\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
     {2, "runs: program version and configuration of each start of amfid", schema_v2},
+    {3, "passages: speed_given_mps (the detector's) and speed_estimated", schema_v3},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

@@ -31,6 +31,12 @@ static int check_passage(const amfi_passage_row *r, char *err, size_t errlen)
     if (rc == 0)
         rc = st_check_num("passages.speed_mps", r->speed_mps, &R_SPEED, err, errlen);
     if (rc == 0)
+        rc = st_check_num("passages.speed_given_mps", r->speed_given_mps, &R_SPEED, err,
+                          errlen);
+    if (rc == 0 && r->speed_estimated != 0 && r->speed_estimated != 1)
+        rc = st_fail(err, errlen, AMFI_EINVAL,
+                     "passages.speed_estimated: %d is not 0 or 1", r->speed_estimated);
+    if (rc == 0)
         rc = st_check_num("passages.gvw_kg", r->gvw_kg, &R_KG, err, errlen);
     if (rc == 0)
         rc = st_check_num("passages.lambda", r->lambda, &R_POS, err, errlen);
@@ -100,6 +106,8 @@ int amfi_store_add_passage(amfi_store *s, const amfi_passage_row *r,
         if (b == SQLITE_OK) b = st_bind_real(st, 10, r->residual_rms);
         if (b == SQLITE_OK) b = st_bind_text(st, 11, r->formulation);
         if (b == SQLITE_OK) b = st_bind_real(st, 12, r->solve_ms);
+        if (b == SQLITE_OK) b = st_bind_real(st, 13, r->speed_given_mps);
+        if (b == SQLITE_OK) b = sqlite3_bind_int(st, 14, r->speed_estimated);
         rc = st_run(s, ST_INS_PASSAGE, b, "passages: insert", err, errlen);
         if (rc == 0)
             pid = sqlite3_last_insert_rowid(s->db);

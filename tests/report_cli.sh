@@ -40,18 +40,19 @@ awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
     cat "$tmp/ddl.sql"
     cat <<'EOF'
 PRAGMA journal_mode = WAL;
-PRAGMA user_version = 2;
-INSERT INTO schema_migrations (version, description) VALUES (1, 'report_cli fixture'), (2, 'runs');
+PRAGMA user_version = 3;
+INSERT INTO schema_migrations (version, description) VALUES (1, 'report_cli fixture'), (2, 'runs'),
+    (3, 'speed_given_mps');
 WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 40)
 INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status,
-                      reason, lambda, residual_rms, formulation, solve_ms)
+                      reason, lambda, residual_rms, formulation, solve_ms, speed_given_mps)
 SELECT i, 1763769600000000 + i * 3600000000, 1, 25.0, 2,
        CASE WHEN i % 10 = 0 THEN NULL ELSE 15000.0 + 1000 * (i % 7) END,
        CASE WHEN i % 10 = 0 THEN 'gap' ELSE 'ok' END,
        CASE WHEN i % 10 = 0 THEN '12 samples missing in the window' ELSE '' END,
        CASE WHEN i % 10 = 0 THEN NULL ELSE 7.94e-9 END,
        CASE WHEN i % 10 = 0 THEN NULL ELSE 0.001 END,
-       CASE WHEN i % 10 = 0 THEN NULL ELSE 'paper' END, 15.0
+       CASE WHEN i % 10 = 0 THEN NULL ELSE 'paper' END, 15.0, 25.0
 FROM k;
 INSERT INTO axles (passage_id, idx, spacing_m, load_kg)
 SELECT id, 1, NULL, 0.4 * gvw_kg FROM passages;
@@ -221,11 +222,12 @@ if ok passages-csv --db "$ex" --passages --format csv --status gap; then
     n=$(($(wc -l < "$tmp/out") - 1))
     [ "$n" -eq 4 ] || problem "$n CSV rows of gap passages, expected 4"
     hdr=$(head -1 "$tmp/out")
-    [ "$(echo "$hdr" | awk -F, '{print NF}')" -eq 33 ] || problem "CSV header has $(echo "$hdr" | awk -F, '{print NF}') columns"
-    bad_rows=$(awk -F, 'NR > 1 && NF != 33' "$tmp/out" | wc -l)
-    [ "$bad_rows" -eq 0 ] || problem "$bad_rows CSV rows without 33 columns"
+    [ "$(echo "$hdr" | awk -F, '{print NF}')" -eq 35 ] || problem "CSV header has $(echo "$hdr" | awk -F, '{print NF}') columns"
+    echo "$hdr" | grep -q ',status,reason,speed_given_mps,speed_estimated$' || problem "CSV header: $hdr"
+    bad_rows=$(awk -F, 'NR > 1 && NF != 35' "$tmp/out" | wc -l)
+    [ "$bad_rows" -eq 0 ] || problem "$bad_rows CSV rows without 35 columns"
     has '^2025-11-22T10:00:00Z,1763805600000000,10,10,1,25\.000,2,,,,'
-    has ',gap,12 samples missing in the window$'
+    has ',gap,12 samples missing in the window,25\.000,0$'
 fi
 if ok passages-csv-values --db "$ex" --passages --format csv --from 2025-11-22T03:00:00Z --to 2025-11-22T03:00:00Z; then
     row=$(sed -n 2p "$tmp/out")
@@ -307,7 +309,7 @@ if ok passages-json-mixed --db "$ex" --summary --overloads --passages --format j
     n=$(grep -o '"passage_id":' "$tmp/out" | wc -l)
     [ "$n" -eq "$want" ] || problem "$n passage objects, expected $want (gap passages + overloads at the 96/53/EC defaults)"
     has '"by_status":\{"ok":36,"gap":4,'
-    has ',"passages":\[\{"time_utc":"2025-11-22T10:00:00Z",.*"reason":"12 samples missing in the window"\}.*\]\}$'
+    has ',"passages":\[\{"time_utc":"2025-11-22T10:00:00Z",.*"reason":"12 samples missing in the window","speed_given_mps":25\.0,"speed_estimated":false\}.*\]\}$'
 fi
 if ok passages-json-none --db "$ex" --passages --format json --lane 7; then
     [ -z "$jcheck" ] || "$jcheck" site_id=fixture-1 < "$tmp/out" || problem "JSON does not parse"
@@ -403,7 +405,7 @@ bad foreign 1 'not an amfi store' --db "$tmp/recipes.db"
 
 cp "$tmp/pristine.db" "$tmp/newer.db"
 sqlite3 "$tmp/newer.db" "PRAGMA user_version = 7"
-bad newer 1 'schema version 7 is newer than this program.s 2' --db "$tmp/newer.db"
+bad newer 1 'schema version 7 is newer than this program.s 3' --db "$tmp/newer.db"
 
 cp "$tmp/pristine.db" "$tmp/damaged.db"
 sqlite3 "$tmp/damaged.db" "PRAGMA ignore_check_constraints = ON; UPDATE passages SET gvw_kg = -1 WHERE id = 3"
@@ -465,7 +467,7 @@ if command -v gnuplot > /dev/null; then
     fi
     # an empty store still draws (empty plots saying so), a missing dir parent fails
     sqlite3 "$tmp/empty.db" < "$tmp/ddl.sql"
-    sqlite3 "$tmp/empty.db" "PRAGMA user_version = 2; INSERT INTO schema_migrations (version, description) VALUES (1, 'e'), (2, 'e')"
+    sqlite3 "$tmp/empty.db" "PRAGMA user_version = 3; INSERT INTO schema_migrations (version, description) VALUES (1, 'e'), (2, 'e'), (3, 'e')"
     if ok plot-empty --db "$tmp/empty.db" --plot "$tmp/plots-empty"; then
         for p in gvw trend gvw_histogram passages_per_hour speed; do png_ok "$tmp/plots-empty/$p.png"; done
     fi

@@ -146,6 +146,7 @@ static void ok_row(amfi_passage_row *r, int64_t vehicle_id, int64_t utime,
     r->utime = utime;
     r->lane = 1;
     r->speed_mps = 25.0;
+    r->speed_given_mps = 25.0;
     r->n_axles = 2;
     r->spacing_m[0] = 4.5;
     r->axle_kg[0] = 0.4 * gvw_kg;
@@ -839,25 +840,78 @@ static void test_runs_and_migration_from_v1(void **state)
     assert_string_equal("/etc/amfid/amfid.yaml",
                         raw_text(db, "SELECT config_path FROM runs", buf, sizeof buf));
     assert_int_equal(1, raw_int(db, "SELECT started_at LIKE '____-__-__T__:__:__.___Z' FROM runs"));
-    raw_exec(db, "DROP TABLE runs; DELETE FROM schema_migrations WHERE version = 2; "
-                 "PRAGMA user_version = 1");
+    raw_exec(db, "DROP TABLE runs; ALTER TABLE passages DROP COLUMN speed_given_mps; "
+                 "ALTER TABLE passages DROP COLUMN speed_estimated; "
+                 "DELETE FROM schema_migrations WHERE version >= 2; PRAGMA user_version = 1");
     sqlite3_close(db);
 
     /* read-only openers do not migrate: they say so */
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 1 is older than this program's 2"));
+    assert_non_null(strstr(err, "schema version 1 is older than this program's 3"));
     assert_null(ro);
 
     /* read-write: migrated, the data kept */
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(2, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(2, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(3, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM runs"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
     sqlite3_close(db);
     assert_int_equal(0, amfi_store_add_run(f->s, "0.2.0", "a.yaml", &id, err, sizeof err));
     assert_int_equal(1, id);
+}
+
+/* ---- version 3: the detector's speed; a version-2 file migrates -------------- */
+
+static void test_speed_given_and_migration_from_v2(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    amfi_passage_row r;
+    amfi_store *ro = NULL;
+    sqlite3 *db;
+
+    /* an estimated speed beside the detector's */
+    ok_row(&r, 1, DAY_US, 18000.0);
+    r.speed_mps = 24.1;
+    r.speed_given_mps = 25.0;
+    r.speed_estimated = 1;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    r.speed_given_mps = 400.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.speed_given_mps: 400 m/s is out of range"));
+    r.speed_given_mps = 25.0;
+    r.speed_estimated = 2;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.speed_estimated: 2 is not 0 or 1"));
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    db = raw_open(f->path);
+    assert_int_equal(1, raw_int(db, "SELECT speed_estimated FROM passages"));
+    assert_int_equal(1, raw_int(db, "SELECT speed_given_mps = 25.0 AND speed_mps = 24.1 "
+                                    "FROM passages"));
+    /* make it a version-2 file: the detector's speed was the one weighed with */
+    raw_exec(db, "ALTER TABLE passages DROP COLUMN speed_given_mps; "
+                 "ALTER TABLE passages DROP COLUMN speed_estimated; "
+                 "UPDATE passages SET speed_mps = 25.0; "
+                 "DELETE FROM schema_migrations WHERE version = 3; PRAGMA user_version = 2");
+    sqlite3_close(db);
+
+    assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
+    assert_non_null(strstr(err, "schema version 2 is older than this program's 3"));
+    assert_null(ro);
+
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(3, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE speed_given_mps = 25.0 "
+                                    "AND speed_mps = 25.0 AND speed_estimated = 0"));
+    sqlite3_close(db);
+    ok_row(&r, 2, 2 * DAY_US, 18000.0);
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
 }
 
 /* ---- what amfid and amfi-report read back ------------------------------------ */
@@ -1293,6 +1347,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_corrupt_rows_reported, setup, teardown),
         cmocka_unit_test_setup_teardown(test_readonly, setup, teardown),
         cmocka_unit_test_setup_teardown(test_runs_and_migration_from_v1, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_speed_given_and_migration_from_v2, setup, teardown),
         cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
         cmocka_unit_test_setup_teardown(test_many_passages, setup, teardown),
