@@ -18,7 +18,7 @@ pids=""
 cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
 trap cleanup EXIT
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
-N=8
+N=4
 
 sed -e "s/^  speed: measured /  speed: estimate /" "$config" > "$dir/amfid.yaml"
 grep -q "^  speed: estimate " "$dir/amfid.yaml" || fail "the test's solver.speed did not apply"
@@ -30,8 +30,9 @@ timeout 120 "$sim" --vehicles $N --headway 3 --speedup 10 --seed 7 --speed-error
   2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1
 kill -TERM $apid
+# an estimated passage is ~100 sweeps: the drain takes minutes under ASan
 i=0; while kill -0 $apid 2>/dev/null; do
-  i=$((i + 1)); [ $i -lt 600 ] || fail "amfid did not stop on SIGTERM"; sleep 0.1; done
+  i=$((i + 1)); [ $i -lt 3000 ] || fail "amfid did not stop on SIGTERM"; sleep 0.1; done
 wait $apid || fail "amfid exit status $?"
 
 q() { sqlite3 "$dir/s.db" "$1"; }
