@@ -127,6 +127,8 @@ static void round_make(struct round *r, int i)
     r->passage.formulation = "modal";
     r->passage.solve_ms = 14.5 + 0.25 * (i % 8);
     r->passage.site_id = "selftest-site";
+    r->passage.speed_given_mps = r->vehicle.speed_mps * 1.02; /* the detector 2 % high */
+    r->passage.speed_estimated = 1;
 
     r->unsolved = r->passage;
     r->unsolved.passage_id = 100000 + i;
@@ -264,7 +266,9 @@ static void print_round(const struct round *r)
     put_d("residual_rms", p->residual_rms, ";");
     put_s("formulation", p->formulation, ";");
     put_d("solve_ms", p->solve_ms, ";");
-    put_s("site_id", p->site_id, "\n");
+    put_s("site_id", p->site_id, ";");
+    put_d("speed_given_mps", p->speed_given_mps, ";");
+    put_i("speed_estimated", p->speed_estimated, "\n");
 
     const amfi_indicator_t *d = &r->indicator;
     printf("%s\tamfi.indicator_t\t", AMFI_CHANNEL_INDICATOR);
