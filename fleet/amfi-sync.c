@@ -34,7 +34,8 @@ enum { BATCH_ROWS = 5000, SITE_ID_MAX = 63 };
 static volatile sig_atomic_t stop_requested;
 static void on_signal(int sig) { (void)sig; stop_requested = 1; }
 
-/* 64-bit FNV-1a over a row's text form (fields separated by 0x1f). */
+/* 64-bit FNV-1a over a row's text form (fields separated by 0x1f); row_hash
+ * takes the first ncols columns (fleet_table.hash_cols). */
 static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
 {
     const unsigned char *b = p;
@@ -86,12 +87,12 @@ static const unsigned char *col_text(sqlite3_stmt *st, int i, char tmp[40], int 
     return *isnull ? (const unsigned char *)"" : sqlite3_column_text(st, i);
 }
 
-static uint64_t row_hash(sqlite3_stmt *st)
+static uint64_t row_hash(sqlite3_stmt *st, int ncols)
 {
     uint64_t h = 0xcbf29ce484222325ULL;
     char tmp[40];
     int isnull;
-    for (int i = 0; i < sqlite3_column_count(st); i++) {
+    for (int i = 0; i < ncols && i < sqlite3_column_count(st); i++) {
         const unsigned char *s = col_text(st, i, tmp, &isnull);
         h = fnv1a(h, isnull ? "\x01N" : (const char *)s, isnull ? 2 : strlen((const char *)s));
         h = fnv1a(h, "\x1f", 1);
@@ -181,8 +182,11 @@ static int apply_schema(PGconn *pg)
 }
 
 
-/* COPY the rows of one SELECT into table dst with the site id in front. */
+/* COPY the rows of one SELECT into table dst with the site id in front;
+ * the last row's id and the hash of its first hash_cols columns go to
+ * *last_id and *last_hash when last_id is not NULL. */
 static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst, const char *cols,
+                     int hash_cols,
                      const char *sel, int64_t lo, int64_t hi, int64_t *last_id, uint64_t *last_hash,
                      long *nrows)
 {
@@ -205,7 +209,7 @@ static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst,
             if (buf_field(&b, s, isnull)) { rc = SQLITE_NOMEM; break; }
         }
         if (buf_put(&b, "\n", 1)) { rc = SQLITE_NOMEM; break; }
-        if (last_id) { *last_id = sqlite3_column_int64(st, 0); *last_hash = row_hash(st); }
+        if (last_id) { *last_id = sqlite3_column_int64(st, 0); *last_hash = row_hash(st, hash_cols); }
         n++;
     }
     if (rc != SQLITE_DONE) {
@@ -256,7 +260,7 @@ static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const struct fl
         }
         sqlite3_bind_int64(st, 1, hwm);
         int rc = sqlite3_step(st);
-        uint64_t h = rc == SQLITE_ROW ? row_hash(st) : 0;
+        uint64_t h = rc == SQLITE_ROW ? row_hash(st, t->hash_cols) : 0;
         sqlite3_finalize(st);
         if (rc != SQLITE_ROW || h != hash) {
             fprintf(stderr,
@@ -276,11 +280,11 @@ static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const struct fl
         long n = 0, nc = 0;
         snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE id > ?1 AND ?2 > 0 ORDER BY id LIMIT %d",
                  t->cols, t->name, BATCH_ROWS);
-        int rc = copy_rows(pg, db, site, t->name, t->cols, sql, hwm, 1, &last, &lh, &n);
+        int rc = copy_rows(pg, db, site, t->name, t->cols, t->hash_cols, sql, hwm, 1, &last, &lh, &n);
         if (!rc && n > 0 && t->child) {
             snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE %s > ?1 AND %s <= ?2 ORDER BY %s",
                      t->child_cols, t->child, t->child_parent, t->child_parent, t->child_parent);
-            rc = copy_rows(pg, db, site, t->child, t->child_cols, sql, hwm, last, NULL, NULL, &nc);
+            rc = copy_rows(pg, db, site, t->child, t->child_cols, 0, sql, hwm, last, NULL, NULL, &nc);
         }
         if (!rc && n > 0) {
             char shwm[24], shash[24];
@@ -380,6 +384,23 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         return EX_RETRY;
     }
     sqlite3_busy_timeout(db, 5000);
+    /* The columns shipped are those of the current store schema; amfid
+     * migrates an older store when it starts (read-only here, amfi-sync
+     * cannot). Retried: follow mode goes on once amfid has run. */
+    sqlite3_stmt *uv = NULL;
+    int store_version = -1;
+    if (sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &uv, NULL) == SQLITE_OK
+        && sqlite3_step(uv) == SQLITE_ROW)
+        store_version = sqlite3_column_int(uv, 0);
+    sqlite3_finalize(uv);
+    if (store_version < FLEET_MIN_STORE_VERSION) {
+        fprintf(stderr, "amfi-sync: %s: store schema version %d, this amfi-sync needs %d or newer: "
+                        "start the new amfid once (it migrates the store), then sync\n",
+                store, store_version, FLEET_MIN_STORE_VERSION);
+        sqlite3_close(db);
+        PQfinish(pg);
+        return EX_RETRY;
+    }
     char site[SITE_ID_MAX + 1] = "";
     if (!store_site_id(db, site)) {
         if (!site_opt) {

@@ -77,22 +77,32 @@ static const char fleet_v2[] =
     "  FROM indicators AS i\n"
     "  LEFT JOIN alerts AS a ON a.site_id = i.site_id AND a.indicator_id = i.id;\n";
 
+/* Version 3: the passage's detector speed and whether the speed used was
+ * estimated (site store version 3, issue 12). Rows shipped before: the
+ * detector speed unknown (NULL), not estimated (0, as the site store says
+ * of them). A constant default adds the column without rewriting the
+ * table. */
+static const char fleet_v3[] =
+    "ALTER TABLE passages ADD COLUMN speed_given_mps double precision,\n"
+    "  ADD COLUMN speed_estimated integer NOT NULL DEFAULT 0;\n";
+
 const struct fleet_migration fleet_migrations[] = {
     {1, "site tables with site_id, fleet_sync_state, fleet views", fleet_v1},
     {2, "fleet_window_trend: indicators with their alerts, per site", fleet_v2},
+    {3, "passages: speed_given_mps and speed_estimated", fleet_v3},
 };
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
 
 const struct fleet_table fleet_tables[] = {
     {"passages",
      "id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason, lambda, "
-     "residual_rms, formulation, solve_ms, stored_at",
+     "residual_rms, formulation, solve_ms, stored_at, speed_given_mps, speed_estimated", 14,
      "axles", "passage_id, idx, spacing_m, load_kg", "passage_id"},
     {"indicators",
-     "id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state",
+     "id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state", 10,
      NULL, NULL, NULL},
-    {"alerts", "id, utime, level, kind, message, indicator_id, raised", NULL, NULL, NULL},
-    {"baseline", "id, utime_set, n, mean_kg, std_kg, source, note, set_at", NULL, NULL, NULL},
-    {"runs", "id, started_at, version, config_path", NULL, NULL, NULL},
+    {"alerts", "id, utime, level, kind, message, indicator_id, raised", 7, NULL, NULL, NULL},
+    {"baseline", "id, utime_set, n, mean_kg, std_kg, source, note, set_at", 8, NULL, NULL, NULL},
+    {"runs", "id, started_at, version, config_path", 4, NULL, NULL, NULL},
 };
 const int fleet_n_tables = (int)(sizeof fleet_tables / sizeof fleet_tables[0]);

@@ -20,11 +20,18 @@ extern const int fleet_n_migrations;
 struct fleet_table {
     const char *name;
     const char *cols;
+    int hash_cols;             /* leading columns in the row hash: those of
+                                  central version 1, so that marks written
+                                  before a column was added still match */
     const char *child;         /* NULL or child table */
     const char *child_cols;    /* its columns, parent id first */
     const char *child_parent;  /* the parent id column in the child */
 };
 extern const struct fleet_table fleet_tables[];
 extern const int fleet_n_tables;
+
+/* The oldest site store schema (PRAGMA user_version) whose columns
+ * fleet_tables names: amfid migrates older stores when it starts. */
+#define FLEET_MIN_STORE_VERSION 3
 
 #endif

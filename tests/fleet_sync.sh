@@ -23,6 +23,8 @@ fail() { echo "FAIL $case: $*"; failures=$((failures + 1)); }
 awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
      on && !/^```/' "$doc" > "$tmp/ddl.sql"
 [ -s "$tmp/ddl.sql" ] || { echo "fleet_sync.sh: no DDL block in $doc" >&2; exit 1; }
+store_version=$(sed -n 's/.*PRAGMA user_version` (this document: version \([0-9]*\)).*/\1/p' "$doc")
+[ -n "$store_version" ] || { echo "fleet_sync.sh: no schema version in $doc" >&2; exit 1; }
 
 # add_rows DB N: N passages (2 axles each), an indicator per 10, an alert per 50.
 add_rows() {
@@ -53,6 +55,7 @@ SQL
 # mkstore DB SITE N
 mkstore() {
     { cat "$tmp/ddl.sql"; echo "PRAGMA journal_mode = WAL;
+PRAGMA user_version = $store_version;
 INSERT INTO meta (key, value) VALUES ('site.id', '$2');
 INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note) VALUES (0, 30, 17800, 1900, 'auto', '');
 INSERT INTO runs (version, config_path) VALUES ('0.test', '/etc/amfi/amfid.yaml');"; } |
@@ -70,11 +73,12 @@ same() {
 
 case=init
 "$sync" --pg "$PG_CONNINFO" --init-schema 2> "$tmp/init.log" || fail "--init-schema: $(cat "$tmp/init.log")"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 2 ] || fail "schema version"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 3 ] || fail "schema version"
 # a central database of version 1 migrates on the next contact
-pg_q "DROP VIEW fleet_window_trend; DELETE FROM fleet_migrations WHERE version = 2"
-"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 2"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 2 ] || fail "not migrated to 2"
+pg_q "DROP VIEW fleet_window_trend; ALTER TABLE passages DROP COLUMN speed_given_mps,
+      DROP COLUMN speed_estimated; DELETE FROM fleet_migrations WHERE version > 1"
+"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 3"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 3 ] || fail "not migrated to 3"
 pg_q "SELECT count(*) FROM fleet_window_trend" > /dev/null || fail "no fleet_window_trend after migration"
 grep -q password "$tmp/init.log" && fail "log mentions a password"
 
@@ -153,6 +157,24 @@ add_rows "$tmp/c-backup.db" 500  # ids past the mark, but the row at the mark di
 [ $? = 3 ] || fail "restored store with more rows: not refused"
 [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-c'")" = "$before" ] || fail "rows merged"
 same "$tmp/c.db" site-c
+
+case=old-store
+# a store amfid has not migrated yet (version 2): nothing shipped, exit 1
+# (retried in follow mode), the message says what to do
+cp "$tmp/a.db" "$tmp/old.db"
+sqlite3 "$tmp/old.db" "PRAGMA user_version = 2; UPDATE meta SET value = 'site-old' WHERE key = 'site.id'"
+"$sync" --db "$tmp/old.db" --pg "$PG_CONNINFO" --once 2> "$tmp/old.log"
+rc=$?
+[ $rc = 1 ] || fail "a version-2 store: exit $rc, expected 1"
+grep -q "store schema version 2, this amfi-sync needs" "$tmp/old.log" || fail "message: $(cat "$tmp/old.log")"
+[ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-old'")" = 0 ] || fail "a version-2 store shipped"
+# the new columns ship as they are in the store
+add_rows "$tmp/a.db" 20
+sqlite3 "$tmp/a.db" "UPDATE passages SET speed_given_mps = 26.25, speed_estimated = 1 WHERE id = (SELECT max(id) FROM passages)"
+"$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync of estimated speeds"
+[ "$(pg_q "SELECT speed_given_mps || ' ' || speed_estimated FROM passages WHERE site_id = 'site-a' ORDER BY id DESC LIMIT 1")" = "26.25 1" ] ||
+    fail "speed_given_mps/speed_estimated not shipped"
+same "$tmp/a.db" site-a
 
 case=usage
 "$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --site 'bad id' --once 2> /dev/null
