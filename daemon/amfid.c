@@ -64,13 +64,6 @@ void set_error(daemon_s *d, const char *fmt, ...)
     LOG_WARN("%s", d->last_error);
 }
 
-double amfid_mono_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
 static volatile sig_atomic_t stop_flag, reload_flag;
 static void on_stop(int sig)
 {
@@ -278,7 +271,7 @@ int amfid_run(daemon_s *d)
             reload_flag = 0;
             reload(d);
         }
-        double now = amfid_mono_s();
+        double now = amfi_mono_s();
         if (now - last_beat >= d->cfg.daemon.status_period_s) {
             heartbeat(d);
             reject_tick(d);

@@ -25,6 +25,7 @@
 #include "amfi/amfi.h"
 #include "amfi_config.h"
 #include "amfi_msg_check.h"
+#include "amfi_time.h" /* amfi_mono_s: timeouts, backoff, periods (wall time) */
 #include "amfi_version.h"
 #include "indicators.h"
 #include "pool.h"
@@ -45,8 +46,6 @@ extern FILE *amfid_log_stream;
 #define LOG_INFO(...) amfid_log(SD_INFO "amfid: ", __VA_ARGS__)
 #define LOG_WARN(...) amfid_log(SD_WARNING "amfid: ", __VA_ARGS__)
 #define LOG_ERR(...) amfid_log(SD_ERR "amfid: ", __VA_ARGS__)
-
-double amfid_mono_s(void);
 
 /* ---- command line (options.c) ------------------------------------------- */
 
@@ -75,7 +74,7 @@ typedef struct reject_state {
     int64_t total;
     int64_t held, held_by[REJECT_NINPUTS][REJECT_NREASONS]; /* not logged this period */
     int logged;                                             /* lines logged this period */
-    double period_start;                                    /* amfid_mono_s() */
+    double period_start;                                    /* amfi_mono_s() */
 } reject_state;
 
 /* Alert notices (notify.c). */
@@ -84,7 +83,7 @@ typedef struct reject_state {
 struct notice;
 typedef struct notify_state {
     int pid[NOTIFY_MAX_RUNNING];        /* running children, 0: free slot */
-    double started[NOTIFY_MAX_RUNNING]; /* amfid_mono_s() at spawn */
+    double started[NOTIFY_MAX_RUNNING]; /* amfi_mono_s() at spawn */
     int term_sent[NOTIFY_MAX_RUNNING];  /* SIGTERM sent (timed out) */
     int running;
     struct notice *queue[NOTIFY_QUEUE];
@@ -108,7 +107,7 @@ typedef struct metrics_state {
     char open_kind[OPEN_KINDS][32];      /* alert kinds seen, and whether open */
     int open[OPEN_KINDS];
     double start_wall;            /* time(NULL) at start */
-    double last_write;            /* amfid_mono_s() of the last write */
+    double last_write;            /* amfi_mono_s() of the last write */
     int64_t write_errors;
     int failing;                  /* the last write failed (logged once) */
 } metrics_state;
@@ -141,7 +140,7 @@ typedef struct daemon_s {
     job **held;
     int held_n, held_head, held_peak;
     int64_t passages_lost;         /* held queue overflowed (each logged) */
-    double retry_at, retry_wait;   /* amfid_mono_s() of the next try; backoff */
+    double retry_at, retry_wait;   /* amfi_mono_s() of the next try; backoff */
     int degraded;
     int64_t degraded_utime;        /* data time the store_degraded alert was raised */
     char degraded_msg[1024];       /* its message, stored once the store writes again */
@@ -151,7 +150,7 @@ typedef struct daemon_s {
     metrics_state metrics;
     int64_t run_id;                /* this start's row in the store's runs table */
     int64_t samples_missing;       /* as of the last heartbeat */
-    double intake_recorded;        /* amfid_mono_s() of the last record_intake */
+    double intake_recorded;        /* amfi_mono_s() of the last record_intake */
 } daemon_s;
 
 void set_error(daemon_s *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

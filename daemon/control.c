@@ -88,7 +88,7 @@ void restore_indicator_state(daemon_s *d)
 
 void record_intake(daemon_s *d, int force)
 {
-    double now = amfid_mono_s();
+    double now = amfi_mono_s();
     if (!force && d->intake_recorded > 0 && now - d->intake_recorded < INTAKE_PERIOD_S)
         return;
     d->intake_recorded = now;

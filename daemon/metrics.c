@@ -215,7 +215,7 @@ void metrics_tick(daemon_s *d, int force)
     const char *path = d->cfg.daemon.metrics_path;
     if (!path[0])
         return;
-    double now = amfid_mono_s();
+    double now = amfi_mono_s();
     if (!force && m->last_write > 0 && now - m->last_write < d->cfg.daemon.metrics_interval_s)
         return;
     m->last_write = now;

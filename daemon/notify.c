@@ -68,7 +68,7 @@ static int start_child(daemon_s *d, struct notice *n)
     for (int i = 0; i < NOTIFY_MAX_RUNNING; i++)
         if (ns->pid[i] == 0) {
             ns->pid[i] = pid;
-            ns->started[i] = amfid_mono_s();
+            ns->started[i] = amfi_mono_s();
             ns->term_sent[i] = 0;
             ns->running++;
             ns->started_total++;
@@ -157,7 +157,7 @@ void notify_tick(daemon_s *d)
     notify_state *ns = &d->notify;
     if (ns->running == 0 && ns->queued == 0)
         return;
-    double now = amfid_mono_s();
+    double now = amfi_mono_s();
     for (int i = 0; i < NOTIFY_MAX_RUNNING; i++) {
         if (ns->pid[i] == 0)
             continue;

@@ -259,7 +259,7 @@ static void hold(daemon_s *d, job *j)
         d->held_peak = d->held_n;
     if (!d->degraded) {
         d->retry_wait = 1.0;
-        d->retry_at = amfid_mono_s() + d->retry_wait;
+        d->retry_at = amfi_mono_s() + d->retry_wait;
     }
     set_degraded(d, 1);
 }
@@ -277,9 +277,9 @@ static int store_job(daemon_s *d, job *j)
 
 void pipeline_retry(daemon_s *d, double final)
 {
-    double until = amfid_mono_s() + final;
+    double until = amfi_mono_s() + final;
     while (d->held_n > 0) {
-        double now = amfid_mono_s();
+        double now = amfi_mono_s();
         if (now < d->retry_at) {
             if (final <= 0)
                 return;
@@ -302,9 +302,9 @@ void pipeline_retry(daemon_s *d, double final)
             return;
         }
         d->retry_wait = fmin(2.0 * d->retry_wait, 30.0);
-        d->retry_at = amfid_mono_s() + d->retry_wait;
+        d->retry_at = amfi_mono_s() + d->retry_wait;
         sd_notifyf(0, "STATUS=degraded: store cannot be written, %d passages held", d->held_n);
-        if (final <= 0 || amfid_mono_s() >= until) {
+        if (final <= 0 || amfi_mono_s() >= until) {
             if (final > 0)
                 break;
             return;

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "pool.h"
+#include "amfi_time.h"
 
 void job_free(job *j)
 {
@@ -94,13 +95,6 @@ void queue_close(queue *q)
 
 /* ---- solver threads ------------------------------------------------------- */
 
-static double mono_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
 /* Weigh the job's passage; the result goes into the job. */
 static void solve_job(amfi_solver *s, job *j)
 {
@@ -118,11 +112,11 @@ static void solve_job(amfi_solver *s, job *j)
     amfi_result r;
     amfi_speed_result sr;
     char err[256];
-    double t0 = mono_s();
+    double t0 = amfi_mono_s();
     int rc = j->speed_estimate
                  ? amfi_solve_speed(s, &p, &j->lambda, &j->speed_prior, &r, &sr, err, sizeof err)
                  : amfi_solve(s, &p, &j->lambda, &r, err, sizeof err);
-    j->solve_ms = 1e3 * (mono_s() - t0);
+    j->solve_ms = 1e3 * (amfi_mono_s() - t0);
     if (rc != 0) {
         snprintf(j->status, sizeof j->status, "error");
         snprintf(j->reason, sizeof j->reason, "solver: %.180s", err);

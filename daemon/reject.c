@@ -74,7 +74,7 @@ void reject_note(daemon_s *d, int input, int reason, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(d->last_error, sizeof d->last_error, fmt, ap);
     va_end(ap);
-    double now = amfid_mono_s();
+    double now = amfi_mono_s();
     if (now - r->period_start >= REJECT_LOG_PERIOD_S)
         summarise(d, now);
     if (r->logged < REJECT_LOG_BURST) {
@@ -91,14 +91,14 @@ void reject_note(daemon_s *d, int input, int reason, const char *fmt, ...)
 
 void reject_tick(daemon_s *d)
 {
-    double now = amfid_mono_s();
+    double now = amfi_mono_s();
     if (now - d->rej.period_start >= REJECT_LOG_PERIOD_S)
         summarise(d, now);
 }
 
 void reject_final(daemon_s *d)
 {
-    summarise(d, amfid_mono_s());
+    summarise(d, amfi_mono_s());
     const reject_state *r = &d->rej;
     for (int i = 0; i < REJECT_NINPUTS; i++)
         for (int k = 0; k < REJECT_NREASONS; k++)

@@ -27,6 +27,7 @@
 #include "amfi_cli.h"
 #include "amfi_config.h"
 #include "fleet_schema.h"
+#include "amfi_time.h"
 
 enum { BATCH_ROWS = 5000, SITE_ID_MAX = 63 };
 
@@ -105,16 +106,10 @@ static uint64_t row_hash(sqlite3_stmt *st, int ncols)
  * set no watchdog). */
 static uint64_t wd_usec;
 static double wd_last;
-static double mono_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 static void keepalive(void)
 {
     if (!wd_usec) return;
-    double now = mono_s();
+    double now = amfi_mono_s();
     if (now - wd_last >= 0.5e-6 * (double)wd_usec) {
         sd_notify(0, "WATCHDOG=1");
         wd_last = now;
@@ -456,9 +451,9 @@ static void usage(FILE *f)
 /* Sleeps s seconds or until a stop is asked, pinging the watchdog. */
 static void pause_s(double s)
 {
-    double end = mono_s() + s;
+    double end = amfi_mono_s() + s;
     while (!stop_requested) {
-        double left = end - mono_s();
+        double left = end - amfi_mono_s();
         if (left <= 0) break;
         if (wd_usec && left > 0.25e-6 * (double)wd_usec) left = 0.25e-6 * (double)wd_usec;
         struct timespec ts = {(time_t)left, (long)((left - (double)(time_t)left) * 1e9)};
@@ -529,7 +524,7 @@ int main(int argc, char **argv)
      * batch in flight. Under systemd (Type=notify): READY after the first
      * pass, STATUS after each, WATCHDOG pings (keepalive). */
     if (sd_watchdog_enabled(0, &wd_usec) <= 0) wd_usec = 0;
-    wd_last = mono_s();
+    wd_last = amfi_mono_s();
     double backoff = 1;
     int ready = 0, rc = 0;
     while (!stop_requested) {

@@ -93,6 +93,7 @@
 #include "traffic.h"
 #include "vbi.h"
 #include "vehicle.h"
+#include "amfi_time.h"
 
 #define PROG "sim_publisher"
 
@@ -520,13 +521,6 @@ static int emit(bus *b, const char *channel, int64_t utime, const void *data, in
         rc_;                                                                          \
     })
 
-static double wall_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
 typedef struct planned {
     amfi_sim_vehicle v;  /* id = first + index in the plan + 1 */
     int rec;             /* its population record (first + index without
@@ -674,7 +668,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
     long next_add = 0, next_announce = 0, left = 0;
     const double t_end_extra = 3.0;
     double t_last_left = -1.0;
-    const double w0 = wall_s();
+    const double w0 = amfi_mono_s();
     gsl_rng *noise = gsl_rng_alloc(gsl_rng_mt19937);
     gsl_rng_set(noise, o->seed ^ 0x5eedu);
     int stepped = 0; /* the damage step has happened */
@@ -784,7 +778,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             break;
         /* pacing */
         if (o->speedup > 0) {
-            double due = w0 + amfi_sim_time(sim) / o->speedup - wall_s();
+            double due = w0 + amfi_sim_time(sim) / o->speedup - amfi_mono_s();
             if (due > 0) {
                 struct timespec ts = {(time_t)due, (long)((due - floor(due)) * 1e9)};
                 nanosleep(&ts, NULL);

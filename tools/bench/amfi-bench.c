@@ -22,13 +22,7 @@
 
 #include "amfi/amfi.h"
 #include "amfi_cli.h"
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
+#include "amfi_time.h"
 
 static double force(double t, int a, void *user)
 {
@@ -147,13 +141,13 @@ int main(int argc, char **argv)
         amfi_passage pe = p;
         pe.speed_mps = 26.0;
         for (int k = 0; k < reps; k++) {
-            double t0 = now_ms();
+            double t0 = (1e3 * amfi_mono_s());
             if (r->estimate ? amfi_solve_speed(s, &pe, &lam, &prior, &res, &sres, err, sizeof err)
                             : amfi_solve(s, &p, &lam, &res, err, sizeof err)) {
                 fprintf(stderr, "amfi-bench: %s\n", err);
                 return 1;
             }
-            t[k] = now_ms() - t0;
+            t[k] = (1e3 * amfi_mono_s()) - t0;
         }
         qsort(t, reps, sizeof *t, cmp);
         printf("%-10s %-6s %-11s %-8s %6d %9.2f %9.2f %12.2f %+10.3f %8d\n", "paper", r->coords,

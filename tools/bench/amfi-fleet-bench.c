@@ -25,6 +25,7 @@
 
 #include "amfi_cli.h"
 #include "store.h"
+#include "amfi_time.h"
 
 #define WINDOW 500 /* ok passages behind one indicator row */
 
@@ -34,13 +35,6 @@ static struct {
     unsigned long seed;
     long long start_s; /* first day, s since 1970 UTC */
 } opt = {NULL, NULL, NULL, 50, 365, 2000, 2, 0, 1, 1735689600LL /* 2025-01-01 */};
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static void site_paths(int k, char *id, size_t idlen, char *path, size_t plen)
 {
@@ -259,9 +253,9 @@ static int time_query(PGconn *pg, const char *what, const char *sql, int nparams
     double first = 0, best = 1e9;
     int rows = 0;
     for (int i = 0; i < 4; i++) {
-        double t0 = now_s();
+        double t0 = amfi_mono_s();
         PGresult *res = q(pg, sql, nparams, params);
-        double dt = now_s() - t0;
+        double dt = amfi_mono_s() - t0;
         if (!res) return -1;
         rows = PQntuples(res);
         PQclear(res);
@@ -323,15 +317,15 @@ int main(int argc, char **argv)
            opt.sites, opt.days, opt.per_day, total);
     fflush(stdout);
 
-    double t0 = now_s();
+    double t0 = amfi_mono_s();
     if (!opt.keep) {
         if (mkdir(opt.dir, 0755) != 0 && errno != EEXIST) {
             fprintf(stderr, "amfi-fleet-bench: %s: %s\n", opt.dir, strerror(errno));
             return 1;
         }
         if (run_parallel(opt.sites, make_store)) return 1;
-        printf("stores built:   %8.1f s (%.0f passages/s, %d jobs)\n", now_s() - t0,
-               (double)total / (now_s() - t0), opt.jobs);
+        printf("stores built:   %8.1f s (%.0f passages/s, %d jobs)\n", amfi_mono_s() - t0,
+               (double)total / (amfi_mono_s() - t0), opt.jobs);
         fflush(stdout);
     }
 
@@ -343,9 +337,9 @@ int main(int argc, char **argv)
     }
     long long before = count_central(pg, "SELECT count(*) FROM passages WHERE site_id LIKE 'bench-%'");
     long long axles0 = count_central(pg, "SELECT count(*) FROM axles WHERE site_id LIKE 'bench-%'");
-    double t1 = now_s();
+    double t1 = amfi_mono_s();
     if (run_parallel(opt.sites, sync_site)) { PQfinish(pg); return 1; }
-    double dt = now_s() - t1;
+    double dt = amfi_mono_s() - t1;
     long long after = count_central(pg, "SELECT count(*) FROM passages WHERE site_id LIKE 'bench-%'");
     long long axles = count_central(pg, "SELECT count(*) FROM axles WHERE site_id LIKE 'bench-%'");
     printf("shipped:        %8.1f s: %lld passages (+%lld axles) = %.0f passages/s with axles\n", dt,
@@ -381,6 +375,6 @@ int main(int argc, char **argv)
                          "SELECT count(*) FROM passages WHERE site_id = $1"
                          " AND utime >= $2 AND utime < $3", 3, p3);
     PQfinish(pg);
-    printf("total:          %8.1f s\n", now_s() - t0);
+    printf("total:          %8.1f s\n", amfi_mono_s() - t0);
     return bad ? 1 : 0;
 }

@@ -55,6 +55,7 @@
 #include "traffic.h"
 #include "vbi.h"
 #include "vehicle.h"
+#include "amfi_time.h"
 
 #define PROG "amfi-paper"
 #define N_LEVELS 5
@@ -87,13 +88,6 @@ typedef struct ctx {
     amfi_sim_params sp;
     FILE *md;                          /* the report */
 } ctx;
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
 
 static void die(const char *fmt, const char *a, const char *b)
 {
@@ -490,7 +484,7 @@ static int batches(ctx *c)
             free(perm);
         }
         gsl_rng_free(r);
-        double t0 = now_s();
+        double t0 = amfi_mono_s();
         pthread_t th[64];
         for (int t = 0; t < o->threads; t++)
             pthread_create(&th[t], NULL, batch_thread, &j);
@@ -498,7 +492,7 @@ static int batches(ctx *c)
             pthread_join(th[t], NULL);
         if (j.failed)
             die("batch %s failed%s", cname[cond], "");
-        double secs = now_s() - t0;
+        double secs = amfi_mono_s() - t0;
         fprintf(c->md, "### %s (%ld passages simulated and solved in %.0f s on %d threads)\n\n",
                 cname[cond], per_cond, secs, o->threads);
         fprintf(c->md, "| damage | true mean t | true STD t | inferred mean t | inferred STD t |%s "
@@ -1009,13 +1003,13 @@ static void *spd_thread(void *arg)
                                         : 0.0;
         amfi_passage_rec pr;
         amfi_result res;
-        double t = now_s();
+        double t = amfi_mono_s();
         if (run_passage(c, &w, c->damaged[spd_level[cond]], j->prof, &spec, &m, v_used, &fixed,
                         &pr, &res)) {
             j->failed = 1;
             break;
         }
-        out->ms_given = 1e3 * (now_s() - t);
+        out->ms_given = 1e3 * (amfi_mono_s() - t);
         out->gvw_true = rec->axle_kg[0] + rec->axle_kg[1];
         out->v_true = spec.speed_mps;
         out->v_given = v_used > 0 ? v_used : pr.speed_measured_mps;
@@ -1025,12 +1019,12 @@ static void *spd_thread(void *arg)
         out->gvw_exact = res.gvw_kg;
         amfi_speed_result sr;
         p.speed_mps = out->v_given;
-        t = now_s();
+        t = amfi_mono_s();
         if (!rc) {
             prior.criterion = AMFI_SPEED_REGULARISED;
             rc = amfi_solve_speed(w.solver, &p, &fixed, &prior, &res, &sr, err, sizeof err);
         }
-        out->ms_reg = 1e3 * (now_s() - t);
+        out->ms_reg = 1e3 * (amfi_mono_s() - t);
         out->gvw_reg = res.gvw_kg;
         out->v_reg = sr.speed_mps;
         out->n_reg = res.n_solves;
@@ -1244,7 +1238,7 @@ int main(int argc, char **argv)
     c.md = fopen(path, "w");
     if (!c.md)
         die("%s: %s", path, strerror(errno));
-    double t0 = now_s();
+    double t0 = amfi_mono_s();
     fprintf(c.md, "# The paper's experiments, reproduced\n\n"
                   "Made by `amfi-paper%s` (tools/research/amfi-paper.c). Bridge: %s (%.0f m, %d "
                   "elements); simulator: half-car vehicles on the FE bridge (sim_publisher/vbi.c),"
@@ -1266,9 +1260,9 @@ int main(int argc, char **argv)
     }
     if (!c.o.quick && !c.o.speed_batch)
         batch_plots(&c);
-    fprintf(c.md, "Total run time %.0f s.\n", now_s() - t0);
+    fprintf(c.md, "Total run time %.0f s.\n", amfi_mono_s() - t0);
     fclose(c.md);
-    printf("%s: report %s (%.0f s)\n", PROG, path, now_s() - t0);
+    printf("%s: report %s (%.0f s)\n", PROG, path, amfi_mono_s() - t0);
     amfi_traffic_free(c.recs);
     for (int l = 0; l < N_LEVELS; l++)
         amfi_bridge_destroy(c.damaged[l]);
