@@ -230,14 +230,12 @@ static int fetch_table(PGconn *pg, sqlite3 *db, const char *site_lit, const char
         if (row[len - 1] == '\n') row[len - 1] = 0;
         char *id = NULL;
         int k = 0;
-        sqlite3_reset(st);
-        sqlite3_clear_bindings(st);
         for (char *f = row; f && k < ncols; k++) {
             char *tab = strchr(f, '\t');
             if (tab) *tab = 0;
             char *v = copy_field(f);
             if (k == 0) id = v;
-            if (v) sqlite3_bind_text(st, k + 1, v, -1, SQLITE_TRANSIENT);
+            if (v) sqlite3_bind_text(st, k + 1, v, -1, SQLITE_STATIC);
             f = tab ? tab + 1 : NULL;
         }
         if (k != ncols)
@@ -248,6 +246,9 @@ static int fetch_table(PGconn *pg, sqlite3 *db, const char *site_lit, const char
                       id ? id : "NULL", sqlite3_errmsg(db));
         else
             (*n)++;
+        /* the fields are bound SQLITE_STATIC: unbind before the row goes */
+        sqlite3_reset(st);
+        sqlite3_clear_bindings(st);
         PQfreemem(row);
         row = NULL;
     }
