@@ -15,7 +15,8 @@
  * close, migrate, the prepared statements, messages), store_check.c
  * (argument checks, statement helpers), store_write.c (inserts),
  * store_read.c (what amfid reads back, maintenance), store_report.c (the
- * queries of reports); store_internal.h is shared by them only.
+ * queries of reports), store_export.c (the passage listing), store_speed.c
+ * (the estimated speeds); store_internal.h is shared by them only.
  *
  * Workload: one writer thread in amfid opens one handle at start-up, adds one
  * passage per vehicle (a few per second at most, one transaction each: the
@@ -341,6 +342,31 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
 int amfi_store_each_passage(amfi_store *s, int64_t from, int64_t to,
                             const char *status, amfi_store_passage_fn fn,
                             void *ctx, char *err, size_t errlen);
+
+/* ---- estimated speeds (store_speed.c) ----------------------------------- */
+
+/* The two speeds of one passage whose speed was estimated (speed_estimated
+ * = 1, both speeds known and > 0): its correction is
+ * speed_mps / speed_given_mps − 1. */
+typedef struct amfi_speed_pair {
+    int64_t utime;          /* data time, µs */
+    double speed_mps;       /* the speed weighed with (the estimate), m/s */
+    double speed_given_mps; /* the detector's, m/s */
+} amfi_speed_pair;
+
+/* *yes = 1 when some passage has an estimated speed (both speeds known). */
+int amfi_store_has_estimated(amfi_store *s, int *yes, char *err, size_t errlen);
+
+/* The estimated passages the filter selects (time range, status or NULL,
+   lane), oldest first (utime, id): *out is malloc'd (free it; NULL when *n
+   is 0). A speed outside (0, 150] m/s is AMFI_STORE_ECORRUPT. */
+int amfi_store_speed_pairs(amfi_store *s, const amfi_passage_filter *f, amfi_speed_pair **out,
+                           size_t *n, char *err, size_t errlen);
+
+/* The newest min(max, rows) estimated passages (by utime, then id), oldest
+   first: refills amfid's speed-drift window after a restart. max >= 1. */
+int amfi_store_recent_speed_pairs(amfi_store *s, int max, amfi_speed_pair **out, size_t *n,
+                                  char *err, size_t errlen);
 
 /* ---- maintenance ------------------------------------------------------- */
 

@@ -3,7 +3,7 @@
  * amfi-report: what amfid's store holds, for people.
  *
  *   amfi-report --db PATH [--summary] [--trend] [--alerts] [--errors]
- *               [--passages] [--histogram] [--overloads]
+ *               [--passages] [--histogram] [--overloads] [--speed]
  *               [--from T] [--to T] [--status S] [--lane N] [--bin-kg W]
  *               [--format table|csv|json] [--config FILE] [--plot DIR]
  *               [--set-baseline-last N | --set-baseline MEAN_KG,STD_KG,N]
@@ -15,9 +15,12 @@
  * inferred GVW against the truth (simulations); sets a manual baseline from
  * the last N ok passages or from explicit values; checks the file's
  * integrity; lists passages (filtered by time, status, lane), the GVW
- * histogram per lane and the overloads against legal limits (report_export.c).
+ * histogram per lane and the overloads against legal limits (report_export.c);
+ * shows the speed corrections of the passages whose speed amfid estimated
+ * (report_speed.c).
  * Every section prints as a table, CSV (one section at a time) or one JSON
- * document. With no option: summary, trend and alerts. The table format ends
+ * document. With no option: summary, trend and alerts, and the speed
+ * corrections when the store holds estimated speeds. The table format ends
  * with the sqlite3 queries one would type next. Schema: docs/schema.md.
  *
  * The database is opened read-only (amfid may be writing it: WAL readers
@@ -48,6 +51,7 @@
 #include "report_export.h"
 #include "report_pg.h"
 #include "report_plot.h"
+#include "report_speed.h"
 #include "store.h"
 
 #define PROG "amfi-report"
@@ -70,6 +74,7 @@ typedef struct options {
     const char *plot_dir;   /* --plot DIR, NULL: none */
     const char *config;     /* --config FILE, NULL: none */
     int passages, histogram, overloads;
+    int speed;              /* --speed; 2: by default, when the store has estimated speeds */
     int format;             /* FMT_* */
     export_opts ex;         /* --from --to --status --lane --bin-kg, limits */
     int bin_given;
@@ -97,7 +102,7 @@ static void usage(FILE *f)
             "[--note TEXT] [--check]\n"
             "       [--passages] [--histogram] [--overloads] [--from T] [--to T] "
             "[--status S]\n"
-            "       [--lane N] [--bin-kg W] [--format table|csv|json] [--plot DIR] "
+            "       [--speed] [--lane N] [--bin-kg W] [--format table|csv|json] [--plot DIR] "
             "[--config FILE]\n"
             "\n"
             "Reports on amfid's SQLite store (schema: docs/schema.md).\n"
@@ -128,11 +133,15 @@ static void usage(FILE *f)
             "  -H, --histogram              GVW histogram of the ok passages per lane\n"
             "  -O, --overloads              ok passages over the legal GVW or axle "
             "limit (--config)\n"
+            "  -C, --speed                  speed corrections of the estimated passages "
+            "(speed used /\n"
+            "                               detector's - 1): distribution, one line per "
+            "day\n"
             "  -f, --from T, -T, --to T     only passages in [T, T]: YYYY-MM-DD or "
             "YYYY-MM-DDTHH:MM[:SS], UTC\n"
             "  -S, --status S               only passages of status S (--passages)\n"
             "  -l, --lane N                 only lane N (--passages, --histogram, "
-            "--overloads)\n"
+            "--overloads, --speed)\n"
             "  -w, --bin-kg W               histogram bin width, kg (default "
             "report.histogram_bin_kg)\n"
             "  -F, --format F               table (default), csv (one section) or "
@@ -143,7 +152,8 @@ static void usage(FILE *f)
             "thresholds, site name, legal limits\n"
             "  -h, --help                   this help\n"
             "  -V, --version                print the version\n"
-            "With no option: --summary --trend --alerts.\n"
+            "With no option: --summary --trend --alerts (and --speed when the store "
+            "has estimated speeds).\n"
             "Exit status: 0 ok, 1 database error or check failed, 2 usage "
             "error.\n",
             TREND_ROWS, ALERT_ROWS);
@@ -228,6 +238,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"passages", no_argument, NULL, 'P'},
         {"histogram", no_argument, NULL, 'H'},
         {"overloads", no_argument, NULL, 'O'},
+        {"speed", no_argument, NULL, 'C'},
         {"from", required_argument, NULL, 'f'},
         {"to", required_argument, NULL, 'T'},
         {"status", required_argument, NULL, 'S'},
@@ -273,6 +284,7 @@ static int parse_args(int argc, char **argv, options *o)
         case 'P': o->passages = 1; break;
         case 'H': o->histogram = 1; break;
         case 'O': o->overloads = 1; break;
+        case 'C': o->speed = 1; break;
         case 'f':
         case 'T':
             {
@@ -349,7 +361,7 @@ static int parse_args(int argc, char **argv, options *o)
                            "--check work on a site's store (--db)");
     if (o->pg && !o->site) {
         if (o->summary || o->trend || o->alerts || o->errors || o->passages || o->histogram
-            || o->overloads || o->plot_dir || o->format != FMT_TABLE)
+            || o->overloads || o->speed || o->plot_dir || o->format != FMT_TABLE)
             return usage_error("--site", "the report sections need one site: without --site, "
                                "--pg prints the fleet summary only");
         return 0;
@@ -364,13 +376,15 @@ static int parse_args(int argc, char **argv, options *o)
         return usage_error("--from", "after --to");
     if (!o->summary && !o->trend && !o->alerts && !o->errors && !o->check
         && !o->plot_dir && !o->baseline_last && !o->baseline_given && !o->passages
-        && !o->histogram && !o->overloads)
+        && !o->histogram && !o->overloads && !o->speed) {
         o->summary = o->trend = o->alerts = 1;
+        o->speed = 2; /* when the store has estimated speeds (report_main) */
+    }
     if (o->ex.status && !o->passages)
         return usage_error("--status", "only with --passages");
     if (o->format != FMT_TABLE) {
         int n = o->summary + o->trend + o->alerts + o->errors + o->passages + o->histogram
-                + o->overloads;
+                + o->overloads + (o->speed == 1);
         if (o->check || o->plot_dir || o->baseline_last || o->baseline_given)
             return usage_error("--format", "csv and json are for the report sections, not "
                                "--check, --plot or --set-baseline*");
@@ -730,6 +744,12 @@ static int section_overloads(amfi_store *s)
     return export_overloads(s, &g_opt->ex, FMT_TABLE, g_out, NULL, err, sizeof err)
                ? data_error("%s", err) : 0;
 }
+static int section_speed(amfi_store *s)
+{
+    char err[512];
+    return export_speed(s, &g_opt->ex, FMT_TABLE, g_out, NULL, err, sizeof err)
+               ? data_error("%s", err) : 0;
+}
 
 /* --format csv|json: the chosen sections as one CSV table or one JSON
  * document ({"site_id": ..., "summary": {...}, ..., "passages": [...]}).
@@ -759,6 +779,8 @@ static int export_all(const options *o, amfi_store *s)
             rc = export_histogram(s, x, fmt, stdout, NULL, err, sizeof err);
         else if (o->overloads)
             rc = export_overloads(s, x, fmt, stdout, NULL, err, sizeof err);
+        else if (o->speed)
+            rc = export_speed(s, x, fmt, stdout, NULL, err, sizeof err);
         return rc ? data_error("%s", err) : 0;
     }
     json_t *root = json_object();
@@ -780,6 +802,8 @@ static int export_all(const options *o, amfi_store *s)
         rc = export_histogram(s, x, fmt, NULL, root, err, sizeof err);
     if (rc == 0 && o->overloads)
         rc = export_overloads(s, x, fmt, NULL, root, err, sizeof err);
+    if (rc == 0 && o->speed)
+        rc = export_speed(s, x, fmt, NULL, root, err, sizeof err);
     if (rc != 0) {
         json_decref(root);
         return data_error("%s", err);
@@ -942,6 +966,17 @@ static int report_main(options *op)
         return EXIT_DATA;
     }
     g_out = stdout;
+    if (o.speed == 2) {
+        /* by default: only when the store has estimated speeds */
+        int yes = 0;
+        if (amfi_store_has_estimated(s, &yes, err, sizeof err) != 0) {
+            data_error("%s", err);
+            amfi_store_close(s);
+            free(cfg);
+            return EXIT_DATA;
+        }
+        o.speed = yes;
+    }
     if (o.format != FMT_TABLE) {
         rc = export_all(&o, s);
         amfi_store_close(s);
@@ -973,6 +1008,8 @@ static int report_main(options *op)
         rc = run_section(section_histogram, s, &printed);
     if (rc == 0 && o.overloads)
         rc = run_section(section_overloads, s, &printed);
+    if (rc == 0 && o.speed)
+        rc = run_section(section_speed, s, &printed);
     if (rc == 0 && o.plot_dir) {
         if (printed)
             printf("\n");

@@ -8,7 +8,9 @@
  * the baseline band (mean ± 2 STD); the indicator trend (STD ratio, mean
  * ratio, p-value) with the alert thresholds and every raised and cleared
  * alert marked; the GVW histogram of the baseline against the latest
- * window; passages per hour by status; the speed distribution.
+ * window; passages per hour by status; the speed distribution; and, when
+ * the store has estimated speeds (issue 12), the daily median speed
+ * correction with its p5-p95 band (report_speed.c).
  *
  * Single-threaded, the caller's thread. Memory: four doubles per passage
  * (a million passages: 32 MB).
@@ -26,6 +28,7 @@
 #include <time.h>
 
 #include "report_plot.h"
+#include "report_speed.h"
 
 extern char **environ;
 
@@ -175,6 +178,8 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     amfi_alert_rec *al = NULL;
     double *ok = NULL, *bl = NULL, *la = NULL, *sp = NULL;
     FILE *f = NULL;
+    speed_day *sdays = NULL;
+    size_t n_sdays = 0;
     int rc = -1, n_ind = 0, n_al = 0, found = 0;
     int64_t total_ind = 0, total_al = 0;
     char serr[512], site[128], t0s[32], t1s[32], sub[256], path[4096];
@@ -388,6 +393,24 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     if (close_data(f, dir, "speed.dat", err, errlen) != 0)
         goto out;
 
+    /* speed_correction.dat: one line per UTC day with estimated speeds */
+    {
+        export_opts every = {.from = 0, .to = AMFI_STORE_MAX_UTIME};
+        speed_stats sall;
+        if (speed_corrections(s, &every, &sall, &sdays, &n_sdays, err, errlen) != 0)
+            goto out;
+    }
+    if (n_sdays > 0) {
+        if (!(f = open_data(dir, "speed_correction.dat", err, errlen)))
+            goto out;
+        fprintf(f, "# day_utc_s n median_pct p5_pct p95_pct (c = speed used / detector's - 1)\n");
+        for (size_t k = 0; k < n_sdays; k++)
+            fprintf(f, "%.0f %zu %.4f %.4f %.4f\n", (double)sdays[k].day_utime / 1e6,
+                    sdays[k].st.n, sdays[k].st.median, sdays[k].st.p5, sdays[k].st.p95);
+        if (close_data(f, dir, "speed_correction.dat", err, errlen) != 0)
+            goto out;
+    }
+
     /* the script */
     if (!(f = open_data(dir, "plots.gp", err, errlen)))
         goto out;
@@ -478,6 +501,20 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         "set output\n",
         n_sp, sub,
         n_sp ? "" : "set xrange [0:150]\nset yrange [0:1]\nset label 99 'no passage with a speed in this store' at graph 0.5, graph 0.5 center\n");
+    /* 6: speed corrections per day, when there are any */
+    if (n_sdays > 0)
+        fprintf(f,
+            "unset label 99\nset output o.'speed_correction.png'\n"
+            "set xdata time\nset timefmt '%%s'\nset format x \"%%d %%b\\n%%Y\"\nset autoscale x\n"
+            "set xrange [%.0f:%.0f]\nset xtics 86400\nset autoscale y\n"
+            "set title \"Speed correction of the estimated passages per day (c = speed used / detector's - 1)\\n%s\"\n"
+            "set xlabel 'day (UTC, data time)'\nset ylabel 'c (%%)'\n"
+            "plot d.'speed_correction.dat' using 1:4:5 with filledcurves fc rgb '#aec7e8' fs transparent solid 0.5 title 'p5 .. p95', \\\n"
+            "     d.'speed_correction.dat' using 1:3 with linespoints pt 7 ps 0.6 lw 2 lc rgb '#1f77b4' title 'daily median', \\\n"
+            "     0 with lines dt 2 lc rgb 'black' notitle\n"
+            "set output\nset xtics autofreq\n",
+            (double)sdays[0].day_utime / 1e6 - 43200,
+            (double)sdays[n_sdays - 1].day_utime / 1e6 + 43200, sub);
     if (close_data(f, dir, "plots.gp", err, errlen) != 0)
         goto out;
     f = NULL;
@@ -488,8 +525,9 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         {"trend.png", "indicator trend, thresholds, alerts raised and cleared"},
         {"gvw_histogram.png", "GVW histogram, baseline against the latest window"},
         {"passages_per_hour.png", "passages per hour by status"},
-        {"speed.png", "speed distribution"}};
-    for (int k = 0; k < 5; k++) {
+        {"speed.png", "speed distribution"},
+        {"speed_correction.png", "daily median speed correction, p5 .. p95"}};
+    for (int k = 0; k < (n_sdays > 0 ? 6 : 5); k++) {
         struct stat stt;
         snprintf(path, sizeof path, "%s/%s", dir, png[k][0]);
         if (stat(path, &stt) != 0 || stt.st_size < 100) {
@@ -506,5 +544,6 @@ out:
     free(al);
     free(ok);
     free(sp);
+    free(sdays);
     return rc;
 }
