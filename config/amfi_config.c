@@ -113,6 +113,7 @@ void amfi_config_defaults(amfi_site_config *c)
     /* The engine's defaults (docs/indicators.md has the simulation behind
      * each value); set field by field, so the padding stays zero. */
     amfi_indicator_params_default(&d->indicators);
+    amfi_speed_drift_params_default(&d->speed_drift);
     /* sim_publisher's ideal simulation (docs/simulator.md): every inaccuracy
      * is switched on explicitly. */
     amfi_sim_config *m = &c->sim;

@@ -23,6 +23,7 @@
 
 #include "amfi/amfi.h"
 #include "indicators.h"
+#include "speed_drift.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -52,6 +53,9 @@ typedef struct amfi_daemon_config {
     int alert_max_running;    /* alerts.command_max_running: at once, 1 .. 64 */
     char metrics_path[512];   /* metrics.textfile: Prometheus text file; "" off */
     double metrics_interval_s; /* metrics.interval_s: rewritten every, [1, 3600] */
+    /* alerts.speed_drift.*: the speed-drift alert's parameters (speed_drift.h,
+     * docs/indicators.md), defaults from amfi_speed_drift_params_default(). */
+    amfi_speed_drift_params speed_drift;
     /* daemon.indicators.*: the indicator engine's own parameters
      * (indicators.h, docs/indicators.md), its defaults from
      * amfi_indicator_params_default() and checked, at load, by

@@ -35,7 +35,7 @@ static const field store_fields[] = {
 /* Offsets of the engine's amfi_indicator_params inside the site config. */
 #define IND(m) DC(indicators.m)
 
-static const enum_name onoff_names[] = {{"off", 0}, {"on", 1}, {NULL, 0}};
+const enum_name onoff_names[] = {{"off", 0}, {"on", 1}, {NULL, 0}};
 
 static const field indicator_fields[] = {
     {.key = "window", .kind = &K_INT, .off = IND(window), .lo = 10, .hi = 1000000},

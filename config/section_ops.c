@@ -4,8 +4,9 @@
  * amfid tells the people and programs that watch it: a program run for
  * every raised and cleared alert (alerts.command, like smartd's -M exec),
  * and its counters in Prometheus' text format for node-exporter's textfile
- * collector (metrics.textfile). Both are off by default. Runs on the loader's
- * thread.
+ * collector (metrics.textfile). Both are off by default. Also the
+ * speed-drift alert's settings (alerts.speed_drift, speed_drift.h). Runs on
+ * the loader's thread.
  */
 #include "sections.h"
 
@@ -17,12 +18,23 @@
 #define OPS(m) offsetof(amfi_site_config, daemon.m)
 #define OPS_CAP(m) sizeof(((amfi_daemon_config *)0)->m)
 
+#define DRIFT(m) OPS(speed_drift.m)
+
+static const field speed_drift_fields[] = {
+    {.key = "enabled", .kind = &K_ENUM, .off = DRIFT(enabled), .aux = onoff_names},
+    {.key = "window", .kind = &K_INT, .off = DRIFT(window), .lo = 2,
+     .hi = AMFI_SPEED_DRIFT_MAX_WINDOW},
+    {.key = "threshold", .kind = &K_DOUBLE, .off = DRIFT(threshold), .lo = 0,
+     .hi = AMFI_SPEED_DRIFT_MAX_THRESHOLD, .flags = F_LO_OPEN},
+    {.key = NULL}};
+
 const field alerts_fields[] = {
     {.key = "command", .kind = &K_PATH, .off = OPS(alert_command), .hi = OPS_CAP(alert_command)},
     {.key = "command_timeout_s", .kind = &K_DOUBLE, .off = OPS(alert_timeout_s), .lo = 0,
      .hi = 3600, .flags = F_LO_OPEN},
     {.key = "command_max_running", .kind = &K_INT, .off = OPS(alert_max_running), .lo = 1,
      .hi = 64},
+    {.key = "speed_drift", .kind = &K_MAP, .aux = speed_drift_fields},
     {.key = NULL}};
 
 const field metrics_fields[] = {
@@ -39,7 +51,15 @@ int ops_check(ctx *x, amfi_site_config *c)
     const char *cmd = c->daemon.alert_command;
     const char *prom = c->daemon.metrics_path;
     struct stat st;
+    const char *blamed = NULL;
+    char why[256], path[PATH_LEN];
 
+    if (amfi_speed_drift_params_check(&c->daemon.speed_drift, &blamed, why, sizeof why) != 0) {
+        pathf(path, "alerts.speed_drift.%s", blamed ? blamed : "");
+        int line = noted(x, path);
+        return fail(x, line ? line : first_noted(x, "alerts.speed_drift", "alerts", NULL), path,
+                    "%s", why);
+    }
     if (cmd[0]) {
         int line = noted(x, "alerts.command");
         if (cmd[0] != '/')

@@ -44,6 +44,7 @@ extern const field site_fields[];   /* site: */
 extern const field alerts_fields[]; /* alerts: */
 extern const field metrics_fields[]; /* metrics: */
 extern const field report_fields[]; /* report: */
+extern const enum_name onoff_names[]; /* off | on (section_daemon.c) */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */
 int bridge_free_dofs(const amfi_bridge_params *b);

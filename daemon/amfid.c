@@ -97,6 +97,10 @@ static int start_config(daemon_s *d, const amfid_options *o)
         fprintf(stderr, "amfid: %s: daemon.indicators: %s\n", o->config, err);
         return 2;
     }
+    if (drift_create(d, err, sizeof err)) {
+        fprintf(stderr, "amfid: %s: alerts.speed_drift: %s\n", o->config, err);
+        return 2;
+    }
     /* A solver is built once here to check the solver section. */
     amfi_solver *probe = NULL;
     if (amfi_solver_create(d->bridge, &d->cfg.solver, &probe, err, sizeof err)) {
@@ -189,6 +193,7 @@ static int start_runtime(daemon_s *d)
         return 1;
     }
     restore_indicator_state(d);
+    drift_restore(d);
     amfi_tracker_params tp = {d->cfg.bridge.span_m,
                               d->cfg.solver.pre_roll_s + d->cfg.daemon.margin_s,
                               d->cfg.solver.post_roll_s + d->cfg.daemon.margin_s,
@@ -341,6 +346,7 @@ void amfid_stop(daemon_s *d)
     amfi_tracker_destroy(d->tracker);
     amfi_store_close(d->store);
     amfi_indicators_destroy(d->ind);
+    drift_destroy(d);
     amfi_bridge_destroy(d->bridge);
 }
 

@@ -12,7 +12,8 @@
  * Files: amfid.c (main: start-up, loop, shutdown), options.c (command
  * line), intake.c (bus handlers, validation, windows to jobs), pool.c (job
  * queues, solver threads), pipeline.c (in-order store, indicators,
- * publish), control.c (configuration, heartbeat, reload, restart state).
+ * publish), control.c (configuration, heartbeat, reload, restart state),
+ * drift.c (the speed-drift alert).
  */
 #ifndef AMFID_H
 #define AMFID_H
@@ -30,6 +31,7 @@
 #include "indicators.h"
 #include "pool.h"
 #include "ring.h"
+#include "speed_drift.h"
 #include "store.h"
 #include "tracker.h"
 
@@ -120,6 +122,8 @@ typedef struct daemon_s {
     amfi_store *store;
     amfi_indicators *ind;
     amfi_indicator_params ind_params; /* in force (a reload reports changes) */
+    amfi_speed_drift *drift;       /* the speed-drift alert (drift.c) */
+    amfi_speed_drift_params drift_params; /* in force (a reload reports changes) */
     amfi_tracker *tracker;
     amfi_ring *rings[AMFI_MAX_SENSORS];
     pool pool;
@@ -207,6 +211,10 @@ int pipeline_complete(daemon_s *d, job *j);
 /* Store a job now, outside the entry order (invalid vehicles); takes the job
  * (held, in order, if the store cannot write). */
 int pipeline_store_now(daemon_s *d, job *j);
+/* One alert event out the way every alert goes: stored (indicator_id <= 0:
+ * none), published on the alert channel, counted in the metrics, handed to
+ * alerts.command and logged (a raise as a warning). */
+void emit_alert(daemon_s *d, int64_t utime, const amfi_alert_event *a, int64_t indicator_id);
 /* Read the eventfd and complete every result the solvers handed back. */
 void pipeline_drain_results(daemon_s *d);
 /* Retry the held passages when their time has come (the loop); with
@@ -236,6 +244,19 @@ void metrics_indicator(daemon_s *d, double std_ratio, double p_value, double mea
 void metrics_alert(daemon_s *d, const char *kind, int raised);
 /* Rewrite metrics.textfile when metrics.interval_s has passed (force: now). */
 void metrics_tick(daemon_s *d, int force);
+
+/* ---- the speed-drift alert (drift.c), main thread -------------------------- */
+
+/* The engine from alerts.speed_drift: 0, or an amfi_speed_drift_create code
+ * with the message in err. */
+int drift_create(daemon_s *d, char *err, size_t errlen);
+/* The window from the store's newest estimated passages, the open alert. */
+void drift_restore(daemon_s *d);
+/* One stored passage whose speed was estimated: its two speeds, m/s. */
+void drift_feed(daemon_s *d, int64_t utime, double speed_mps, double speed_given_mps);
+/* SIGHUP: a changed alerts.speed_drift is reported (applies at the next start). */
+void drift_reload(daemon_s *d, const amfi_site_config *n);
+void drift_destroy(daemon_s *d);
 
 /* ---- configuration, state, heartbeat, reload (control.c), main thread ----- */
 

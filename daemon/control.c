@@ -206,6 +206,7 @@ void reload(daemon_s *d)
     indicator_params(&n.daemon, &ip);
     if (!amfi_indicator_params_equal(&ip, &d->ind_params))
         LOG_WARN("reload: indicator settings take effect at the next start");
+    drift_reload(d, &n);
     LOG_INFO("reload: configuration %s applied", d->config_path);
 }
 

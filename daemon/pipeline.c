@@ -4,7 +4,8 @@
  * parked by their release order and, in that order, stored (one
  * transaction each), published on the passage channel, and the ok ones fed
  * to the indicator engine, whose baselines, indicators and alerts are
- * stored and published too.
+ * stored and published too; the estimated speeds feed the speed-drift
+ * alert (drift.c).
  *
  * A passage is acknowledged when its transaction has committed; only then
  * is it published and fed to the indicators. When the store cannot write
@@ -103,22 +104,26 @@ static void feed_indicators(daemon_s *d, const job *j)
         metrics_indicator(d, ev.std_ratio, ev.p_value,
                           ev.baseline_mean_kg > 0 ? ev.mean_kg / ev.baseline_mean_kg : NAN);
     }
-    for (int i = 0; (bits & AMFI_IND_ALERT) && i < n_al; i++) {
-        int64_t aid = 0;
-        if (amfi_store_add_alert(d->store, j->w.v.utime, al[i].level, al[i].kind, al[i].message,
-                                 ind_id, al[i].raised, &aid, err, sizeof err))
-            set_error(d, "store: %s", err);
-        amfi_alert_t m = {j->w.v.utime, aid, (char *)al[i].level, (char *)al[i].kind,
-                          al[i].message, ind_id, (int8_t)al[i].raised, d->cfg.site.id};
-        amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
-        metrics_alert(d, al[i].kind, al[i].raised);
-        notify_alert(d, j->w.v.utime, aid, al[i].level, al[i].kind, al[i].message, ind_id,
-                     al[i].raised);
-        if (al[i].raised)
-            LOG_WARN("ALERT %s (%s): %s", al[i].kind, al[i].level, al[i].message);
-        else
-            LOG_INFO("alert cleared %s: %s", al[i].kind, al[i].message);
-    }
+    for (int i = 0; (bits & AMFI_IND_ALERT) && i < n_al; i++)
+        emit_alert(d, j->w.v.utime, &al[i], ind_id);
+}
+
+void emit_alert(daemon_s *d, int64_t utime, const amfi_alert_event *a, int64_t ind_id)
+{
+    char err[256];
+    int64_t aid = 0;
+    if (amfi_store_add_alert(d->store, utime, a->level, a->kind, a->message, ind_id, a->raised,
+                             &aid, err, sizeof err))
+        set_error(d, "store: %s", err);
+    amfi_alert_t m = {utime, aid, (char *)a->level, (char *)a->kind, (char *)a->message, ind_id,
+                      (int8_t)a->raised, d->cfg.site.id};
+    amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
+    metrics_alert(d, a->kind, a->raised);
+    notify_alert(d, utime, aid, a->level, a->kind, a->message, ind_id, a->raised);
+    if (a->raised)
+        LOG_WARN("ALERT %s (%s): %s", a->kind, a->level, a->message);
+    else
+        LOG_INFO("alert cleared %s: %s", a->kind, a->message);
 }
 
 /* The row of a job. */
@@ -173,6 +178,8 @@ static int store_now(daemon_s *d, job *j)
     d->passages_stored++;
     metrics_passage(d, j->status, j->solved, j->solve_ms);
     publish_passage(d, j, id);
+    if (j->speed_estimated)
+        drift_feed(d, j->w.v.utime, r.speed_mps, r.speed_given_mps);
     if (j->solved) {
         d->passages_ok++;
         feed_indicators(d, j);
