@@ -73,6 +73,33 @@ static int hand_over(int rc, amfi_speed_pair *a, size_t n, amfi_speed_pair **out
     return rc;
 }
 
+/* Run one of the two queries (SQL parameters: ?1 .. ?4 the filter's from,
+ * to, status, lane; or ?1 the limit) into *out. */
+static int query_pairs(amfi_store *s, const char *sql, const amfi_passage_filter *f, int max,
+                       amfi_speed_pair **out, size_t *n, char *err, size_t errlen)
+{
+    sqlite3_stmt *st = NULL;
+    amfi_speed_pair *a = NULL;
+    size_t k = 0;
+    int rc = 0, src = sqlite3_prepare_v2(s->db, sql, -1, &st, NULL);
+    if (src != SQLITE_OK) {
+        rc = st_db_fail(s, src, "speeds: prepare", err, errlen);
+    } else if (f) {
+        sqlite3_bind_int64(st, 1, f->from);
+        sqlite3_bind_int64(st, 2, f->to);
+        if (f->status)
+            sqlite3_bind_text(st, 3, f->status, -1, SQLITE_TRANSIENT);
+        if (f->lane_given)
+            sqlite3_bind_int(st, 4, f->lane);
+    } else {
+        sqlite3_bind_int(st, 1, max);
+    }
+    if (rc == 0)
+        rc = read_pairs(s, st, &a, &k, err, errlen);
+    sqlite3_finalize(st);
+    return hand_over(rc, a, k, out, n);
+}
+
 int amfi_store_speed_pairs(amfi_store *s, const amfi_passage_filter *f, amfi_speed_pair **out,
                            size_t *n, char *err, size_t errlen)
 {
@@ -88,27 +115,12 @@ int amfi_store_speed_pairs(amfi_store *s, const amfi_passage_filter *f, amfi_spe
         rc = AMFI_EINVAL;
     if (rc != 0)
         return rc;
-    sqlite3_stmt *st = NULL;
-    amfi_speed_pair *a = NULL;
-    size_t k = 0;
-    int src = sqlite3_prepare_v2(s->db,
+    return query_pairs(s,
         "SELECT id, utime, speed_mps, speed_given_mps FROM passages "
         "WHERE utime >= ?1 AND utime <= ?2 AND (?3 IS NULL OR status = ?3) "
         "AND (?4 IS NULL OR lane = ?4) AND speed_estimated = 1 "
-        "AND speed_mps > 0 AND speed_given_mps > 0 ORDER BY utime, id", -1, &st, NULL);
-    if (src != SQLITE_OK) {
-        rc = st_db_fail(s, src, "speeds: prepare", err, errlen);
-    } else {
-        sqlite3_bind_int64(st, 1, f->from);
-        sqlite3_bind_int64(st, 2, f->to);
-        if (f->status)
-            sqlite3_bind_text(st, 3, f->status, -1, SQLITE_TRANSIENT);
-        if (f->lane_given)
-            sqlite3_bind_int(st, 4, f->lane);
-        rc = read_pairs(s, st, &a, &k, err, errlen);
-    }
-    sqlite3_finalize(st);
-    return hand_over(rc, a, k, out, n);
+        "AND speed_mps > 0 AND speed_given_mps > 0 ORDER BY utime, id",
+        f, 0, out, n, err, errlen);
 }
 
 int amfi_store_recent_speed_pairs(amfi_store *s, int max, amfi_speed_pair **out, size_t *n,
@@ -121,19 +133,9 @@ int amfi_store_recent_speed_pairs(amfi_store *s, int max, amfi_speed_pair **out,
         rc = st_fail(err, errlen, AMFI_EINVAL, "speeds: max %d must be >= 1", max);
     if (rc != 0)
         return rc;
-    sqlite3_stmt *st = NULL;
-    amfi_speed_pair *a = NULL;
-    size_t k = 0;
-    int src = sqlite3_prepare_v2(s->db,
+    return query_pairs(s,
         "SELECT * FROM (SELECT id, utime, speed_mps, speed_given_mps FROM passages "
         "WHERE speed_estimated = 1 AND speed_mps > 0 AND speed_given_mps > 0 "
-        "ORDER BY utime DESC, id DESC LIMIT ?1) ORDER BY utime, id", -1, &st, NULL);
-    if (src != SQLITE_OK) {
-        rc = st_db_fail(s, src, "speeds: prepare", err, errlen);
-    } else {
-        sqlite3_bind_int(st, 1, max);
-        rc = read_pairs(s, st, &a, &k, err, errlen);
-    }
-    sqlite3_finalize(st);
-    return hand_over(rc, a, k, out, n);
+        "ORDER BY utime DESC, id DESC LIMIT ?1) ORDER BY utime, id",
+        NULL, max, out, n, err, errlen);
 }

@@ -22,13 +22,18 @@
 
 /* ---- small writers ------------------------------------------------------- */
 
-static const char *iso(int64_t utime, char buf[32])
+const char *export_utc(int64_t utime, const char *fmt, char buf[32])
 {
     time_t t = (time_t)(utime / 1000000);
     struct tm tm;
-    if (!gmtime_r(&t, &tm) || strftime(buf, 32, "%Y-%m-%dT%H:%M:%SZ", &tm) == 0)
+    if (!gmtime_r(&t, &tm) || strftime(buf, 32, fmt, &tm) == 0)
         snprintf(buf, 32, "%lld", (long long)utime);
     return buf;
+}
+
+static const char *iso(int64_t utime, char buf[32])
+{
+    return export_utc(utime, "%Y-%m-%dT%H:%M:%SZ", buf);
 }
 
 /* An RFC 4180 field: quoted when it holds a comma, a quote or a line break. */

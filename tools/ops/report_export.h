@@ -62,6 +62,10 @@ typedef struct report_intake {
 } report_intake;
 int export_read_intake(amfi_store *s, report_intake *in, char *err, size_t errlen);
 
+/* utime (µs since 1970) as strftime's fmt in UTC into buf (the number of
+ * µs when it cannot be shown); returns buf. */
+const char *export_utc(int64_t utime, const char *fmt, char buf[32]);
+
 /* ISO 8601 in UTC: "2025-11-22", "2025-11-22T13:05", "2025-11-22 13:05:09",
  * "2025-11-22T13:05:09.25", each with an optional Z or zero offset (+00:00):
  * µs since 1970. end_of = 1 (for --to) makes a date, a minute or a second

@@ -14,7 +14,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "amfi_json.h"
 
@@ -104,11 +103,7 @@ int speed_corrections(amfi_store *s, const export_opts *o, speed_stats *all, spe
 
 static const char *day_str(int64_t utime, char buf[32])
 {
-    time_t t = (time_t)(utime / 1000000);
-    struct tm tm;
-    if (!gmtime_r(&t, &tm) || strftime(buf, 32, "%Y-%m-%d", &tm) == 0)
-        snprintf(buf, 32, "%lld", (long long)utime);
-    return buf;
+    return export_utc(utime, "%Y-%m-%d", buf);
 }
 
 /* "%+.2f %%" or "-" */
