@@ -111,7 +111,7 @@ static const char *pct(double x, char buf[32])
 {
     if (isnan(x))
         return "-";
-    snprintf(buf, 32, "%+.2f %%", x);
+    snprintf(buf, 32, "%+.2f %%", fabs(x) < 0.005 ? 0.0 : x); /* never "-0.00 %" */
     return buf;
 }
 
