@@ -3,13 +3,13 @@
 # The speed-drift alert on the bus (issue 12): amfid with solver.speed:
 # estimate and alerts.speed_drift.window 4 (threshold 2 %), sim_publisher
 # streaming inside a private network namespace.
-#   run "high": the detector reads every speed 4 % high (--speed-error
+#   run "high" (4 vehicles): the detector reads every speed 4 % high (--speed-error
 #     0.04,0), so each correction is about 1/1.04 - 1 = -3.85 %: the
 #     speed_drift alert (info) is raised once, at the 4th estimated passage,
 #     stored, published on AMFI_ALERT and logged; amfi-report --speed shows
 #     the median correction near -3.85 %; a restart on the same store keeps
 #     the alert open and refills the window.
-#   run "exact": the detector is exact: no alert; the median correction is
+#   run "exact" (4 vehicles): the detector is exact: no alert; the median correction is
 #     within 0.5 % of zero.
 # Usage: daemon_speed_drift.sh AMFID SIM_PUBLISHER AMFI_REPORT LCM_PASSAGES CONFIG
 set -u
@@ -23,7 +23,7 @@ pids=""
 cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
 trap cleanup EXIT
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
-N=5
+N=4
 
 sed -e "s/^  speed: measured /  speed: estimate /" -e "s/^    window: 200 /    window: 4 /" \
   "$config" > "$dir/amfid.yaml"
