@@ -33,14 +33,18 @@ problem() { echo "FAIL $name: $*"; failures=$((failures + 1)); }
 awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
      on && !/^```/' "$doc" > "$tmp/ddl.sql"
 [ -s "$tmp/ddl.sql" ] || { echo "report_speed.sh: no DDL block in $doc" >&2; exit 1; }
+# the fixture is at the document's schema version, with its migration rows
+v=$(sed -n 's/.*PRAGMA user_version` (this document: version \([0-9]*\)).*/\1/p' "$doc")
+[ -n "$v" ] || { echo "report_speed.sh: no schema version in $doc" >&2; exit 1; }
+migrations="PRAGMA user_version = $v;
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $v)
+INSERT INTO schema_migrations (version, description) SELECT i, 'report_speed fixture' FROM k;"
 db=$tmp/speed.db
 {
     cat "$tmp/ddl.sql"
+    echo "$migrations"
     cat <<'EOF'
 PRAGMA journal_mode = WAL;
-PRAGMA user_version = 3;
-INSERT INTO schema_migrations (version, description) VALUES (1, 'report_speed fixture'),
-    (2, 'runs'), (3, 'speed_given_mps');
 WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 10),
      d(day, base) AS (VALUES (0, 1.001), (1, 0.98), (2, 0.96))
 INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason,
@@ -154,8 +158,7 @@ grep -qF '"speed":{"n":32' "$tmp/out" || problem "no speed object by default"
 
 # a store without estimated speeds: not by default, and said so when asked
 sqlite3 "$tmp/plain.db" < "$tmp/ddl.sql"
-sqlite3 "$tmp/plain.db" "PRAGMA user_version = 3; INSERT INTO schema_migrations (version, description)
-    VALUES (1, 'p'), (2, 'p'), (3, 'p')"
+sqlite3 "$tmp/plain.db" "$migrations"
 sqlite3 "$tmp/plain.db" "INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg,
     status, speed_given_mps, speed_estimated) VALUES (1, 1763769600000000, 1, 27.5, 0, NULL, 'gap',
     25.0, 0)"
