@@ -65,7 +65,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 3
+#define AMFI_STORE_SCHEMA_VERSION 4
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -141,6 +141,12 @@ typedef struct amfi_passage_row {
     double residual_rms; /* m/s², >= 0, or NaN */
     const char *formulation; /* solver output equation, 1 .. 63 bytes, or NULL */
     double solve_ms;     /* solver wall time, ms, >= 0, or NaN */
+    int n_vehicles;      /* vehicles of the event it was weighed in (the
+                            ones on the span together), 1 .. 64; 0 is taken
+                            as 1 */
+    double quality;      /* its weight's separability from the event's other
+                            vehicles (amfi_vehicle_result.quality), 1 .. 1e9;
+                            NaN or 0: unknown (not solved jointly), NULL */
 } amfi_passage_row;
 /* Status "ok" further needs 1 <= n_axles, 0 < gvw_kg, 0 < speed_mps and
  * every spacing and axle load known. */

@@ -103,6 +103,7 @@ static const range R_NONNEG = {0.0, HUGE_VAL, 0, ""};
 static const range R_MS = {0.0, HUGE_VAL, 0, "ms"};
 static const range R_RATIO = {0.0, 1e6, 0, ""};
 static const range R_PROB = {0.0, 1.0, 0, ""};
+static const range R_QUALITY = {1.0, 1e9, 0, ""};
 static const range R_FINITE = {-HUGE_VAL, HUGE_VAL, 0, ""};
 
 /* NULL-terminated word lists of the schema's enumerations. */

@@ -188,11 +188,24 @@ static const char schema_v3[] =
     "  CHECK (speed_estimated IN (0, 1));\n"
     "UPDATE passages SET speed_given_mps = speed_mps;\n";
 
+/* Version 4 (issue 13): vehicles that shared the span are weighed together
+ * (amfid's event solve, amfi_solve_multi). n_vehicles is the size of the
+ * event a passage was weighed in (1 alone); quality the separability figure
+ * of its weight (amfi_vehicle_result.quality: 1 alone or fully separable,
+ * larger when its axles trade load with another vehicle's). Rows written
+ * before were single-vehicle passages: n_vehicles 1, quality NULL. */
+static const char schema_v4[] =
+    "ALTER TABLE passages ADD COLUMN n_vehicles INTEGER NOT NULL DEFAULT 1\n"
+    "  CHECK (n_vehicles BETWEEN 1 AND 64);\n"
+    "ALTER TABLE passages ADD COLUMN quality REAL\n"
+    "  CHECK (quality >= 1 AND quality <= 1e9);\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
     {2, "runs: program version and configuration of each start of amfid", schema_v2},
     {3, "passages: speed_given_mps (the detector's) and speed_estimated", schema_v3},
+    {4, "passages: n_vehicles (vehicles weighed together) and quality", schema_v4},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

@@ -6,6 +6,7 @@
  * passage or a truth is one transaction with its axle rows. The thread of
  * the handle (amfid's pipeline thread); no state beyond the handle.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -36,6 +37,11 @@ static int check_passage(const amfi_passage_row *r, char *err, size_t errlen)
     if (rc == 0 && r->speed_estimated != 0 && r->speed_estimated != 1)
         rc = st_fail(err, errlen, AMFI_EINVAL,
                      "passages.speed_estimated: %d is not 0 or 1", r->speed_estimated);
+    if (rc == 0 && (r->n_vehicles < 0 || r->n_vehicles > 64))
+        rc = st_fail(err, errlen, AMFI_EINVAL,
+                     "passages.n_vehicles: %d is out of range [1, 64]", r->n_vehicles);
+    if (rc == 0 && r->quality != 0.0)
+        rc = st_check_num("passages.quality", r->quality, &R_QUALITY, err, errlen);
     if (rc == 0)
         rc = st_check_num("passages.gvw_kg", r->gvw_kg, &R_KG, err, errlen);
     if (rc == 0)
@@ -108,6 +114,8 @@ int amfi_store_add_passage(amfi_store *s, const amfi_passage_row *r,
         if (b == SQLITE_OK) b = st_bind_real(st, 12, r->solve_ms);
         if (b == SQLITE_OK) b = st_bind_real(st, 13, r->speed_given_mps);
         if (b == SQLITE_OK) b = sqlite3_bind_int(st, 14, r->speed_estimated);
+        if (b == SQLITE_OK) b = sqlite3_bind_int(st, 15, r->n_vehicles > 0 ? r->n_vehicles : 1);
+        if (b == SQLITE_OK) b = st_bind_real(st, 16, r->quality != 0.0 ? r->quality : NAN);
         rc = st_run(s, ST_INS_PASSAGE, b, "passages: insert", err, errlen);
         if (rc == 0)
             pid = sqlite3_last_insert_rowid(s->db);

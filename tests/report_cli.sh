@@ -40,9 +40,9 @@ awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
     cat "$tmp/ddl.sql"
     cat <<'EOF'
 PRAGMA journal_mode = WAL;
-PRAGMA user_version = 3;
+PRAGMA user_version = 4;
 INSERT INTO schema_migrations (version, description) VALUES (1, 'report_cli fixture'), (2, 'runs'),
-    (3, 'speed_given_mps');
+    (3, 'speed_given_mps'), (4, 'n_vehicles');
 WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 40)
 INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status,
                       reason, lambda, residual_rms, formulation, solve_ms, speed_given_mps)
@@ -467,7 +467,7 @@ if command -v gnuplot > /dev/null; then
     fi
     # an empty store still draws (empty plots saying so), a missing dir parent fails
     sqlite3 "$tmp/empty.db" < "$tmp/ddl.sql"
-    sqlite3 "$tmp/empty.db" "PRAGMA user_version = 3; INSERT INTO schema_migrations (version, description) VALUES (1, 'e'), (2, 'e'), (3, 'e')"
+    sqlite3 "$tmp/empty.db" "PRAGMA user_version = 4; INSERT INTO schema_migrations (version, description) VALUES (1, 'e'), (2, 'e'), (3, 'e'), (4, 'e')"
     if ok plot-empty --db "$tmp/empty.db" --plot "$tmp/plots-empty"; then
         for p in gvw trend gvw_histogram passages_per_hour speed; do png_ok "$tmp/plots-empty/$p.png"; done
     fi

@@ -842,19 +842,21 @@ static void test_runs_and_migration_from_v1(void **state)
     assert_int_equal(1, raw_int(db, "SELECT started_at LIKE '____-__-__T__:__:__.___Z' FROM runs"));
     raw_exec(db, "DROP TABLE runs; ALTER TABLE passages DROP COLUMN speed_given_mps; "
                  "ALTER TABLE passages DROP COLUMN speed_estimated; "
+                 "ALTER TABLE passages DROP COLUMN n_vehicles; "
+                 "ALTER TABLE passages DROP COLUMN quality; "
                  "DELETE FROM schema_migrations WHERE version >= 2; PRAGMA user_version = 1");
     sqlite3_close(db);
 
     /* read-only openers do not migrate: they say so */
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 1 is older than this program's 3"));
+    assert_non_null(strstr(err, "schema version 1 is older than this program's 4"));
     assert_null(ro);
 
     /* read-write: migrated, the data kept */
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(3, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(4, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(4, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM runs"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
     sqlite3_close(db);
@@ -895,22 +897,81 @@ static void test_speed_given_and_migration_from_v2(void **state)
     /* make it a version-2 file: the detector's speed was the one weighed with */
     raw_exec(db, "ALTER TABLE passages DROP COLUMN speed_given_mps; "
                  "ALTER TABLE passages DROP COLUMN speed_estimated; "
+                 "ALTER TABLE passages DROP COLUMN n_vehicles; "
+                 "ALTER TABLE passages DROP COLUMN quality; "
                  "UPDATE passages SET speed_mps = 25.0; "
-                 "DELETE FROM schema_migrations WHERE version = 3; PRAGMA user_version = 2");
+                 "DELETE FROM schema_migrations WHERE version >= 3; PRAGMA user_version = 2");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 2 is older than this program's 3"));
+    assert_non_null(strstr(err, "schema version 2 is older than this program's 4"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(3, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(4, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(4, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE speed_given_mps = 25.0 "
                                     "AND speed_mps = 25.0 AND speed_estimated = 0"));
     sqlite3_close(db);
     ok_row(&r, 2, 2 * DAY_US, 18000.0);
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+}
+
+/* ---- version 4: vehicles weighed together; a version-3 file migrates --------- */
+
+static void test_event_columns_and_migration_from_v3(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    amfi_passage_row r;
+    amfi_store *ro = NULL;
+    sqlite3 *db;
+
+    ok_row(&r, 1, DAY_US, 18000.0); /* memset: n_vehicles 0 (taken as 1), quality 0 (NULL) */
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    ok_row(&r, 2, DAY_US + 500000, 21000.0);
+    r.n_vehicles = 3;
+    r.quality = 1.7;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    r.n_vehicles = 65;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.n_vehicles: 65 is out of range"));
+    r.n_vehicles = 2;
+    r.quality = 0.5;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.quality"));
+    r.quality = INFINITY;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.quality"));
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    db = raw_open(f->path);
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE vehicle_id = 1 AND "
+                                    "n_vehicles = 1 AND quality IS NULL"));
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE vehicle_id = 2 AND "
+                                    "n_vehicles = 3 AND quality = 1.7"));
+    /* make it a version-3 file, as amfid before issue 13 left it */
+    raw_exec(db, "ALTER TABLE passages DROP COLUMN n_vehicles; "
+                 "ALTER TABLE passages DROP COLUMN quality; "
+                 "DELETE FROM schema_migrations WHERE version >= 4; PRAGMA user_version = 3");
+    sqlite3_close(db);
+
+    assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
+    assert_non_null(strstr(err, "schema version 3 is older than this program's 4"));
+    assert_null(ro);
+
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(4, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(4, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages WHERE n_vehicles = 1 "
+                                    "AND quality IS NULL"));
+    sqlite3_close(db);
+    ok_row(&r, 3, 2 * DAY_US, 18000.0);
+    r.n_vehicles = 2;
+    r.quality = 4.0;
     assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
 }
 
@@ -1347,6 +1408,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_corrupt_rows_reported, setup, teardown),
         cmocka_unit_test_setup_teardown(test_readonly, setup, teardown),
         cmocka_unit_test_setup_teardown(test_runs_and_migration_from_v1, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_event_columns_and_migration_from_v3, setup, teardown),
         cmocka_unit_test_setup_teardown(test_speed_given_and_migration_from_v2, setup, teardown),
         cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
