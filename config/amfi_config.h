@@ -46,6 +46,13 @@ typedef struct amfi_daemon_config {
     double ring_s;            /* daemon.ring_s: seconds of samples kept per sensor */
     double margin_s;          /* daemon.window_margin_s: data around the solver window */
     double max_wait_s;        /* daemon.max_wait_s: data time to wait for a window */
+    double max_event_s;       /* daemon.max_event_s: vehicles sharing the span are
+                                 weighed together while first entry to last exit
+                                 is at most this, s, [0, 600]; 0 = never (multiple) */
+    int max_event_axles;      /* daemon.max_event_axles: axles of such an event,
+                                 2 .. AMFI_MAX_AXLES */
+    int single_presence_only; /* daemon.indicators.single_presence_only: the
+                                 indicators take only passages weighed alone */
     double status_period_s;   /* daemon.status_period_s: heartbeat, wall time */
     char alert_command[512];  /* alerts.command: run for each raised and cleared alert;
                                  "" none */

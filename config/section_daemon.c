@@ -56,6 +56,9 @@ static const field indicator_fields[] = {
      .flags = F_LO_OPEN},
     {.key = "mean_clear_ratio", .kind = &K_DOUBLE, .off = IND(mean_clear_ratio), .lo = 0.5,
      .hi = 10},
+    /* amfid's filter in front of the engine (pipeline.c), not an engine parameter */
+    {.key = "single_presence_only", .kind = &K_ENUM, .off = DC(single_presence_only),
+     .aux = onoff_names},
     {.key = NULL}};
 
 const field daemon_fields[] = {
@@ -71,6 +74,9 @@ const field daemon_fields[] = {
     {.key = "window_margin_s", .kind = &K_DOUBLE, .off = DC(margin_s), .lo = 0, .hi = 5},
     {.key = "max_wait_s", .kind = &K_DOUBLE, .off = DC(max_wait_s), .lo = 0, .hi = 3600,
      .flags = F_LO_OPEN},
+    {.key = "max_event_s", .kind = &K_DOUBLE, .off = DC(max_event_s), .lo = 0, .hi = 600},
+    {.key = "max_event_axles", .kind = &K_INT, .off = DC(max_event_axles), .lo = 2,
+     .hi = AMFI_MAX_AXLES},
     {.key = "status_period_s", .kind = &K_DOUBLE, .off = DC(status_period_s), .lo = 0.1,
      .hi = 3600},
     {.key = "indicators", .kind = &K_MAP, .aux = indicator_fields},

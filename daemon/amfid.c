@@ -197,7 +197,8 @@ static int start_runtime(daemon_s *d)
     amfi_tracker_params tp = {d->cfg.bridge.span_m,
                               d->cfg.solver.pre_roll_s + d->cfg.daemon.margin_s,
                               d->cfg.solver.post_roll_s + d->cfg.daemon.margin_s,
-                              d->cfg.daemon.max_wait_s, d->cfg.solver.n_sensors};
+                              d->cfg.daemon.max_wait_s, d->cfg.solver.n_sensors,
+                              d->cfg.daemon.max_event_s, d->cfg.daemon.max_event_axles};
     d->tracker = amfi_tracker_create(&tp);
     d->pend_cap = d->cfg.daemon.queue_size + AMFI_TRACKER_MAX_PENDING + 16;
     d->pending = calloc((size_t)d->pend_cap, sizeof *d->pending);

@@ -189,9 +189,11 @@ void reload(daemon_s *d)
         strcmp(n.daemon.ch_truth, d->cfg.daemon.ch_truth) ||
         n.daemon.workers != d->cfg.daemon.workers ||
         n.daemon.queue_size != d->cfg.daemon.queue_size || n.daemon.ring_s != d->cfg.daemon.ring_s ||
-        n.daemon.sync_full != d->cfg.daemon.sync_full)
-        LOG_WARN("reload: channels, workers, queue, ring and store changes take effect at the "
-                 "next start");
+        n.daemon.sync_full != d->cfg.daemon.sync_full ||
+        n.daemon.max_event_s != d->cfg.daemon.max_event_s ||
+        n.daemon.max_event_axles != d->cfg.daemon.max_event_axles)
+        LOG_WARN("reload: channels, workers, queue, ring, event limits and store changes take "
+                 "effect at the next start");
     /* λ policy, output channels, heartbeat, waits: now. The λ policy is
      * copied into each job at release (intake.c): passages released from
      * now on are solved with the new one, those already queued with theirs. */
@@ -204,7 +206,8 @@ void reload(daemon_s *d)
     d->cfg.daemon.max_wait_s = n.daemon.max_wait_s;
     amfi_indicator_params ip;
     indicator_params(&n.daemon, &ip);
-    if (!amfi_indicator_params_equal(&ip, &d->ind_params))
+    if (!amfi_indicator_params_equal(&ip, &d->ind_params) ||
+        n.daemon.single_presence_only != d->cfg.daemon.single_presence_only)
         LOG_WARN("reload: indicator settings take effect at the next start");
     drift_reload(d, &n);
     LOG_INFO("reload: configuration %s applied", d->config_path);

@@ -5,7 +5,11 @@
  * transaction each), published on the passage channel, and the ok ones fed
  * to the indicator engine, whose baselines, indicators and alerts are
  * stored and published too; the estimated speeds feed the speed-drift
- * alert (drift.c).
+ * alert (drift.c). An event of several vehicles weighed together
+ * (tracker.h) becomes one row per vehicle, in entry order, each with the
+ * event's size and its own weight and quality; with
+ * daemon.indicators.single_presence_only the indicators take only the
+ * passages weighed alone (the one filter here, not in the engine).
  *
  * A passage is acknowledged when its transaction has committed; only then
  * is it published and fed to the indicators. When the store cannot write
@@ -61,6 +65,8 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id)
     m.site_id = d->cfg.site.id;
     m.speed_given_mps = j->w.v.speed_mps;
     m.speed_estimated = (int8_t)j->speed_estimated;
+    m.n_vehicles = (int16_t)(j->w.n_vehicles > 1 ? j->w.n_vehicles : 1);
+    m.quality = j->quality > 0 ? j->quality : NAN;
     amfi_passage_t_publish(d->lcm, d->cfg.daemon.ch_passage, &m);
 }
 
@@ -148,6 +154,8 @@ static void job_row(const daemon_s *d, const job *j, amfi_passage_row *r)
     r->residual_rms = j->solved ? j->residual_rms : NAN;
     r->formulation = amfi_formulation_name(d->cfg.solver.formulation);
     r->solve_ms = j->solve_ms;
+    r->n_vehicles = j->w.n_vehicles > 1 ? j->w.n_vehicles : 1;
+    r->quality = j->quality > 0 ? j->quality : NAN;
 }
 
 static int store_now(daemon_s *d, job *j)
@@ -182,7 +190,8 @@ static int store_now(daemon_s *d, job *j)
         drift_feed(d, j->w.v.utime, r.speed_mps, r.speed_given_mps);
     if (j->solved) {
         d->passages_ok++;
-        feed_indicators(d, j);
+        if (!d->cfg.daemon.single_presence_only || j->w.n_vehicles <= 1)
+            feed_indicators(d, j);
     }
     return 0;
 }
@@ -272,7 +281,7 @@ static void hold(daemon_s *d, job *j)
 }
 
 /* Store in order: behind any held passage, or now. Takes the job. */
-static int store_job(daemon_s *d, job *j)
+static int store_one(daemon_s *d, job *j)
 {
     if (d->held_n > 0 || store_now(d, j) != 0) {
         hold(d, j);
@@ -280,6 +289,55 @@ static int store_job(daemon_s *d, job *j)
     }
     job_free(j);
     return 0;
+}
+
+/* The job of vehicle i of an event: its own vehicle, result and status
+ * (the event's when the event was not solved), no samples. NULL: out of
+ * memory. */
+static job *vehicle_job(const job *e, int i)
+{
+    job *j = malloc(sizeof *j);
+    if (!j)
+        return NULL;
+    *j = *e;
+    j->accel = NULL;
+    j->w.v = e->w.ev[i];
+    j->quality = NAN;
+    if (!e->solved)
+        return j;
+    const job_vehicle *o = &e->veh[i];
+    j->quality = o->quality;
+    j->solved = o->solved;
+    j->gvw_kg = o->solved ? o->gvw_kg : NAN;
+    for (int a = 0; a < AMFI_MAX_AXLES; a++)
+        j->axle_kg[a] = o->solved && a < j->w.v.n_axles ? o->axle_kg[a] : NAN;
+    if (!o->solved) {
+        snprintf(j->status, sizeof j->status, "error");
+        snprintf(j->reason, sizeof j->reason, "%s", o->reason);
+    }
+    return j;
+}
+
+/* Store a passage, or each vehicle of an event in entry order. Takes the job. */
+static int store_job(daemon_s *d, job *e)
+{
+    if (e->w.n_vehicles <= 1)
+        return store_one(d, e);
+    int rc = 0;
+    for (int i = 0; i < e->w.n_vehicles; i++) {
+        job *j = vehicle_job(e, i);
+        if (!j) {
+            d->passages_lost++;
+            set_error(d, "out of memory: passage of vehicle %lld at utime %lld LOST",
+                      (long long)e->w.ev[i].vehicle_id, (long long)e->w.ev[i].utime);
+            rc = -1;
+            continue;
+        }
+        if (store_one(d, j))
+            rc = -1;
+    }
+    job_free(e);
+    return rc;
 }
 
 void pipeline_retry(daemon_s *d, double final)

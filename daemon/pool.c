@@ -95,9 +95,73 @@ void queue_close(queue *q)
 
 /* ---- solver threads ------------------------------------------------------- */
 
-/* Weigh the job's passage; the result goes into the job. */
+/* Weigh an event's vehicles together (amfi_solve_multi, the job's λ
+ * policy, the detector's speeds: the speed search is one vehicle's); the
+ * result goes into the job: the event's λ and residual, each vehicle's
+ * weight and quality in j->veh. A vehicle whose weight is not positive is
+ * an error of its own; a failed solve is every vehicle's. */
+static void solve_event(amfi_solver *s, job *j)
+{
+    amfi_multi_passage p;
+    memset(&p, 0, sizeof p);
+    p.n_samples = j->w.n;
+    p.scan_rate_hz = j->scan_rate_hz;
+    p.t_first_s = j->w.t_first_s;
+    for (int i = 0; i < j->n_sensors; i++)
+        p.accel[i] = j->accel + (size_t)i * j->w.n;
+    p.n_vehicles = j->w.n_vehicles;
+    for (int v = 0; v < p.n_vehicles; v++) {
+        const amfi_vehicle_ev *e = &j->w.ev[v];
+        amfi_vehicle *ve = &p.vehicle[v];
+        ve->entry_s = 1e-6 * (double)(e->utime - j->w.v.utime);
+        ve->speed_mps = e->speed_mps;
+        ve->n_axles = e->n_axles;
+        for (int a = 0; a + 1 < e->n_axles; a++)
+            ve->axle_spacing_m[a] = e->spacing_m[a];
+    }
+    amfi_multi_result *r = malloc(sizeof *r);
+    char err[256] = "out of memory";
+    double t0 = amfi_mono_s();
+    int rc = r ? amfi_solve_multi(s, &p, &j->lambda, r, err, sizeof err) : AMFI_ENOMEM;
+    j->solve_ms = 1e3 * (amfi_mono_s() - t0);
+    if (rc != 0) {
+        snprintf(j->status, sizeof j->status, "error");
+        snprintf(j->reason, sizeof j->reason, "solver, %d vehicles together: %.150s",
+                 p.n_vehicles, err);
+        j->gvw_kg = NAN;
+        free(r);
+        return;
+    }
+    j->solved = 1;
+    snprintf(j->status, sizeof j->status, "ok");
+    j->lambda_used = r->all.lambda_ref;
+    j->residual_rms = r->all.residual_rms;
+    j->gvw_kg = r->total_gvw_kg;
+    for (int v = 0; v < p.n_vehicles; v++) {
+        const amfi_vehicle_result *vr = &r->vehicle[v];
+        job_vehicle *o = &j->veh[v];
+        o->quality = vr->quality;
+        if (!(vr->gvw_kg > 0.0) || !isfinite(vr->gvw_kg)) {
+            snprintf(o->reason, sizeof o->reason,
+                     "inferred GVW %.0f kg is not positive in the joint solve of %d vehicles",
+                     vr->gvw_kg, p.n_vehicles);
+            continue;
+        }
+        o->solved = 1;
+        o->gvw_kg = vr->gvw_kg;
+        for (int a = 0; a < vr->n_axles; a++)
+            o->axle_kg[a] = vr->axle_kg[a];
+    }
+    free(r);
+}
+
+/* Weigh the job's passage (or event); the result goes into the job. */
 static void solve_job(amfi_solver *s, job *j)
 {
+    if (j->w.n_vehicles > 1) {
+        solve_event(s, j);
+        return;
+    }
     amfi_passage p;
     memset(&p, 0, sizeof p);
     p.n_samples = j->w.n;

@@ -19,7 +19,17 @@
 #include "amfi/amfi.h"
 #include "tracker.h"
 
-/* One passage between the threads: all a solver thread reads is here. */
+/* One vehicle's result in a joint solve (an event of several vehicles). */
+typedef struct job_vehicle {
+    int solved;              /* 1: gvw_kg and axle_kg hold its weight */
+    double gvw_kg, axle_kg[AMFI_MAX_AXLES];
+    double quality;          /* amfi_vehicle_result.quality */
+    char reason[200];        /* why not solved (status "error") */
+} job_vehicle;
+
+/* One passage, or one event of several vehicles solved together (w.n_vehicles
+ * > 1: the pipeline stores a row per vehicle), between the threads: all a
+ * solver thread reads is here. */
 typedef struct job {
     amfi_window w;           /* the window (and its status) */
     int n_sensors;
@@ -33,8 +43,10 @@ typedef struct job {
     double speed_used_mps;   /* the speed weighed with: the estimate, or w.v.speed_mps */
     int speed_estimated;     /* 1: speed_used_mps is amfi_solve_speed's estimate */
     double gvw_kg, axle_kg[AMFI_MAX_AXLES], lambda_used, residual_rms, solve_ms;
+    double quality;          /* a vehicle of an event: its separability; else NaN */
     char status[16];
     char reason[200];
+    job_vehicle veh[AMFI_MAX_VEHICLES]; /* an event (w.n_vehicles > 1), solved: per vehicle */
 } job;
 
 void job_free(job *j);

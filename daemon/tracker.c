@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * tracker.c: passage windows from vehicle events and sample rings.
+ * tracker.c: passage windows from vehicle events and sample rings: one
+ * vehicle alone, or an event of the vehicles that share the span (tracker.h).
+ * Thread: the bus (main) thread, which owns the tracker.
  */
 #include <math.h>
 #include <stdio.h>
@@ -28,11 +30,16 @@ struct amfi_tracker {
 amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p)
 {
     if (!(p->span_m > 0) || !(p->pre_s >= 0) || !(p->post_s >= 0) || !(p->max_wait_s > 0) ||
-        p->n_sensors < 1 || p->n_sensors > AMFI_MAX_SENSORS)
+        p->n_sensors < 1 || p->n_sensors > AMFI_MAX_SENSORS || !(p->max_event_s >= 0) ||
+        p->max_event_axles < 0 || p->max_event_axles == 1 ||
+        p->max_event_axles > AMFI_MAX_AXLES)
         return NULL;
     amfi_tracker *t = calloc(1, sizeof *t);
-    if (t)
+    if (t) {
         t->p = *p;
+        if (t->p.max_event_axles == 0)
+            t->p.max_event_axles = AMFI_MAX_AXLES;
+    }
     return t;
 }
 
@@ -77,12 +84,22 @@ int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, const char **why
     return 0;
 }
 
-/* Another vehicle (pending or recently released) on the span at the same time. */
-static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, int64_t *other)
+static int in_event(const amfi_window *w, int64_t id)
+{
+    for (int i = 0; i < w->n_vehicles; i++)
+        if (w->ev[i].vehicle_id == id)
+            return 1;
+    return 0;
+}
+
+/* Another vehicle (pending or recently released), not of the event w, on
+ * the span at the same time as v. */
+static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, const amfi_window *w,
+                       int64_t *other)
 {
     span me = span_of(t, v);
     for (int i = 0; i < t->n_pend; i++) {
-        if (t->pend[i].vehicle_id == v->vehicle_id)
+        if (in_event(w, t->pend[i].vehicle_id))
             continue;
         span o = span_of(t, &t->pend[i]);
         if (o.t_in < me.t_out && me.t_in < o.t_out) {
@@ -92,12 +109,116 @@ static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, int64_t 
     }
     for (int i = 0; i < t->n_recent; i++) {
         const span *o = &t->recent[i];
-        if (o->id != v->vehicle_id && o->t_in < me.t_out && me.t_in < o->t_out) {
+        if (!in_event(w, o->id) && o->t_in < me.t_out && me.t_in < o->t_out) {
             *other = o->id;
             return 1;
         }
     }
     return 0;
+}
+
+/* Front axle position of v at time t_us (µs), m from the entry. */
+static double front_m(const amfi_vehicle_ev *v, double t_us)
+{
+    return v->speed_mps * 1e-6 * (t_us - (double)v->utime);
+}
+
+/* Vehicles of one lane in the event overtaking each other on the span (a
+ * follower's front axle level with or ahead of its leader's while both are
+ * on it): the events contradict each other. 1 with the reason, else 0. */
+static int inconsistent(const amfi_tracker *t, const amfi_window *w, char *why, size_t len)
+{
+    for (int i = 0; i < w->n_vehicles; i++)
+        for (int j = i + 1; j < w->n_vehicles; j++) {
+            const amfi_vehicle_ev *a = &w->ev[i], *b = &w->ev[j]; /* a entered first */
+            if (a->lane != b->lane)
+                continue;
+            span sa = span_of(t, a), sb = span_of(t, b);
+            double lo = fmax(sa.t_in, sb.t_in), hi = fmin(sa.t_out, sb.t_out);
+            if (lo >= hi)
+                continue;
+            /* fronts are linear in time: their gap's worst is at an end;
+             * the front leaves the span before the last axle does */
+            double hi_front = fmin(hi, fmin((double)a->utime + 1e6 * t->p.span_m / a->speed_mps,
+                                            (double)b->utime + 1e6 * t->p.span_m / b->speed_mps));
+            double g0 = front_m(a, lo) - front_m(b, lo);
+            double g1 = hi_front > lo ? front_m(a, hi_front) - front_m(b, hi_front) : g0;
+            if (g0 <= 0 || g1 <= 0) {
+                snprintf(why, len,
+                         "vehicles %lld and %lld of lane %d contradict each other: %lld would "
+                         "overtake %lld on the span (%.2f s apart at %.1f and %.1f m/s)",
+                         (long long)a->vehicle_id, (long long)b->vehicle_id, a->lane,
+                         (long long)b->vehicle_id, (long long)a->vehicle_id,
+                         1e-6 * (double)(b->utime - a->utime), a->speed_mps, b->speed_mps);
+                return 1;
+            }
+        }
+    return 0;
+}
+
+/* The event that starts with pend[0]: the pending vehicles, by entry, whose
+ * time on the span overlaps the chain's so far. Fills out->ev and
+ * out->n_vehicles; returns NULL, or the status of a bad event ("multiple":
+ * a limit broken; "invalid": the vehicles contradict each other) with the
+ * reason in out->reason. */
+static const char *gather(const amfi_tracker *t, amfi_window *out)
+{
+    out->ev[0] = t->pend[0];
+    out->n_vehicles = 1;
+    if (!(t->p.max_event_s > 0))
+        return NULL;
+    const span first = span_of(t, &t->pend[0]);
+    double end = first.t_out;
+    int axles = t->pend[0].n_axles;
+    for (int i = 1; i < t->n_pend; i++) {
+        const amfi_vehicle_ev *v = &t->pend[i];
+        const span s = span_of(t, v);
+        if (s.t_in >= end)
+            break;
+        if (out->n_vehicles == AMFI_MAX_VEHICLES) {
+            snprintf(out->reason, sizeof out->reason,
+                     "vehicle %lld joins an event of %d vehicles on the span together: more "
+                     "than %d cannot be weighed together",
+                     (long long)v->vehicle_id, out->n_vehicles, AMFI_MAX_VEHICLES);
+            return "multiple";
+        }
+        out->ev[out->n_vehicles++] = *v;
+        axles += v->n_axles;
+        end = fmax(end, s.t_out);
+        if (axles > t->p.max_event_axles) {
+            snprintf(out->reason, sizeof out->reason,
+                     "%d vehicles on the span together with %d axles in all: more than "
+                     "daemon.max_event_axles (%d)",
+                     out->n_vehicles, axles, t->p.max_event_axles);
+            return "multiple";
+        }
+        if (end - first.t_in > 1e6 * t->p.max_event_s) {
+            snprintf(out->reason, sizeof out->reason,
+                     "%d vehicles on the span one after another for %.2f s: longer than "
+                     "daemon.max_event_s (%.2f s)",
+                     out->n_vehicles, 1e-6 * (end - first.t_in), t->p.max_event_s);
+            return "multiple";
+        }
+    }
+    if (out->n_vehicles > 1 && inconsistent(t, out, out->reason, sizeof out->reason))
+        return "invalid";
+    return NULL;
+}
+
+/* Remember the released vehicles' spans and take them off the queue (the
+ * event's vehicles are the first n of pend). */
+static void release(amfi_tracker *t, amfi_window *out)
+{
+    out->seq = ++t->seq;
+    for (int i = 0; i < out->n_vehicles; i++) {
+        t->recent[t->recent_head] = span_of(t, &t->pend[i]);
+        t->recent_head = (t->recent_head + 1) % RECENT;
+        if (t->n_recent < RECENT)
+            t->n_recent++;
+    }
+    memmove(t->pend, t->pend + out->n_vehicles,
+            sizeof *t->pend * (size_t)(t->n_pend - out->n_vehicles));
+    t->n_pend -= out->n_vehicles;
 }
 
 int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_window *out)
@@ -106,12 +227,22 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
         return 0;
     const amfi_vehicle_ev *v = &t->pend[0];
     const int ns = t->p.n_sensors;
-    const amfi_passage_times w = window_of(t, v);
-    const double t0 = (double)v->utime + 1e6 * w.start_s;
-    const double t1 = (double)v->utime + 1e6 * w.end_s;
     memset(out, 0, sizeof *out);
     out->v = *v;
     out->status = "ok";
+    const char *bad = gather(t, out);
+    if (bad) { /* refused whatever its data: released at once, never waited for */
+        out->status = bad;
+        release(t, out);
+        return 1;
+    }
+    /* the event's window: the earliest start to the latest end */
+    double t0 = INFINITY, t1 = -INFINITY;
+    for (int i = 0; i < out->n_vehicles; i++) {
+        const amfi_passage_times w = window_of(t, &out->ev[i]);
+        t0 = fmin(t0, (double)out->ev[i].utime + 1e6 * w.start_s);
+        t1 = fmax(t1, (double)out->ev[i].utime + 1e6 * w.end_s);
+    }
     /* Decide: all data present, data gone, or waited long enough. */
     int complete = 1, gone = 0, jumping = 0;
     const amfi_ring *gone_ring = NULL; /* a ring whose data left before t0 */
@@ -165,21 +296,17 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
                        : "the data stream stopped before the passage's end (max_wait exceeded)");
     } else {
         int64_t other;
-        if (overlapping(t, v, &other)) {
-            out->status = "multiple";
-            snprintf(out->reason, sizeof out->reason,
-                     "vehicle %lld on the span at the same time", (long long)other);
-        }
+        for (int i = 0; i < out->n_vehicles; i++)
+            if (overlapping(t, &out->ev[i], out, &other)) {
+                out->status = "multiple";
+                snprintf(out->reason, sizeof out->reason,
+                         "vehicle %lld on the span at the same time%s", (long long)other,
+                         t->p.max_event_s > 0 ? ", already stored without it" : "");
+                break;
+            }
     }
     if (rings[0] && amfi_ring_started(rings[0]))
         out->t_first_s = (amfi_ring_utime(rings[0], out->k0[0]) - (double)v->utime) * 1e-6;
-    out->seq = ++t->seq;
-    /* remember its span, release */
-    t->recent[t->recent_head] = span_of(t, v);
-    t->recent_head = (t->recent_head + 1) % RECENT;
-    if (t->n_recent < RECENT)
-        t->n_recent++;
-    memmove(t->pend, t->pend + 1, sizeof *t->pend * (size_t)(t->n_pend - 1));
-    t->n_pend--;
+    release(t, out);
     return 1;
 }

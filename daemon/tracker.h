@@ -9,9 +9,23 @@
  * falls silent, once the newest data is max_wait past the window's end. A
  * released window says how it is to be stored: "ok" (to be solved), "gap"
  * (samples missing), "late" (the data left the ring before the vehicle
- * event arrived), or "multiple" (another vehicle on the span at the same
- * time: the single-vehicle solve would be wrong). Not thread-safe: the bus
- * thread owns it. Capacity fixed at creation.
+ * event arrived), "multiple" (vehicles on the span together that cannot be
+ * weighed together) or "invalid" (their events contradict each other).
+ *
+ * Events (issue 13): vehicles whose times on the span overlap, on any lane
+ * (the beam has no width), form one event, released as one window from the
+ * first entry's window start to the last exit's window end, to be solved
+ * jointly (amfi_solve_multi); a chain A-B-C, where A and C never meet, is one
+ * event. An event longer than max_event_s (first entry to last exit), with
+ * more than max_event_axles axles or AMFI_MAX_VEHICLES vehicles, is released
+ * at once as "multiple" with the reason (no waiting for its data); an event
+ * whose vehicles of one lane would overlap each other on the span (the
+ * follower's front axle ahead of the leader's last) as "invalid".
+ * max_event_s = 0 turns events off: every vehicle that shares the span is
+ * "multiple" (the behaviour before issue 13). A vehicle whose event arrives
+ * after a partner was released is "multiple" too.
+ *
+ * Not thread-safe: the bus thread owns it. Capacity fixed at creation.
  */
 #ifndef AMFI_TRACKER_H
 #define AMFI_TRACKER_H
@@ -38,15 +52,19 @@ typedef struct amfi_tracker_params {
     double post_s;       /* window after the last exit (solver post-roll + margin) */
     double max_wait_s;   /* data time past a window's end before it is given up */
     int n_sensors;
+    double max_event_s;  /* first entry to last exit of an event, s; 0: no events */
+    int max_event_axles; /* axles of an event, 2 .. AMFI_MAX_AXLES (0: AMFI_MAX_AXLES) */
 } amfi_tracker_params;
 
 typedef struct amfi_window {
-    amfi_vehicle_ev v;
+    amfi_vehicle_ev v;    /* the first vehicle of the event (ev[0]) */
+    int n_vehicles;       /* vehicles in the event, 1 .. AMFI_MAX_VEHICLES */
+    amfi_vehicle_ev ev[AMFI_MAX_VEHICLES]; /* by entry time */
     int64_t seq;          /* release order, from 1 */
     int64_t k0[AMFI_MAX_SENSORS]; /* first sample index per sensor */
     int n;                /* samples per sensor */
-    double t_first_s;     /* time of the first sample relative to entry, per sensor 0 */
-    const char *status;   /* "ok", "gap", "late", "multiple" */
+    double t_first_s;     /* time of the first sample relative to v's entry, sensor 0 */
+    const char *status;   /* "ok", "gap", "late", "multiple", "invalid" */
     char reason[200];
 } amfi_window;
 
@@ -59,7 +77,8 @@ void amfi_tracker_destroy(amfi_tracker *t);
  * or the id is already pending (then `why` says which). */
 int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, const char **why);
 
-/* Release the next window if it is decided (1), or none (0). rings: one per
+/* Release the next window (one vehicle, or an event of several) if it is
+ * decided (1), or none (0). rings: one per
  * sensor (NULL while a sensor has sent nothing). `flush` releases every
  * pending window now, as "gap" when its data is incomplete (shutdown). */
 int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_window *out);

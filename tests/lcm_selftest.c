@@ -129,6 +129,8 @@ static void round_make(struct round *r, int i)
     r->passage.site_id = "selftest-site";
     r->passage.speed_given_mps = r->vehicle.speed_mps * 1.02; /* the detector 2 % high */
     r->passage.speed_estimated = 1;
+    r->passage.n_vehicles = (int16_t)(1 + i % 3);   /* weighed alone or with others */
+    r->passage.quality = 1.0 + 0.5 * (i % 3);
 
     r->unsolved = r->passage;
     r->unsolved.passage_id = 100000 + i;
@@ -268,7 +270,9 @@ static void print_round(const struct round *r)
     put_d("solve_ms", p->solve_ms, ";");
     put_s("site_id", p->site_id, ";");
     put_d("speed_given_mps", p->speed_given_mps, ";");
-    put_i("speed_estimated", p->speed_estimated, "\n");
+    put_i("speed_estimated", p->speed_estimated, ";");
+    put_i("n_vehicles", p->n_vehicles, ";");
+    put_d("quality", p->quality, "\n");
 
     const amfi_indicator_t *d = &r->indicator;
     printf("%s\tamfi.indicator_t\t", AMFI_CHANNEL_INDICATOR);

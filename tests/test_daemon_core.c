@@ -2,7 +2,8 @@
 /*
  * test_daemon_core.c: the sample ring (gaps, duplicates, out-of-order and
  * late blocks) and the passage tracker (windows in data time, release
- * order, gaps, late vehicle events, multiple presence).
+ * order, gaps, late vehicle events, multiple presence; events of vehicles
+ * sharing the span: chains, two lanes, the limits, contradicting events).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -164,7 +165,7 @@ static void ring_outage_then_resume(void **state)
 static void tracker_after_poisoned_first_block(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1};
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = amfi_ring_create(RATE, 60.0);
     amfi_ring *rings[1] = {r};
@@ -196,7 +197,7 @@ static void tracker_after_poisoned_first_block(void **state)
 static void tracker_windows(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1};
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(3.0); /* samples 0 .. 2999 */
     amfi_ring *rings[1] = {r};
@@ -233,7 +234,7 @@ static void tracker_windows(void **state)
 static void tracker_multiple_and_late(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1};
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(4.0);
     amfi_ring *rings[1] = {r};
@@ -276,7 +277,7 @@ static void tracker_multiple_and_late(void **state)
     amfi_tracker_destroy(t);
     /* two sensors, the second falls silent: given up max_wait (5 s) after
      * the window's end, as a gap */
-    amfi_tracker_params p2 = {20.0, 0.35, 0.05, 5.0, 2};
+    amfi_tracker_params p2 = {20.0, 0.35, 0.05, 5.0, 2, 0.0, 0};
     t = amfi_tracker_create(&p2);
     amfi_ring *a1 = amfi_ring_create(RATE, 60.0), *a2 = amfi_ring_create(RATE, 60.0);
     amfi_ring *two[2] = {a1, a2};
@@ -301,6 +302,159 @@ static void tracker_multiple_and_late(void **state)
     amfi_tracker_destroy(t);
 }
 
+static amfi_vehicle_ev vehicle_in(int64_t id, double entry_s, int lane, double speed_mps,
+                                   int n_axles)
+{
+    amfi_vehicle_ev v = vehicle(id, entry_s);
+    v.lane = lane;
+    v.speed_mps = speed_mps;
+    v.n_axles = n_axles;
+    for (int a = 0; a + 1 < n_axles; a++)
+        v.spacing_m[a] = 4.0;
+    return v;
+}
+
+/* Vehicles whose times on the span overlap form one event: a chain of three
+ * (the first and the last never meet), one window from the first's start to
+ * the last's end; two lanes at the same time; a vehicle alone stays alone;
+ * one of a lane overtaking another on the span is a contradiction. */
+static void tracker_events_chain_and_lanes(void **state)
+{
+    (void)state;
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0};
+    amfi_tracker *t = amfi_tracker_create(&p);
+    amfi_ring *r = filled(14.0);
+    amfi_ring *rings[1] = {r};
+    amfi_window w;
+    /* each on the span 1.0 s (25 m + 5 m at 25 m/s) */
+    amfi_vehicle_ev a = vehicle(1, 1.0), b = vehicle(2, 1.8), c = vehicle(3, 2.6),
+                    d = vehicle(4, 5.0);
+    assert_int_equal(amfi_tracker_add(t, &c, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &d, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.n_vehicles, 3);
+    assert_int_equal(w.v.vehicle_id, 1);
+    assert_int_equal(w.ev[0].vehicle_id, 1);
+    assert_int_equal(w.ev[1].vehicle_id, 2);
+    assert_int_equal(w.ev[2].vehicle_id, 3);
+    assert_int_equal(w.seq, 1);
+    /* 1.0 − 0.35 s .. 2.6 + 1.0 + 0.05 s */
+    assert_int_equal(w.k0[0], 650);
+    assert_int_equal(w.n, 3001);
+    assert_true(fabs(w.t_first_s + 0.35) < 1e-9);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.n_vehicles, 1);
+    assert_int_equal(w.v.vehicle_id, 4);
+    assert_int_equal(w.seq, 2);
+    /* two lanes, side by side: one event */
+    amfi_vehicle_ev e = vehicle_in(5, 7.0, 1, 25.0, 2), f = vehicle_in(6, 7.0, 2, 20.0, 3);
+    amfi_tracker_add(t, &e, NULL);
+    amfi_tracker_add(t, &f, NULL);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.n_vehicles, 2);
+    assert_int_equal(w.ev[1].lane, 2);
+    /* ends with f: 7.0 + (20 + 8) / 20 + 0.05 s */
+    assert_int_equal(w.n, (int)lround((1.4 + 0.05 + 0.35) * RATE) + 1);
+    /* lane 1: vehicle 8 enters 0.3 s after 7 at twice its speed and would
+     * pass it on the span: both stored invalid with the reason, at once */
+    amfi_vehicle_ev g = vehicle_in(7, 9.0, 1, 20.0, 2), h = vehicle_in(8, 9.3, 1, 40.0, 2);
+    amfi_tracker_add(t, &g, NULL);
+    amfi_tracker_add(t, &h, NULL);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "invalid");
+    assert_int_equal(w.n_vehicles, 2);
+    assert_non_null(strstr(w.reason, "8 would overtake 7"));
+    /* the same pair on two lanes is fine */
+    g = vehicle_in(9, 11.0, 1, 20.0, 2), h = vehicle_in(10, 11.3, 2, 40.0, 2);
+    amfi_tracker_add(t, &g, NULL);
+    amfi_tracker_add(t, &h, NULL);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.n_vehicles, 2);
+    assert_int_equal(amfi_tracker_pending(t), 0);
+    amfi_ring_destroy(r);
+    amfi_tracker_destroy(t);
+}
+
+/* The limits: an event too long, with too many axles or vehicles, is
+ * released at once (its data not waited for) as multiple with the reason;
+ * a vehicle that overlaps one already released is multiple too. */
+static void tracker_event_limits(void **state)
+{
+    (void)state;
+    amfi_tracker_params bad = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 1};
+    assert_null(amfi_tracker_create(&bad));
+    bad.max_event_axles = AMFI_MAX_AXLES + 1;
+    assert_null(amfi_tracker_create(&bad));
+    bad.max_event_axles = 0;
+    bad.max_event_s = -1.0;
+    assert_null(amfi_tracker_create(&bad));
+
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 2.0, 0};
+    amfi_tracker *t = amfi_tracker_create(&p);
+    amfi_ring *r = filled(0.5); /* no data for any of them yet */
+    amfi_ring *rings[1] = {r};
+    amfi_window w;
+    amfi_vehicle_ev v1 = vehicle(1, 1.0), v2 = vehicle(2, 1.8);
+    amfi_tracker_add(t, &v1, NULL);
+    amfi_tracker_add(t, &v2, NULL);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0); /* 1.8 s: waits for data */
+    amfi_vehicle_ev v3 = vehicle(3, 2.6), v4 = vehicle(4, 3.4);
+    amfi_tracker_add(t, &v3, NULL);
+    amfi_tracker_add(t, &v4, NULL);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1); /* 2.6 s > 2 s: at once */
+    assert_string_equal(w.status, "multiple");
+    assert_int_equal(w.n_vehicles, 3);
+    assert_non_null(strstr(w.reason, "longer than daemon.max_event_s (2.00 s)"));
+    /* vehicle 4 met vehicle 3, released: multiple once its data is in */
+    for (int k = 5; k < 60; k++) {
+        double x[100];
+        block(x, 100, 0);
+        amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL);
+    }
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "multiple");
+    assert_int_equal(w.n_vehicles, 1);
+    assert_int_equal(w.v.vehicle_id, 4);
+    assert_non_null(strstr(w.reason, "vehicle 3 on the span at the same time, already stored"));
+    amfi_tracker_destroy(t);
+
+    /* axles: two three-axle vehicles, at most 5 */
+    amfi_tracker_params pa = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 5};
+    t = amfi_tracker_create(&pa);
+    amfi_vehicle_ev a1 = vehicle_in(11, 1.0, 1, 25.0, 3), a2 = vehicle_in(12, 1.2, 2, 25.0, 3);
+    amfi_tracker_add(t, &a1, NULL);
+    amfi_tracker_add(t, &a2, NULL);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "multiple");
+    assert_int_equal(w.n_vehicles, 2);
+    assert_non_null(strstr(w.reason, "6 axles in all: more than daemon.max_event_axles (5)"));
+    amfi_tracker_destroy(t);
+
+    /* vehicles: nine one-axle vehicles 0.1 s apart, 8 at most together */
+    amfi_tracker_params pv = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0};
+    t = amfi_tracker_create(&pv);
+    for (int i = 0; i < 9; i++) {
+        amfi_vehicle_ev v = vehicle_in(20 + i, 1.0 + 0.1 * i, 1, 25.0, 1);
+        assert_int_equal(amfi_tracker_add(t, &v, NULL), 0);
+    }
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "multiple");
+    assert_int_equal(w.n_vehicles, AMFI_MAX_VEHICLES);
+    assert_non_null(strstr(w.reason, "vehicle 28 joins an event of 8"));
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_int_equal(w.v.vehicle_id, 28);
+    assert_string_equal(w.status, "multiple");
+    assert_int_equal(amfi_tracker_pending(t), 0);
+    amfi_tracker_destroy(t);
+    amfi_ring_destroy(r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -311,6 +465,8 @@ int main(void)
         cmocka_unit_test(tracker_after_poisoned_first_block),
         cmocka_unit_test(tracker_windows),
         cmocka_unit_test(tracker_multiple_and_late),
+        cmocka_unit_test(tracker_events_chain_and_lanes),
+        cmocka_unit_test(tracker_event_limits),
     };
     return cmocka_run_group_tests_name("daemon core", tests, NULL, NULL);
 }
