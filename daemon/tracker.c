@@ -60,6 +60,20 @@ static span span_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
     return s;
 }
 
+/* What makes two vehicles one event: with events, their windows overlap
+ * (one on the span inside the other's pre- or post-roll would be a force
+ * the other's solve does not know); without, their times on the span
+ * (then "multiple", as before events). */
+static span reach_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
+{
+    if (!(t->p.max_event_s > 0))
+        return span_of(t, v);
+    const amfi_passage_times w = window_of(t, v);
+    span s = {v->vehicle_id, (double)v->utime + 1e6 * w.start_s,
+              (double)v->utime + 1e6 * w.end_s};
+    return s;
+}
+
 int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, const char **why)
 {
     const char *dummy;
@@ -97,11 +111,11 @@ static int in_event(const amfi_window *w, int64_t id)
 static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, const amfi_window *w,
                        int64_t *other)
 {
-    span me = span_of(t, v);
+    span me = reach_of(t, v);
     for (int i = 0; i < t->n_pend; i++) {
         if (in_event(w, t->pend[i].vehicle_id))
             continue;
-        span o = span_of(t, &t->pend[i]);
+        span o = reach_of(t, &t->pend[i]);
         if (o.t_in < me.t_out && me.t_in < o.t_out) {
             *other = o.id;
             return 1;
@@ -157,7 +171,7 @@ static int inconsistent(const amfi_tracker *t, const amfi_window *w, char *why, 
 }
 
 /* The event that starts with pend[0]: the pending vehicles, by entry, whose
- * time on the span overlaps the chain's so far. Fills out->ev and
+ * window overlaps the chain's so far. Fills out->ev and
  * out->n_vehicles; returns NULL, or the status of a bad event ("multiple":
  * a limit broken; "invalid": the vehicles contradict each other) with the
  * reason in out->reason. */
@@ -167,12 +181,13 @@ static const char *gather(const amfi_tracker *t, amfi_window *out)
     out->n_vehicles = 1;
     if (!(t->p.max_event_s > 0))
         return NULL;
-    const span first = span_of(t, &t->pend[0]);
-    double end = first.t_out;
+    const span first = reach_of(t, &t->pend[0]);
+    double end = first.t_out;                       /* of the windows */
+    double exit_us = span_of(t, &t->pend[0]).t_out; /* the last exit */
     int axles = t->pend[0].n_axles;
     for (int i = 1; i < t->n_pend; i++) {
         const amfi_vehicle_ev *v = &t->pend[i];
-        const span s = span_of(t, v);
+        const span s = reach_of(t, v);
         if (s.t_in >= end)
             break;
         if (out->n_vehicles == AMFI_MAX_VEHICLES) {
@@ -185,6 +200,7 @@ static const char *gather(const amfi_tracker *t, amfi_window *out)
         out->ev[out->n_vehicles++] = *v;
         axles += v->n_axles;
         end = fmax(end, s.t_out);
+        exit_us = fmax(exit_us, span_of(t, v).t_out);
         if (axles > t->p.max_event_axles) {
             snprintf(out->reason, sizeof out->reason,
                      "%d vehicles on the span together with %d axles in all: more than "
@@ -192,11 +208,12 @@ static const char *gather(const amfi_tracker *t, amfi_window *out)
                      out->n_vehicles, axles, t->p.max_event_axles);
             return "multiple";
         }
-        if (end - first.t_in > 1e6 * t->p.max_event_s) {
+        const double on_s = 1e-6 * (exit_us - (double)t->pend[0].utime);
+        if (on_s > t->p.max_event_s) {
             snprintf(out->reason, sizeof out->reason,
                      "%d vehicles on the span one after another for %.2f s: longer than "
                      "daemon.max_event_s (%.2f s)",
-                     out->n_vehicles, 1e-6 * (end - first.t_in), t->p.max_event_s);
+                     out->n_vehicles, on_s, t->p.max_event_s);
             return "multiple";
         }
     }
@@ -211,7 +228,7 @@ static void release(amfi_tracker *t, amfi_window *out)
 {
     out->seq = ++t->seq;
     for (int i = 0; i < out->n_vehicles; i++) {
-        t->recent[t->recent_head] = span_of(t, &t->pend[i]);
+        t->recent[t->recent_head] = reach_of(t, &t->pend[i]);
         t->recent_head = (t->recent_head + 1) % RECENT;
         if (t->n_recent < RECENT)
             t->n_recent++;

@@ -12,18 +12,21 @@
  * event arrived), "multiple" (vehicles on the span together that cannot be
  * weighed together) or "invalid" (their events contradict each other).
  *
- * Events (issue 13): vehicles whose times on the span overlap, on any lane
- * (the beam has no width), form one event, released as one window from the
- * first entry's window start to the last exit's window end, to be solved
- * jointly (amfi_solve_multi); a chain A-B-C, where A and C never meet, is one
- * event. An event longer than max_event_s (first entry to last exit), with
- * more than max_event_axles axles or AMFI_MAX_VEHICLES vehicles, is released
- * at once as "multiple" with the reason (no waiting for its data); an event
- * whose vehicles of one lane would overlap each other on the span (the
- * follower's front axle ahead of the leader's last) as "invalid".
- * max_event_s = 0 turns events off: every vehicle that shares the span is
- * "multiple" (the behaviour before issue 13). A vehicle whose event arrives
- * after a partner was released is "multiple" too.
+ * Events (issue 13): vehicles whose windows overlap (one on the span in the
+ * other's pre- or post-roll is a force the other's solve would not know), on
+ * any lane (the beam has no width), form one event, released as one window
+ * from the first entry's window start to the last exit's window end, to be
+ * solved jointly (amfi_solve_multi); a chain A-B-C, where A and C never
+ * meet, is one event. An event longer than max_event_s (first entry to last
+ * exit), with more than max_event_axles axles or AMFI_MAX_VEHICLES vehicles,
+ * is released at once as "multiple" with the reason (no waiting for its
+ * data); an event in which a vehicle would overtake another of its lane on
+ * the span (its front axle level with or ahead of the leader's) as
+ * "invalid".
+ * max_event_s = 0 turns events off: every vehicle that shares the span
+ * (times on the span overlapping) is "multiple", the behaviour before issue
+ * 13. A vehicle whose event arrives after a partner was released is
+ * "multiple" too.
  *
  * Not thread-safe: the bus thread owns it. Capacity fixed at creation.
  */
