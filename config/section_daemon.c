@@ -88,6 +88,15 @@ int daemon_check(ctx *x, amfi_site_config *c)
     char why[256], path[PATH_LEN];
     int line;
 
+    /* an event's samples must still be in the ring when its last vehicle
+     * has left (tracker.h): the ring holds more than the longest event */
+    if (c->daemon.max_event_s >= c->daemon.ring_s)
+        return fail(x, first_noted(x, "daemon.max_event_s", "daemon.ring_s", "daemon"),
+                    "daemon.max_event_s",
+                    "%g s is not below daemon.ring_s (%g s): an event's samples would leave "
+                    "the ring before it ends",
+                    c->daemon.max_event_s, c->daemon.ring_s);
+
     if (amfi_indicator_params_check(&c->daemon.indicators, &blamed, why, sizeof why) == 0)
         return 0;
     pathf(path, "daemon.indicators.%s", blamed ? blamed : "");

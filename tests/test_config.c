@@ -460,6 +460,16 @@ static void test_indicator_defaults_are_the_engines(void **state)
     assert_int_equal(20, c.daemon.indicators.window);
     assert_int_equal(0, c.daemon.indicators.mean_shift);
     assert_true(c.daemon.indicators.std_clear_ratio == 1.08); /* = alert: allowed */
+    /* amfid's filter in front of the engine, and the event limits (issue 13) */
+    assert_int_equal(0, c.daemon.single_presence_only);
+    assert_true(c.daemon.max_event_s == 10.0);
+    assert_int_equal(AMFI_MAX_AXLES, c.daemon.max_event_axles);
+    if (load_text("daemon:\n  max_event_s: 0\n  max_event_axles: 6\n"
+                  "  indicators: {single_presence_only: on}\n", &c, err))
+        fail_msg("%s", err);
+    assert_int_equal(1, c.daemon.single_presence_only);
+    assert_true(c.daemon.max_event_s == 0.0);
+    assert_int_equal(6, c.daemon.max_event_axles);
 }
 
 /* Steps and workspace just under the bounds load; just over, they do not. */
@@ -672,6 +682,15 @@ static const bad_case bad_cases[] = {
     {"daemon_workers_zero", "daemon:\n  workers: 0\n", 2, "daemon.workers", "1 .. 64"},
     {"daemon_channel_empty", "daemon:\n  channels: {accel: \"\"}\n", 2,
      "daemon.channels.accel", "characters long"},
+    /* issue 13: events of vehicles weighed together */
+    {"daemon_event_axles_one", "daemon:\n  max_event_axles: 1\n", 2, "daemon.max_event_axles",
+     "2 .. 12"},
+    {"daemon_event_negative", "daemon:\n  max_event_s: -1\n", 2, "daemon.max_event_s",
+     "[0, 600]"},
+    {"daemon_event_beyond_ring", "daemon:\n  ring_s: 20\n  max_event_s: 30\n", 3,
+     "daemon.max_event_s", "30 s is not below daemon.ring_s (20 s)"},
+    {"daemon_single_presence_bad", "daemon:\n  indicators: {single_presence_only: yes}\n", 2,
+     "daemon.indicators.single_presence_only", "off"},
     {"daemon_clear_above_alert",
      "daemon:\n  indicators: {std_alert_ratio: 1.05, std_clear_ratio: 1.2}\n", 2,
      "daemon.indicators.std_clear_ratio", "must not exceed"},
