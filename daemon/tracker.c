@@ -111,11 +111,11 @@ static int in_event(const amfi_window *w, int64_t id)
 static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, const amfi_window *w,
                        int64_t *other)
 {
-    span me = reach_of(t, v);
+    span me = span_of(t, v);
     for (int i = 0; i < t->n_pend; i++) {
         if (in_event(w, t->pend[i].vehicle_id))
             continue;
-        span o = reach_of(t, &t->pend[i]);
+        span o = span_of(t, &t->pend[i]);
         if (o.t_in < me.t_out && me.t_in < o.t_out) {
             *other = o.id;
             return 1;
@@ -171,23 +171,26 @@ static int inconsistent(const amfi_tracker *t, const amfi_window *w, char *why, 
 }
 
 /* The event that starts with pend[0]: the pending vehicles, by entry, whose
- * window overlaps the chain's so far. Fills out->ev and
- * out->n_vehicles; returns NULL, or the status of a bad event ("multiple":
- * a limit broken; "invalid": the vehicles contradict each other) with the
- * reason in out->reason. */
-static const char *gather(const amfi_tracker *t, amfi_window *out)
+ * window (by_window) or time on the span overlaps the chain's so far. Fills
+ * out->ev and out->n_vehicles; returns NULL, or the status of a bad event
+ * ("multiple": a limit broken; "invalid": the vehicles contradict each
+ * other) with the reason in out->reason. */
+static const char *gather(const amfi_tracker *t, amfi_window *out, int by_window)
 {
     out->ev[0] = t->pend[0];
     out->n_vehicles = 1;
+    out->reason[0] = '\0';
     if (!(t->p.max_event_s > 0))
         return NULL;
-    const span first = reach_of(t, &t->pend[0]);
+    span (*const reach)(const amfi_tracker *, const amfi_vehicle_ev *) =
+        by_window ? reach_of : span_of;
+    const span first = reach(t, &t->pend[0]);
     double end = first.t_out;                       /* of the windows */
     double exit_us = span_of(t, &t->pend[0]).t_out; /* the last exit */
     int axles = t->pend[0].n_axles;
     for (int i = 1; i < t->n_pend; i++) {
         const amfi_vehicle_ev *v = &t->pend[i];
-        const span s = reach_of(t, v);
+        const span s = reach(t, v);
         if (s.t_in >= end)
             break;
         if (out->n_vehicles == AMFI_MAX_VEHICLES) {
@@ -228,7 +231,7 @@ static void release(amfi_tracker *t, amfi_window *out)
 {
     out->seq = ++t->seq;
     for (int i = 0; i < out->n_vehicles; i++) {
-        t->recent[t->recent_head] = reach_of(t, &t->pend[i]);
+        t->recent[t->recent_head] = span_of(t, &t->pend[i]);
         t->recent_head = (t->recent_head + 1) % RECENT;
         if (t->n_recent < RECENT)
             t->n_recent++;
@@ -247,7 +250,13 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
     memset(out, 0, sizeof *out);
     out->v = *v;
     out->status = "ok";
-    const char *bad = gather(t, out);
+    /* Vehicles whose windows overlap, as one event; when that event breaks
+     * a limit, those whose times on the span overlap (a smaller event: one
+     * in another's pre- or post-roll only is then a force unknown to its
+     * solve, the lesser evil against storing both without a weight). */
+    const char *bad = gather(t, out, 1);
+    if (bad && strcmp(bad, "multiple") == 0)
+        bad = gather(t, out, 0);
     if (bad) { /* refused whatever its data: released at once, never waited for */
         out->status = bad;
         release(t, out);

@@ -19,8 +19,9 @@
  * solved jointly (amfi_solve_multi); a chain A-B-C, where A and C never
  * meet, is one event. An event longer than max_event_s (first entry to last
  * exit), with more than max_event_axles axles or AMFI_MAX_VEHICLES vehicles,
- * is released at once as "multiple" with the reason (no waiting for its
- * data); an event in which a vehicle would overtake another of its lane on
+ * is cut down to the vehicles whose times on the span overlap; when that
+ * still breaks a limit, it is released at once as "multiple" with the reason
+ * (no waiting for its data); an event in which a vehicle would overtake another of its lane on
  * the span (its front axle level with or ahead of the leader's) as
  * "invalid".
  * max_event_s = 0 turns events off: every vehicle that shares the span

@@ -436,6 +436,28 @@ static void tracker_event_limits(void **state)
     assert_non_null(strstr(w.reason, "6 axles in all: more than daemon.max_event_axles (5)"));
     amfi_tracker_destroy(t);
 
+    /* over the limit by windows, within it by times on the span: cut down.
+     * 2 (on the span 2.2 .. 3.2 s) is in 1's post-roll (1.0 .. 2.0 .. 2.05 s)
+     * and on the span with 3: six axles by windows, at most 4: 1 alone,
+     * then 2 and 3 together */
+    amfi_tracker_params p4 = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 4};
+    t = amfi_tracker_create(&p4);
+    amfi_vehicle_ev c1 = vehicle(31, 1.0), c2 = vehicle(32, 2.2), c3 = vehicle(33, 2.5);
+    amfi_tracker_add(t, &c1, NULL);
+    amfi_tracker_add(t, &c2, NULL);
+    amfi_tracker_add(t, &c3, NULL);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.n_vehicles, 1);
+    assert_int_equal(w.v.vehicle_id, 31);
+    assert_string_equal(w.reason, "");
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.n_vehicles, 2);
+    assert_int_equal(w.ev[0].vehicle_id, 32);
+    assert_int_equal(w.ev[1].vehicle_id, 33);
+    amfi_tracker_destroy(t);
+
     /* vehicles: nine one-axle vehicles 0.1 s apart, 8 at most together */
     amfi_tracker_params pv = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0};
     t = amfi_tracker_create(&pv);
