@@ -95,6 +95,18 @@ void queue_close(queue *q)
 
 /* ---- solver threads ------------------------------------------------------- */
 
+/* The job's samples as a passage's (amfi_passage and amfi_multi_passage
+ * share these fields). */
+static void job_samples(const job *j, amfi_passage *p)
+{
+    memset(p, 0, sizeof *p);
+    p->n_samples = j->w.n;
+    p->scan_rate_hz = j->scan_rate_hz;
+    p->t_first_s = j->w.t_first_s;
+    for (int i = 0; i < j->n_sensors; i++)
+        p->accel[i] = j->accel + (size_t)i * j->w.n;
+}
+
 /* Weigh an event's vehicles together (amfi_solve_multi, the job's λ
  * policy, the detector's speeds: the speed search is one vehicle's); the
  * result goes into the job: the event's λ and residual, each vehicle's
@@ -102,13 +114,14 @@ void queue_close(queue *q)
  * an error of its own; a failed solve is every vehicle's. */
 static void solve_event(amfi_solver *s, job *j)
 {
+    amfi_passage one;
+    job_samples(j, &one);
     amfi_multi_passage p;
     memset(&p, 0, sizeof p);
-    p.n_samples = j->w.n;
-    p.scan_rate_hz = j->scan_rate_hz;
-    p.t_first_s = j->w.t_first_s;
-    for (int i = 0; i < j->n_sensors; i++)
-        p.accel[i] = j->accel + (size_t)i * j->w.n;
+    p.n_samples = one.n_samples;
+    p.scan_rate_hz = one.scan_rate_hz;
+    p.t_first_s = one.t_first_s;
+    memcpy(p.accel, one.accel, sizeof p.accel);
     p.n_vehicles = j->w.n_vehicles;
     for (int v = 0; v < p.n_vehicles; v++) {
         const amfi_vehicle_ev *e = &j->w.ev[v];
@@ -163,12 +176,7 @@ static void solve_job(amfi_solver *s, job *j)
         return;
     }
     amfi_passage p;
-    memset(&p, 0, sizeof p);
-    p.n_samples = j->w.n;
-    p.scan_rate_hz = j->scan_rate_hz;
-    p.t_first_s = j->w.t_first_s;
-    for (int i = 0; i < j->n_sensors; i++)
-        p.accel[i] = j->accel + (size_t)i * j->w.n;
+    job_samples(j, &p);
     p.speed_mps = j->w.v.speed_mps;
     p.n_axles = j->w.v.n_axles;
     for (int a = 0; a + 1 < p.n_axles; a++)

@@ -314,6 +314,22 @@ static amfi_vehicle_ev vehicle_in(int64_t id, double entry_s, int lane, double s
     return v;
 }
 
+/* Add two vehicles; the next window is one event of n with this status
+ * (and a reason holding `why`, unless NULL). */
+static void pair_released_as(amfi_tracker *t, amfi_ring **rings, amfi_vehicle_ev a,
+                             amfi_vehicle_ev b, const char *status, int n, const char *why)
+{
+    amfi_window w;
+    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_string_equal(w.status, status);
+    assert_int_equal(w.n_vehicles, n);
+    assert_int_equal(w.ev[0].vehicle_id, a.vehicle_id);
+    if (why)
+        assert_non_null(strstr(w.reason, why));
+}
+
 /* Vehicles whose times on the span overlap form one event: a chain of three
  * (the first and the last never meet), one window from the first's start to
  * the last's end; two lanes at the same time; a vehicle alone stays alone;
@@ -362,20 +378,11 @@ static void tracker_events_chain_and_lanes(void **state)
     assert_int_equal(w.n, (int)lround((1.4 + 0.05 + 0.35) * RATE) + 1);
     /* lane 1: vehicle 8 enters 0.3 s after 7 at twice its speed and would
      * pass it on the span: both stored invalid with the reason, at once */
-    amfi_vehicle_ev g = vehicle_in(7, 9.0, 1, 20.0, 2), h = vehicle_in(8, 9.3, 1, 40.0, 2);
-    amfi_tracker_add(t, &g, NULL);
-    amfi_tracker_add(t, &h, NULL);
-    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
-    assert_string_equal(w.status, "invalid");
-    assert_int_equal(w.n_vehicles, 2);
-    assert_non_null(strstr(w.reason, "8 would overtake 7"));
+    pair_released_as(t, rings, vehicle_in(7, 9.0, 1, 20.0, 2), vehicle_in(8, 9.3, 1, 40.0, 2),
+                     "invalid", 2, "8 would overtake 7");
     /* the same pair on two lanes is fine */
-    g = vehicle_in(9, 11.0, 1, 20.0, 2), h = vehicle_in(10, 11.3, 2, 40.0, 2);
-    amfi_tracker_add(t, &g, NULL);
-    amfi_tracker_add(t, &h, NULL);
-    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
-    assert_string_equal(w.status, "ok");
-    assert_int_equal(w.n_vehicles, 2);
+    pair_released_as(t, rings, vehicle_in(9, 11.0, 1, 20.0, 2),
+                     vehicle_in(10, 11.3, 2, 40.0, 2), "ok", 2, NULL);
     assert_int_equal(amfi_tracker_pending(t), 0);
     amfi_ring_destroy(r);
     amfi_tracker_destroy(t);
@@ -427,13 +434,8 @@ static void tracker_event_limits(void **state)
     /* axles: two three-axle vehicles, at most 5 */
     amfi_tracker_params pa = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 5};
     t = amfi_tracker_create(&pa);
-    amfi_vehicle_ev a1 = vehicle_in(11, 1.0, 1, 25.0, 3), a2 = vehicle_in(12, 1.2, 2, 25.0, 3);
-    amfi_tracker_add(t, &a1, NULL);
-    amfi_tracker_add(t, &a2, NULL);
-    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
-    assert_string_equal(w.status, "multiple");
-    assert_int_equal(w.n_vehicles, 2);
-    assert_non_null(strstr(w.reason, "6 axles in all: more than daemon.max_event_axles (5)"));
+    pair_released_as(t, rings, vehicle_in(11, 1.0, 1, 25.0, 3), vehicle_in(12, 1.2, 2, 25.0, 3),
+                     "multiple", 2, "6 axles in all: more than daemon.max_event_axles (5)");
     amfi_tracker_destroy(t);
 
     /* over the limit by windows, within it by times on the span: cut down.
