@@ -296,6 +296,8 @@ const field solver_fields[] = {
      .hi = 50, .flags = F_LO_OPEN},
     {.key = "speed_grid", .kind = &K_DOUBLE, .off = SC(speed_prior.grid_rel), .lo = 1e-4,
      .hi = 0.05},
+    {.key = "speed_coarse_rate_hz", .kind = &K_DOUBLE, .off = SC(speed_prior.coarse_rate_hz),
+     .lo = 0, .hi = MAX_RATE_HZ},
     {.key = "speed_criterion", .kind = &K_ENUM, .off = SC(speed_prior.criterion),
      .aux = speed_criterion_names},
     {.key = NULL}};
@@ -357,5 +359,9 @@ int solver_check(ctx *x, amfi_site_config *c)
                                    "solver.speed_sd"),
                     "solver.speed_grid", "%g is wider than the range (speed_range_sd x "
                     "speed_sd = %g)", sp->grid_rel, sp->range_sd * sp->rel_sd);
+    if (sp->coarse_rate_hz > 0 && sp->coarse_rate_hz < 100)
+        return fail(x, first_noted(x, "solver.speed_coarse_rate_hz", NULL, NULL),
+                    "solver.speed_coarse_rate_hz", "%g Hz: 0 (no coarse model) or >= 100",
+                    sp->coarse_rate_hz);
     return 0;
 }

@@ -95,10 +95,14 @@ static void recovers_biased_speed(void **state)
     amfi_solver *s = solver();
     amfi_lambda lam;
     amfi_lambda_default(&lam);
-    /* (noise, bias, criterion): the residual criterion once (it is the
-     * weaker one, docs/results/speed-estimation.md); kept short for ASan */
-    const struct { double noise, bias; int c; } cases[] = {
-        {0.0, -0.04, 0}, {0.03, -0.04, 0}, {0.03, 0.04, 0}, {0.03, -0.04, 1}};
+    /* (noise, bias, criterion, coarse rate): the two-level search (coarse
+     * model at 1000 Hz, the default) and the grid on the full model (coarse
+     * 0); the residual criterion once, on the full model only (it is the
+     * weaker one: on the coarse model its minimum is the range's slow end,
+     * docs/results/speed-estimation.md); kept short for ASan */
+    const struct { double noise, bias; int c; double coarse; } cases[] = {
+        {0.0, -0.04, 0, 1000}, {0.03, -0.04, 0, 1000}, {0.03, 0.04, 0, 1000},
+        {0.03, -0.04, 0, 0},   {0.03, -0.04, 1, 0}};
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         int n;
         double *acc = record(cases[k].noise, &n);
@@ -109,6 +113,7 @@ static void recovers_biased_speed(void **state)
                 amfi_speed_prior pr;
                 amfi_speed_prior_default(&pr);
                 pr.criterion = (amfi_speed_criterion)c;
+                pr.coarse_rate_hz = cases[k].coarse;
                 pr.range_sd = 1.5; /* ±4.5 %: holds the ±4 % bias, 46 grid sweeps */
                 amfi_result plain, est;
                 amfi_speed_result sr;
@@ -119,13 +124,20 @@ static void recovers_biased_speed(void **state)
                 if (rc)
                     fail_msg("%s", err);
                 double ve = sr.speed_mps / TRUE_SPEED - 1, ge = est.gvw_kg / true_gvw_kg - 1;
-                print_message("noise %.0f%% given %+.0f%% %-11s: speed %+.3f%% in %d sweeps, "
-                              "GVW %+.2f%% (given speed: %+.2f%%)\n",
+                print_message("noise %.0f%% given %+.0f%% %-11s coarse %4.0f Hz: speed %+.3f%% "
+                              "in %d sweeps (+%d coarse), GVW %+.2f%% (given speed: %+.2f%%)\n",
                               100 * noise[b], 100 * bias[b], amfi_speed_criterion_name(pr.criterion),
-                              100 * ve, est.n_solves, 100 * ge,
+                              pr.coarse_rate_hz, 100 * ve, est.n_solves, sr.n_coarse, 100 * ge,
                               100 * (gvw_plain / true_gvw_kg - 1));
                 assert_true(fabs(ve) < 0.005);
                 assert_true(fabs(ge) < 0.01);
+                /* the budget: <= 10 full-model sweeps, final solve included */
+                if (pr.coarse_rate_hz > 0) {
+                    assert_true(est.n_solves <= 10);
+                    assert_true(sr.n_coarse > 0);
+                } else {
+                    assert_int_equal(sr.n_coarse, 0);
+                }
                 assert_false(sr.at_bound);
                 assert_true(sr.j_best <= sr.j_given);
                 assert_true(sr.speed_given_mps == p.speed_mps);

@@ -39,10 +39,14 @@ void amfi_solver_destroy(amfi_solver *s)
     free(s->lc_res);
     free(s->lc_smo);
     free(s->lc_kap);
+    amfi_solver_destroy(s->coarse);
     free(s);
 }
 
-size_t amfi_solver_workspace_bytes(const amfi_solver *s) { return s->bytes; }
+size_t amfi_solver_workspace_bytes(const amfi_solver *s)
+{
+    return s->bytes + (s->coarse ? s->coarse->bytes : 0);
+}
 
 static int check_params(const amfi_bridge *b, const amfi_solver_params *p, char *err,
                         size_t errlen)

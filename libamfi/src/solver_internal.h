@@ -56,6 +56,10 @@ struct amfi_solver {
     /* L-curve (points sorted by λ) */
     int lc_cap, lc_n;
     double *lc_lam, *lc_res, *lc_smo, *lc_kap;
+
+    /* speed search (speed.c): the coarse model, created at the first
+     * two-level search, owned and freed with this solver */
+    struct amfi_solver *coarse;
 };
 
 /* Position of axle a at step j, m (x = speed·vf[a]·t − off[a], t = t0 + j·h):

@@ -5,12 +5,19 @@
  * the axles through the same window, and the A-MFI fit's cost at each trial
  * (one sweep, λ fixed) is the data term of
  *   J(v) = n_eff·ln C(v) + ((v − v0)/(σ·v0))²   (amfi.h).
- * J is evaluated on a fine grid of speeds around v0 (finer than the narrow
- * dip the cost has at the true speed), then refined between the best grid
- * point's neighbours with GSL's Brent minimiser; the passage is finally solved at the estimate as
- * amfi_solve would (its own window). Sits above solver.c in libamfi's call
- * graph (internal.h): calls the solver's begin/lambda/end steps and the
- * sweep dispatcher, never called back.
+ * Two levels (docs/solver.md, "Speed estimation"): J is evaluated on a grid
+ * of speeds around v0 finer than the narrow dip the cost has at the true
+ * speed, on a coarse model (the same bridge and sensors at coarse_rate_hz,
+ * with the modes that rate resolves: a sweep costs ~1/100 of the full
+ * model's); then the full model refines around the coarse minimum with
+ * GSL's Brent minimiser (3-10 sweeps); the passage is finally solved at the
+ * estimate as amfi_solve would (its own window). With coarse_rate_hz 0 (or
+ * not below the calculation rate) the grid runs on the full model (the
+ * first version: ~97 sweeps a passage). Sits above solver.c in libamfi's
+ * call graph (internal.h): calls the solver's begin/lambda/end steps and
+ * the sweep dispatcher, never called back. The coarse model is a second
+ * amfi_solver owned by the first (s->coarse), created at the first search
+ * that needs it.
  *
  * No sweep shares another's factorisation: the Riccati recursion depends on
  * where the axles are at every step, so each trial speed costs one sweep.
@@ -31,7 +38,8 @@ void amfi_speed_prior_default(amfi_speed_prior *p)
     p->range_sd = 3.0;
     p->grid_rel = 0.002;
     p->tol_rel = 2e-4;
-    p->brent_evals = 6;
+    p->brent_evals = 4;
+    p->coarse_rate_hz = 1000.0;
     p->criterion = AMFI_SPEED_REGULARISED;
 }
 
@@ -83,18 +91,36 @@ int amfi_speed_prior_check(const amfi_speed_prior *p, double speed_mps, char *er
     if (p->brent_evals < 0 || p->brent_evals > 100)
         return amfi_fail(err, errlen, AMFI_EINVAL,
                          "speed prior: brent_evals %d must be 0..100", p->brent_evals);
+    if (!(isfinite(p->coarse_rate_hz) &&
+          (p->coarse_rate_hz == 0 || (p->coarse_rate_hz >= 100 && p->coarse_rate_hz <= 1e6))))
+        return amfi_fail(err, errlen, AMFI_EINVAL,
+                         "speed prior: coarse rate %g Hz must be 0 (none) or in [100, 1e6]",
+                         p->coarse_rate_hz);
     if (p->criterion != AMFI_SPEED_REGULARISED && p->criterion != AMFI_SPEED_RESIDUAL)
         return amfi_fail(err, errlen, AMFI_EINVAL, "speed prior: unknown criterion %d",
                          (int)p->criterion);
     return AMFI_OK;
 }
 
+/* One level of the search: its solver (window set), λ per step and n_eff. */
 typedef struct search {
     struct amfi_solver *s;
     const amfi_speed_prior *pr;
     double v0, lam_h, n_eff;
     int evals, brent_left, rc;
 } search;
+
+/* n_eff of J for the solver's current window: the data samples in it. */
+static double n_eff_of(const struct amfi_solver *s, const amfi_passage *ps,
+                       const amfi_speed_prior *pr)
+{
+    if (pr->data_dof > 0)
+        return pr->data_dof;
+    double data_steps = s->N * (ps->scan_rate_hz < s->p.calc_rate_hz
+                                    ? ps->scan_rate_hz / s->p.calc_rate_hz
+                                    : 1.0);
+    return data_steps * s->ns;
+}
 
 /* J(v); a failed sweep gives DBL_MAX and its status in q->rc. */
 static double objective(double v, void *user)
@@ -148,6 +174,61 @@ static double brent(search *q, double a, double fa, double x, double fx, double 
     return best;
 }
 
+/* The grid v0 + i·g over [lo, hi]: the best point, whether it is an end of
+ * the range, and its neighbours (xa, fa), (xb, fb) for Brent. */
+typedef struct grid_best {
+    double x, f, xa, fa, xb, fb, f0;
+    int edge;
+} grid_best;
+
+static grid_best grid(search *q, double lo, double hi, double g)
+{
+    const double v0 = q->v0;
+    int i_lo = -(int)floor((v0 - lo) / g + 1e-9), i_hi = (int)floor((hi - v0) / g + 1e-9);
+    grid_best r = {v0, DBL_MAX, v0, DBL_MAX, v0, DBL_MAX, DBL_MAX, 0};
+    double prev_x = v0, prev_f = DBL_MAX;
+    int best_i = 0;
+    for (int i = i_lo; i <= i_hi && !q->rc; i++) {
+        double v = v0 + i * g, f = objective(v, q);
+        if (i == 0)
+            r.f0 = f;
+        if (f < r.f) {
+            r.x = v, r.f = f, best_i = i;
+            r.xa = prev_x, r.fa = prev_f;
+            r.edge = i == i_lo || i == i_hi;
+            r.xb = v, r.fb = DBL_MAX; /* until the next point */
+        } else if (i == best_i + 1) {
+            r.xb = v, r.fb = f;
+        }
+        prev_x = v, prev_f = f;
+    }
+    return r;
+}
+
+/* The coarse model: the solver's bridge, sensors and policies at `rate` Hz
+ * with the observable modes that rate resolves (modal). Kept with the
+ * solver; rebuilt only when the rate changes. */
+static int coarse_solver(struct amfi_solver *s, double rate, char *err, size_t errlen)
+{
+    if (s->coarse && s->coarse->p.calc_rate_hz == rate)
+        return AMFI_OK;
+    amfi_solver_destroy(s->coarse);
+    s->coarse = NULL;
+    amfi_solver_params p = s->p;
+    p.calc_rate_hz = rate;
+    p.coords = AMFI_COORDS_MODAL;
+    p.modes = AMFI_MODES_RESOLVED;
+    char e[200];
+    int rc = amfi_solver_create(s->b, &p, &s->coarse, e, sizeof e);
+    if (rc)
+        return amfi_fail(err, errlen, rc, "speed search: the coarse model at %g Hz: %s", rate,
+                         e);
+    return AMFI_OK;
+}
+
+#define SWEEP_FAILED(q)                                                                  \
+    amfi_fail(err, errlen, (q).rc, "speed search: sweep failed: %s", amfi_strerror((q).rc))
+
 int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *lam,
                      const amfi_speed_prior *pr, amfi_result *res, amfi_speed_result *sr,
                      char *err, size_t errlen)
@@ -172,59 +253,100 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
                 lo = vmin < v0 ? vmin : v0;
         }
     }
-    if ((rc = amfi_solve_begin(s, ps, lam, lo, err, errlen)) != 0)
-        return rc;
+    const int two_level = pr->coarse_rate_hz > 0 && pr->coarse_rate_hz < s->p.calc_rate_hz;
+    const double g = pr->grid_rel * v0;
+
+    /* λ on the full model: fixed, or the L-curve's at v0 in the search window. */
     search q = {s, pr, v0, 0.0, 0.0, 0, pr->brent_evals, 0};
     int n_lc = 0;
-    s->speed = v0;
+    if (!two_level || lam->automatic) {
+        if ((rc = amfi_solve_begin(s, ps, lam, lo, err, errlen)) != 0)
+            return rc;
+        s->speed = v0;
+    }
     if ((rc = amfi_solve_lambda(s, lam, &q.lam_h, &n_lc, err, errlen)) != 0)
         return rc;
-    double data_steps = s->N * (ps->scan_rate_hz < s->p.calc_rate_hz
-                                    ? ps->scan_rate_hz / s->p.calc_rate_hz
-                                    : 1.0);
-    q.n_eff = pr->data_dof > 0 ? pr->data_dof : data_steps * s->ns;
 
-    /* Grid: v0 + i·grid_rel·v0 over [lo, hi]. The cost has a narrow dip at
-     * the true speed (about ±0.25 % wide: the entry and exit transients of
-     * the axles) on a slope (docs/solver.md), so a bracketing search from a
-     * few points finds the slope's end, not the dip; the grid must be finer
-     * than the dip. Then Brent between the best point's neighbours. */
-    const double g = pr->grid_rel * v0;
-    int i_lo = -(int)floor((v0 - lo) / g + 1e-9), i_hi = (int)floor((hi - v0) / g + 1e-9);
-    double best = v0, fbest = DBL_MAX, f0 = DBL_MAX;
-    double xa = v0, fa = DBL_MAX, xb = v0, fb = DBL_MAX, prev_x = v0, prev_f = DBL_MAX;
-    int best_i = 0, edge = 0;
-    for (int i = i_lo; i <= i_hi && !q.rc; i++) {
-        double v = v0 + i * g, f = objective(v, &q);
-        if (i == 0)
-            f0 = f;
-        if (f < fbest) {
-            best = v, fbest = f, best_i = i;
-            xa = prev_x, fa = prev_f;
-            edge = i == i_lo || i == i_hi;
-            xb = v, fb = DBL_MAX; /* until the next point */
-        } else if (i == best_i + 1) {
-            xb = v, fb = f;
-        }
-        prev_x = v, prev_f = f;
-    }
-    if (q.rc)
-        return amfi_fail(err, errlen, q.rc, "speed search: sweep failed: %s",
-                         amfi_strerror(q.rc));
-    sr->at_bound = edge;
-    if (!edge && fbest < fa && fbest < fb) {
-        best = brent(&q, xa, fa, best, fbest, xb, fb, &fbest);
+    double best, fbest, j_given, j_best = DBL_MAX;
+    int edge, n_coarse = 0;
+    if (!two_level) {
+        /* The grid on the full model, then Brent between the best point's neighbours. */
+        q.n_eff = n_eff_of(s, ps, pr);
+        grid_best r = grid(&q, lo, hi, g);
         if (q.rc)
-            return amfi_fail(err, errlen, q.rc, "speed search: sweep failed: %s",
-                             amfi_strerror(q.rc));
+            return SWEEP_FAILED(q);
+        best = r.x, fbest = r.f, edge = r.edge;
+        j_given = r.f0;
+        if (!edge && r.f < r.fa && r.f < r.fb) {
+            best = brent(&q, r.xa, r.fa, r.x, r.f, r.xb, r.fb, &fbest);
+            if (q.rc)
+                return SWEEP_FAILED(q);
+        }
+    } else {
+        /* 1. The grid on the coarse model, at the same λ (rate-independent λ_ref). */
+        if ((rc = coarse_solver(s, pr->coarse_rate_hz, err, errlen)) != 0)
+            return rc;
+        struct amfi_solver *c = s->coarse;
+        if ((rc = amfi_solve_begin(c, ps, lam, lo, err, errlen)) != 0)
+            return rc;
+        search qc = {c, pr, v0, q.lam_h / amfi_lambda_scale(s, lam) * amfi_lambda_scale(c, lam),
+                     n_eff_of(c, ps, pr), 0, 0, 0};
+        grid_best r = grid(&qc, lo, hi, g);
+        n_coarse = qc.evals;
+        if (qc.rc)
+            return SWEEP_FAILED(qc);
+        edge = r.edge;
+        /* 2. The full model around the coarse minimum: x and x ± d (d = 1.5 grid
+         * steps: the coarse model's minimum lies within a step or two of the
+         * full model's, docs/solver.md), up to two steps of d downhill until x
+         * is below both, then Brent. Its window is that of the slowest speed
+         * it may try. */
+        const double d = 1.5 * g;
+        double wlo = r.x - 3.0 * d;
+        if (wlo < lo)
+            wlo = lo;
+        if ((rc = amfi_solve_begin(s, ps, lam, wlo, err, errlen)) != 0)
+            return rc;
+        q.n_eff = n_eff_of(s, ps, pr);
+        double x = r.x, fx = objective(x, &q);
+        double a = x - d < wlo ? wlo : x - d, fa = a < x ? objective(a, &q) : DBL_MAX;
+        double b = x + d > hi ? hi : x + d, fb = b > x ? objective(b, &q) : DBL_MAX;
+        for (int shift = 0; shift < 2 && !q.rc && !(fx < fa && fx < fb); shift++) {
+            if (fa <= fb) {
+                if (a - d < wlo - 1e-9 * v0)
+                    break;
+                b = x, fb = fx, x = a, fx = fa, a = x - d, fa = objective(a, &q);
+            } else {
+                if (b + d > hi + 1e-9 * v0)
+                    break;
+                a = x, fa = fx, x = b, fx = fb, b = x + d, fb = objective(b, &q);
+            }
+        }
+        if (q.rc)
+            return SWEEP_FAILED(q);
+        best = x, fbest = fx;
+        if (fx < fa && fx < fb) {
+            best = brent(&q, a, fa, x, fx, b, fb, &fbest);
+            if (q.rc)
+                return SWEEP_FAILED(q);
+        } else {
+            if (fa < fbest)
+                best = a, fbest = fa;
+            if (fb < fbest)
+                best = b, fbest = fb;
+        }
+        /* J at v0 and at the minimum, both on the model of the grid. */
+        j_given = r.f0, j_best = r.f;
     }
+    sr->at_bound = edge;
     sr->speed_given_mps = v0;
     sr->speed_mps = best;
     sr->lo_mps = lo;
     sr->hi_mps = hi;
     sr->n_evals = q.evals;
-    sr->j_given = f0;
-    sr->j_best = fbest;
+    sr->n_coarse = n_coarse;
+    sr->j_given = j_given;
+    sr->j_best = two_level ? j_best : fbest;
 
     /* The result: amfi_solve at the estimate, in its own window, same λ. */
     amfi_passage pv = *ps;

@@ -420,6 +420,7 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
     if (o && (json_object_set_new(o, "speed_mps", amfi_json_num(sr->speed_mps)) ||
               json_object_set_new(o, "speed_given_mps", amfi_json_num(sr->speed_given_mps)) ||
               json_object_set_new(o, "speed_estimated", json_boolean(estimated)) ||
+              json_object_set_new(o, "speed_coarse_sweeps", json_integer(sr->n_coarse)) ||
               json_object_set_new(o, "n_solves", json_integer(r->n_solves)))) {
         json_decref(o);
         o = NULL;

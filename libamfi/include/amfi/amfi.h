@@ -291,7 +291,8 @@ void amfi_solver_destroy(amfi_solver *s); /* NULL-safe */
 int amfi_solve(amfi_solver *s, const amfi_passage *p, const amfi_lambda *lam,
                amfi_result *res, char *err, size_t errlen);
 
-/* Bytes held by the solver's workspace (for benchmarks). */
+/* Bytes held by the solver's workspace, the speed search's coarse model included
+ * (for benchmarks). */
 size_t amfi_solver_workspace_bytes(const amfi_solver *s);
 
 const char *amfi_formulation_name(amfi_formulation f);
@@ -316,13 +317,18 @@ typedef struct amfi_speed_prior {
     double grid_rel; /* grid step / v0, 1e-4 .. range_sd·σ: below the cost's dip width */
     double tol_rel;  /* Brent stops when its bracket is below tol_rel·v0, 0 < tol < 0.01 */
     int brent_evals; /* Brent iterations (sweeps) after the grid, 0 .. 100 */
+    double coarse_rate_hz; /* the grid's model: the same bridge at this calculation
+                              rate with the modes it resolves, then the full model
+                              refines; 0 (or >= the solver's rate): the grid on the
+                              full model. 0 or [100, 1e6] */
     double data_dof; /* n_eff in J; 0: the data samples in the window (the
                         residuals as independent); a small value tempers the
                         data against the prior (model error is correlated) */
     amfi_speed_criterion criterion;
 } amfi_speed_prior;
 
-/* σ 3 %, ±3 σ, grid 0.2 %, tol 0.02 %, 6 Brent sweeps, regularised cost. */
+/* σ 3 %, ±3 σ, grid 0.2 %, tol 0.02 %, 4 Brent sweeps, coarse model at
+ * 1000 Hz, regularised cost. */
 void amfi_speed_prior_default(amfi_speed_prior *p);
 
 /* Check a prior (and the detector's speed v0): 0, or AMFI_EINVAL with a
@@ -335,13 +341,16 @@ typedef struct amfi_speed_result {
     double speed_mps;       /* the estimate: the speed the result was solved with */
     double lo_mps, hi_mps;  /* the range searched (the low end raised to what the data covers) */
     int at_bound;           /* 1: the minimum lay at an end of the range */
-    int n_evals;            /* sweeps of the search (the final solve's apart) */
-    double j_given, j_best; /* J at v0 and at the estimate */
+    int n_evals;            /* full-model sweeps of the search (the final solve's apart) */
+    int n_coarse;           /* coarse-model sweeps (the grid; 0 when single-level) */
+    double j_given, j_best; /* J at v0 and at the grid's minimum (two levels: on the
+                               coarse model) or at the estimate (one level) */
 } amfi_speed_result;
 
 /* Estimate the passage's speed (p->speed_mps is the detector's, the prior
- * mean): J on a grid, then a Brent search (GSL gsl_min) between the best
- * grid point's neighbours, then solve at the
+ * mean): J on a grid (on the coarse model, prior->coarse_rate_hz), then a
+ * Brent search (GSL gsl_min) on the full model around the grid's minimum,
+ * then solve at the
  * estimate as amfi_solve does: `res` is amfi_solve's result at speed_mps
  * (res->n_solves counts every sweep, search included). λ is fixed during
  * the search (the L-curve's at v0 when lam is automatic). The axle spacings
