@@ -164,7 +164,8 @@ typedef struct amfi_site_config {
     amfi_report_config report;       /* report.* */
     int speed_estimate;              /* solver.speed: 0 measured (default), 1 estimate */
     amfi_speed_prior speed_prior;    /* solver.speed_sd, speed_range_sd, speed_grid,
-                                        speed_criterion (amfi_speed_prior_default) */
+                                        speed_coarse_rate_hz, speed_criterion,
+                                        speed_pick (amfi_speed_prior_default) */
 } amfi_site_config;
 
 /* Fill `c` (not NULL) with the paper-20m defaults: amfi_bridge_params_paper20,

@@ -252,6 +252,11 @@ _Static_assert(sizeof(amfi_speed_criterion) == sizeof(int),
 static const enum_name speed_criterion_names[] = {
     {"regularised", AMFI_SPEED_REGULARISED}, {"residual", AMFI_SPEED_RESIDUAL}, {NULL, 0}};
 
+/* solver.speed_pick -> speed_prior.pick */
+_Static_assert(sizeof(amfi_speed_pick) == sizeof(int), "amfi_speed_pick is written as an int");
+static const enum_name speed_pick_names[] = {
+    {"min", AMFI_SPEED_PICK_MIN}, {"dip", AMFI_SPEED_PICK_DIP}, {NULL, 0}};
+
 /* solver.initial_state -> free_initial_state */
 static const enum_name initial_state_names[] = {{"rest", 0}, {"free", 1}, {NULL, 0}};
 
@@ -300,6 +305,7 @@ const field solver_fields[] = {
      .lo = 0, .hi = MAX_RATE_HZ},
     {.key = "speed_criterion", .kind = &K_ENUM, .off = SC(speed_prior.criterion),
      .aux = speed_criterion_names},
+    {.key = "speed_pick", .kind = &K_ENUM, .off = SC(speed_prior.pick), .aux = speed_pick_names},
     {.key = NULL}};
 
 /* Without `sensors` in the file, the one sensor follows bridge.span_m. */

@@ -32,7 +32,7 @@ amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p)
     if (!(p->span_m > 0) || !(p->pre_s >= 0) || !(p->post_s >= 0) || !(p->max_wait_s > 0) ||
         p->n_sensors < 1 || p->n_sensors > AMFI_MAX_SENSORS || !(p->max_event_s >= 0) ||
         p->max_event_axles < 0 || p->max_event_axles == 1 ||
-        p->max_event_axles > AMFI_MAX_AXLES)
+        p->max_event_axles > AMFI_MAX_AXLES || !(p->slow_frac >= 0) || !(p->slow_frac <= 0.5))
         return NULL;
     amfi_tracker *t = calloc(1, sizeof *t);
     if (t) {
@@ -46,17 +46,28 @@ amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p)
 void amfi_tracker_destroy(amfi_tracker *t) { free(t); }
 int amfi_tracker_pending(const amfi_tracker *t) { return t->n_pend; }
 
-/* The vehicle's passage window (libamfi's one definition), seconds from its entry. */
-static amfi_passage_times window_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
+/* The vehicle's passage window (libamfi's one definition), seconds from its
+ * entry, at its speed·(1 − frac). */
+static amfi_passage_times window_at(const amfi_tracker *t, const amfi_vehicle_ev *v,
+                                    double frac)
 {
-    return amfi_passage_window(t->p.span_m, v->speed_mps, v->n_axles, v->spacing_m,
-                               t->p.pre_s, t->p.post_s);
+    return amfi_passage_window(t->p.span_m, v->speed_mps * (1.0 - frac), v->n_axles,
+                               v->spacing_m, t->p.pre_s, t->p.post_s);
 }
 
+/* The data a passage needs: the window at the slowest speed the speed
+ * search may try (slow_frac; 0 without it). */
+static amfi_passage_times window_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
+{
+    return window_at(t, v, t->p.slow_frac);
+}
+
+/* While the vehicle is on the span, at its measured speed. */
 static span span_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
 {
-    span s = {v->vehicle_id, (double)v->utime,
-              (double)v->utime + 1e6 * window_of(t, v).on_span_s};
+    amfi_passage_times w = amfi_passage_window(t->p.span_m, v->speed_mps, v->n_axles,
+                                               v->spacing_m, 0.0, 0.0);
+    span s = {v->vehicle_id, (double)v->utime, (double)v->utime + 1e6 * w.on_span_s};
     return s;
 }
 
@@ -68,7 +79,7 @@ static span reach_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
 {
     if (!(t->p.max_event_s > 0))
         return span_of(t, v);
-    const amfi_passage_times w = window_of(t, v);
+    const amfi_passage_times w = window_at(t, v, 0.0); /* at the measured speed */
     span s = {v->vehicle_id, (double)v->utime + 1e6 * w.start_s,
               (double)v->utime + 1e6 * w.end_s};
     return s;

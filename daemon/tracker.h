@@ -58,6 +58,8 @@ typedef struct amfi_tracker_params {
     int n_sensors;
     double max_event_s;  /* first entry to last exit of an event, s; 0: no events */
     int max_event_axles; /* axles of an event, 2 .. AMFI_MAX_AXLES (0: AMFI_MAX_AXLES) */
+    double slow_frac;    /* the window ends where it would for speed·(1 − slow_frac):
+                            room for the speed search's slowest trial (0 .. 0.5) */
 } amfi_tracker_params;
 
 typedef struct amfi_window {

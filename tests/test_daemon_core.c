@@ -165,7 +165,7 @@ static void ring_outage_then_resume(void **state)
 static void tracker_after_poisoned_first_block(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0}; /* events off */
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = amfi_ring_create(RATE, 60.0);
     amfi_ring *rings[1] = {r};
@@ -197,7 +197,7 @@ static void tracker_after_poisoned_first_block(void **state)
 static void tracker_windows(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0}; /* events off */
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(3.0); /* samples 0 .. 2999 */
     amfi_ring *rings[1] = {r};
@@ -231,10 +231,46 @@ static void tracker_windows(void **state)
     amfi_tracker_destroy(t);
 }
 
+/* slow_frac (room for the speed search): the window ends where it would
+ * for the speed·(1 − slow_frac); co-presence still goes by the measured
+ * speed. 25 m/s, 25 m of span and axles: 1.0 s on the span at 25, 1.25 s
+ * at 20 (slow_frac 0.2). */
+static void tracker_slow_frac(void **state)
+{
+    (void)state;
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.2}; /* events off */
+    amfi_tracker *t = amfi_tracker_create(&p);
+    amfi_ring *r = filled(4.0);
+    amfi_ring *rings[1] = {r};
+    amfi_window w;
+    /* b enters 1.1 s after a: a has left at its measured speed (1.0 s), not
+     * at 20 m/s (1.25 s); both ok, not multiple */
+    amfi_vehicle_ev a = vehicle(1, 0.5), b = vehicle(2, 1.6);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_int_equal(w.v.vehicle_id, 1);
+    assert_string_equal(w.status, "ok");
+    /* window: entry 0.5 − 0.35 .. entry + 1.25 + 0.05 s */
+    assert_int_equal(w.k0[0], 150);
+    assert_int_equal(w.n, 1651);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_int_equal(w.v.vehicle_id, 2);
+    assert_string_equal(w.status, "ok");
+    amfi_ring_destroy(r);
+    amfi_tracker_destroy(t);
+    /* out of range */
+    amfi_tracker_params bad = p;
+    bad.slow_frac = 0.6;
+    assert_null(amfi_tracker_create(&bad));
+    bad.slow_frac = -0.1;
+    assert_null(amfi_tracker_create(&bad));
+}
+
 static void tracker_multiple_and_late(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0}; /* events off */
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(4.0);
     amfi_ring *rings[1] = {r};
@@ -277,7 +313,7 @@ static void tracker_multiple_and_late(void **state)
     amfi_tracker_destroy(t);
     /* two sensors, the second falls silent: given up max_wait (5 s) after
      * the window's end, as a gap */
-    amfi_tracker_params p2 = {20.0, 0.35, 0.05, 5.0, 2, 0.0, 0};
+    amfi_tracker_params p2 = {20.0, 0.35, 0.05, 5.0, 2, 0.0, 0, 0.0};
     t = amfi_tracker_create(&p2);
     amfi_ring *a1 = amfi_ring_create(RATE, 60.0), *a2 = amfi_ring_create(RATE, 60.0);
     amfi_ring *two[2] = {a1, a2};
@@ -337,7 +373,7 @@ static void pair_released_as(amfi_tracker *t, amfi_ring **rings, amfi_vehicle_ev
 static void tracker_events_chain_and_lanes(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0};
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0, 0.0};
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(14.0);
     amfi_ring *rings[1] = {r};
@@ -394,7 +430,7 @@ static void tracker_events_chain_and_lanes(void **state)
 static void tracker_event_limits(void **state)
 {
     (void)state;
-    amfi_tracker_params bad = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 1};
+    amfi_tracker_params bad = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 1, 0.0};
     assert_null(amfi_tracker_create(&bad));
     bad.max_event_axles = AMFI_MAX_AXLES + 1;
     assert_null(amfi_tracker_create(&bad));
@@ -402,7 +438,7 @@ static void tracker_event_limits(void **state)
     bad.max_event_s = -1.0;
     assert_null(amfi_tracker_create(&bad));
 
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 2.0, 0};
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 2.0, 0, 0.0};
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(0.5); /* no data for any of them yet */
     amfi_ring *rings[1] = {r};
@@ -432,7 +468,7 @@ static void tracker_event_limits(void **state)
     amfi_tracker_destroy(t);
 
     /* axles: two three-axle vehicles, at most 5 */
-    amfi_tracker_params pa = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 5};
+    amfi_tracker_params pa = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 5, 0.0};
     t = amfi_tracker_create(&pa);
     pair_released_as(t, rings, vehicle_in(11, 1.0, 1, 25.0, 3), vehicle_in(12, 1.2, 2, 25.0, 3),
                      "multiple", 2, "6 axles in all: more than daemon.max_event_axles (5)");
@@ -442,7 +478,7 @@ static void tracker_event_limits(void **state)
      * 2 (on the span 2.2 .. 3.2 s) is in 1's post-roll (1.0 .. 2.0 .. 2.05 s)
      * and on the span with 3: six axles by windows, at most 4: 1 alone,
      * then 2 and 3 together */
-    amfi_tracker_params p4 = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 4};
+    amfi_tracker_params p4 = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 4, 0.0};
     t = amfi_tracker_create(&p4);
     amfi_vehicle_ev c1 = vehicle(31, 1.0), c2 = vehicle(32, 2.2), c3 = vehicle(33, 2.5);
     amfi_tracker_add(t, &c1, NULL);
@@ -461,7 +497,7 @@ static void tracker_event_limits(void **state)
     amfi_tracker_destroy(t);
 
     /* vehicles: nine one-axle vehicles 0.1 s apart, 8 at most together */
-    amfi_tracker_params pv = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0};
+    amfi_tracker_params pv = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0, 0.0};
     t = amfi_tracker_create(&pv);
     for (int i = 0; i < 9; i++) {
         amfi_vehicle_ev v = vehicle_in(20 + i, 1.0 + 0.1 * i, 1, 25.0, 1);
@@ -491,6 +527,7 @@ int main(void)
         cmocka_unit_test(tracker_multiple_and_late),
         cmocka_unit_test(tracker_events_chain_and_lanes),
         cmocka_unit_test(tracker_event_limits),
+        cmocka_unit_test(tracker_slow_frac),
     };
     return cmocka_run_group_tests_name("daemon core", tests, NULL, NULL);
 }

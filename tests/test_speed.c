@@ -37,13 +37,13 @@ static double forces(double t, int a, void *user)
 
 /* Mid-span acceleration at RATE for SECONDS from entry, with white noise of
  * `noise` × its RMS (seeded). */
-static double *record(double noise, int *n)
+static double *record_on(const amfi_bridge *on, double noise, int *n)
 {
     const double off[2] = {0.0, 5.0}, xs = 10.0;
     *n = (int)(SECONDS * RATE) + 1;
     double *acc = malloc(sizeof(double) * *n);
     char err[256];
-    assert_int_equal(amfi_forward_newmark(bridge, TRUE_SPEED, 2, off, forces, NULL, 1, &xs,
+    assert_int_equal(amfi_forward_newmark(on, TRUE_SPEED, 2, off, forces, NULL, 1, &xs,
                                           2e-5, RATE, *n, acc, err, sizeof err),
                      0);
     if (noise > 0) {
@@ -59,6 +59,8 @@ static double *record(double noise, int *n)
     }
     return acc;
 }
+
+static double *record(double noise, int *n) { return record_on(bridge, noise, n); }
 
 static amfi_solver *solver(void)
 {
@@ -153,6 +155,57 @@ static void recovers_biased_speed(void **state)
     amfi_solver_destroy(s);
 }
 
+/* A bridge 10 % softer than the solver's model (the damage the estimate must
+ * not absorb): recorded on the damaged bridge with 3 % noise, solved with
+ * the healthy model from a detector speed 4 % slow and 4 % fast. Pick dip
+ * finds the true speed within 0.5 % (the issue's RMS target) and keeps the
+ * damage's growth of the inferred GVW, 1/(1 − δ) − 1 = +11.1 %, within a
+ * quarter of it (the issue's criterion); pick min is printed beside it (it
+ * follows the misfit to slower speeds, docs/results/speed-estimation.md). */
+static void damaged_bridge(void **state)
+{
+    (void)state;
+    amfi_bridge_params bp;
+    amfi_bridge *soft;
+    char err[256];
+    amfi_bridge_params_paper20(&bp);
+    bp.damage = 0.1;
+    assert_int_equal(amfi_bridge_create(&bp, &soft, err, sizeof err), 0);
+    int n;
+    double *acc = record_on(soft, 0.03, &n);
+    amfi_solver *s = solver();
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    const double growth = 1 / (1 - bp.damage) - 1;
+    for (int k = 0; k < 2; k++) {
+        const double bias = k ? 0.04 : -0.04;
+        amfi_passage p = passage(acc, n, TRUE_SPEED * (1 + bias));
+        for (int pick = AMFI_SPEED_PICK_MIN; pick <= AMFI_SPEED_PICK_DIP; pick++) {
+            amfi_speed_prior pr;
+            amfi_speed_prior_default(&pr);
+            pr.pick = (amfi_speed_pick)pick;
+            amfi_result est;
+            amfi_speed_result sr;
+            if (amfi_solve_speed(s, &p, &lam, &pr, &est, &sr, err, sizeof err))
+                fail_msg("%s", err);
+            double ve = sr.speed_mps / TRUE_SPEED - 1, ge = est.gvw_kg / true_gvw_kg - 1;
+            print_message("damage 10%% given %+.0f%% pick %s: speed %+.3f%%, GVW %+.2f%% "
+                          "(1/(1 - d) - 1 = %+.2f%%), dip %g\n",
+                          100 * bias, amfi_speed_pick_name(pr.pick), 100 * ve, 100 * ge,
+                          100 * growth, sr.dip);
+            if (pick == AMFI_SPEED_PICK_DIP) {
+                assert_true(fabs(ve) < 0.005);
+                assert_true(fabs(ge - growth) < 0.25 * growth);
+                assert_true(sr.dip < 0);
+                assert_true(est.n_solves <= 10);
+            }
+        }
+    }
+    free(acc);
+    amfi_solver_destroy(s);
+    amfi_bridge_destroy(soft);
+}
+
 static void refuses_bad_priors(void **state)
 {
     (void)state;
@@ -240,6 +293,7 @@ int main(void)
         cmocka_unit_test(resolved_modes),
         cmocka_unit_test(recovers_biased_speed),
         cmocka_unit_test(refuses_bad_priors),
+        cmocka_unit_test(damaged_bridge),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

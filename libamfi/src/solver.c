@@ -40,12 +40,13 @@ void amfi_solver_destroy(amfi_solver *s)
     free(s->lc_smo);
     free(s->lc_kap);
     amfi_solver_destroy(s->coarse);
+    free(s->grid_f);
     free(s);
 }
 
 size_t amfi_solver_workspace_bytes(const amfi_solver *s)
 {
-    return s->bytes + (s->coarse ? s->coarse->bytes : 0);
+    return s->bytes + (s->coarse ? s->coarse->bytes : 0) + sizeof(double) * (size_t)s->grid_cap;
 }
 
 static int check_params(const amfi_bridge *b, const amfi_solver_params *p, char *err,

@@ -60,6 +60,8 @@ struct amfi_solver {
     /* speed search (speed.c): the coarse model, created at the first
      * two-level search, owned and freed with this solver */
     struct amfi_solver *coarse;
+    double *grid_f; /* J on the grid, grid_cap points */
+    int grid_cap;
 };
 
 /* Position of axle a at step j, m (x = speed·vf[a]·t − off[a], t = t0 + j·h):

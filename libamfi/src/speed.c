@@ -24,6 +24,7 @@
  */
 #include <float.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <gsl/gsl_errno.h>
@@ -41,6 +42,12 @@ void amfi_speed_prior_default(amfi_speed_prior *p)
     p->brent_evals = 4;
     p->coarse_rate_hz = 1000.0;
     p->criterion = AMFI_SPEED_REGULARISED;
+    p->pick = AMFI_SPEED_PICK_DIP;
+}
+
+const char *amfi_speed_pick_name(amfi_speed_pick p)
+{
+    return p == AMFI_SPEED_PICK_MIN ? "min" : "dip";
 }
 
 const char *amfi_speed_criterion_name(amfi_speed_criterion c)
@@ -96,6 +103,8 @@ int amfi_speed_prior_check(const amfi_speed_prior *p, double speed_mps, char *er
         return amfi_fail(err, errlen, AMFI_EINVAL,
                          "speed prior: coarse rate %g Hz must be 0 (none) or in [100, 1e6]",
                          p->coarse_rate_hz);
+    if (p->pick != AMFI_SPEED_PICK_MIN && p->pick != AMFI_SPEED_PICK_DIP)
+        return amfi_fail(err, errlen, AMFI_EINVAL, "speed prior: unknown pick %d", (int)p->pick);
     if (p->criterion != AMFI_SPEED_REGULARISED && p->criterion != AMFI_SPEED_RESIDUAL)
         return amfi_fail(err, errlen, AMFI_EINVAL, "speed prior: unknown criterion %d",
                          (int)p->criterion);
@@ -150,6 +159,10 @@ static double brent(search *q, double a, double fa, double x, double fx, double 
                     double *fbest)
 {
     const double tol = q->pr->tol_rel * q->v0;
+    if (!(a < x && x < b && fx < fa && fx < fb)) { /* not a bracket: GSL would abort */
+        *fbest = fx;
+        return x;
+    }
     gsl_function F = {objective, q};
     gsl_min_fminimizer *m = gsl_min_fminimizer_alloc(gsl_min_fminimizer_brent);
     if (!m) {
@@ -174,35 +187,101 @@ static double brent(search *q, double a, double fa, double x, double fx, double 
     return best;
 }
 
-/* The grid v0 + i·g over [lo, hi]: the best point, whether it is an end of
- * the range, and its neighbours (xa, fa), (xb, fb) for Brent. */
+/* The grid v0 + i·g over [glo, ghi] (the range [lo, hi] and, for pick
+ * dip, the trend's points beyond it): the picked point (prior->pick) among
+ * the points in [lo, hi], whether it is an end of the range, and its
+ * neighbours (xa, fa), (xb, fb) for Brent. J at every point goes to fv. */
 typedef struct grid_best {
-    double x, f, xa, fa, xb, fb, f0;
+    double x, f, xa, fa, xb, fb, f0, dip;
     int edge;
 } grid_best;
 
-static grid_best grid(search *q, double lo, double hi, double g)
+static int grid_points(double v0, double lo, double hi, double g, int *i_lo)
 {
-    const double v0 = q->v0;
-    int i_lo = -(int)floor((v0 - lo) / g + 1e-9), i_hi = (int)floor((hi - v0) / g + 1e-9);
-    grid_best r = {v0, DBL_MAX, v0, DBL_MAX, v0, DBL_MAX, DBL_MAX, 0};
-    double prev_x = v0, prev_f = DBL_MAX;
-    int best_i = 0;
-    for (int i = i_lo; i <= i_hi && !q->rc; i++) {
-        double v = v0 + i * g, f = objective(v, q);
-        if (i == 0)
-            r.f0 = f;
-        if (f < r.f) {
-            r.x = v, r.f = f, best_i = i;
-            r.xa = prev_x, r.fa = prev_f;
-            r.edge = i == i_lo || i == i_hi;
-            r.xb = v, r.fb = DBL_MAX; /* until the next point */
-        } else if (i == best_i + 1) {
-            r.xb = v, r.fb = f;
+    *i_lo = -(int)floor((v0 - lo) / g + 1e-9);
+    return (int)floor((hi - v0) / g + 1e-9) - *i_lo + 1;
+}
+
+/* The dip's trend: the grid points 0.6-1.2 % away on each side, k0..k1 steps. */
+static void trend_span(const amfi_speed_prior *pr, int *k0, int *k1)
+{
+    *k0 = (int)lround(0.006 / pr->grid_rel);
+    if (*k0 < 2)
+        *k0 = 2;
+    *k1 = 2 * *k0;
+}
+
+static grid_best grid(search *q, double glo, double ghi, double lo, double hi, double g,
+                      double *fv)
+{
+    const double v0 = q->v0, eps = 1e-9 * v0;
+    int i_lo, n = grid_points(v0, glo, ghi, g, &i_lo);
+    grid_best r = {v0, DBL_MAX, v0, DBL_MAX, v0, DBL_MAX, DBL_MAX, NAN, 0};
+    int c_lo = n, c_hi = -1; /* the candidates: the points in [lo, hi] */
+    for (int k = 0; k < n && !q->rc; k++) {
+        double v = v0 + (i_lo + k) * g;
+        fv[k] = objective(v, q);
+        if (i_lo + k == 0)
+            r.f0 = fv[k];
+        if (v >= lo - eps && v <= hi + eps) {
+            if (k < c_lo)
+                c_lo = k;
+            c_hi = k;
         }
-        prev_x = v, prev_f = f;
     }
+    if (q->rc || c_hi < c_lo)
+        return r;
+    int best = c_lo;
+    for (int k = c_lo; k <= c_hi; k++)
+        if (fv[k] < fv[best])
+            best = k;
+    if (q->pr->pick == AMFI_SPEED_PICK_DIP) {
+        int k0, k1, pick = -1;
+        trend_span(q->pr, &k0, &k1);
+        double rmin = 0.0;
+        for (int k = c_lo > k1 ? c_lo : k1; k <= c_hi && k + k1 < n; k++) {
+            double sl = 0.0, sr = 0.0;
+            for (int j = k0; j <= k1; j++)
+                sl += fv[k - j], sr += fv[k + j];
+            double dip = fv[k] - 0.5 * (sl + sr) / (k1 - k0 + 1);
+            if (dip < rmin)
+                rmin = dip, pick = k;
+        }
+        if (pick >= 0)
+            best = pick, r.dip = rmin;
+    }
+    r.x = v0 + (i_lo + best) * g;
+    r.f = fv[best];
+    r.edge = best == c_lo || best == c_hi;
+    if (best > 0)
+        r.xa = r.x - g, r.fa = fv[best - 1];
+    if (best < n - 1)
+        r.xb = r.x + g, r.fb = fv[best + 1];
     return r;
+}
+
+double amfi_speed_slowest_frac(const amfi_speed_prior *p)
+{
+    double f = p->range_sd * p->rel_sd;
+    if (p->pick == AMFI_SPEED_PICK_DIP) {
+        int k0, k1;
+        trend_span(p, &k0, &k1);
+        f += k1 * p->grid_rel;
+    }
+    return isfinite(f) && f > 0 ? (f < 0.5 ? f : 0.5) : 0.0;
+}
+
+/* The grid's values: a buffer kept with the solver, grown on demand. */
+static double *grid_buffer(struct amfi_solver *s, int n)
+{
+    if (n > s->grid_cap) {
+        double *p = realloc(s->grid_f, sizeof(double) * (size_t)n);
+        if (!p)
+            return NULL;
+        s->grid_f = p;
+        s->grid_cap = n;
+    }
+    return s->grid_f;
 }
 
 /* The coarse model: the solver's bridge, sensors and policies at `rate` Hz
@@ -239,7 +318,7 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
     if (rc)
         return rc;
     const double v0 = ps->speed_mps, step = pr->rel_sd * v0;
-    double lo = v0 - pr->range_sd * step, hi = v0 + pr->range_sd * step;
+    double lo = v0 - pr->range_sd * step, hi = v0 + pr->range_sd * step, vmin = 0.0;
     /* Raise the low end to the slowest speed whose window the data cover. */
     if (ps->n_samples >= 2 && isfinite(ps->scan_rate_hz) && ps->scan_rate_hz > 0 &&
         isfinite(ps->t_first_s) && ps->n_axles >= 1 && ps->n_axles <= AMFI_MAX_AXLES) {
@@ -248,36 +327,53 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
                                                     ps->axle_spacing_m, 0.0, 0.0);
         double avail = t_last - s->p.post_roll_s;
         if (avail > 0 && isfinite(w1.on_span_s) && w1.on_span_s > 0) {
-            double vmin = w1.on_span_s / avail * (1.0 + 1e-9);
+            vmin = w1.on_span_s / avail * (1.0 + 1e-9);
             if (vmin > lo)
                 lo = vmin < v0 ? vmin : v0;
         }
     }
     const int two_level = pr->coarse_rate_hz > 0 && pr->coarse_rate_hz < s->p.calc_rate_hz;
     const double g = pr->grid_rel * v0;
+    /* pick dip: the trend's points beyond the range, as far as the data cover */
+    double glo = lo, ghi = hi;
+    if (pr->pick == AMFI_SPEED_PICK_DIP) {
+        int k0, k1;
+        trend_span(pr, &k0, &k1);
+        glo = lo - k1 * g, ghi = hi + k1 * g;
+        if (glo < vmin)
+            glo = vmin;
+        if (glo < 0.5 * lo)
+            glo = 0.5 * lo;
+        if (glo > lo) /* data short of even the range's low end: amfi_solve_begin says so */
+            glo = lo;
+    }
+    int i_lo;
+    double *fv = grid_buffer(s, grid_points(v0, glo, ghi, g, &i_lo));
+    if (!fv)
+        return amfi_fail(err, errlen, AMFI_ENOMEM, "speed search: out of memory");
 
     /* λ on the full model: fixed, or the L-curve's at v0 in the search window. */
     search q = {s, pr, v0, 0.0, 0.0, 0, pr->brent_evals, 0};
     int n_lc = 0;
     if (!two_level || lam->automatic) {
-        if ((rc = amfi_solve_begin(s, ps, lam, lo, err, errlen)) != 0)
+        if ((rc = amfi_solve_begin(s, ps, lam, glo, err, errlen)) != 0)
             return rc;
         s->speed = v0;
     }
     if ((rc = amfi_solve_lambda(s, lam, &q.lam_h, &n_lc, err, errlen)) != 0)
         return rc;
 
-    double best, fbest, j_given, j_best = DBL_MAX;
+    double best, fbest, j_given, j_best = DBL_MAX, dip;
     int edge, n_coarse = 0;
     if (!two_level) {
         /* The grid on the full model, then Brent between the best point's neighbours. */
         q.n_eff = n_eff_of(s, ps, pr);
-        grid_best r = grid(&q, lo, hi, g);
+        grid_best r = grid(&q, glo, ghi, lo, hi, g, fv);
         if (q.rc)
             return SWEEP_FAILED(q);
-        best = r.x, fbest = r.f, edge = r.edge;
+        best = r.x, fbest = r.f, edge = r.edge, dip = r.dip;
         j_given = r.f0;
-        if (!edge && r.f < r.fa && r.f < r.fb) {
+        if (!edge) {
             best = brent(&q, r.xa, r.fa, r.x, r.f, r.xb, r.fb, &fbest);
             if (q.rc)
                 return SWEEP_FAILED(q);
@@ -287,15 +383,15 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
         if ((rc = coarse_solver(s, pr->coarse_rate_hz, err, errlen)) != 0)
             return rc;
         struct amfi_solver *c = s->coarse;
-        if ((rc = amfi_solve_begin(c, ps, lam, lo, err, errlen)) != 0)
+        if ((rc = amfi_solve_begin(c, ps, lam, glo, err, errlen)) != 0)
             return rc;
         search qc = {c, pr, v0, q.lam_h / amfi_lambda_scale(s, lam) * amfi_lambda_scale(c, lam),
                      n_eff_of(c, ps, pr), 0, 0, 0};
-        grid_best r = grid(&qc, lo, hi, g);
+        grid_best r = grid(&qc, glo, ghi, lo, hi, g, fv);
         n_coarse = qc.evals;
         if (qc.rc)
             return SWEEP_FAILED(qc);
-        edge = r.edge;
+        edge = r.edge, dip = r.dip;
         /* 2. The full model around the coarse minimum: x and x ± d (d = 1.5 grid
          * steps: the coarse model's minimum lies within a step or two of the
          * full model's, docs/solver.md), up to two steps of d downhill until x
@@ -325,7 +421,7 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
         if (q.rc)
             return SWEEP_FAILED(q);
         best = x, fbest = fx;
-        if (fx < fa && fx < fb) {
+        if (a < x && x < b && fx < fa && fx < fb) {
             best = brent(&q, a, fa, x, fx, b, fb, &fbest);
             if (q.rc)
                 return SWEEP_FAILED(q);
@@ -345,6 +441,11 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
     sr->hi_mps = hi;
     sr->n_evals = q.evals;
     sr->n_coarse = n_coarse;
+    sr->dip = dip;
+    sr->grid_n = grid_points(v0, glo, ghi, g, &i_lo);
+    sr->grid_lo_mps = v0 + i_lo * g;
+    sr->grid_step_mps = g;
+    sr->grid_j = fv;
     sr->j_given = j_given;
     sr->j_best = two_level ? j_best : fbest;
 

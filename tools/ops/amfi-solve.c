@@ -58,6 +58,7 @@ typedef struct options {
     const char *accel;
     const char *forces;      /* NULL: not written */
     const char *lcurve;      /* NULL: not written */
+    const char *speed_trace; /* --speed-trace: the search's grid, NULL: not written */
     const char *formulation; /* NULL: the config's */
     const char *lambda;      /* NULL: the config's; "auto" or a number */
     double speed_mps;        /* NaN until given */
@@ -108,6 +109,7 @@ static void usage(FILE *f)
             "                           detector's value (default: the config's solver.speed)\n"
             "      --speed-sd FRACTION  the detector's relative SD, 0 < f < 1 (default: the\n"
             "                           config's solver.speed_sd)\n"
+            "      --speed-trace FILE   write the speed search's grid: speed_mps,J,dip\n"
             "  -h, --help               this help\n"
             "  -V, --version            print the version\n"
             "Exit status: 0 ok, 1 data or solver error, 2 usage error.\n",
@@ -216,6 +218,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"lcurve", required_argument, NULL, 'L'},
         {"estimate-speed", no_argument, NULL, 'E'},
         {"speed-sd", required_argument, NULL, 'S'},
+        {"speed-trace", required_argument, NULL, 'T'},
         {"vehicle", required_argument, NULL, 'v'},
         AMFI_CLI_END};
     memset(o, 0, sizeof *o);
@@ -263,6 +266,7 @@ static int parse_args(int argc, char **argv, options *o)
         case 'f': o->formulation = val; break;
         case 'F': o->forces = val; break;
         case 'L': o->lcurve = val; break;
+        case 'T': o->speed_trace = val; break;
         case 'S':
             if (amfi_cli_double(val, &x) != 0 || !(x > 0 && x < 1))
                 return usage_error(opt, "'%s' must be a fraction in (0, 1)",
@@ -395,6 +399,34 @@ static int write_lcurve(const char *path, const amfi_result *r)
     return finish_file(f, "--lcurve", path);
 }
 
+/* The speed search's grid: the trial speed, J, and J minus its trend
+ * (solver.speed_pick dip's measure; empty where the trend is not defined). */
+static int write_speed_trace(const char *path, const amfi_speed_result *sr, double grid_rel)
+{
+    FILE *f = open_out("--speed-trace", path);
+    if (!f)
+        return -1;
+    fputs("speed_mps,J,dip\n", f);
+    int k0 = (int)lround(0.006 / grid_rel);
+    if (k0 < 2)
+        k0 = 2;
+    const int k1 = 2 * k0;
+    for (int k = 0; k < sr->grid_n; k++) {
+        csv_num(f, sr->grid_lo_mps + k * sr->grid_step_mps);
+        fputc(',', f);
+        csv_num(f, sr->grid_j[k]);
+        fputc(',', f);
+        if (k >= k1 && k + k1 < sr->grid_n) {
+            double sl = 0, sh = 0;
+            for (int j = k0; j <= k1; j++)
+                sl += sr->grid_j[k - j], sh += sr->grid_j[k + j];
+            csv_num(f, sr->grid_j[k] - 0.5 * (sl + sh) / (k1 - k0 + 1));
+        }
+        fputc('\n', f);
+    }
+    return finish_file(f, "--speed-trace", path);
+}
+
 /* The result as one JSON line on stdout (common/amfi_json.h). */
 static int print_json(const amfi_site_config *c, const amfi_result *r,
                       const amfi_speed_result *sr, int estimated,
@@ -421,6 +453,7 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
               json_object_set_new(o, "speed_given_mps", amfi_json_num(sr->speed_given_mps)) ||
               json_object_set_new(o, "speed_estimated", json_boolean(estimated)) ||
               json_object_set_new(o, "speed_coarse_sweeps", json_integer(sr->n_coarse)) ||
+              json_object_set_new(o, "speed_dip", amfi_json_num(sr->dip)) ||
               json_object_set_new(o, "n_solves", json_integer(r->n_solves)))) {
         json_decref(o);
         o = NULL;
@@ -481,6 +514,11 @@ int main(int argc, char **argv)
     }
     if (o.estimate_speed)
         cfg.speed_estimate = 1;
+    if (o.speed_trace && !cfg.speed_estimate) {
+        fprintf(stderr, PROG ": --speed-trace needs --estimate-speed (or solver.speed: "
+                        "estimate in the configuration)\n");
+        return EXIT_USAGE;
+    }
     if (!isnan(o.speed_sd)) {
         if (!cfg.speed_estimate) {
             fprintf(stderr, PROG ": --speed-sd needs --estimate-speed (or solver.speed: "
@@ -575,6 +613,7 @@ int main(int argc, char **argv)
     memset(&sres, 0, sizeof sres);
     sres.speed_mps = sres.speed_given_mps =
         o.n_vehicles > 0 ? o.vehicle[0].speed_mps : o.speed_mps;
+    sres.dip = NAN;
     static amfi_multi_result mres;
     struct timespec t_a, t_b;
     clock_gettime(CLOCK_MONOTONIC, &t_a);
@@ -607,6 +646,8 @@ int main(int argc, char **argv)
                      o.n_vehicles ? o.vehicle[0].entry_s : 0.0) != 0)
         goto done;
     if (o.lcurve && write_lcurve(o.lcurve, &res) != 0)
+        goto done;
+    if (o.speed_trace && write_speed_trace(o.speed_trace, &sres, cfg.speed_prior.grid_rel) != 0)
         goto done;
     if (print_json(&cfg, &res, &sres, cfg.speed_estimate, o.n_vehicles ? &mres : NULL,
                    csv.rate_hz,

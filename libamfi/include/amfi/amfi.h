@@ -311,6 +311,21 @@ typedef enum amfi_speed_criterion {
     AMFI_SPEED_RESIDUAL = 1     /* ‖y − d‖²_W alone */
 } amfi_speed_criterion;
 
+/* Which point of the grid the search refines around: */
+typedef enum amfi_speed_pick {
+    AMFI_SPEED_PICK_MIN = 0, /* J's smallest value */
+    AMFI_SPEED_PICK_DIP = 1  /* J's deepest dip below its local trend: J minus the mean
+                                of J over the grid points 0.6-1.2 % slower and
+                                0.6-1.2 % faster. The narrow dip at the true speed
+                                (the axles' entry and exit transients) stays where it
+                                is when the bridge is stiffer or softer than the
+                                model, while the trend tilts towards slower speeds
+                                (docs/solver.md). Points closer than 1.2 % to an end
+                                of the range have no trend and are not candidates;
+                                without any dip (J above its trend everywhere) the
+                                smallest value is taken. */
+} amfi_speed_pick;
+
 typedef struct amfi_speed_prior {
     double rel_sd;   /* σ: the detector's relative standard deviation, 0 < σ < 1 */
     double range_sd; /* search v0·(1 ± range_sd·σ), > 0, range_sd·σ < 0.5 */
@@ -325,6 +340,7 @@ typedef struct amfi_speed_prior {
                         residuals as independent); a small value tempers the
                         data against the prior (model error is correlated) */
     amfi_speed_criterion criterion;
+    amfi_speed_pick pick;
 } amfi_speed_prior;
 
 /* σ 3 %, ±3 σ, grid 0.2 %, tol 0.02 %, 4 Brent sweeps, coarse model at
@@ -345,6 +361,11 @@ typedef struct amfi_speed_result {
     int n_coarse;           /* coarse-model sweeps (the grid; 0 when single-level) */
     double j_given, j_best; /* J at v0 and at the grid's minimum (two levels: on the
                                coarse model) or at the estimate (one level) */
+    double dip;             /* pick dip: the picked grid point's J minus its trend
+                               (< 0; NAN when no dip was found or pick is min) */
+    int grid_n;             /* the grid: J at grid_lo_mps + k·grid_step_mps, */
+    double grid_lo_mps, grid_step_mps; /* k = 0 .. grid_n − 1, on the grid's */
+    const double *grid_j;   /* model; held by the solver until its next search */
 } amfi_speed_result;
 
 /* Estimate the passage's speed (p->speed_mps is the detector's, the prior
@@ -362,6 +383,12 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *p, const amfi_lambda *l
 
 const char *amfi_speed_criterion_name(amfi_speed_criterion c);
 int amfi_speed_criterion_parse(const char *name, amfi_speed_criterion *c); /* 0 ok */
+const char *amfi_speed_pick_name(amfi_speed_pick p); /* "min", "dip" */
+
+/* How far below the detector's speed the search may try, as a fraction of
+ * it (the range, and pick dip's trend points beyond it): data for a passage
+ * to be estimated should cover the window of speed·(1 − this). 0 .. 0.5. */
+double amfi_speed_slowest_frac(const amfi_speed_prior *p);
 
 /* ---- several vehicles on the span, solved jointly (multi.c) ------------ */
 
