@@ -4,10 +4,17 @@
  * (amfid.c). Everything else is in the library amfid_lib, which the fuzz
  * target fuzz/fuzz_intake.c drives the same way on an in-memory bus.
  */
+#include <gsl/gsl_errno.h>
+
 #include "amfid.h"
 
 int main(int argc, char **argv)
 {
+    /* GSL's default error handler aborts the process. Every GSL call in
+     * libamfi and the indicators checks its status or its result (a NaN
+     * p-value is no alert), so a domain error must not take the daemon
+     * down: errors are returned, not fatal. */
+    gsl_set_error_handler_off();
     amfid_options o;
     amfid_parse_options(argc, argv, &o);
     static daemon_s d; /* large; zeroed */
