@@ -67,7 +67,9 @@ static const double levels[N_LEVELS] = {0.0, 0.025, 0.05, 0.075, 0.10};
 
 typedef struct opts {
     const char *out, *config, *population;
-    int quick, vehicles, reps, threads, batch_lcurve, plots, batches_only;
+    int quick, vehicles, reps, threads, plots, batches_only;
+    int batch_lcurve;     /* the batches' second solve: 0 none, 1 a per-vehicle L-curve,
+                             2 the speed estimated (--batch-estimate) */
     int speed_batch;      /* > 0: only the speed-estimation batch, this many vehicles */
     double speed_grid;    /* its grid step (fraction of the given speed) */
     double speed_dof;     /* its data_dof (0: the samples) */
@@ -114,6 +116,8 @@ static void usage(FILE *f)
             "  -j, --threads T                 worker threads, 1 .. 64\n"
             "      --lambda-ref VALUE          the fixed lambda at the reference rate\n"
             "      --batch-lcurve              also solve batches with a per-vehicle L-curve\n"
+            "      --batch-estimate            also solve batches with the speed estimated from the\n"
+            "                                  detector's (--speed-coarse, --speed-pick apply)\n"
             "      --batches-only              skip the single-vehicle experiments\n"
             "      --initial-state rest|free   the solver's initial state\n"
             "      --pre-roll SEC              solver pre-roll, 0 .. 0.5 s\n"
@@ -135,7 +139,7 @@ static void usage(FILE *f)
 
 static void parse(int argc, char **argv, opts *o)
 {
-    enum { O_LAMBDA_REF = 256, O_BATCH_LCURVE, O_BATCHES_ONLY, O_INITIAL_STATE, O_PRE_ROLL,
+    enum { O_LAMBDA_REF = 256, O_BATCH_LCURVE, O_BATCH_ESTIMATE, O_BATCHES_ONLY, O_INITIAL_STATE, O_PRE_ROLL,
            O_NO_PLOTS, O_SPEED_BATCH, O_SPEED_GRID, O_SPEED_DOF,
            O_SPEED_COARSE, O_SPEED_PICK };
     static const struct option longopts[] = {
@@ -146,6 +150,7 @@ static void parse(int argc, char **argv, opts *o)
         {"threads", required_argument, NULL, 'j'},
         {"lambda-ref", required_argument, NULL, O_LAMBDA_REF},
         {"batch-lcurve", no_argument, NULL, O_BATCH_LCURVE},
+        {"batch-estimate", no_argument, NULL, O_BATCH_ESTIMATE},
         {"batches-only", no_argument, NULL, O_BATCHES_ONLY},
         {"initial-state", required_argument, NULL, O_INITIAL_STATE},
         {"pre-roll", required_argument, NULL, O_PRE_ROLL},
@@ -169,6 +174,7 @@ static void parse(int argc, char **argv, opts *o)
         switch (k) {
         case 'q': o->quick = 1; break;
         case O_BATCH_LCURVE: o->batch_lcurve = 1; break;
+        case O_BATCH_ESTIMATE: o->batch_lcurve = 2; break;
         case O_BATCHES_ONLY: o->batches_only = 1; break;
         case O_NO_PLOTS: o->plots = 0; break;
         case 'o': o->out = v; break;
@@ -339,6 +345,12 @@ static void *batch_thread(void *arg)
     if (batch_worker(c, &w, &fixed, &j->failed))
         return NULL;
     lc.automatic = 1;
+    amfi_speed_prior prior;
+    amfi_speed_prior_default(&prior);
+    prior.grid_rel = c->o.speed_grid;
+    prior.data_dof = c->o.speed_dof;
+    prior.coarse_rate_hz = c->o.speed_coarse;
+    prior.pick = (amfi_speed_pick)c->o.speed_pick;
     for (;;) {
         long it = take_item(&j->lock, &j->next, j->n_items, &j->failed);
         if (it < 0)
@@ -386,15 +398,22 @@ static void *batch_thread(void *arg)
         j->gvw_true[it] = rec->axle_kg[0] + rec->axle_kg[1];
         j->gvw_fixed[it] = res.gvw_kg;
         if (c->o.batch_lcurve) {
-            /* the same measured data, solved again */
+            /* the same measured data, solved again: with an L-curve, or with the
+             * speed estimated from the detector's (then lam_lc holds the
+             * estimate's relative error) */
             amfi_passage p = recorded_passage(c, &w, &pr, &spec, pr.speed_measured_mps);
-            if (amfi_solve(w.solver, &p, &lc, &res, err, sizeof err)) {
+            amfi_speed_result sr;
+            int rc = c->o.batch_lcurve == 2
+                         ? amfi_solve_speed(w.solver, &p, &fixed, &prior, &res, &sr, err, sizeof err)
+                         : amfi_solve(w.solver, &p, &lc, &res, err, sizeof err);
+            if (rc) {
                 fprintf(stderr, "%s: solve: %s\n", PROG, err);
                 j->failed = 1;
                 break;
             }
             j->gvw_lc[it] = res.gvw_kg;
-            j->lam_lc[it] = res.lambda_ref;
+            j->lam_lc[it] = c->o.batch_lcurve == 2 ? sr.speed_mps / spec.speed_mps - 1
+                                                   : res.lambda_ref;
         }
     }
     worker_fini(&w);
@@ -438,14 +457,19 @@ static int batches(ctx *c)
     FILE *csv = fopen(path, "w");
     if (!csv)
         die("%s: %s", path, strerror(errno));
+    const char *sec = o->batch_lcurve == 2 ? "estimated speed" : "L-curve";
     fprintf(csv, "condition,repetition,damage,n,true_mean_t,true_std_t,mean_t,std_t%s\n",
-            o->batch_lcurve ? ",lcurve_mean_t,lcurve_std_t,lcurve_lambda_median" : "");
+            o->batch_lcurve == 2 ? ",est_mean_t,est_std_t,est_speed_err_median"
+            : o->batch_lcurve    ? ",lcurve_mean_t,lcurve_std_t,lcurve_lambda_median"
+                                 : "");
     snprintf(path, sizeof path, "%s/table4_vehicles.csv", o->out);
     FILE *vcsv = fopen(path, "w");
     if (!vcsv)
         die("%s: %s", path, strerror(errno));
     fprintf(vcsv, "condition,repetition,damage,record,gvw_true_kg,gvw_fixed_kg%s\n",
-            o->batch_lcurve ? ",gvw_lcurve_kg,lambda_lcurve" : "");
+            o->batch_lcurve == 2 ? ",gvw_est_kg,speed_est_err"
+            : o->batch_lcurve    ? ",gvw_lcurve_kg,lambda_lcurve"
+                                 : "");
     const char *cname[3] = {"ideal", "table5", "table5_same"};
     fprintf(c->md, "## Table 4: inferred GVW over batches of %d vehicles\n\n", o->vehicles);
     fprintf(c->md,
@@ -462,7 +486,10 @@ static int batches(ctx *c)
             o->reps, o->vehicles, c->cfg.solver.calc_rate_hz,
             c->cfg.solver.free_initial_state ? "free" : "at rest", c->cfg.solver.pre_roll_s,
             o->lambda_ref,
-            o->batch_lcurve ? "; and a per-vehicle L-curve on the same data" : "");
+            o->batch_lcurve == 2 ? "; and the same data weighed with the speed estimated from "
+                                   "the detector's (amfi_solve_speed, fixed λ)"
+            : o->batch_lcurve    ? "; and a per-vehicle L-curve on the same data"
+                                 : "");
     /* --quick (the test suite, under sanitizers): the two conditions the
      * trend check needs; table5_same explains a result, it checks nothing. */
     const int n_cond = o->quick ? 2 : 3;
@@ -513,9 +540,12 @@ static int batches(ctx *c)
         double secs = amfi_mono_s() - t0;
         fprintf(c->md, "### %s (%ld passages simulated and solved in %.0f s on %d threads)\n\n",
                 cname[cond], per_cond, secs, o->threads);
+        char hdr[128] = "";
+        if (o->batch_lcurve)
+            snprintf(hdr, sizeof hdr, " %s: mean t | %s: STD t |", sec, sec);
         fprintf(c->md, "| damage | true mean t | true STD t | inferred mean t | inferred STD t |%s "
                        "paper STD t | paper mean t |\n",
-                o->batch_lcurve ? " L-curve mean t | L-curve STD t |" : "");
+                hdr);
         fprintf(c->md, "|---|---|---|---|---|%s---|---|\n", o->batch_lcurve ? "---|---|" : "");
         static const double pstd[3][N_LEVELS] = {{2.07, 2.18, 2.71, 3.45, 4.14},
                                                  {2.27, 2.55, 2.89, 3.34, 3.88},
@@ -582,7 +612,9 @@ static int batches(ctx *c)
         /* Trends: per repetition and over all repetitions. */
         fprintf(c->md, "| trend of inferred GVW with damage | R² STD | slope STD t/%% | R² mean | "
                        "monotonic STD | STD(10 %%) > STD(0 %%) |%s\n",
-                o->batch_lcurve ? " R² STD, L-curve |" : "");
+                o->batch_lcurve == 2 ? " R² STD, estimated speed |"
+                : o->batch_lcurve    ? " R² STD, L-curve |"
+                                     : "");
         fprintf(c->md, "|---|---|---|---|---|---|%s\n", o->batch_lcurve ? "---|" : "");
         {
             double ax[N_LEVELS], as[N_LEVELS], am[N_LEVELS], al[N_LEVELS];
@@ -701,6 +733,37 @@ static int resolve(const ctx *c, worker *w, const amfi_passage_rec *pr, double s
         fprintf(stderr, "%s: solve: %s\n", PROG, err);
         return -1;
     }
+    return 0;
+}
+
+/* The same passage weighed with the speed estimated from `speed` (the
+ * detector's): the batch options' prior, λ fixed. */
+static int resolve_estimated(const ctx *c, worker *w, const amfi_passage_rec *pr,
+                             double spacing, double speed, const amfi_lambda *lam,
+                             amfi_result *res, double *speed_est)
+{
+    amfi_passage p;
+    memset(&p, 0, sizeof p);
+    p.n_samples = pr->n;
+    p.scan_rate_hz = c->sp.scan_rate_hz;
+    p.t_first_s = pr->t_first_s;
+    p.accel[0] = w->acc;
+    p.speed_mps = speed;
+    p.n_axles = 2;
+    p.axle_spacing_m[0] = spacing;
+    amfi_speed_prior prior;
+    amfi_speed_prior_default(&prior);
+    prior.grid_rel = c->o.speed_grid;
+    prior.data_dof = c->o.speed_dof;
+    prior.coarse_rate_hz = c->o.speed_coarse;
+    prior.pick = (amfi_speed_pick)c->o.speed_pick;
+    amfi_speed_result sr;
+    char err[256];
+    if (amfi_solve_speed(w->solver, &p, lam, &prior, res, &sr, err, sizeof err)) {
+        fprintf(stderr, "%s: solve: %s\n", PROG, err);
+        return -1;
+    }
+    *speed_est = sr.speed_mps;
     return 0;
 }
 
@@ -867,15 +930,20 @@ static void single_vehicle(ctx *c)
 
     /* Speed used (true 25 m/s). */
     fprintf(c->md, "## Speed error (true 25 m/s)\n\n| speed used | GVW error, fixed λ | GVW "
-                   "error, L-curve | paper |\n|---|---|---|---|\n");
+                   "error, L-curve | paper | estimated from it (fixed λ): speed, GVW error "
+                   "|\n|---|---|---|---|---|\n");
     const double speeds[4] = {23, 24, 26, 27};
     const char *pspeed[4] = {"−8.9 %", "−4.4 %", "−13.0 %", "−49.5 %"};
     for (int i = 0; i < 4; i++) {
         amfi_result a, b2;
         resolve(c, &w, &pr, S, speeds[i], &fixed, &a);
         resolve(c, &w, &pr, S, speeds[i], &lc, &b2);
-        fprintf(c->md, "| %.0f m/s | %+.2f %% | %+.2f %% | %s |\n", speeds[i], pct(a.gvw_kg),
-                pct(b2.gvw_kg), pspeed[i]);
+        amfi_result e;
+        double v_est = NAN;
+        if (resolve_estimated(c, &w, &pr, S, speeds[i], &fixed, &e, &v_est))
+            die("speed estimate%s%s", "", "");
+        fprintf(c->md, "| %.0f m/s | %+.2f %% | %+.2f %% | %s | %.3f m/s, %+.2f %% |\n",
+                speeds[i], pct(a.gvw_kg), pct(b2.gvw_kg), pspeed[i], v_est, pct(e.gvw_kg));
     }
     fprintf(c->md, "\n");
 
