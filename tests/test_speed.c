@@ -190,9 +190,9 @@ static void damaged_bridge(void **state)
                 fail_msg("%s", err);
             double ve = sr.speed_mps / TRUE_SPEED - 1, ge = est.gvw_kg / true_gvw_kg - 1;
             print_message("damage 10%% given %+.0f%% pick %s: speed %+.3f%%, GVW %+.2f%% "
-                          "(1/(1 - d) - 1 = %+.2f%%), dip %g\n",
+                          "(1/(1 - d) - 1 = %+.2f%%), dip %g, %d sweeps\n",
                           100 * bias, amfi_speed_pick_name(pr.pick), 100 * ve, 100 * ge,
-                          100 * growth, sr.dip);
+                          100 * growth, sr.dip, est.n_solves);
             if (pick == AMFI_SPEED_PICK_DIP) {
                 assert_true(fabs(ve) < 0.005);
                 assert_true(fabs(ge - growth) < 0.25 * growth);

@@ -331,7 +331,7 @@ typedef struct amfi_speed_prior {
     double range_sd; /* search v0·(1 ± range_sd·σ), > 0, range_sd·σ < 0.5 */
     double grid_rel; /* grid step / v0, 1e-4 .. range_sd·σ: below the cost's dip width */
     double tol_rel;  /* Brent stops when its bracket is below tol_rel·v0, 0 < tol < 0.01 */
-    int brent_evals; /* Brent iterations (sweeps) after the grid, 0 .. 100 */
+    int brent_evals; /* Brent sweeps after the grid (GSL's first point included), 0 .. 100 */
     double coarse_rate_hz; /* the grid's model: the same bridge at this calculation
                               rate with the modes it resolves, then the full model
                               refines; 0 (or >= the solver's rate): the grid on the
@@ -343,7 +343,7 @@ typedef struct amfi_speed_prior {
     amfi_speed_pick pick;
 } amfi_speed_prior;
 
-/* σ 3 %, ±3 σ, grid 0.2 %, tol 0.02 %, 4 Brent sweeps, coarse model at
+/* σ 3 %, ±3 σ, grid 0.2 %, tol 0.02 %, 2 Brent sweeps (after the grid, or the local grid of two levels), coarse model at
  * 1000 Hz, regularised cost. */
 void amfi_speed_prior_default(amfi_speed_prior *p);
 
