@@ -402,10 +402,10 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
          * k = −3 .. 3, d = 1.5 grid steps (±0.9 %: on simulated traffic the
          * coarse model's dip lies up to 0.8 % from the full model's,
          * docs/results/speed-estimation.md; the points are closer than the
-         * dip's half-width to any speed between them, and over ±0.9 % the
-         * trend moves J far less than the dip's depth, so the smallest is
-         * the dip's), then Brent between the best point's neighbours. Its
-         * window is that of the slowest point. */
+         * dip's half-width to any speed between them); the pick is, as on
+         * the coarse grid, the point deepest below the others' trend (pick
+         * dip) or the smallest (pick min); then Brent between the pick's
+         * neighbours. Its window is that of the slowest point. */
         const double d = 1.5 * g;
         double wlo = r.x - 3.0 * d;
         if (wlo < lo)
@@ -426,6 +426,39 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
         }
         if (q.rc)
             return SWEEP_FAILED(q);
+        if (pr->pick == AMFI_SPEED_PICK_DIP && nl >= 4) {
+            /* the point deepest below the line through the others: the full
+             * model's J has a trend here too (the coarse pick can sit 0.8 %
+             * from the dip, on the slope), so the smallest J may be an end */
+            double rmin = 0.0;
+            int kd = -1;
+            for (int k = 0; k < nl; k++) {
+                double sx = 0, sy = 0, sxx = 0, sxy = 0;
+                int m = 0;
+                for (int i = 0; i < nl; i++) {
+                    if (i == k)
+                        continue;
+                    double u = (lx[i] - r.x) / d;
+                    sx += u, sy += lf[i], sxx += u * u, sxy += u * lf[i], m++;
+                }
+                double den = m * sxx - sx * sx;
+                if (!(den > 0))
+                    continue;
+                double slope = (m * sxy - sx * sy) / den, icpt = (sy - slope * sx) / m;
+                double rk = lf[k] - (icpt + slope * (lx[k] - r.x) / d);
+                if (rk < rmin)
+                    rmin = rk, kd = k;
+            }
+            if (kd >= 0) {
+                /* the dip spans one or two points: the lower of the pick and
+                 * its neighbours is the dip's bottom */
+                kb = kd;
+                if (kd > 0 && lf[kd - 1] < lf[kb])
+                    kb = kd - 1;
+                if (kd < nl - 1 && lf[kd + 1] < lf[kb])
+                    kb = kd + 1;
+            }
+        }
         best = lx[kb], fbest = lf[kb];
         if (kb > 0 && kb < nl - 1) {
             best = brent(&q, lx[kb - 1], lf[kb - 1], lx[kb], lf[kb], lx[kb + 1], lf[kb + 1],
