@@ -8,7 +8,7 @@
  * Two levels (docs/solver.md, "Speed estimation"): J is evaluated on a grid
  * of speeds around v0 finer than the narrow dip the cost has at the true
  * speed, on a coarse model (the same bridge and sensors at coarse_rate_hz,
- * with the modes that rate resolves: a sweep costs ~1/100 of the full
+ * with the modes that rate resolves: a sweep costs ~1/13 of the full
  * model's); then the full model refines around the coarse pick (7 points
  * over ±0.9 %, then GSL's Brent minimiser: 10 sweeps with the final
  * solve); the passage is finally solved at the
