@@ -3,12 +3,15 @@
  * amfi-year-sim: a year of traffic at a site, from the per-vehicle error
  * model, with the site climate and the drifting mix of sim_publisher's
  * --environment site (sim_publisher/environment.c, mix.c, used as they
- * are), watched by amfid's indicator engine (indicators/, used as it is):
- * false alarms per healthy year and detection delays in vehicles and days,
- * with the environment on and off (issue 14, docs/results/year-evaluation.md).
+ * are), watched by amfid's indicator engine (indicators/indicators.c, the
+ * STD and mean rules), the scale indicator (indicators/scale.c) and the
+ * known-truck runs (indicators/known_truck.c), side by side: false alarms
+ * per healthy year and detection delays in vehicles (runs) and days, with
+ * the environment on and off (issue 14, docs/results/year-evaluation.md).
  *
  *   amfi-year-sim [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]
  *                 [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]
+ *                 [--scale-fa F] [--mix-probe]
  *
  * Stream model (kg). A run starts on a random day of the year (commissioning)
  * and lasts 365 days. Vehicles arrive uniformly within each day, --flow a
@@ -25,18 +28,25 @@
  * uniform stiffness change scales every inferred weight by its inverse
  * (issue 14).
  *
- * Indicator: amfid's engine with amfi_indicator_params_default (the STD rule
- * "std_increase", warning, and the mean rule "mean_shift", info); the
+ * Indicators: amfid's engine with amfi_indicator_params_default (the STD
+ * rule "std_increase", warning, and the mean rule "mean_shift", info); the
  * automatic baseline is the first baseline_n vehicles after commissioning.
+ * The scale indicator with amfi_scale_params_default (vehicles_per_day =
+ * --flow; --scale-fa its target), fed each vehicle's deck temperature (drift
+ * off: a constant 10 °C). Known truck: one run a week (the week's third day,
+ * between 8 and 16 h) of a 14 t truck, inferred = (14 t + e) / ((1 − d) ·
+ * f(T_deck)) with the same e, amfi_known_truck_params_default with run_sd =
+ * --meas-sd / 14 t, the prior temperature slopes.
  *
  * False alarms: --years healthy runs; every raise of a kind is a false alarm
  * of that kind; printed per healthy year (the mean over runs).
  * Detection: --det-runs runs per damage level, the damage starting at a
  * uniformly random time in days [30, 335) of the run (after the baseline);
- * delay = vehicles (and days) from the damage to the first STD raise after
- * it, or "not within" the rest of the run plus 120 days. A run whose STD
- * alert is raised before the damage is counted as false and still runs on
- * (the raise must happen again after a clear to count).
+ * delay = vehicles (known truck: runs) and days from the damage to each
+ * warning kind's first raise after it, or "not within" the rest of the run
+ * plus 120 days. A run whose alert is raised before the damage is counted
+ * as false and still runs on (the raise must happen again after a clear to
+ * count).
  *
  * Output: a markdown table on stdout. One gsl_rng_mt19937 seeded with --seed;
  * the climate's weather per run from the same generator. Single thread.
@@ -53,6 +63,8 @@
 #include "environment.h"
 #include "indicators.h"
 #include "mix.h"
+#include "known_truck.h"
+#include "scale.h"
 
 #define PROG "amfi-year-sim"
 #define GVW_MU 8765.0
@@ -61,6 +73,8 @@
 #define GVW_HI 15000.0
 #define MAX_DAMAGE 8
 #define DAY_S 86400.0
+#define TRUCK_KG 14000.0 /* the known truck's reference GVW: a loaded two-axle truck */
+#define DECK_OFF_C 10.0 /* drift off: a constant deck at the modulus law's reference */
 
 typedef struct {
     unsigned long seed;
@@ -69,6 +83,8 @@ typedef struct {
     int n_damage;
     double damage[MAX_DAMAGE];
     int drift_on, drift_off;
+    double scale_fa; /* --scale-fa: the scale indicator's target false alarms a year (0: default) */
+    int mix_probe;   /* --mix-probe */
 } opts;
 
 /* One run's world: the climate, the calendar, the damage. */
@@ -80,25 +96,34 @@ typedef struct {
     double day0;       /* day of the year at run time 0 */
     double damage;     /* from damage_t_s on */
     double damage_t_s; /* run time of the damage, s; INFINITY: none */
+    double deck_c;     /* deck temperature at the last vehicle (drift off: DECK_OFF_C) */
 } world;
+
+/* A true GVW, loaded with probability `share`. */
+static double draw_gvw(gsl_rng *rng, double share)
+{
+    const int loaded = gsl_rng_uniform(rng) < share;
+    double x;
+    do
+        x = GVW_MU + gsl_ran_gaussian_ziggurat(rng, GVW_SD);
+    while (x < GVW_LO || x > GVW_HI || (x >= GVW_MU) != loaded);
+    return x;
+}
 
 static double true_gvw(world *w, double t_s)
 {
-    const double share = w->drift ? amfi_mix_loaded_share(&w->mix, w->day0 + t_s / DAY_S) : 0.5;
-    const int loaded = gsl_rng_uniform(w->rng) < share;
-    double x;
-    do
-        x = GVW_MU + gsl_ran_gaussian_ziggurat(w->rng, GVW_SD);
-    while (x < GVW_LO || x > GVW_HI || (x >= GVW_MU) != loaded);
-    return x;
+    return draw_gvw(w->rng,
+                    w->drift ? amfi_mix_loaded_share(&w->mix, w->day0 + t_s / DAY_S) : 0.5);
 }
 
 static double inferred(world *w, double t_s, double meas_sd)
 {
     double f = 1.0;
+    w->deck_c = DECK_OFF_C;
     if (w->drift) {
         amfi_env_advance(&w->env, t_s);
         f = amfi_env_modulus_factor(&w->env.p, w->env.deck_c);
+        w->deck_c = w->env.deck_c;
     }
     const double d = t_s >= w->damage_t_s ? w->damage : 0.0;
     double x = true_gvw(w, t_s) + gsl_ran_gaussian_ziggurat(w->rng, meas_sd);
@@ -121,43 +146,109 @@ static void world_start(world *w, gsl_rng *rng, int drift)
     w->damage_t_s = INFINITY;
 }
 
-static amfi_indicators *make(void)
+/* The indicators of one run, side by side. */
+enum { K_STD, K_MEAN, K_SCALE, K_TRUCK, N_KIND };
+static const char *const kind_name[N_KIND] = {"std_increase", "mean_shift", "scale_shift",
+                                              "known_truck"};
+
+typedef struct {
+    amfi_indicators *ind;
+    amfi_scale *scale;
+    amfi_known_truck *truck;
+} engines;
+
+static engines make(const opts *o)
 {
     amfi_indicator_params p;
-    amfi_indicators *ind;
+    amfi_scale_params sp;
+    engines e;
     char err[256];
     amfi_indicator_params_default(&p);
-    if (amfi_indicators_create(&p, &ind, err, sizeof err)) {
+    amfi_scale_params_default(&sp);
+    sp.vehicles_per_day = o->flow;
+    if (o->scale_fa > 0)
+        sp.false_alarms_per_year = o->scale_fa;
+    amfi_known_truck_params kp;
+    amfi_known_truck_params_default(&kp);
+    kp.run_sd = o->meas_sd / TRUCK_KG;
+    if (amfi_indicators_create(&p, &e.ind, err, sizeof err) ||
+        amfi_scale_create(&sp, &e.scale, err, sizeof err) ||
+        amfi_known_truck_create(&kp, &sp, &e.truck, err, sizeof err)) {
         fprintf(stderr, "%s: %s\n", PROG, err);
         exit(2);
     }
-    return ind;
+    return e;
 }
 
-/* Raises in this push: bit 1 std_increase, bit 2 mean_shift. */
-static int push(amfi_indicators *ind, double gvw)
+static void unmake(engines *e)
 {
-    amfi_alert_event ev[2];
+    amfi_indicators_destroy(e->ind);
+    amfi_scale_destroy(e->scale);
+    amfi_known_truck_destroy(e->truck);
+}
+
+/* One known-truck run at run time t_s (the deck as at the vehicle just
+ * pushed): 1 << K_TRUCK when its alert was raised. */
+static int truck_run(engines *e, world *w, double t_s, double meas_sd)
+{
+    double f = 1.0;
+    if (w->drift)
+        f = amfi_env_modulus_factor(&w->env.p, w->env.deck_c);
+    const double d = t_s >= w->damage_t_s ? w->damage : 0.0;
+    const double g = (TRUCK_KG + gsl_ran_gaussian_ziggurat(w->rng, meas_sd)) / ((1.0 - d) * f);
+    amfi_alert_event ev;
+    const int r = amfi_known_truck_push(e->truck, g, TRUCK_KG, w->deck_c, NULL, &ev);
+    if (r < 0) {
+        fprintf(stderr, "%s: known-truck run rejected %g kg at %g °C\n", PROG, g, w->deck_c);
+        exit(1);
+    }
+    return (r & AMFI_IND_ALERT) && ev.raised ? 1 << K_TRUCK : 0;
+}
+
+/* Raises in this push: bit 1 << K_*. */
+static int push(engines *e, double gvw, double deck_c)
+{
+    amfi_alert_event ev[2], sev;
     int n = 0, r = 0;
-    if (amfi_indicators_push(ind, gvw, NULL, ev, &n) < 0) {
+    if (amfi_indicators_push(e->ind, gvw, NULL, ev, &n) < 0) {
         fprintf(stderr, "%s: push rejected %g kg\n", PROG, gvw);
         exit(1);
     }
     for (int i = 0; i < n; i++)
         if (ev[i].raised)
-            r |= strcmp(ev[i].kind, "std_increase") == 0 ? 1 : 2;
+            r |= strcmp(ev[i].kind, "std_increase") == 0 ? 1 << K_STD : 1 << K_MEAN;
+    const int sr = amfi_scale_push(e->scale, gvw, deck_c, NULL, &sev);
+    if (sr < 0) {
+        fprintf(stderr, "%s: scale push rejected %g kg at %g °C\n", PROG, gvw, deck_c);
+        exit(1);
+    }
+    if ((sr & AMFI_IND_ALERT) && sev.raised)
+        r |= 1 << K_SCALE;
     return r;
 }
 
-/* Drive one run for `days` days, counting raises per kind in fa[]. Returns
- * the vehicles pushed. With stop_on_detect, stops at the first STD raise
- * after the damage and sets *delay_veh, *delay_days (raises before the
- * damage are counted in fa[0]). */
-static long run(world *w, const opts *o, double days, long fa[2], int stop_on_detect,
-                long *delay_veh, double *delay_days)
+/* What one run saw, per kind: raises before the damage (all of them in a
+ * healthy run) and the first raise after it (-1: none). */
+typedef struct {
+    long fa[N_KIND];
+    long det_veh[N_KIND];
+    double det_days[N_KIND];
+} outcome;
+
+/* Drive one run for `days` days. With a damage, stops once every warning
+ * kind (std_increase, scale_shift) was raised after it. Returns the
+ * vehicles pushed. */
+static long run(world *w, const opts *o, double days, outcome *out)
 {
-    amfi_indicators *ind = make();
-    long pushed = 0, after = 0;
+    engines e = make(o);
+    long pushed = 0, after = 0, runs_after = 0, week = 0;
+    /* one known-truck run a week, on the week's third day between 8 and 16 h */
+    double next_truck = (2.0 + (8.0 + 8.0 * gsl_rng_uniform(w->rng)) / 24.0) * DAY_S;
+    for (int k = 0; k < N_KIND; k++) {
+        out->fa[k] = 0;
+        out->det_veh[k] = -1;
+        out->det_days[k] = -1.0;
+    }
     for (long day = 0; day < (long)days; day++) {
         /* --flow is the mean over a week: with drift on the weekdays carry
          * more, the weekend days the mix's weekend factor of a weekday */
@@ -168,24 +259,38 @@ static long run(world *w, const opts *o, double days, long fa[2], int stop_on_de
         const long n = (long)floor(flow + gsl_rng_uniform(w->rng));
         for (long i = 0; i < n; i++) {
             const double t = (day + (i + gsl_rng_uniform(w->rng)) / (double)n) * DAY_S;
-            const int r = push(ind, inferred(w, t, o->meas_sd));
+            const double g = inferred(w, t, o->meas_sd);
+            int r = push(&e, g, w->deck_c);
+            const int damaged = t >= w->damage_t_s;
             pushed++;
-            if (t >= w->damage_t_s)
+            if (damaged)
                 after++;
-            if (r & 1) {
-                if (stop_on_detect && t >= w->damage_t_s) {
-                    *delay_veh = after;
-                    *delay_days = (t - w->damage_t_s) / DAY_S;
-                    amfi_indicators_destroy(ind);
-                    return pushed;
-                }
-                fa[0]++;
+            if (t >= next_truck) {
+                r |= truck_run(&e, w, t, o->meas_sd);
+                if (damaged)
+                    runs_after++;
+                week++;
+                next_truck =
+                    (7.0 * week + 2.0 + (8.0 + 8.0 * gsl_rng_uniform(w->rng)) / 24.0) * DAY_S;
             }
-            if (r & 2)
-                fa[1]++;
+            for (int k = 0; k < N_KIND; k++) {
+                if (!(r & (1 << k)))
+                    continue;
+                if (!damaged)
+                    out->fa[k]++;
+                else if (out->det_veh[k] < 0) {
+                    out->det_veh[k] = k == K_TRUCK ? runs_after : after;
+                    out->det_days[k] = (t - w->damage_t_s) / DAY_S;
+                }
+            }
+            if (damaged && out->det_veh[K_STD] >= 0 && out->det_veh[K_SCALE] >= 0 &&
+                out->det_veh[K_TRUCK] >= 0) {
+                unmake(&e);
+                return pushed;
+            }
         }
     }
-    amfi_indicators_destroy(ind);
+    unmake(&e);
     return pushed;
 }
 
@@ -207,54 +312,271 @@ static double quantile(double *v, long n, double q) /* v sorted; nearest rank */
 
 static void evaluate(const opts *o, gsl_rng *rng, int drift)
 {
-    long fa[2] = {0, 0}, vehicles = 0;
+    long fa[N_KIND] = {0}, vehicles = 0;
     world w;
+    outcome oc;
+    const char *dn = drift ? "on" : "off";
     for (long y = 0; y < o->years; y++) {
         world_start(&w, rng, drift);
-        vehicles += run(&w, o, 365.0, fa, 0, NULL, NULL);
+        vehicles += run(&w, o, 365.0, &oc);
+        for (int k = 0; k < N_KIND; k++)
+            fa[k] += oc.fa[k];
     }
-    printf("| %s | healthy | %ld years, %.0f vehicles/year | std_increase %.2f/year, "
-           "mean_shift %.2f/year | | | | |\n",
-           drift ? "on" : "off", o->years, (double)vehicles / (double)o->years,
-           (double)fa[0] / (double)o->years, (double)fa[1] / (double)o->years);
+    for (int k = 0; k < N_KIND; k++)
+        printf("| %s | %s | healthy | %ld years, %.0f vehicles/year | %.2f/year | | | | |\n",
+               kind_name[k], dn, o->years, (double)vehicles / (double)o->years,
+               (double)fa[k] / (double)o->years);
     fflush(stdout);
-    for (int k = 0; k < o->n_damage; k++) {
-        double *dv = malloc(sizeof(double) * (size_t)o->det_runs);
-        double *dd = malloc(sizeof(double) * (size_t)o->det_runs);
-        long found = 0, early = 0;
-        if (!dv || !dd) {
-            fprintf(stderr, "%s: out of memory\n", PROG);
-            exit(1);
-        }
-        for (long r = 0; r < o->det_runs; r++) {
-            long f2[2] = {0, 0}, veh = -1;
-            double days = -1.0;
-            world_start(&w, rng, drift);
-            w.damage = o->damage[k];
-            w.damage_t_s = (30.0 + gsl_rng_uniform(rng) * 305.0) * DAY_S;
-            (void)run(&w, o, 365.0 + 120.0, f2, 1, &veh, &days);
-            early += f2[0] > 0;
-            if (veh >= 0) {
-                dv[found] = (double)veh;
-                dd[found] = days;
-                found++;
+    enum { NK = 3 };
+    const int kinds[NK] = {K_STD, K_SCALE, K_TRUCK};
+    for (int d = 0; d < o->n_damage; d++) {
+        double *dv[NK], *dd[NK];
+        long found[NK] = {0}, early[NK] = {0};
+        for (int j = 0; j < NK; j++) {
+            dv[j] = malloc(sizeof(double) * (size_t)o->det_runs);
+            dd[j] = malloc(sizeof(double) * (size_t)o->det_runs);
+            if (!dv[j] || !dd[j]) {
+                fprintf(stderr, "%s: out of memory\n", PROG);
+                exit(1);
             }
         }
-        qsort(dv, (size_t)found, sizeof *dv, cmp_double);
-        qsort(dd, (size_t)found, sizeof *dd, cmp_double);
-        if (found)
-            printf("| %s | %.1f %% | %ld/%ld detected (%ld runs with a false STD alert "
-                   "before) | | %.0f | %.0f | %.2f | %.2f |\n",
-                   drift ? "on" : "off", 100.0 * o->damage[k], found, o->det_runs, early,
-                   quantile(dv, found, 0.5), quantile(dv, found, 0.95), quantile(dd, found, 0.5),
-                   quantile(dd, found, 0.95));
-        else
-            printf("| %s | %.1f %% | 0/%ld detected | | | | | |\n", drift ? "on" : "off",
-                   100.0 * o->damage[k], o->det_runs);
+        for (long r = 0; r < o->det_runs; r++) {
+            world_start(&w, rng, drift);
+            w.damage = o->damage[d];
+            w.damage_t_s = (30.0 + gsl_rng_uniform(rng) * 305.0) * DAY_S;
+            (void)run(&w, o, 365.0 + 120.0, &oc);
+            for (int j = 0; j < NK; j++) {
+                const int k = kinds[j];
+                early[j] += oc.fa[k] > 0;
+                if (oc.det_veh[k] >= 0) {
+                    dv[j][found[j]] = (double)oc.det_veh[k];
+                    dd[j][found[j]] = oc.det_days[k];
+                    found[j]++;
+                }
+            }
+        }
+        for (int j = 0; j < NK; j++) {
+            qsort(dv[j], (size_t)found[j], sizeof(double), cmp_double);
+            qsort(dd[j], (size_t)found[j], sizeof(double), cmp_double);
+            if (found[j])
+                printf("| %s | %s | %.1f %% | %ld/%ld detected (%ld runs with a false alert "
+                       "before) | | %.0f | %.0f | %.2f | %.2f |\n",
+                       kind_name[kinds[j]], dn, 100.0 * o->damage[d], found[j], o->det_runs,
+                       early[j], quantile(dv[j], found[j], 0.5), quantile(dv[j], found[j], 0.95),
+                       quantile(dd[j], found[j], 0.5), quantile(dd[j], found[j], 0.95));
+            else
+                printf("| %s | %s | %.1f %% | 0/%ld detected | | | | | |\n", kind_name[kinds[j]],
+                       dn, 100.0 * o->damage[d], o->det_runs);
+            free(dv[j]);
+            free(dd[j]);
+        }
         fflush(stdout);
-        free(dv);
-        free(dd);
     }
+}
+
+/* --mix-probe: how far each candidate scale estimator moves when only the
+ * loaded share moves (no temperature, no damage): a baseline of 10 000
+ * vehicles at share 1/2, then 400 blocks of 500 at each share; the mean and
+ * SD of ln s per estimator, against ln(1 / (1 − 0.025)) = 0.0253 of a 2.5 %
+ * loss. Estimators: the baseline's classes with a free share (scale.h), a
+ * two-normal mixture with a free share, the median
+ * of the log ratios of the deciles (block against baseline), the ratio of
+ * the means, the ratio of the medians. */
+static int cmp_double(const void *a, const void *b);
+
+static double sorted_q(const double *v, int n, double q) /* linear interpolation */
+{
+    const double h = q * (n - 1);
+    const int i = (int)floor(h);
+    return i + 1 < n ? v[i] + (h - i) * (v[i + 1] - v[i]) : v[n - 1];
+}
+
+/* The rejected alternative, kept for --mix-probe: a two-normal mixture
+ * fitted by EM to the baseline, then each block fitted with the same two
+ * normals stretched by s and a free share (EM, closed-form M step in 1/s). */
+#define EM_MAX_ITER 500
+#define SD_FLOOR_KG 1.0
+
+static double npdf(double x, double mu, double sd)
+{
+    const double z = (x - mu) / sd;
+    return exp(-0.5 * z * z) / sd;
+}
+
+static int gauss_fit(const double *x, int n, double mu[2], double sd[2], double *pi)
+{
+    if (n < 4 || !x)
+        return -1;
+    double mean = 0.0;
+    for (int i = 0; i < n; i++)
+        mean += x[i];
+    mean /= n;
+    /* start: the halves below and above the mean */
+    double s0 = 0, s1 = 0, q0 = 0, q1 = 0;
+    int n0 = 0, n1 = 0;
+    for (int i = 0; i < n; i++) {
+        if (x[i] < mean) {
+            s0 += x[i];
+            n0++;
+        } else {
+            s1 += x[i];
+            n1++;
+        }
+    }
+    if (n0 < 2 || n1 < 2)
+        return -1;
+    mu[0] = s0 / n0;
+    mu[1] = s1 / n1;
+    for (int i = 0; i < n; i++) {
+        if (x[i] < mean)
+            q0 += (x[i] - mu[0]) * (x[i] - mu[0]);
+        else
+            q1 += (x[i] - mu[1]) * (x[i] - mu[1]);
+    }
+    sd[0] = sqrt(q0 / n0);
+    sd[1] = sqrt(q1 / n1);
+    if (!(sd[0] > SD_FLOOR_KG) || !(sd[1] > SD_FLOOR_KG))
+        return -1;
+    double w = (double)n1 / n, ll_old = -INFINITY;
+    for (int it = 0; it < EM_MAX_ITER; it++) {
+        double r_sum = 0, rx0 = 0, rx1 = 0, ll = 0;
+        for (int i = 0; i < n; i++) {
+            const double a = (1 - w) * npdf(x[i], mu[0], sd[0]), b = w * npdf(x[i], mu[1], sd[1]);
+            const double t = a + b;
+            const double r = t > 0 ? b / t : (x[i] > mu[1] ? 1.0 : 0.0);
+            ll += log(t > 1e-300 ? t : 1e-300);
+            r_sum += r;
+            rx1 += r * x[i];
+            rx0 += (1 - r) * x[i];
+        }
+        if (r_sum < 1.0 || r_sum > n - 1.0)
+            return -1;
+        const double m0 = rx0 / (n - r_sum), m1 = rx1 / r_sum;
+        double v0 = 0, v1 = 0;
+        for (int i = 0; i < n; i++) {
+            const double a = (1 - w) * npdf(x[i], mu[0], sd[0]), b = w * npdf(x[i], mu[1], sd[1]);
+            const double t = a + b;
+            const double r = t > 0 ? b / t : (x[i] > mu[1] ? 1.0 : 0.0);
+            v0 += (1 - r) * (x[i] - m0) * (x[i] - m0);
+            v1 += r * (x[i] - m1) * (x[i] - m1);
+        }
+        mu[0] = m0;
+        mu[1] = m1;
+        sd[0] = fmax(sqrt(v0 / (n - r_sum)), SD_FLOOR_KG);
+        sd[1] = fmax(sqrt(v1 / r_sum), SD_FLOOR_KG);
+        w = r_sum / n;
+        if (fabs(ll - ll_old) < 1e-10 * fabs(ll))
+            break;
+        ll_old = ll;
+    }
+    if (mu[0] > mu[1]) {
+        double t = mu[0];
+        mu[0] = mu[1];
+        mu[1] = t;
+        t = sd[0];
+        sd[0] = sd[1];
+        sd[1] = t;
+        w = 1 - w;
+    }
+    *pi = w;
+    return 0;
+}
+
+static double gauss_block_log(const double *x, int n, const double mu[2], const double sd[2],
+                            double pi0, double *pi)
+{
+    if (n < 2 || !x)
+        return NAN;
+    double u = 1.0, w = pi0 > 0.01 && pi0 < 0.99 ? pi0 : 0.5;
+    const double i0 = 1.0 / (sd[0] * sd[0]), i1 = 1.0 / (sd[1] * sd[1]);
+    for (int it = 0; it < EM_MAX_ITER; it++) {
+        double r_sum = 0, A = 0, B = 0;
+        for (int i = 0; i < n; i++) {
+            const double y = u * x[i];
+            const double a = (1 - w) * npdf(y, mu[0], sd[0]), b = w * npdf(y, mu[1], sd[1]);
+            const double t = a + b;
+            const double r = t > 0 ? b / t : (y > 0.5 * (mu[0] + mu[1]) ? 1.0 : 0.0);
+            r_sum += r;
+            A += x[i] * x[i] * ((1 - r) * i0 + r * i1);
+            B += x[i] * ((1 - r) * mu[0] * i0 + r * mu[1] * i1);
+        }
+        const double u_new = (B + sqrt(B * B + 4.0 * A * n)) / (2.0 * A);
+        double w_new = r_sum / n;
+        if (w_new < 1e-6)
+            w_new = 1e-6;
+        if (w_new > 1 - 1e-6)
+            w_new = 1 - 1e-6;
+        const int done = fabs(log(u_new / u)) < 1e-8 && fabs(w_new - w) < 1e-7;
+        u = u_new;
+        w = w_new;
+        if (done)
+            break;
+    }
+    if (pi)
+        *pi = w;
+    return -log(u);
+}
+
+static void mix_probe(const opts *o, gsl_rng *rng)
+{
+    enum { NB = 10000, B = 500, R = 400, NQ = 9 };
+    static double base[NB], blk[B], sorted[B];
+    static const double shares[] = {0.35, 0.40, 0.45, 0.50, 0.52, 0.57};
+    double mu[2], sd[2], pi, qb[NQ], mean_b = 0;
+    static amfi_scale_ref ref;
+    static double scratch[B];
+    for (int i = 0; i < NB; i++) {
+        base[i] = draw_gvw(rng, 0.5) + gsl_ran_gaussian_ziggurat(rng, o->meas_sd);
+        mean_b += base[i] / NB;
+    }
+    if (gauss_fit(base, NB, mu, sd, &pi)) {
+        fprintf(stderr, "%s: mixture fit failed\n", PROG);
+        exit(1);
+    }
+    printf("baseline mixture: empty %.0f ± %.0f kg, loaded %.0f ± %.0f kg, loaded share %.3f\n\n",
+           mu[0], sd[0], mu[1], sd[1], pi);
+    qsort(base, NB, sizeof(double), cmp_double);
+    if (amfi_scale_ref_fit(&ref, base, NB, GVW_MU, 0.15)) {
+        fprintf(stderr, "%s: class fit failed\n", PROG);
+        exit(1);
+    }
+    for (int q = 0; q < NQ; q++)
+        qb[q] = sorted_q(base, NB, 0.1 * (q + 1));
+    printf("| loaded share | classes (free share, scale.h) | two-normal mixture (free share) "
+           "| median of decile log ratios | ratio of means | ratio of medians |\n"
+           "|---|---|---|---|---|---|\n");
+    for (size_t k = 0; k < sizeof shares / sizeof shares[0]; k++) {
+        double s1[5] = {0}, s2[5] = {0};
+        for (int r = 0; r < R; r++) {
+            double m = 0, e[5], lr[NQ];
+            for (int i = 0; i < B; i++) {
+                blk[i] = draw_gvw(rng, shares[k]) + gsl_ran_gaussian_ziggurat(rng, o->meas_sd);
+                sorted[i] = blk[i];
+                m += blk[i] / B;
+            }
+            qsort(sorted, B, sizeof(double), cmp_double);
+            for (int q = 0; q < NQ; q++)
+                lr[q] = log(sorted_q(sorted, B, 0.1 * (q + 1)) / qb[q]);
+            qsort(lr, NQ, sizeof(double), cmp_double);
+            e[1] = gauss_block_log(blk, B, mu, sd, pi, NULL);
+            e[2] = lr[NQ / 2];
+            e[3] = log(m / mean_b);
+            e[4] = log(sorted_q(sorted, B, 0.5) / qb[4]);
+            memcpy(scratch, blk, sizeof scratch);
+            e[0] = amfi_scale_ref_block_log(&ref, scratch, B, NULL);
+            for (int j = 0; j < 5; j++) {
+                s1[j] += e[j];
+                s2[j] += e[j] * e[j];
+            }
+        }
+        printf("| %.2f |", shares[k]);
+        for (int j = 0; j < 5; j++) {
+            const double mean = s1[j] / R, var = (s2[j] - R * mean * mean) / (R - 1);
+            printf(" %+.4f (SD %.4f) |", mean, var > 0 ? sqrt(var) : 0.0);
+        }
+        printf("\n");
+    }
+    printf("\nln s of a 2.5 %% stiffness loss: %+.4f\n", log(1.0 / 0.975));
 }
 
 static void usage(FILE *f)
@@ -262,6 +584,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: %s [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]\n"
             "       [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]\n"
+            "       [--scale-fa F] [--mix-probe]\n"
             "A year of traffic with the site climate and the drifting mix, watched by\n"
             "amfid's indicator engine: false alarms per healthy year, detection delays.\n"
             "  --seed S          generator seed (default 1)\n"
@@ -271,6 +594,8 @@ static void usage(FILE *f)
             "  --damage LIST     stiffness losses, fractions (default 0.025,0.05,0.10)\n"
             "  --meas-sd T       per-vehicle error, t (default 0.3)\n"
             "  --drift WHICH     temperature and mix drift on, off or both (default both)\n"
+            "  --scale-fa F      scale indicator's target false alarms a year (default: its own)\n"
+            "  --mix-probe       only: how each scale estimator moves with the loaded share\n"
             "  -h, --help        this help\n"
             "  -V, --version     print the version\n",
             PROG);
@@ -280,7 +605,7 @@ int main(int argc, char **argv)
 {
     opts o = {.seed = 1, .years = 20, .det_runs = 20, .flow = 2000, .meas_sd = 300.0,
               .n_damage = 3, .damage = {0.025, 0.05, 0.10}, .drift_on = 1, .drift_off = 1};
-    enum { O_SEED = 256, O_YEARS, O_DET_RUNS, O_FLOW, O_DAMAGE, O_MEAS_SD, O_DRIFT };
+    enum { O_SEED = 256, O_YEARS, O_DET_RUNS, O_FLOW, O_DAMAGE, O_MEAS_SD, O_DRIFT, O_SCALE_FA, O_MIX_PROBE };
     static const struct option longopts[] = {
         {"seed", required_argument, NULL, O_SEED},
         {"years", required_argument, NULL, O_YEARS},
@@ -289,6 +614,8 @@ int main(int argc, char **argv)
         {"damage", required_argument, NULL, O_DAMAGE},
         {"meas-sd", required_argument, NULL, O_MEAS_SD},
         {"drift", required_argument, NULL, O_DRIFT},
+        {"scale-fa", required_argument, NULL, O_SCALE_FA},
+        {"mix-probe", no_argument, NULL, O_MIX_PROBE},
         AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -303,6 +630,8 @@ int main(int argc, char **argv)
             o.n_damage = amfi_cli_list(&c, v, o.damage, MAX_DAMAGE, 1e-4, 0.5);
             break;
         case O_MEAS_SD: o.meas_sd = 1000.0 * amfi_cli_num(&c, v, 0, 10); break;
+        case O_SCALE_FA: o.scale_fa = amfi_cli_num(&c, v, 1e-4, 1000); break;
+        case O_MIX_PROBE: o.mix_probe = 1; break;
         case O_DRIFT:
             if (!strcmp(v, "on") || !strcmp(v, "off") || !strcmp(v, "both")) {
                 o.drift_on = strcmp(v, "off") != 0;
@@ -318,8 +647,14 @@ int main(int argc, char **argv)
         return 1;
     gsl_rng_set(rng, o.seed);
     const clock_t c0 = clock();
-    printf("| drift | damage | runs | false alarms | median delay (vehicles) | p95 (vehicles) "
-           "| median delay (days) | p95 (days) |\n|---|---|---|---|---|---|---|---|\n");
+    if (o.mix_probe) {
+        mix_probe(&o, rng);
+        gsl_rng_free(rng);
+        return 0;
+    }
+    printf("| indicator | drift | damage | runs | false alarms | median delay (vehicles; "
+           "known_truck: runs) | p95 (vehicles; runs) | median delay (days) | p95 (days) |\n"
+           "|---|---|---|---|---|---|---|---|---|\n");
     if (o.drift_off)
         evaluate(&o, rng, 0);
     if (o.drift_on)
