@@ -48,7 +48,7 @@ void amfi_scale_params_default(amfi_scale_params *p)
     p->frost_slope = 0.018;
     p->slope_prior_sd = 0.001;
     p->design_shift = 0.025;
-    p->false_alarms_per_year = 0.2;
+    p->false_alarms_per_year = 0.05; /* measured: about 0.25 a year (docs/indicators.md) */
     p->vehicles_per_day = 2000.0;
     p->clear_after = 4;
 }

@@ -77,8 +77,9 @@ typedef struct amfi_scale_params {
 } amfi_scale_params;
 
 /* The defaults (B 500, 40 blocks, knee 0 °C, floor −10 °C, slopes 0.0025 and
- * 0.018 /°C, prior SD 0.001, design 2.5 %, 0.2 false alarms a year at 2000
- * vehicles a day), justified in docs/indicators.md. */
+ * 0.018 /°C, prior SD 0.001, design 2.5 %, 0.05 false alarms a year at
+ * 2000 vehicles a day: the design rate; the measured one is about 5 times
+ * that, docs/indicators.md), justified in docs/indicators.md. */
 void amfi_scale_params_default(amfi_scale_params *p);
 
 /* 0 when *p is valid, else AMFI_IND_EINVAL with *field (may be NULL) the

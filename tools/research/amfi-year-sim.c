@@ -11,7 +11,7 @@
  *
  *   amfi-year-sim [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]
  *                 [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]
- *                 [--scale-fa F] [--mix-probe]
+ *                 [--scale-fa F] [--mix-probe] [--prior-scale F]
  *
  * Stream model (kg). A run starts on a random day of the year (commissioning)
  * and lasts 365 days. Vehicles arrive uniformly within each day, --flow a
@@ -85,6 +85,7 @@ typedef struct {
     int drift_on, drift_off;
     double scale_fa; /* --scale-fa: the scale indicator's target false alarms a year (0: default) */
     int mix_probe;   /* --mix-probe */
+    double prior_scale; /* --prior-scale: the temperature model's prior slopes × this */
 } opts;
 
 /* One run's world: the climate, the calendar, the damage. */
@@ -168,6 +169,8 @@ static engines make(const opts *o)
     sp.vehicles_per_day = o->flow;
     if (o->scale_fa > 0)
         sp.false_alarms_per_year = o->scale_fa;
+    sp.warm_slope *= o->prior_scale;
+    sp.frost_slope *= o->prior_scale;
     amfi_known_truck_params kp;
     amfi_known_truck_params_default(&kp);
     kp.run_sd = o->meas_sd / TRUCK_KG;
@@ -584,7 +587,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: %s [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]\n"
             "       [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]\n"
-            "       [--scale-fa F] [--mix-probe]\n"
+            "       [--scale-fa F] [--mix-probe] [--prior-scale F]\n"
             "A year of traffic with the site climate and the drifting mix, watched by\n"
             "amfid's indicator engine: false alarms per healthy year, detection delays.\n"
             "  --seed S          generator seed (default 1)\n"
@@ -596,6 +599,8 @@ static void usage(FILE *f)
             "  --drift WHICH     temperature and mix drift on, off or both (default both)\n"
             "  --scale-fa F      scale indicator's target false alarms a year (default: its own)\n"
             "  --mix-probe       only: how each scale estimator moves with the loaded share\n"
+            "  --prior-scale F   temperature model's prior slopes × F (default 1: the\n"
+            "                    simulator's own law)\n"
             "  -h, --help        this help\n"
             "  -V, --version     print the version\n",
             PROG);
@@ -604,8 +609,12 @@ static void usage(FILE *f)
 int main(int argc, char **argv)
 {
     opts o = {.seed = 1, .years = 20, .det_runs = 20, .flow = 2000, .meas_sd = 300.0,
-              .n_damage = 3, .damage = {0.025, 0.05, 0.10}, .drift_on = 1, .drift_off = 1};
-    enum { O_SEED = 256, O_YEARS, O_DET_RUNS, O_FLOW, O_DAMAGE, O_MEAS_SD, O_DRIFT, O_SCALE_FA, O_MIX_PROBE };
+              .n_damage = 3, .damage = {0.025, 0.05, 0.10}, .drift_on = 1, .drift_off = 1,
+              .prior_scale = 1.0};
+    enum {
+        O_SEED = 256, O_YEARS, O_DET_RUNS, O_FLOW, O_DAMAGE, O_MEAS_SD, O_DRIFT, O_SCALE_FA,
+        O_MIX_PROBE, O_PRIOR_SCALE
+    };
     static const struct option longopts[] = {
         {"seed", required_argument, NULL, O_SEED},
         {"years", required_argument, NULL, O_YEARS},
@@ -616,6 +625,7 @@ int main(int argc, char **argv)
         {"drift", required_argument, NULL, O_DRIFT},
         {"scale-fa", required_argument, NULL, O_SCALE_FA},
         {"mix-probe", no_argument, NULL, O_MIX_PROBE},
+        {"prior-scale", required_argument, NULL, O_PRIOR_SCALE},
         AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -632,6 +642,7 @@ int main(int argc, char **argv)
         case O_MEAS_SD: o.meas_sd = 1000.0 * amfi_cli_num(&c, v, 0, 10); break;
         case O_SCALE_FA: o.scale_fa = amfi_cli_num(&c, v, 1e-4, 1000); break;
         case O_MIX_PROBE: o.mix_probe = 1; break;
+        case O_PRIOR_SCALE: o.prior_scale = amfi_cli_num(&c, v, 0, 5); break;
         case O_DRIFT:
             if (!strcmp(v, "on") || !strcmp(v, "off") || !strcmp(v, "both")) {
                 o.drift_on = strcmp(v, "off") != 0;
