@@ -46,6 +46,8 @@ void amfi_cusum_init(amfi_cusum *c, double k_ref, double h)
     c->h = h;
     c->s = 0.0;
     c->n = 0;
+    c->alerted = 0;
+    c->zero_run = 0;
 }
 
 int amfi_cusum_add(amfi_cusum *c, double z)
@@ -61,4 +63,30 @@ void amfi_cusum_reset(amfi_cusum *c)
 {
     c->s = 0.0;
     c->n = 0;
+}
+
+int amfi_cusum_alert_step(amfi_cusum *c, double z, int clear_after)
+{
+    const int over = amfi_cusum_add(c, z);
+    if (!c->alerted) {
+        if (!over)
+            return 0;
+        c->alerted = 1;
+        c->zero_run = 0;
+        return 1;
+    }
+    if (c->s > c->h)
+        c->s = c->h;
+    c->zero_run = c->s > 0 ? 0 : c->zero_run + 1;
+    if (c->zero_run < clear_after)
+        return 0;
+    c->alerted = 0;
+    c->zero_run = 0;
+    return -1;
+}
+
+void amfi_cusum_set_alerted(amfi_cusum *c, int alerted)
+{
+    c->alerted = alerted != 0;
+    c->zero_run = 0;
 }

@@ -26,6 +26,8 @@ typedef struct amfi_cusum {
     double h;       /* decision threshold, SD units, > 0 */
     double s;       /* the statistic S_k */
     long n;         /* increments since the last reset */
+    int alerted;    /* the alert rule's state (amfi_cusum_alert_step) */
+    int zero_run;   /* increments in a row with S = 0 while alerted */
 } amfi_cusum;
 
 /* Siegmund's approximation of the ARL (in increments) of the CUSUM (k_ref,
@@ -39,13 +41,24 @@ double amfi_cusum_arl(double k_ref, double h, double mu);
  * is not finite. */
 double amfi_cusum_threshold(double k_ref, double arl0, double mu);
 
-/* S = 0, n = 0 with the given k_ref and h. */
+/* S = 0, n = 0, not alerted, with the given k_ref and h. */
 void amfi_cusum_init(amfi_cusum *c, double k_ref, double h);
 
 /* Add one standardized increment z (finite); returns 1 when S >= h after
  * it, else 0. The statistic is not reset by an alarm (the caller decides). */
 int amfi_cusum_add(amfi_cusum *c, double z);
 
+/* S = 0, n = 0 (the alert state stays). */
 void amfi_cusum_reset(amfi_cusum *c);
+
+/* The alert rule of the scale and known-truck indicators: add z; when not
+ * alerted and S >= h, raise (returns 1); while alerted, S is capped at h
+ * (a clear does not wait for the evidence of a long alert to drain) and
+ * the alert clears after clear_after increments in a row with S = 0
+ * (returns −1); otherwise 0. */
+int amfi_cusum_alert_step(amfi_cusum *c, double z, int clear_after);
+
+/* Restore the alert state (after a restart): 0 or 1. */
+void amfi_cusum_set_alerted(amfi_cusum *c, int alerted);
 
 #endif

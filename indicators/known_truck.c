@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "cusum.h"
+#include "ind_internal.h"
 
 #define MAX_BASELINE 1000
 
@@ -24,7 +25,6 @@ struct amfi_known_truck {
     int nb, have_baseline;
     double mean_b, sigma;
     amfi_cusum cusum;
-    int alerted, zero_run;
 };
 
 void amfi_known_truck_params_default(amfi_known_truck_params *p)
@@ -40,16 +40,7 @@ void amfi_known_truck_params_default(amfi_known_truck_params *p)
 
 static int bad(const char *name, const char **field, char *err, size_t errlen, const char *why)
 {
-    if (field)
-        *field = name;
-    if (err && errlen)
-        snprintf(err, errlen, "known-truck indicator: %s %s", name, why);
-    return AMFI_IND_EINVAL;
-}
-
-static int in(double v, double lo, double hi)
-{
-    return isfinite(v) && v >= lo && v <= hi;
+    return ind_bad("known-truck indicator", name, field, err, errlen, why);
 }
 
 int amfi_known_truck_params_check(const amfi_known_truck_params *p, const char **field,
@@ -59,13 +50,13 @@ int amfi_known_truck_params_check(const amfi_known_truck_params *p, const char *
         *field = NULL;
     if (p->baseline_runs < 2 || p->baseline_runs > MAX_BASELINE)
         return bad("baseline_runs", field, err, errlen, "must be in [2, 1000]");
-    if (!in(p->run_sd, 1e-4, 1))
+    if (!ind_in(p->run_sd, 1e-4, 1))
         return bad("run_sd", field, err, errlen, "must be in [0.0001, 1]");
-    if (!in(p->design_shift, 1e-4, 0.5) || p->design_shift >= 0.5)
+    if (!ind_in(p->design_shift, 1e-4, 0.5) || p->design_shift >= 0.5)
         return bad("design_shift", field, err, errlen, "must be in [0.0001, 0.5)");
-    if (!in(p->false_alarms_per_year, 1e-4, 1000))
+    if (!ind_in(p->false_alarms_per_year, 1e-4, 1000))
         return bad("false_alarms_per_year", field, err, errlen, "must be in [0.0001, 1000]");
-    if (!in(p->runs_per_year, 1, 1e5))
+    if (!ind_in(p->runs_per_year, 1, 1e5))
         return bad("runs_per_year", field, err, errlen, "must be in [1, 100000]");
     if (p->clear_after < 1 || p->clear_after > 1000000)
         return bad("clear_after", field, err, errlen, "must be in [1, 1000000]");
@@ -110,7 +101,7 @@ void amfi_known_truck_destroy(amfi_known_truck *k)
 
 int amfi_known_truck_set_slopes(amfi_known_truck *k, double warm_slope, double frost_slope)
 {
-    if (!in(warm_slope, -0.1, 0.1) || !in(frost_slope, -0.1, 0.1))
+    if (!ind_in(warm_slope, -0.1, 0.1) || !ind_in(frost_slope, -0.1, 0.1))
         return AMFI_IND_EINVAL;
     k->warm = warm_slope;
     k->frost = frost_slope;
@@ -119,15 +110,14 @@ int amfi_known_truck_set_slopes(amfi_known_truck *k, double warm_slope, double f
 
 void amfi_known_truck_set_alerted(amfi_known_truck *k, int alerted)
 {
-    k->alerted = alerted != 0;
-    k->zero_run = 0;
+    amfi_cusum_set_alerted(&k->cusum, alerted);
 }
 
 const char *amfi_known_truck_state(const amfi_known_truck *k)
 {
     if (!k->have_baseline)
         return "baseline";
-    if (k->alerted)
+    if (k->cusum.alerted)
         return "alert";
     return k->cusum.s > 0 ? "watch" : "normal";
 }
@@ -148,7 +138,9 @@ static int fit_baseline(amfi_known_truck *k)
     const double h = amfi_cusum_threshold(kr, arl0 < 1 ? 1 : arl0, margin);
     if (!(h >= 0))
         return AMFI_IND_EINVAL;
+    const int alerted = k->cusum.alerted; /* restored before the baseline, maybe */
     amfi_cusum_init(&k->cusum, kr, h);
+    amfi_cusum_set_alerted(&k->cusum, alerted);
     k->have_baseline = 1;
     return AMFI_IND_OK;
 }
@@ -156,14 +148,14 @@ static int fit_baseline(amfi_known_truck *k)
 int amfi_known_truck_push(amfi_known_truck *k, double inferred_kg, double reference_kg,
                           double deck_c, amfi_known_truck_eval *eval, amfi_alert_event *alert)
 {
-    if (!in(inferred_kg, 1e-9, AMFI_IND_MAX_GVW_KG) || !(inferred_kg > 0) ||
-        !in(reference_kg, 1e-9, AMFI_IND_MAX_GVW_KG) || !(reference_kg > 0) ||
-        !in(deck_c, AMFI_SCALE_T_MIN, AMFI_SCALE_T_MAX))
+    if (!ind_in(inferred_kg, 1e-9, AMFI_IND_MAX_GVW_KG) || !(inferred_kg > 0) ||
+        !ind_in(reference_kg, 1e-9, AMFI_IND_MAX_GVW_KG) || !(reference_kg > 0) ||
+        !ind_in(deck_c, AMFI_SCALE_T_MIN, AMFI_SCALE_T_MAX))
         return AMFI_IND_EINVAL;
     const double ratio = inferred_kg / reference_kg;
     const double rc_ = ratio * amfi_scale_temp_factor(&k->temp, k->warm, k->frost, deck_c);
     const double y = log(rc_);
-    int rc = AMFI_IND_EVAL, change = 0;
+    int rc = AMFI_IND_EVAL;
     k->runs++;
     if (!k->have_baseline) {
         k->base[k->nb++] = y;
@@ -186,21 +178,7 @@ int amfi_known_truck_push(amfi_known_truck *k, double inferred_kg, double refere
         return rc;
     }
     const double z = (y - k->mean_b) / k->sigma;
-    const int over = amfi_cusum_add(&k->cusum, z);
-    if (!k->alerted && over) {
-        k->alerted = 1;
-        k->zero_run = 0;
-        change = 1;
-    } else if (k->alerted) {
-        if (k->cusum.s > k->cusum.h)
-            k->cusum.s = k->cusum.h;
-        k->zero_run = k->cusum.s > 0 ? 0 : k->zero_run + 1;
-        if (k->zero_run >= k->p.clear_after) {
-            k->alerted = 0;
-            k->zero_run = 0;
-            change = 1;
-        }
-    }
+    const int step = amfi_cusum_alert_step(&k->cusum, z, k->p.clear_after);
     if (eval) {
         eval->run = k->runs;
         eval->ratio = ratio;
@@ -212,13 +190,13 @@ int amfi_known_truck_push(amfi_known_truck *k, double inferred_kg, double refere
         eval->sigma = k->sigma;
         eval->state = amfi_known_truck_state(k);
     }
-    if (change) {
+    if (step) {
         rc |= AMFI_IND_ALERT;
         if (alert) {
             alert->level = "warning";
             alert->kind = "known_truck";
-            alert->raised = k->alerted;
-            if (k->alerted)
+            alert->raised = step > 0;
+            if (step > 0)
                 snprintf(alert->message, sizeof alert->message,
                          "known truck: inferred/reference %.4f (compensated %.4f, baseline "
                          "%.4f, deck %.1f °C): CUSUM %.2f >= %.2f",

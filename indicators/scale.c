@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "cusum.h"
+#include "ind_internal.h"
 
 #define EM_MAX_ITER 500
 #define BOOT_N 100
@@ -31,7 +32,6 @@ struct amfi_scale {
     int nx;
     double t_sum;
     amfi_cusum cusum;
-    int alerted, zero_run;
 };
 
 void amfi_scale_params_default(amfi_scale_params *p)
@@ -55,16 +55,7 @@ void amfi_scale_params_default(amfi_scale_params *p)
 
 static int bad(const char *name, const char **field, char *err, size_t errlen, const char *why)
 {
-    if (field)
-        *field = name;
-    if (err && errlen)
-        snprintf(err, errlen, "scale indicator: %s %s", name, why);
-    return AMFI_IND_EINVAL;
-}
-
-static int in(double v, double lo, double hi)
-{
-    return isfinite(v) && v >= lo && v <= hi;
+    return ind_bad("scale indicator", name, field, err, errlen, why);
 }
 
 int amfi_scale_params_check(const amfi_scale_params *p, const char **field, char *err,
@@ -78,27 +69,27 @@ int amfi_scale_params_check(const amfi_scale_params *p, const char **field, char
         (double)p->baseline_blocks * p->block > 1e8)
         return bad("baseline_blocks", field, err, errlen,
                    "must be in [4, 10000] with block · baseline_blocks <= 1e8");
-    if (!in(p->knee_c, -30, 30))
+    if (!ind_in(p->knee_c, -30, 30))
         return bad("knee_c", field, err, errlen, "must be in [-30, 30] °C");
-    if (!in(p->ref_c, -30, 40))
+    if (!ind_in(p->ref_c, -30, 40))
         return bad("ref_c", field, err, errlen, "must be in [-30, 40] °C");
-    if (!in(p->class_split_kg, 100, AMFI_IND_MAX_GVW_KG))
+    if (!ind_in(p->class_split_kg, 100, AMFI_IND_MAX_GVW_KG))
         return bad("class_split_kg", field, err, errlen, "must be in [100, 1e7] kg");
-    if (!in(p->share_range, 0.01, 1))
+    if (!ind_in(p->share_range, 0.01, 1))
         return bad("share_range", field, err, errlen, "must be in [0.01, 1]");
-    if (!in(p->floor_c, -60, p->knee_c - 0.5))
+    if (!ind_in(p->floor_c, -60, p->knee_c - 0.5))
         return bad("floor_c", field, err, errlen, "must be in [-60, knee_c - 0.5] °C");
-    if (!in(p->warm_slope, -0.1, 0.1))
+    if (!ind_in(p->warm_slope, -0.1, 0.1))
         return bad("warm_slope", field, err, errlen, "must be in [-0.1, 0.1] per °C");
-    if (!in(p->frost_slope, -0.1, 0.1))
+    if (!ind_in(p->frost_slope, -0.1, 0.1))
         return bad("frost_slope", field, err, errlen, "must be in [-0.1, 0.1] per °C");
-    if (!in(p->slope_prior_sd, 0, 0.1))
+    if (!ind_in(p->slope_prior_sd, 0, 0.1))
         return bad("slope_prior_sd", field, err, errlen, "must be in [0, 0.1] per °C");
-    if (!in(p->design_shift, 1e-4, 0.5) || p->design_shift >= 0.5)
+    if (!ind_in(p->design_shift, 1e-4, 0.5) || p->design_shift >= 0.5)
         return bad("design_shift", field, err, errlen, "must be in [0.0001, 0.5)");
-    if (!in(p->false_alarms_per_year, 1e-4, 1000))
+    if (!ind_in(p->false_alarms_per_year, 1e-4, 1000))
         return bad("false_alarms_per_year", field, err, errlen, "must be in [0.0001, 1000]");
-    if (!in(p->vehicles_per_day, 1, 1e7))
+    if (!ind_in(p->vehicles_per_day, 1, 1e7))
         return bad("vehicles_per_day", field, err, errlen, "must be in [1, 1e7]");
     if (p->clear_after < 1 || p->clear_after > 1000000)
         return bad("clear_after", field, err, errlen, "must be in [1, 1000000]");
@@ -169,15 +160,14 @@ int amfi_scale_get_model(const amfi_scale *s, amfi_scale_model *m)
 
 void amfi_scale_set_alerted(amfi_scale *s, int alerted)
 {
-    s->alerted = alerted != 0;
-    s->zero_run = 0;
+    amfi_cusum_set_alerted(&s->cusum, alerted);
 }
 
 const char *amfi_scale_state(const amfi_scale *s)
 {
     if (!s->have_model)
         return "baseline";
-    if (s->alerted)
+    if (s->cusum.alerted)
         return "alert";
     return s->cusum.s > 0.0 ? "watch" : "normal";
 }
@@ -476,8 +466,9 @@ static int fit_baseline(amfi_scale *s)
         return AMFI_IND_EINVAL;
     s->m = m;
     s->have_model = 1;
+    const int alerted = s->cusum.alerted; /* restored before the baseline, maybe */
     amfi_cusum_init(&s->cusum, m.k_ref, m.h);
-    s->zero_run = 0;
+    amfi_cusum_set_alerted(&s->cusum, alerted);
     return AMFI_IND_OK;
 }
 
@@ -516,24 +507,8 @@ int amfi_scale_push(amfi_scale *s, double gvw_kg, double deck_c, amfi_scale_eval
     double pi;
     const double y = amfi_scale_ref_block_log(&s->ref, s->xw, n, &pi);
     const double z = (y - s->m.mean0) / s->m.sigma0;
-    const int over = amfi_cusum_add(&s->cusum, z);
-    int rc = AMFI_IND_EVAL, change = 0;
-    if (!s->alerted && over) {
-        s->alerted = 1;
-        s->zero_run = 0;
-        change = 1;
-    } else if (s->alerted) {
-        /* capped at h while raised: the clear does not wait for the
-         * evidence of a long alert to drain */
-        if (s->cusum.s > s->cusum.h)
-            s->cusum.s = s->cusum.h;
-        s->zero_run = s->cusum.s > 0 ? 0 : s->zero_run + 1;
-        if (s->zero_run >= p->clear_after) {
-            s->alerted = 0;
-            s->zero_run = 0;
-            change = 1;
-        }
-    }
+    const int step = amfi_cusum_alert_step(&s->cusum, z, p->clear_after);
+    int rc = AMFI_IND_EVAL;
     const double tmean = s->t_sum / n;
     if (eval) {
         eval->n = n;
@@ -546,13 +521,13 @@ int amfi_scale_push(amfi_scale *s, double gvw_kg, double deck_c, amfi_scale_eval
         eval->h = s->m.h;
         eval->state = amfi_scale_state(s);
     }
-    if (change) {
+    if (step) {
         rc |= AMFI_IND_ALERT;
         if (alert) {
             alert->level = "warning";
             alert->kind = "scale_shift";
-            alert->raised = s->alerted;
-            if (s->alerted)
+            alert->raised = step > 0;
+            if (step > 0)
                 snprintf(alert->message, sizeof alert->message,
                          "scale of inferred GVW %.4f (temperature-compensated, deck %.1f °C): "
                          "CUSUM %.2f >= %.2f",

@@ -57,6 +57,14 @@ static double modulus(double t)
     return 1.025 * (1.0 - 0.02 * t);
 }
 
+static gsl_rng *rng(unsigned long seed)
+{
+    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+    assert_non_null(r);
+    gsl_rng_set(r, seed);
+    return r;
+}
+
 static amfi_scale *make(const amfi_scale_params *p)
 {
     char err[256] = "";
@@ -99,8 +107,7 @@ static void test_cusum_arl(void **state)
 static void test_cusum_siegmund_mc(void **state)
 {
     (void)state;
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    gsl_rng_set(r, 11);
+    gsl_rng *r = rng(11);
     const double k = 0.5, h = 4.0;
     for (int shifted = 0; shifted <= 1; shifted++) {
         const double mu = shifted ? 1.0 : 0.0;
@@ -139,6 +146,25 @@ static void test_cusum_recursion(void **state)
 
 /* --- parameters --- */
 
+/* One broken parameter f = value in p (a copy of the defaults d): create
+ * refuses it with a message naming it and leaves *out NULL, the check names
+ * it in `field`. */
+#define EXPECT_BAD_PARAM(f, value, create_call, out, check_call)                             \
+    do {                                                                                      \
+        p = d;                                                                                \
+        p.f = value;                                                                          \
+        out = (void *)&p;                                                                     \
+        err[0] = '\0';                                                                        \
+        assert_int_equal(create_call, AMFI_IND_EINVAL);                                       \
+        assert_null(out);                                                                     \
+        if (strstr(err, #f) == NULL)                                                          \
+            fail_msg("%s = %s: message '%s' does not name it", #f, #value, err);              \
+        field = NULL;                                                                         \
+        assert_int_equal(check_call, AMFI_IND_EINVAL);                                        \
+        assert_string_equal(field, #f);                                                       \
+    } while (0)
+
+
 static void test_params(void **state)
 {
     (void)state;
@@ -155,18 +181,8 @@ static void test_params(void **state)
     char err[256];
     const char *field;
 #define EXPECT_BAD(f, value)                                                                  \
-    do {                                                                                      \
-        p = d;                                                                                \
-        p.f = value;                                                                          \
-        s = (amfi_scale *)&p;                                                                 \
-        err[0] = '\0';                                                                        \
-        assert_int_equal(amfi_scale_create(&p, &s, err, sizeof err), AMFI_IND_EINVAL);        \
-        assert_null(s);                                                                       \
-        if (strstr(err, #f) == NULL)                                                          \
-            fail_msg("%s = %s: message '%s' does not name it", #f, #value, err);              \
-        assert_int_equal(amfi_scale_params_check(&p, &field, NULL, 0), AMFI_IND_EINVAL);      \
-        assert_string_equal(field, #f);                                                       \
-    } while (0)
+    EXPECT_BAD_PARAM(f, value, amfi_scale_create(&p, &s, err, sizeof err), s,                   \
+                     amfi_scale_params_check(&p, &field, NULL, 0))
     EXPECT_BAD(block, 49);
     EXPECT_BAD(baseline_blocks, 3);
     EXPECT_BAD(class_split_kg, 0.0);
@@ -198,8 +214,7 @@ static void test_estimator(void **state)
     enum { NB = 20000, B = 500, R = 60 };
     static double base[NB], blk[B];
     static amfi_scale_ref ref;
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    gsl_rng_set(r, 5);
+    gsl_rng *r = rng(5);
     for (int i = 0; i < NB; i++)
         base[i] = draw(r, 0.5);
     assert_int_equal(amfi_scale_ref_fit(&ref, base, NB, SPLIT, 0.15), AMFI_IND_OK);
@@ -270,8 +285,7 @@ static amfi_scale *baseline(gsl_rng *r, amfi_scale_params *p, double t_mean, dou
 static void test_temperature_fit(void **state)
 {
     (void)state;
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    gsl_rng_set(r, 7);
+    gsl_rng *r = rng(7);
     amfi_scale_params p;
     amfi_scale_model m;
     amfi_scale_params_default(&p);
@@ -312,8 +326,7 @@ static void test_reject(void **state)
     for (size_t i = 0; i < sizeof bad_t / sizeof bad_t[0]; i++)
         assert_int_equal(amfi_scale_push(s, 9000.0, bad_t[i], NULL, NULL), AMFI_IND_EINVAL);
     /* nothing entered: the baseline still needs all of its 200 vehicles */
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    gsl_rng_set(r, 3);
+    gsl_rng *r = rng(3);
     for (int i = 0; i < 199; i++)
         assert_int_equal(amfi_scale_push(s, draw(r, 0.5), 10.0, NULL, NULL), 0);
     assert_int_equal(amfi_scale_push(s, draw(r, 0.5), 10.0, NULL, NULL), AMFI_IND_BASELINE);
@@ -376,8 +389,7 @@ static stream_out stream(amfi_scale *s, gsl_rng *r, double day0, double days, do
 static void test_stream_winter(void **state)
 {
     (void)state;
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    gsl_rng_set(r, 21);
+    gsl_rng *r = rng(21);
     amfi_scale_params p;
     amfi_scale_params_default(&p);
     amfi_scale *s = make(&p);
@@ -399,8 +411,7 @@ static void test_stream_winter(void **state)
 static void test_stream_clear(void **state)
 {
     (void)state;
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    gsl_rng_set(r, 23);
+    gsl_rng *r = rng(23);
     amfi_scale_params p;
     amfi_scale_params_default(&p);
     p.baseline_blocks = 20;
@@ -432,18 +443,8 @@ static void test_known_truck(void **state)
     char err[256];
     const char *field;
 #define EXPECT_BAD(f, value)                                                                  \
-    do {                                                                                      \
-        p = d;                                                                                \
-        p.f = value;                                                                          \
-        err[0] = '\0';                                                                        \
-        assert_int_equal(amfi_known_truck_create(&p, &tp, &k, err, sizeof err),               \
-                         AMFI_IND_EINVAL);                                                    \
-        assert_null(k);                                                                       \
-        if (strstr(err, #f) == NULL)                                                          \
-            fail_msg("%s = %s: message '%s' does not name it", #f, #value, err);              \
-        assert_int_equal(amfi_known_truck_params_check(&p, &field, NULL, 0), AMFI_IND_EINVAL); \
-        assert_string_equal(field, #f);                                                       \
-    } while (0)
+    EXPECT_BAD_PARAM(f, value, amfi_known_truck_create(&p, &tp, &k, err, sizeof err), k,        \
+                     amfi_known_truck_params_check(&p, &field, NULL, 0))
     EXPECT_BAD(baseline_runs, 1);
     EXPECT_BAD(run_sd, 0.0);
     EXPECT_BAD(design_shift, NAN);

@@ -1,0 +1,34 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * ind_internal.h: helpers shared by the parameter checks of the scale and
+ * known-truck indicators (scale.c, known_truck.c); not installed, not part
+ * of the API. Pure functions.
+ */
+#ifndef AMFI_INDICATORS_INTERNAL_H
+#define AMFI_INDICATORS_INTERNAL_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "indicators.h"
+
+/* 1 when v is finite and in [lo, hi]. */
+static inline int ind_in(double v, double lo, double hi)
+{
+    return isfinite(v) && v >= lo && v <= hi;
+}
+
+/* Blame parameter `name` of indicator `who`: *field (may be NULL) = name,
+ * err (may be NULL) = "who: name why"; returns AMFI_IND_EINVAL. */
+static inline int ind_bad(const char *who, const char *name, const char **field, char *err,
+                          size_t errlen, const char *why)
+{
+    if (field)
+        *field = name;
+    if (err && errlen)
+        snprintf(err, errlen, "%s: %s %s", who, name, why);
+    return AMFI_IND_EINVAL;
+}
+
+#endif
