@@ -11,7 +11,7 @@
  *
  *   amfi-year-sim [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]
  *                 [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]
- *                 [--scale-fa F] [--mix-probe] [--prior-scale F]
+ *                 [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]
  *
  * Stream model (kg). A run starts on a random day of the year (commissioning)
  * and lasts 365 days. Vehicles arrive uniformly within each day, --flow a
@@ -33,8 +33,8 @@
  * automatic baseline is the first baseline_n vehicles after commissioning.
  * The scale indicator with amfi_scale_params_default (vehicles_per_day =
  * --flow; --scale-fa its target), fed each vehicle's deck temperature (drift
- * off: a constant 10 °C). Known truck: one run a week (the week's third day,
- * between 8 and 16 h) of a 14 t truck, inferred = (14 t + e) / ((1 − d) ·
+ * off: a constant 10 °C). Known truck: --truck-runs runs a week (default 1;
+ * every 7 / N days from the third day, between 8 and 16 h) of a 14 t truck, inferred = (14 t + e) / ((1 − d) ·
  * f(T_deck)) with the same e, amfi_known_truck_params_default with run_sd =
  * --meas-sd / 14 t, the prior temperature slopes.
  *
@@ -86,6 +86,7 @@ typedef struct {
     double scale_fa; /* --scale-fa: the scale indicator's target false alarms a year (0: default) */
     int mix_probe;   /* --mix-probe */
     double prior_scale; /* --prior-scale: the temperature model's prior slopes × this */
+    int truck_runs;     /* --truck-runs: known-truck runs a week */
 } opts;
 
 /* One run's world: the climate, the calendar, the damage. */
@@ -174,6 +175,7 @@ static engines make(const opts *o)
     amfi_known_truck_params kp;
     amfi_known_truck_params_default(&kp);
     kp.run_sd = o->meas_sd / TRUCK_KG;
+    kp.runs_per_year = 52.0 * o->truck_runs;
     if (amfi_indicators_create(&p, &e.ind, err, sizeof err) ||
         amfi_scale_create(&sp, &e.scale, err, sizeof err) ||
         amfi_known_truck_create(&kp, &sp, &e.truck, err, sizeof err)) {
@@ -244,8 +246,10 @@ typedef struct {
 static long run(world *w, const opts *o, double days, outcome *out)
 {
     engines e = make(o);
-    long pushed = 0, after = 0, runs_after = 0, week = 0;
-    /* one known-truck run a week, on the week's third day between 8 and 16 h */
+    long pushed = 0, after = 0, runs_after = 0, truck_j = 0;
+    /* --truck-runs known-truck runs a week, every 7 / N days from day 2, between
+     * 8 and 16 h */
+    const double truck_every = 7.0 / o->truck_runs;
     double next_truck = (2.0 + (8.0 + 8.0 * gsl_rng_uniform(w->rng)) / 24.0) * DAY_S;
     for (int k = 0; k < N_KIND; k++) {
         out->fa[k] = 0;
@@ -272,9 +276,10 @@ static long run(world *w, const opts *o, double days, outcome *out)
                 r |= truck_run(&e, w, t, o->meas_sd);
                 if (damaged)
                     runs_after++;
-                week++;
-                next_truck =
-                    (7.0 * week + 2.0 + (8.0 + 8.0 * gsl_rng_uniform(w->rng)) / 24.0) * DAY_S;
+                truck_j++;
+                next_truck = (floor(truck_every * truck_j) + 2.0 +
+                              (8.0 + 8.0 * gsl_rng_uniform(w->rng)) / 24.0) *
+                             DAY_S;
             }
             for (int k = 0; k < N_KIND; k++) {
                 if (!(r & (1 << k)))
@@ -587,7 +592,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: %s [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]\n"
             "       [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]\n"
-            "       [--scale-fa F] [--mix-probe] [--prior-scale F]\n"
+            "       [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]\n"
             "A year of traffic with the site climate and the drifting mix, watched by\n"
             "amfid's indicator engine: false alarms per healthy year, detection delays.\n"
             "  --seed S          generator seed (default 1)\n"
@@ -601,6 +606,7 @@ static void usage(FILE *f)
             "  --mix-probe       only: how each scale estimator moves with the loaded share\n"
             "  --prior-scale F   temperature model's prior slopes × F (default 1: the\n"
             "                    simulator's own law)\n"
+            "  --truck-runs N    known-truck runs a week, 1 .. 7 (default 1)\n"
             "  -h, --help        this help\n"
             "  -V, --version     print the version\n",
             PROG);
@@ -610,10 +616,10 @@ int main(int argc, char **argv)
 {
     opts o = {.seed = 1, .years = 20, .det_runs = 20, .flow = 2000, .meas_sd = 300.0,
               .n_damage = 3, .damage = {0.025, 0.05, 0.10}, .drift_on = 1, .drift_off = 1,
-              .prior_scale = 1.0};
+              .prior_scale = 1.0, .truck_runs = 1};
     enum {
         O_SEED = 256, O_YEARS, O_DET_RUNS, O_FLOW, O_DAMAGE, O_MEAS_SD, O_DRIFT, O_SCALE_FA,
-        O_MIX_PROBE, O_PRIOR_SCALE
+        O_MIX_PROBE, O_PRIOR_SCALE, O_TRUCK_RUNS
     };
     static const struct option longopts[] = {
         {"seed", required_argument, NULL, O_SEED},
@@ -626,6 +632,7 @@ int main(int argc, char **argv)
         {"scale-fa", required_argument, NULL, O_SCALE_FA},
         {"mix-probe", no_argument, NULL, O_MIX_PROBE},
         {"prior-scale", required_argument, NULL, O_PRIOR_SCALE},
+        {"truck-runs", required_argument, NULL, O_TRUCK_RUNS},
         AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -643,6 +650,7 @@ int main(int argc, char **argv)
         case O_SCALE_FA: o.scale_fa = amfi_cli_num(&c, v, 1e-4, 1000); break;
         case O_MIX_PROBE: o.mix_probe = 1; break;
         case O_PRIOR_SCALE: o.prior_scale = amfi_cli_num(&c, v, 0, 5); break;
+        case O_TRUCK_RUNS: o.truck_runs = (int)amfi_cli_integer(&c, v, 1, 7); break;
         case O_DRIFT:
             if (!strcmp(v, "on") || !strcmp(v, "off") || !strcmp(v, "both")) {
                 o.drift_on = strcmp(v, "off") != 0;
