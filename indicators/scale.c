@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * scale.c: the scale indicator (scale.h): the mixture fit of the baseline,
- * the temperature model, the robust block estimator and its CUSUM. Pure
- * computation; the handle is owned by one thread at a time.
+ * scale.c: the scale indicator (scale.h): the baseline's empty/loaded
+ * classes, the temperature model, the robust block estimator and its CUSUM.
+ * Pure computation; the handle is owned by one thread at a time.
  */
 #include "scale.h"
 
@@ -15,9 +15,7 @@
 #include "cusum.h"
 #include "ind_internal.h"
 
-#define EM_MAX_ITER 500
-#define BOOT_N 100
-#define SD_FLOOR_KG 1.0
+#define BOOT_N 100 /* bootstrap blocks for sigma_boot */
 
 struct amfi_scale {
     amfi_scale_params p;

@@ -125,8 +125,10 @@ typedef struct amfi_scale_eval {
 } amfi_scale_eval;
 
 /* Feed one ok passage: GVW (kg) and deck temperature (°C) at its time.
- * Returns a mask of AMFI_IND_EVAL (a block was evaluated, *eval), 
- * AMFI_IND_BASELINE (the baseline model was just fitted) and AMFI_IND_ALERT
+ * Returns a mask of AMFI_IND_EVAL (a block was evaluated, *eval),
+ * AMFI_IND_BASELINE (the baseline model was just fitted; a degenerate
+ * baseline, e.g. a class with fewer than 2 vehicles, is dropped and
+ * collected again, returning 0) and AMFI_IND_ALERT
  * (*alert holds a state change); 0 when the push only entered the block.
  * Returns AMFI_IND_EINVAL for a GVW that is not finite, <= 0 or above
  * AMFI_IND_MAX_GVW_KG, or a temperature not finite or outside

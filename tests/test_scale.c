@@ -330,6 +330,17 @@ static void test_reject(void **state)
     for (int i = 0; i < 199; i++)
         assert_int_equal(amfi_scale_push(s, draw(r, 0.5), 10.0, NULL, NULL), 0);
     assert_int_equal(amfi_scale_push(s, draw(r, 0.5), 10.0, NULL, NULL), AMFI_IND_BASELINE);
+    amfi_scale_destroy(s);
+    /* a degenerate baseline (no loaded vehicle: one class empty) is dropped
+     * and collected again */
+    s = make(&p);
+    for (int i = 0; i < 400; i++)
+        assert_int_equal(amfi_scale_push(s, 5000.0 + i, 10.0, NULL, NULL), 0);
+    assert_int_equal(amfi_scale_has_baseline(s), 0);
+    assert_string_equal(amfi_scale_state(s), "baseline");
+    for (int i = 0; i < 199; i++)
+        assert_int_equal(amfi_scale_push(s, draw(r, 0.5), 10.0, NULL, NULL), 0);
+    assert_int_equal(amfi_scale_push(s, draw(r, 0.5), 10.0, NULL, NULL), AMFI_IND_BASELINE);
     gsl_rng_free(r);
     amfi_scale_destroy(s);
 }
