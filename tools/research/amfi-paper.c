@@ -256,8 +256,8 @@ static void seed3(gsl_rng *r, unsigned long a, unsigned long b, unsigned long c)
 
 /* The passage the worker's accelerometer recorded (one sensor:
  * c->sp.n_sensors = 1), at speed_mps, with the vehicle's axle spacing. */
-static amfi_passage recorded_passage(const ctx *c, const worker *w, const amfi_passage_rec *pr,
-                                     const amfi_passage_spec *spec, double speed_mps)
+static amfi_passage passage_of(const ctx *c, const worker *w, const amfi_passage_rec *pr,
+                               double spacing_m, double speed_mps)
 {
     amfi_passage p;
     memset(&p, 0, sizeof p);
@@ -267,8 +267,25 @@ static amfi_passage recorded_passage(const ctx *c, const worker *w, const amfi_p
     p.accel[0] = w->acc;
     p.speed_mps = speed_mps;
     p.n_axles = 2;
-    p.axle_spacing_m[0] = spec->car.D1_m + spec->car.D2_m;
+    p.axle_spacing_m[0] = spacing_m;
     return p;
+}
+
+static amfi_passage recorded_passage(const ctx *c, const worker *w, const amfi_passage_rec *pr,
+                                     const amfi_passage_spec *spec, double speed_mps)
+{
+    return passage_of(c, w, pr, spec->car.D1_m + spec->car.D2_m, speed_mps);
+}
+
+/* The speed search's prior from the options (--speed-grid, --speed-dof,
+ * --speed-coarse, --speed-pick). */
+static void options_prior(const ctx *c, amfi_speed_prior *prior)
+{
+    amfi_speed_prior_default(prior);
+    prior->grid_rel = c->o.speed_grid;
+    prior->data_dof = c->o.speed_dof;
+    prior->coarse_rate_hz = c->o.speed_coarse;
+    prior->pick = (amfi_speed_pick)c->o.speed_pick;
 }
 
 /* Simulate spec on bridge `b`, then solve with the speed the detector
@@ -346,11 +363,7 @@ static void *batch_thread(void *arg)
         return NULL;
     lc.automatic = 1;
     amfi_speed_prior prior;
-    amfi_speed_prior_default(&prior);
-    prior.grid_rel = c->o.speed_grid;
-    prior.data_dof = c->o.speed_dof;
-    prior.coarse_rate_hz = c->o.speed_coarse;
-    prior.pick = (amfi_speed_pick)c->o.speed_pick;
+    options_prior(c, &prior);
     for (;;) {
         long it = take_item(&j->lock, &j->next, j->n_items, &j->failed);
         if (it < 0)
@@ -719,15 +732,7 @@ static double pct(double gvw) { return 100.0 * (gvw / 18000.0 - 1.0); }
 static int resolve(const ctx *c, worker *w, const amfi_passage_rec *pr, double spacing,
                    double speed, const amfi_lambda *lam, amfi_result *res)
 {
-    amfi_passage p;
-    memset(&p, 0, sizeof p);
-    p.n_samples = pr->n;
-    p.scan_rate_hz = c->sp.scan_rate_hz;
-    p.t_first_s = pr->t_first_s;
-    p.accel[0] = w->acc; /* n_sensors = 1 in the single-vehicle experiments */
-    p.speed_mps = speed;
-    p.n_axles = 2;
-    p.axle_spacing_m[0] = spacing;
+    amfi_passage p = passage_of(c, w, pr, spacing, speed); /* one sensor here */
     char err[256];
     if (amfi_solve(w->solver, &p, lam, res, err, sizeof err)) {
         fprintf(stderr, "%s: solve: %s\n", PROG, err);
@@ -742,21 +747,9 @@ static int resolve_estimated(const ctx *c, worker *w, const amfi_passage_rec *pr
                              double spacing, double speed, const amfi_lambda *lam,
                              amfi_result *res, double *speed_est)
 {
-    amfi_passage p;
-    memset(&p, 0, sizeof p);
-    p.n_samples = pr->n;
-    p.scan_rate_hz = c->sp.scan_rate_hz;
-    p.t_first_s = pr->t_first_s;
-    p.accel[0] = w->acc;
-    p.speed_mps = speed;
-    p.n_axles = 2;
-    p.axle_spacing_m[0] = spacing;
+    amfi_passage p = passage_of(c, w, pr, spacing, speed);
     amfi_speed_prior prior;
-    amfi_speed_prior_default(&prior);
-    prior.grid_rel = c->o.speed_grid;
-    prior.data_dof = c->o.speed_dof;
-    prior.coarse_rate_hz = c->o.speed_coarse;
-    prior.pick = (amfi_speed_pick)c->o.speed_pick;
+    options_prior(c, &prior);
     amfi_speed_result sr;
     char err[256];
     if (amfi_solve_speed(w->solver, &p, lam, &prior, res, &sr, err, sizeof err)) {
@@ -1053,11 +1046,7 @@ static void *spd_thread(void *arg)
     if (batch_worker(c, &w, &fixed, &j->failed))
         return NULL;
     amfi_speed_prior prior;
-    amfi_speed_prior_default(&prior);
-    prior.grid_rel = c->o.speed_grid;
-    prior.data_dof = c->o.speed_dof;
-    prior.coarse_rate_hz = c->o.speed_coarse;
-    prior.pick = (amfi_speed_pick)c->o.speed_pick;
+    options_prior(c, &prior);
     for (;;) {
         long it = take_item(&j->lock, &j->next, j->n_items, &j->failed);
         if (it < 0)
