@@ -75,6 +75,7 @@ typedef struct opts {
     double speed_dof;     /* its data_dof (0: the samples) */
     double speed_coarse;  /* its coarse_rate_hz (0: the grid on the full model) */
     int speed_pick;       /* its pick (amfi_speed_pick) */
+    int speed_compare;    /* 1: also the full-model grid and the residual (condition 0) */
     int free_state;       /* -1: as configured; 0 rest; 1 free */
     double pre_roll;      /* < 0: as configured */
     double lambda_ref;
@@ -131,6 +132,8 @@ static void usage(FILE *f)
             "      --speed-coarse HZ           its coarse model's rate (default 1000; 0: the\n"
             "                                  grid on the full model)\n"
             "      --speed-pick min|dip        its pick (default dip)\n"
+            "      --speed-no-compare          skip the one-level and residual solves of its\n"
+            "                                  first condition (about 8x its time)\n"
             "  -h, --help                      this help\n"
             "  -V, --version                   print the version\n"
             "Default files from the first of %s.\n",
@@ -141,7 +144,7 @@ static void parse(int argc, char **argv, opts *o)
 {
     enum { O_LAMBDA_REF = 256, O_BATCH_LCURVE, O_BATCH_ESTIMATE, O_BATCHES_ONLY, O_INITIAL_STATE, O_PRE_ROLL,
            O_NO_PLOTS, O_SPEED_BATCH, O_SPEED_GRID, O_SPEED_DOF,
-           O_SPEED_COARSE, O_SPEED_PICK };
+           O_SPEED_COARSE, O_SPEED_PICK, O_SPEED_NO_COMPARE };
     static const struct option longopts[] = {
         {"out", required_argument, NULL, 'o'},
         {"quick", no_argument, NULL, 'q'},
@@ -162,10 +165,11 @@ static void parse(int argc, char **argv, opts *o)
         {"speed-dof", required_argument, NULL, O_SPEED_DOF},
         {"speed-coarse", required_argument, NULL, O_SPEED_COARSE},
         {"speed-pick", required_argument, NULL, O_SPEED_PICK},
+        {"speed-no-compare", no_argument, NULL, O_SPEED_NO_COMPARE},
         AMFI_CLI_END};
     *o = (opts){.out = "docs/results", .vehicles = 500, .reps = 3, .threads = 2, .plots = 1,
                 .lambda_ref = 7.94e-9, .free_state = -1, .pre_roll = -1, .speed_grid = 0.002, .speed_coarse = 1000,
-                 .speed_pick = AMFI_SPEED_PICK_DIP};
+                 .speed_pick = AMFI_SPEED_PICK_DIP, .speed_compare = 1};
     int vehicles_set = 0;
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -197,6 +201,7 @@ static void parse(int argc, char **argv, opts *o)
         case O_SPEED_GRID: o->speed_grid = amfi_cli_num(&c, v, 1e-4, 0.05); break;
         case O_SPEED_DOF: o->speed_dof = amfi_cli_num(&c, v, 0, 1e9); break;
         case O_SPEED_COARSE: o->speed_coarse = amfi_cli_num(&c, v, 0, 1e6); break;
+        case O_SPEED_NO_COMPARE: o->speed_compare = 0; break;
         case O_SPEED_PICK:
             if (strcmp(v, "min") == 0)
                 o->speed_pick = AMFI_SPEED_PICK_MIN;
@@ -1109,7 +1114,7 @@ static void *spd_thread(void *arg)
         out->n_coarse = sr.n_coarse;
         out->at_bound = sr.at_bound;
         out->gvw_res = out->v_res = out->gvw_full = out->v_full = out->ms_full = NAN;
-        if (!rc && cond == 0 && c->o.speed_coarse > 0) {
+        if (!rc && cond == 0 && c->o.speed_compare && c->o.speed_coarse > 0) {
             /* the same criterion with the grid on the full model (one level) */
             prior.coarse_rate_hz = 0;
             t = amfi_mono_s();
@@ -1119,7 +1124,7 @@ static void *spd_thread(void *arg)
             out->v_full = sr.speed_mps;
             prior.coarse_rate_hz = c->o.speed_coarse;
         }
-        if (!rc && cond == 0) { /* the second criterion, on the first condition, one level
+        if (!rc && cond == 0 && c->o.speed_compare) { /* the second criterion, on the first condition, one level
                                    (on the coarse model its minimum is the range's slow end) */
             prior.criterion = AMFI_SPEED_RESIDUAL;
             prior.coarse_rate_hz = 0;
@@ -1247,7 +1252,7 @@ static void speed_batch(ctx *c)
                 "| %.2f %% | %+.3f %%, %.3f %% | ",
                 spd_cond_name[k], m1, s1, w1, m2, s2, w2, m3, s3, w3, spd_rms(vg, n), mv,
                 spd_rms(vr, n));
-        if (k == 0) {
+        if (k == 0 && c->o.speed_compare) {
             spd_stats(g, n, &m4, &s4, &w4);
             double mvs = gsl_stats_mean(vs, 1, n);
             fprintf(c->md, "%+.2f ± %.2f %% (%.1f) | %+.3f %%, %.3f %% | ", m4, s4, w4, mvs,
@@ -1257,7 +1262,7 @@ static void speed_batch(ctx *c)
         }
         fprintf(c->md, "%.1f + %.0f coarse (%.0f at a bound) | %.0f / %.0f |\n", nsum / n,
                 ncs / n, at, msg / n, msr / n);
-        if (k == 0 && c->o.speed_coarse > 0) {
+        if (k == 0 && c->o.speed_compare && c->o.speed_coarse > 0) {
             double mf, sf, wf;
             spd_stats(fg, n, &mf, &sf, &wf);
             full_line = 1;
