@@ -42,7 +42,7 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
     sqlite3_stmt *p = NULL, *a = NULL;
     src = sqlite3_prepare_v2(s->db,
         "SELECT id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, "
-        "reason, speed_given_mps, speed_estimated FROM passages WHERE utime >= ?1 AND utime <= ?2 "
+        "reason, speed_given_mps, speed_estimated, n_vehicles, quality FROM passages WHERE utime >= ?1 AND utime <= ?2 "
         "AND (?3 IS NULL OR status = ?3) AND (?4 IS NULL OR lane = ?4) "
         "ORDER BY utime, id", -1, &p, NULL);
     if (src == SQLITE_OK)
@@ -90,6 +90,9 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
         if (rc == 0) rc = st_read_real_or_null(p, 9, &R_SPEED, &o, &r.speed_given_mps, err, errlen);
         if (rc == 0) rc = st_read_int(p, 10, 0, 1, &o, &v, err, errlen);
         r.speed_estimated = (int)v;
+        if (rc == 0) rc = st_read_int(p, 11, 1, 64, &o, &v, err, errlen);
+        r.n_vehicles = (int)v;
+        if (rc == 0) rc = st_read_real_or_null(p, 12, &R_QUALITY, &o, &r.quality, err, errlen);
         if (rc == 0) {
             int asrc;
             int seen = 0;

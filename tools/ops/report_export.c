@@ -524,7 +524,9 @@ static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
         csv_str(f, r->reason);
         fputc(',', f);
         csv_num(f, r->speed_given_mps, "%.3f");
-        fprintf(f, ",%d\n", r->speed_estimated);
+        fprintf(f, ",%d,%d,", r->speed_estimated, r->n_vehicles);
+        csv_num(f, r->quality, "%.4g");
+        fputc('\n', f);
     } else {
         json_t *o = json_object(), *ax = json_array(), *spc = json_array();
         json_object_set_new(o, "time_utc", jstr(iso(r->utime, t)));
@@ -545,6 +547,8 @@ static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
         json_object_set_new(o, "reason", jstr(r->reason));
         json_object_set_new(o, "speed_given_mps", amfi_json_num(r->speed_given_mps));
         json_object_set_new(o, "speed_estimated", json_boolean(r->speed_estimated));
+        json_object_set_new(o, "n_vehicles", json_integer(r->n_vehicles));
+        json_object_set_new(o, "quality", amfi_json_num(r->quality));
         /* streamed: one element at a time, never the whole array */
         if ((c->n > 1 && fputc(',', f) == EOF) ||
             json_dumpf(o, f, JSON_COMPACT | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10))) {
@@ -572,7 +576,7 @@ int export_passages(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_
             fprintf(f, ",axle%d_kg", a);
         for (int a = 1; a < AMFI_MAX_AXLES; a++)
             fprintf(f, ",spacing%d_m", a);
-        fprintf(f, ",status,reason,speed_given_mps,speed_estimated\n");
+        fprintf(f, ",status,reason,speed_given_mps,speed_estimated,n_vehicles,quality\n");
     } else {
         fputc('[', f);
     }
