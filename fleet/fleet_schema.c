@@ -86,17 +86,27 @@ static const char fleet_v3[] =
     "ALTER TABLE passages ADD COLUMN speed_given_mps double precision,\n"
     "  ADD COLUMN speed_estimated integer NOT NULL DEFAULT 0;\n";
 
+/* Version 4: the number of vehicles of the event a passage was weighed in
+ * and its quality figure (site store version 4, issue 13). Rows shipped
+ * before: weighed alone (1), no quality (NULL), as the site store says of
+ * them. */
+static const char fleet_v4[] =
+    "ALTER TABLE passages ADD COLUMN n_vehicles integer NOT NULL DEFAULT 1,\n"
+    "  ADD COLUMN quality double precision;\n";
+
 const struct fleet_migration fleet_migrations[] = {
     {1, "site tables with site_id, fleet_sync_state, fleet views", fleet_v1},
     {2, "fleet_window_trend: indicators with their alerts, per site", fleet_v2},
     {3, "passages: speed_given_mps and speed_estimated", fleet_v3},
+    {4, "passages: n_vehicles and quality", fleet_v4},
 };
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
 
 const struct fleet_table fleet_tables[] = {
     {"passages",
      "id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason, lambda, "
-     "residual_rms, formulation, solve_ms, stored_at, speed_given_mps, speed_estimated", 14,
+     "residual_rms, formulation, solve_ms, stored_at, speed_given_mps, speed_estimated, "
+     "n_vehicles, quality", 14,
      "axles", "passage_id, idx, spacing_m, load_kg", "passage_id"},
     {"indicators",
      "id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state", 10,

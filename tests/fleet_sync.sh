@@ -73,12 +73,13 @@ same() {
 
 case=init
 "$sync" --pg "$PG_CONNINFO" --init-schema 2> "$tmp/init.log" || fail "--init-schema: $(cat "$tmp/init.log")"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 3 ] || fail "schema version"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 4 ] || fail "schema version"
 # a central database of version 1 migrates on the next contact
 pg_q "DROP VIEW fleet_window_trend; ALTER TABLE passages DROP COLUMN speed_given_mps,
-      DROP COLUMN speed_estimated; DELETE FROM fleet_migrations WHERE version > 1"
-"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 3"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 3 ] || fail "not migrated to 3"
+      DROP COLUMN speed_estimated, DROP COLUMN n_vehicles, DROP COLUMN quality;
+      DELETE FROM fleet_migrations WHERE version > 1"
+"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 4"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 4 ] || fail "not migrated to 4"
 pg_q "SELECT count(*) FROM fleet_window_trend" > /dev/null || fail "no fleet_window_trend after migration"
 grep -q password "$tmp/init.log" && fail "log mentions a password"
 
@@ -159,21 +160,21 @@ add_rows "$tmp/c-backup.db" 500  # ids past the mark, but the row at the mark di
 same "$tmp/c.db" site-c
 
 case=old-store
-# a store amfid has not migrated yet (version 2): nothing shipped, exit 1
+# a store amfid has not migrated yet (version 3): nothing shipped, exit 1
 # (retried in follow mode), the message says what to do
 cp "$tmp/a.db" "$tmp/old.db"
-sqlite3 "$tmp/old.db" "PRAGMA user_version = 2; UPDATE meta SET value = 'site-old' WHERE key = 'site.id'"
+sqlite3 "$tmp/old.db" "PRAGMA user_version = 3; UPDATE meta SET value = 'site-old' WHERE key = 'site.id'"
 "$sync" --db "$tmp/old.db" --pg "$PG_CONNINFO" --once 2> "$tmp/old.log"
 rc=$?
-[ $rc = 1 ] || fail "a version-2 store: exit $rc, expected 1"
-grep -q "store schema version 2, this amfi-sync needs" "$tmp/old.log" || fail "message: $(cat "$tmp/old.log")"
-[ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-old'")" = 0 ] || fail "a version-2 store shipped"
+[ $rc = 1 ] || fail "a version-3 store: exit $rc, expected 1"
+grep -q "store schema version 3, this amfi-sync needs" "$tmp/old.log" || fail "message: $(cat "$tmp/old.log")"
+[ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-old'")" = 0 ] || fail "a version-3 store shipped"
 # the new columns ship as they are in the store
 add_rows "$tmp/a.db" 20
-sqlite3 "$tmp/a.db" "UPDATE passages SET speed_given_mps = 26.25, speed_estimated = 1 WHERE id = (SELECT max(id) FROM passages)"
+sqlite3 "$tmp/a.db" "UPDATE passages SET speed_given_mps = 26.25, speed_estimated = 1, n_vehicles = 2, quality = 1.25 WHERE id = (SELECT max(id) FROM passages)"
 "$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync of estimated speeds"
-[ "$(pg_q "SELECT speed_given_mps || ' ' || speed_estimated FROM passages WHERE site_id = 'site-a' ORDER BY id DESC LIMIT 1")" = "26.25 1" ] ||
-    fail "speed_given_mps/speed_estimated not shipped"
+[ "$(pg_q "SELECT speed_given_mps || ' ' || speed_estimated || ' ' || n_vehicles || ' ' || quality FROM passages WHERE site_id = 'site-a' ORDER BY id DESC LIMIT 1")" = "26.25 1 2 1.25" ] ||
+    fail "speed_given_mps/speed_estimated/n_vehicles/quality not shipped"
 same "$tmp/a.db" site-a
 
 case=usage
