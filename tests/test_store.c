@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include "store.h"
+#include "store_fixture.h"
 
 #ifndef AMFI_SCHEMA_DOC
 #error "AMFI_SCHEMA_DOC (path of docs/schema.md) must be defined"
@@ -38,46 +39,12 @@
 
 /* ---- fixtures ------------------------------------------------------------ */
 
-typedef struct fixture {
-    char dir[64];
-    char path[96];
-    amfi_store *s;
-} fixture;
-
-static int setup(void **state)
-{
-    fixture *f = calloc(1, sizeof *f);
-    char err[ERRLEN];
-    if (!f)
-        return -1;
-    snprintf(f->dir, sizeof f->dir, "/tmp/amfi_test_store_XXXXXX");
-    if (!mkdtemp(f->dir))
-        return -1;
-    snprintf(f->path, sizeof f->path, "%s/amfi.db", f->dir);
-    if (amfi_store_open(f->path, 0, &f->s, err, sizeof err) != 0) {
-        fprintf(stderr, "setup: %s\n", err);
-        return -1;
-    }
-    *state = f;
-    return 0;
-}
-
+static int setup(void **state) { return store_fixture_setup(state, "amfi_test_store"); }
 
 static int teardown(void **state)
 {
-    fixture *f = *state;
-    char p[128];
-    amfi_store_close(f->s);
-    amfi_store_remove(f->path);
-    snprintf(p, sizeof p, "%s/other.db", f->dir);
-    amfi_store_remove(p);
-    snprintf(p, sizeof p, "%s/doc.db", f->dir);
-    amfi_store_remove(p);
-    snprintf(p, sizeof p, "%s/not-sqlite.db", f->dir);
-    unlink(p);
-    rmdir(f->dir);
-    free(f);
-    return 0;
+    static const char *const extra[] = {"other.db", "doc.db", "not-sqlite.db", NULL};
+    return store_fixture_teardown(state, extra);
 }
 
 /* A raw connection to the fixture's file, as a user's sqlite3 would be. */

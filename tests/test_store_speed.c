@@ -21,43 +21,13 @@
 #include <unistd.h>
 
 #include "store.h"
+#include "store_fixture.h"
 
 #define ERRLEN 512
 #define DAY_US INT64_C(86400000000)
 
-typedef struct fixture {
-    char dir[64];
-    char path[96];
-    amfi_store *s;
-} fixture;
-
-static int setup(void **state)
-{
-    fixture *f = calloc(1, sizeof *f);
-    char err[ERRLEN];
-    if (!f)
-        return -1;
-    snprintf(f->dir, sizeof f->dir, "/tmp/amfi_test_store_speed_XXXXXX");
-    if (!mkdtemp(f->dir))
-        return -1;
-    snprintf(f->path, sizeof f->path, "%s/amfi.db", f->dir);
-    if (amfi_store_open(f->path, 0, &f->s, err, sizeof err) != 0) {
-        fprintf(stderr, "setup: %s\n", err);
-        return -1;
-    }
-    *state = f;
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    fixture *f = *state;
-    amfi_store_close(f->s);
-    amfi_store_remove(f->path);
-    rmdir(f->dir);
-    free(f);
-    return 0;
-}
+static int setup(void **state) { return store_fixture_setup(state, "amfi_test_store_speed"); }
+static int teardown(void **state) { return store_fixture_teardown(state, NULL); }
 
 /* An ok passage on `lane` weighed with `used` m/s, the detector saying `given`. */
 static void add(amfi_store *s, int64_t vehicle_id, int64_t utime, int lane, double used,
