@@ -16,7 +16,8 @@
  * (argument checks, statement helpers), store_write.c (inserts),
  * store_read.c (what amfid reads back, maintenance), store_report.c (the
  * queries of reports), store_export.c (the passage listing), store_speed.c
- * (the estimated speeds); store_internal.h is shared by them only.
+ * (the estimated speeds), store_environment.c (the environment readings);
+ * store_internal.h is shared by them only.
  *
  * Workload: one writer thread in amfid opens one handle at start-up, adds one
  * passage per vehicle (a few per second at most, one transaction each: the
@@ -65,7 +66,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 4
+#define AMFI_STORE_SCHEMA_VERSION 5
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -166,6 +167,42 @@ int amfi_store_add_truth(amfi_store *s, int64_t vehicle_id, int64_t utime,
                          double gvw_kg, int n_axles, const double *axle_kg,
                          const double *mean_force_N, double speed_true_mps,
                          char *err, size_t errlen);
+
+/* ---- environment (store_environment.c) --------------------------------- */
+
+/* The temperatures the store accepts, °C (environment_t's plausible range). */
+#define AMFI_STORE_MIN_TEMP_C (-60.0)
+#define AMFI_STORE_MAX_TEMP_C 80.0
+
+/* One reading of the bridge's environment (AMFI_ENVIRONMENT). */
+typedef struct amfi_environment_row {
+    int64_t utime;          /* data time of the reading, µs, 0 .. AMFI_STORE_MAX_UTIME */
+    double deck_c;          /* deck temperature, °C, -60 .. 80 */
+    double air_c;           /* air temperature, °C, -60 .. 80 */
+    int64_t received_utime; /* wall clock when amfid received it, µs */
+} amfi_environment_row;
+
+/* Store n readings in one transaction (all or nothing; n 0: nothing). */
+int amfi_store_add_environment(amfi_store *s, const amfi_environment_row *rows, int n,
+                               char *err, size_t errlen);
+
+/* The deck temperature at data time utime: linear between the readings
+ * just before and just after it when they are at most max_gap_us apart;
+ * otherwise the nearer of them when it is within max_gap_us / 2 of utime;
+ * otherwise (or no readings) NaN. 0, or a status. */
+int amfi_store_deck_c_at(amfi_store *s, int64_t utime, int64_t max_gap_us, double *deck_c,
+                         char *err, size_t errlen);
+
+typedef struct amfi_environment_summary {
+    int64_t n;                    /* readings */
+    int64_t utime_first, utime_last; /* µs; 0 when n is 0 */
+    double deck_min_c, deck_max_c;   /* NaN when n is 0 */
+    double air_min_c, air_max_c;
+} amfi_environment_summary;
+
+/* Count, time span and temperature ranges of the stored readings. */
+int amfi_store_environment_summary(amfi_store *s, amfi_environment_summary *out, char *err,
+                                   size_t errlen);
 
 /* ---- indicators and alerts --------------------------------------------- */
 

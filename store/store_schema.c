@@ -200,12 +200,28 @@ static const char schema_v4[] =
     "ALTER TABLE passages ADD COLUMN quality REAL\n"
     "  CHECK (quality >= 1 AND quality <= 1e9);\n";
 
+/* Version 5 (issue 14): the bridge's environment as amfid received it on
+ * the environment channel (environment_t): deck and air temperature at a
+ * data time, and when amfid received it (wall clock, µs). */
+static const char schema_v5[] =
+    "CREATE TABLE environment (\n"
+    "  id             INTEGER PRIMARY KEY,\n"
+    "  utime          INTEGER NOT NULL  -- data time of the reading, µs\n"
+    "                 CHECK (utime BETWEEN 0 AND 253402300799999999),\n"
+    "  deck_c         REAL NOT NULL CHECK (deck_c BETWEEN -60 AND 80),  -- deck temperature, °C\n"
+    "  air_c          REAL NOT NULL CHECK (air_c BETWEEN -60 AND 80),   -- air temperature, °C\n"
+    "  received_utime INTEGER NOT NULL  -- wall clock when amfid received it, µs\n"
+    "                 CHECK (received_utime BETWEEN 0 AND 253402300799999999)\n"
+    ") STRICT;\n"
+    "CREATE INDEX environment_utime ON environment (utime);\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
     {2, "runs: program version and configuration of each start of amfid", schema_v2},
     {3, "passages: speed_given_mps (the detector's) and speed_estimated", schema_v3},
     {4, "passages: n_vehicles (vehicles weighed together) and quality", schema_v4},
+    {5, "environment: deck and air temperature received on the bus", schema_v5},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

@@ -158,7 +158,8 @@ static void test_create_and_reopen(void **state)
     static const char *const objects[] = {
         "passages", "axles", "truth", "truth_axles", "indicators", "alerts",
         "baseline", "meta", "schema_migrations", "daily_trend", "window_trend",
-        "passage_errors", "passages_utime", "passages_status_utime", "runs"};
+        "passage_errors", "passages_utime", "passages_status_utime", "runs",
+        "environment", "environment_utime"};
     for (size_t k = 0; k < sizeof objects / sizeof objects[0]; k++) {
         sqlite3_stmt *st = NULL;
         assert_int_equal(SQLITE_OK, sqlite3_prepare_v2(db,
@@ -811,19 +812,20 @@ static void test_runs_and_migration_from_v1(void **state)
                  "ALTER TABLE passages DROP COLUMN speed_estimated; "
                  "ALTER TABLE passages DROP COLUMN n_vehicles; "
                  "ALTER TABLE passages DROP COLUMN quality; "
+                 "DROP TABLE environment; "
                  "DELETE FROM schema_migrations WHERE version >= 2; PRAGMA user_version = 1");
     sqlite3_close(db);
 
     /* read-only openers do not migrate: they say so */
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 1 is older than this program's 4"));
+    assert_non_null(strstr(err, "schema version 1 is older than this program's 5"));
     assert_null(ro);
 
     /* read-write: migrated, the data kept */
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(4, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(4, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(5, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(5, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM runs"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
     sqlite3_close(db);
@@ -867,17 +869,18 @@ static void test_speed_given_and_migration_from_v2(void **state)
                  "ALTER TABLE passages DROP COLUMN n_vehicles; "
                  "ALTER TABLE passages DROP COLUMN quality; "
                  "UPDATE passages SET speed_mps = 25.0; "
+                 "DROP TABLE environment; "
                  "DELETE FROM schema_migrations WHERE version >= 3; PRAGMA user_version = 2");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 2 is older than this program's 4"));
+    assert_non_null(strstr(err, "schema version 2 is older than this program's 5"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(4, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(4, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(5, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(5, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE speed_given_mps = 25.0 "
                                     "AND speed_mps = 25.0 AND speed_estimated = 0"));
     sqlite3_close(db);
@@ -922,17 +925,18 @@ static void test_event_columns_and_migration_from_v3(void **state)
     /* make it a version-3 file, as amfid before issue 13 left it */
     raw_exec(db, "ALTER TABLE passages DROP COLUMN n_vehicles; "
                  "ALTER TABLE passages DROP COLUMN quality; "
+                 "DROP TABLE environment; "
                  "DELETE FROM schema_migrations WHERE version >= 4; PRAGMA user_version = 3");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 3 is older than this program's 4"));
+    assert_non_null(strstr(err, "schema version 3 is older than this program's 5"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(4, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(4, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(5, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(5, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages WHERE n_vehicles = 1 "
                                     "AND quality IS NULL"));
     sqlite3_close(db);
@@ -940,6 +944,101 @@ static void test_event_columns_and_migration_from_v3(void **state)
     r.n_vehicles = 2;
     r.quality = 4.0;
     assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+}
+
+/* ---- version 5: the environment; a version-4 file migrates ------------------ */
+
+static void test_environment_and_migration_from_v4(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    double t = 0.0;
+    amfi_environment_summary sum;
+    const int64_t H = INT64_C(3600000000); /* an hour, µs */
+    amfi_environment_row rows[3] = {
+        {DAY_US, 10.0, 8.0, DAY_US + 5},
+        {DAY_US + H, 14.0, 9.5, DAY_US + H + 5},
+        {DAY_US + 5 * H, -2.0, -4.0, DAY_US + 5 * H + 5},
+    };
+
+    /* empty table: NaN, a summary of nothing */
+    assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US, H, &t, err, sizeof err));
+    assert_true(isnan(t));
+    assert_int_equal(0, amfi_store_environment_summary(f->s, &sum, err, sizeof err));
+    assert_int_equal(0, sum.n);
+    assert_true(isnan(sum.deck_min_c));
+
+    assert_int_equal(0, amfi_store_add_environment(f->s, rows, 3, err, sizeof err));
+    assert_int_equal(0, amfi_store_add_environment(f->s, rows, 0, err, sizeof err));
+    /* at a reading, between two within the gap (linear), between two too far
+     * apart (the nearer within half the gap, else NaN), outside the readings */
+    assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US, H, &t, err, sizeof err));
+    assert_float_equal(10.0, t, 1e-12);
+    assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US + H / 4, H, &t, err, sizeof err));
+    assert_float_equal(11.0, t, 1e-12);
+    assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US + H + H / 4, H, &t, err, sizeof err));
+    assert_float_equal(14.0, t, 1e-12); /* 4 h gap: nearest, 15 min away */
+    assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US + 3 * H, H, &t, err, sizeof err));
+    assert_true(isnan(t)); /* 2 h from either */
+    assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US + 3 * H, 4 * H, &t, err, sizeof err));
+    assert_float_equal(6.0, t, 1e-12); /* gap 4 h allowed: linear, halfway */
+    assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US + 5 * H + H / 2, H, &t, err, sizeof err));
+    assert_float_equal(-2.0, t, 1e-12);
+    assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US - H, H, &t, err, sizeof err));
+    assert_true(isnan(t));
+    assert_int_equal(0, amfi_store_environment_summary(f->s, &sum, err, sizeof err));
+    assert_int_equal(3, sum.n);
+    assert_int_equal(DAY_US, sum.utime_first);
+    assert_int_equal(DAY_US + 5 * H, sum.utime_last);
+    assert_float_equal(-2.0, sum.deck_min_c, 0);
+    assert_float_equal(14.0, sum.deck_max_c, 0);
+    assert_float_equal(-4.0, sum.air_min_c, 0);
+    assert_float_equal(9.5, sum.air_max_c, 0);
+
+    /* a batch with one bad row stores nothing, and the message names it */
+    amfi_environment_row bad[2] = {{DAY_US + 6 * H, 1.0, 1.0, 1}, {DAY_US + 7 * H, NAN, 1.0, 1}};
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_environment(f->s, bad, 2, err, sizeof err));
+    assert_non_null(strstr(err, "environment[1].deck_c: NaN"));
+    bad[1].deck_c = 81.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_environment(f->s, bad, 2, err, sizeof err));
+    assert_non_null(strstr(err, "environment[1].deck_c"));
+    bad[1].deck_c = 1.0;
+    bad[1].air_c = -61.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_environment(f->s, bad, 2, err, sizeof err));
+    assert_non_null(strstr(err, "environment[1].air_c"));
+    bad[1].air_c = 1.0;
+    bad[1].utime = -1;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_environment(f->s, bad, 2, err, sizeof err));
+    assert_non_null(strstr(err, "environment[1].utime"));
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_environment(f->s, NULL, 1, err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_deck_c_at(f->s, DAY_US, -1, &t, err, sizeof err));
+    assert_int_equal(0, amfi_store_environment_summary(f->s, &sum, err, sizeof err));
+    assert_int_equal(3, sum.n);
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    /* the schema refuses what the checks refuse */
+    sqlite3 *db = raw_open(f->path);
+    assert_int_not_equal(SQLITE_OK, sqlite3_exec(db, "INSERT INTO environment (utime, deck_c, "
+                                                     "air_c, received_utime) VALUES (1, 90, 0, 1)",
+                                                 NULL, NULL, NULL));
+    /* make it a version-4 file, as amfid before issue 14 left it */
+    raw_exec(db, "DROP TABLE environment; "
+                 "DELETE FROM schema_migrations WHERE version >= 5; PRAGMA user_version = 4");
+    sqlite3_close(db);
+    amfi_store *ro = NULL;
+    assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
+    assert_non_null(strstr(err, "schema version 4 is older than this program's 5"));
+    assert_null(ro);
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(5, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(5, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(0, raw_int(db, "SELECT count(*) FROM environment"));
+    sqlite3_close(db);
+    assert_int_equal(0, amfi_store_add_environment(f->s, rows, 2, err, sizeof err));
+    assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US + H / 2, H, &t, err, sizeof err));
+    assert_float_equal(12.0, t, 1e-12);
 }
 
 /* ---- what amfid and amfi-report read back ------------------------------------ */
@@ -1376,6 +1475,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_readonly, setup, teardown),
         cmocka_unit_test_setup_teardown(test_runs_and_migration_from_v1, setup, teardown),
         cmocka_unit_test_setup_teardown(test_event_columns_and_migration_from_v3, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_environment_and_migration_from_v4, setup, teardown),
         cmocka_unit_test_setup_teardown(test_speed_given_and_migration_from_v2, setup, teardown),
         cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),

@@ -1,0 +1,198 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * store_environment.c: the bridge's environment (issue 14): the readings
+ * amfid received on its environment channel (environment_t), stored in
+ * batches (one transaction per batch, all or nothing), the deck temperature
+ * at a given data time (interpolated between the two readings around it
+ * within a maximum gap), and the summary amfi-report prints. Every value
+ * read back is checked as in store_read.c. The caller's thread; the
+ * statements are prepared and finalized per call (no state in the handle).
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "store_internal.h"
+
+static const range R_TEMP = {AMFI_STORE_MIN_TEMP_C, AMFI_STORE_MAX_TEMP_C, 0, "°C"};
+
+static int prepare(amfi_store *s, const char *sql, sqlite3_stmt **st, const char *what,
+                   char *err, size_t errlen)
+{
+    int src = sqlite3_prepare_v2(s->db, sql, -1, st, NULL);
+    if (src != SQLITE_OK) {
+        *st = NULL;
+        return st_db_fail(s, src, what, err, errlen);
+    }
+    return 0;
+}
+
+static int check_row(const amfi_environment_row *r, int k, char *err, size_t errlen)
+{
+    char name[64];
+    snprintf(name, sizeof name, "environment[%d].utime", k);
+    int rc = st_check_utime(name, r->utime, err, errlen);
+    if (rc == 0) {
+        snprintf(name, sizeof name, "environment[%d].received_utime", k);
+        rc = st_check_utime(name, r->received_utime, err, errlen);
+    }
+    if (rc == 0) {
+        snprintf(name, sizeof name, "environment[%d].deck_c", k);
+        rc = st_check_known(name, r->deck_c, &R_TEMP, err, errlen);
+    }
+    if (rc == 0) {
+        snprintf(name, sizeof name, "environment[%d].air_c", k);
+        rc = st_check_known(name, r->air_c, &R_TEMP, err, errlen);
+    }
+    return rc;
+}
+
+int amfi_store_add_environment(amfi_store *s, const amfi_environment_row *rows, int n,
+                               char *err, size_t errlen)
+{
+    sqlite3_stmt *st = NULL;
+    int rc = st_check_handle(s, 1, err, errlen);
+    if (rc == 0 && (n < 0 || (n > 0 && !rows)))
+        rc = st_fail(err, errlen, AMFI_EINVAL, "environment: %d rows at %p", n,
+                     (const void *)rows);
+    for (int k = 0; rc == 0 && k < n; k++)
+        rc = check_row(&rows[k], k, err, errlen);
+    if (rc != 0 || n == 0)
+        return rc;
+    rc = prepare(s,
+                 "INSERT INTO environment (utime, deck_c, air_c, received_utime) "
+                 "VALUES (?1, ?2, ?3, ?4)",
+                 &st, "environment: prepare insert", err, errlen);
+    if (rc == 0)
+        rc = st_begin(s, err, errlen);
+    for (int k = 0; rc == 0 && k < n; k++) {
+        int b = sqlite3_bind_int64(st, 1, rows[k].utime);
+        if (b == SQLITE_OK) b = sqlite3_bind_double(st, 2, rows[k].deck_c);
+        if (b == SQLITE_OK) b = sqlite3_bind_double(st, 3, rows[k].air_c);
+        if (b == SQLITE_OK) b = sqlite3_bind_int64(st, 4, rows[k].received_utime);
+        int src = b == SQLITE_OK ? sqlite3_step(st) : b;
+        if (src != SQLITE_DONE)
+            rc = st_db_fail(s, src, "environment: insert", err, errlen);
+        sqlite3_reset(st);
+        sqlite3_clear_bindings(st);
+    }
+    if (rc == 0)
+        rc = st_commit(s, err, errlen);
+    else if (st)
+        st_rollback(s);
+    sqlite3_finalize(st);
+    return rc;
+}
+
+/* The reading nearest to utime on one side (before: utime <= t, newest;
+ * else utime >= t, oldest): *found 0 when none. */
+static int one_side(amfi_store *s, int64_t t, int before, int64_t *u, double *deck, int *found,
+                    char *err, size_t errlen)
+{
+    sqlite3_stmt *st = NULL;
+    int rc = prepare(s,
+                     before ? "SELECT id, utime, deck_c FROM environment WHERE utime <= ?1 "
+                              "ORDER BY utime DESC, id DESC LIMIT 1"
+                            : "SELECT id, utime, deck_c FROM environment WHERE utime >= ?1 "
+                              "ORDER BY utime ASC, id ASC LIMIT 1",
+                     &st, "environment: prepare lookup", err, errlen);
+    *found = 0;
+    if (rc != 0)
+        return rc;
+    int src = sqlite3_bind_int64(st, 1, t);
+    if (src == SQLITE_OK)
+        src = sqlite3_step(st);
+    if (src == SQLITE_ROW) {
+        origin o = {"environment", sqlite3_column_int64(st, 0)};
+        rc = st_read_int(st, 1, 0, AMFI_STORE_MAX_UTIME, &o, u, err, errlen);
+        if (rc == 0)
+            rc = st_read_real(st, 2, &R_TEMP, &o, deck, err, errlen);
+        *found = rc == 0;
+    } else if (src != SQLITE_DONE) {
+        rc = st_db_fail(s, src, "environment: lookup", err, errlen);
+    }
+    sqlite3_finalize(st);
+    return rc;
+}
+
+int amfi_store_deck_c_at(amfi_store *s, int64_t utime, int64_t max_gap_us, double *deck_c,
+                         char *err, size_t errlen)
+{
+    int rc = st_check_handle(s, 0, err, errlen);
+    if (rc == 0 && !deck_c)
+        rc = st_fail(err, errlen, AMFI_EINVAL, "environment: output is NULL");
+    if (rc == 0)
+        rc = st_check_utime("environment: utime asked", utime, err, errlen);
+    if (rc == 0 && max_gap_us < 0)
+        rc = st_fail(err, errlen, AMFI_EINVAL, "environment: max_gap_us %lld is negative",
+                     (long long)max_gap_us);
+    if (rc != 0)
+        return rc;
+    *deck_c = NAN;
+    int64_t u0 = 0, u1 = 0;
+    double d0 = NAN, d1 = NAN;
+    int f0 = 0, f1 = 0;
+    rc = one_side(s, utime, 1, &u0, &d0, &f0, err, errlen);
+    if (rc == 0)
+        rc = one_side(s, utime, 0, &u1, &d1, &f1, err, errlen);
+    if (rc != 0)
+        return rc;
+    if (f0 && f1) {
+        if (u1 == u0) /* a reading at utime itself */
+            *deck_c = d0;
+        else if (u1 - u0 <= max_gap_us) /* between two readings close enough */
+            *deck_c = d0 + (d1 - d0) * (double)(utime - u0) / (double)(u1 - u0);
+        else if (utime - u0 <= max_gap_us / 2) /* nearest, within half the gap */
+            *deck_c = d0;
+        else if (u1 - utime <= max_gap_us / 2)
+            *deck_c = d1;
+    } else if (f0 && utime - u0 <= max_gap_us / 2) { /* after the last reading */
+        *deck_c = d0;
+    } else if (f1 && u1 - utime <= max_gap_us / 2) { /* before the first */
+        *deck_c = d1;
+    }
+    return 0;
+}
+
+int amfi_store_environment_summary(amfi_store *s, amfi_environment_summary *out, char *err,
+                                   size_t errlen)
+{
+    sqlite3_stmt *st = NULL;
+    int rc = st_check_handle(s, 0, err, errlen);
+    if (rc == 0 && !out)
+        rc = st_fail(err, errlen, AMFI_EINVAL, "environment: output is NULL");
+    if (rc == 0)
+        rc = prepare(s,
+                     "SELECT count(*), min(utime), max(utime), min(deck_c), max(deck_c), "
+                     "min(air_c), max(air_c) FROM environment",
+                     &st, "environment: prepare summary", err, errlen);
+    if (rc != 0)
+        return rc;
+    amfi_environment_summary r;
+    memset(&r, 0, sizeof r);
+    r.deck_min_c = r.deck_max_c = r.air_min_c = r.air_max_c = NAN;
+    origin o = {"environment", -1};
+    int src = sqlite3_step(st);
+    if (src == SQLITE_ROW) {
+        rc = st_read_int(st, 0, 0, INT64_MAX, &o, &r.n, err, errlen);
+        if (rc == 0 && r.n > 0)
+            rc = st_read_int(st, 1, 0, AMFI_STORE_MAX_UTIME, &o, &r.utime_first, err, errlen);
+        if (rc == 0 && r.n > 0)
+            rc = st_read_int(st, 2, 0, AMFI_STORE_MAX_UTIME, &o, &r.utime_last, err, errlen);
+        if (rc == 0 && r.n > 0)
+            rc = st_read_real(st, 3, &R_TEMP, &o, &r.deck_min_c, err, errlen);
+        if (rc == 0 && r.n > 0)
+            rc = st_read_real(st, 4, &R_TEMP, &o, &r.deck_max_c, err, errlen);
+        if (rc == 0 && r.n > 0)
+            rc = st_read_real(st, 5, &R_TEMP, &o, &r.air_min_c, err, errlen);
+        if (rc == 0 && r.n > 0)
+            rc = st_read_real(st, 6, &R_TEMP, &o, &r.air_max_c, err, errlen);
+    } else {
+        rc = st_db_fail(s, src, "environment: summary", err, errlen);
+    }
+    sqlite3_finalize(st);
+    if (rc == 0)
+        *out = r;
+    return rc;
+}
