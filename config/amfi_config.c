@@ -99,6 +99,7 @@ void amfi_config_defaults(amfi_site_config *c)
     d->recv_buf_bytes = 4194304;
     d->bus_queue = 20000;
     d->ring_s = 60.0;
+    d->environment_max_skew_s = 3600.0;
     d->margin_s = 0.05;
     d->max_wait_s = 10.0;
     d->max_event_s = 10.0;

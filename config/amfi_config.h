@@ -44,6 +44,9 @@ typedef struct amfi_daemon_config {
     int bus_queue;            /* daemon.bus_queue: messages LCM keeps per input channel
                                  between its receive thread and amfid, 30 .. 1000000 */
     double ring_s;            /* daemon.ring_s: seconds of samples kept per sensor */
+    double environment_max_skew_s; /* daemon.environment_max_skew_s: an environment_t
+                                 further than this from the stream's newest data
+                                 time is refused, s, 1 .. 864000 */
     double margin_s;          /* daemon.window_margin_s: data around the solver window */
     double max_wait_s;        /* daemon.max_wait_s: data time to wait for a window */
     double max_event_s;       /* daemon.max_event_s: vehicles sharing the span are

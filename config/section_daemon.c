@@ -71,6 +71,8 @@ const field daemon_fields[] = {
      .hi = 1073741824},
     {.key = "bus_queue", .kind = &K_INT, .off = DC(bus_queue), .lo = 30, .hi = 1000000},
     {.key = "ring_s", .kind = &K_DOUBLE, .off = DC(ring_s), .lo = 5, .hi = 3600},
+    {.key = "environment_max_skew_s", .kind = &K_DOUBLE, .off = DC(environment_max_skew_s),
+     .lo = 1, .hi = 864000},
     {.key = "window_margin_s", .kind = &K_DOUBLE, .off = DC(margin_s), .lo = 0, .hi = 5},
     {.key = "max_wait_s", .kind = &K_DOUBLE, .off = DC(max_wait_s), .lo = 0, .hi = 3600,
      .flags = F_LO_OPEN},

@@ -319,6 +319,11 @@ int amfid_drain(daemon_s *d)
         record_intake(d, 1);
     if (d->passages_lost > 0)
         rc = 1; /* acknowledged passages are safe; these never were */
+    if (d->env.received + d->env.rejected > 0)
+        LOG_INFO("environment: %lld readings received, %lld refused, %lld stored, %lld not "
+                 "stored (%d still buffered: the store refused them)",
+                 (long long)d->env.received, (long long)d->env.rejected,
+                 (long long)d->env.stored, (long long)d->env.lost, d->env.n);
     LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld messages received: "
              "%lld blocks, %lld vehicles, %lld rejected messages",
              (long long)d->passages_stored, (long long)d->passages_ok,

@@ -13,7 +13,7 @@
  * line), intake.c (bus handlers, validation, windows to jobs), pool.c (job
  * queues, solver threads), pipeline.c (in-order store, indicators,
  * publish), control.c (configuration, heartbeat, reload, restart state),
- * drift.c (the speed-drift alert).
+ * drift.c (the speed-drift alert), environment.c (the environment input).
  */
 #ifndef AMFID_H
 #define AMFID_H
@@ -67,7 +67,7 @@ void amfid_parse_options(int argc, char **argv, amfid_options *o);
 /* Refused bus messages (reject.c): per input and reason. The reasons are
  * the raw-buffer checker's (amfi_msg_reason, messages/amfi_msg_check.h) and
  * REJECT_INVALID, a message that decoded but failed amfid's validation. */
-enum { REJECT_ACCEL, REJECT_VEHICLE, REJECT_TRUTH, REJECT_NINPUTS };
+enum { REJECT_ACCEL, REJECT_VEHICLE, REJECT_TRUTH, REJECT_ENVIRONMENT, REJECT_NINPUTS };
 #define REJECT_INVALID AMFI_MSG_NREASONS
 #define REJECT_QUARANTINE (AMFI_MSG_NREASONS + 1) /* an accel block far from the stream */
 #define REJECT_NREASONS (AMFI_MSG_NREASONS + 2)
@@ -78,6 +78,15 @@ typedef struct reject_state {
     int logged;                                             /* lines logged this period */
     double period_start;                                    /* amfi_mono_s() */
 } reject_state;
+
+/* Environment readings waiting to be stored (environment.c). */
+#define ENV_BUF 64
+typedef struct env_state {
+    amfi_environment_row buf[ENV_BUF];
+    int n;                 /* readings in buf, oldest first */
+    int failing;           /* the last flush failed (logged once) */
+    int64_t received, rejected, stored, lost; /* since start */
+} env_state;
 
 /* Alert notices (notify.c). */
 #define NOTIFY_MAX_RUNNING 64 /* alerts.command_max_running's upper bound */
@@ -139,6 +148,7 @@ typedef struct daemon_s {
     int64_t newest_utime;
     int64_t udp_drops, udp_drops_logged; /* kernel drops on our sockets */
     reject_state rej;
+    env_state env;                 /* environment readings (environment.c) */
     /* passages the store could not take (disk full, I/O error, read-only):
      * held in order and retried (pipeline.c); nothing acknowledged is lost */
     job **held;
@@ -203,6 +213,14 @@ const char *reject_reason_name(int reason);
 int intake_subscribe(daemon_s *d);
 /* Windows the tracker has decided: to the solvers, or straight to the store. */
 void release_windows(daemon_s *d, int flush);
+
+/* ---- environment input (environment.c), main thread ----------------------- */
+
+/* The LCM handler of daemon.channels.environment: check, count, buffer. */
+void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user);
+/* Store the buffered readings in one transaction (heartbeat, full, stop);
+ * on failure they stay buffered and the next flush retries. */
+void environment_flush(daemon_s *d);
 
 /* ---- in-order pipeline (pipeline.c), main thread -------------------------- */
 

@@ -107,7 +107,11 @@ void record_intake(daemon_s *d, int force)
               {"intake.messages_refused", (long long)d->rej.total},
               {"intake.datagrams_dropped", (long long)(d->udp_drops > 0 ? d->udp_drops : 0)},
               {"intake.samples_missing", (long long)d->samples_missing},
-              {"intake.passages_lost", (long long)d->passages_lost}};
+              {"intake.passages_lost", (long long)d->passages_lost},
+              {"intake.environment_received", (long long)d->env.received},
+              {"intake.environment_refused", (long long)d->env.rejected},
+              {"intake.environment_stored", (long long)d->env.stored},
+              {"intake.environment_lost", (long long)d->env.lost}};
     char err[256], val[32];
     int rc = 0;
     for (size_t i = 0; rc == 0 && i < sizeof kv / sizeof kv[0]; i++) {
@@ -124,6 +128,7 @@ void record_intake(daemon_s *d, int force)
 
 void heartbeat(daemon_s *d)
 {
+    environment_flush(d);
     int64_t missing = 0, rejected_ring = 0;
     for (int i = 0; i < d->cfg.solver.n_sensors; i++)
         if (d->rings[i]) {
@@ -187,6 +192,7 @@ void reload(daemon_s *d)
     if (strcmp(n.daemon.ch_accel, d->cfg.daemon.ch_accel) ||
         strcmp(n.daemon.ch_vehicle, d->cfg.daemon.ch_vehicle) ||
         strcmp(n.daemon.ch_truth, d->cfg.daemon.ch_truth) ||
+        strcmp(n.daemon.ch_environment, d->cfg.daemon.ch_environment) ||
         n.daemon.workers != d->cfg.daemon.workers ||
         n.daemon.queue_size != d->cfg.daemon.queue_size || n.daemon.ring_s != d->cfg.daemon.ring_s ||
         n.daemon.sync_full != d->cfg.daemon.sync_full ||
@@ -204,6 +210,7 @@ void reload(daemon_s *d)
     memcpy(d->cfg.daemon.ch_status, n.daemon.ch_status, sizeof n.daemon.ch_status);
     d->cfg.daemon.status_period_s = n.daemon.status_period_s;
     d->cfg.daemon.max_wait_s = n.daemon.max_wait_s;
+    d->cfg.daemon.environment_max_skew_s = n.daemon.environment_max_skew_s;
     amfi_indicator_params ip;
     indicator_params(&n.daemon, &ip);
     if (!amfi_indicator_params_equal(&ip, &d->ind_params) ||

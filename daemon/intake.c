@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * intake.c: amfid's bus intake: the LCM handlers of accelerometer blocks,
- * vehicle events and (simulations) the truth, each message validated where
+ * vehicle events and (simulations) the truth (the environment's handler is
+ * in environment.c, subscribed here), each message validated where
  * it enters (messages name the channel and the field); samples into the
  * rings, vehicles into the tracker; and the windows the tracker decides,
  * filled from the rings into jobs for the solver pool (or straight to the
@@ -281,10 +282,10 @@ static void on_truth(const lcm_recv_buf_t *rb, const char *ch, void *user)
  * than half of a 2 500 messages/s stream lost, docs/daemon.md). */
 int intake_subscribe(daemon_s *d)
 {
-    const char *ch[3] = {d->cfg.daemon.ch_accel, d->cfg.daemon.ch_vehicle,
-                         d->cfg.daemon.ch_truth};
-    lcm_msg_handler_t fn[3] = {on_accel, on_vehicle, on_truth};
-    for (int i = 0; i < 3; i++) {
+    const char *ch[4] = {d->cfg.daemon.ch_accel, d->cfg.daemon.ch_vehicle,
+                         d->cfg.daemon.ch_truth, d->cfg.daemon.ch_environment};
+    lcm_msg_handler_t fn[4] = {on_accel, on_vehicle, on_truth, environment_on_message};
+    for (int i = 0; i < 4; i++) {
         lcm_subscription_t *s = lcm_subscribe(d->lcm, ch[i], fn[i], d);
         if (!s || lcm_subscription_set_queue_capacity(s, d->cfg.daemon.bus_queue) != 0) {
             LOG_ERR("cannot subscribe to '%s' with a queue of %d messages", ch[i],

@@ -147,7 +147,8 @@ static void write_all(daemon_s *d, FILE *f)
     fprintf(f, "amfi_messages_received_total %lld\n", (long long)d->messages_in);
     head(f, "amfi_messages_refused_total", "counter",
          "Bus messages refused, by input and reason.");
-    static const char *const inputs[REJECT_NINPUTS] = {"accel", "vehicle", "truth"};
+    static const char *const inputs[REJECT_NINPUTS] = {"accel", "vehicle", "truth",
+                                                         "environment"};
     for (int i = 0; i < REJECT_NINPUTS; i++)
         for (int k = 0; k < REJECT_NREASONS; k++)
             if (d->rej.count[i][k] > 0)

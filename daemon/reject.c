@@ -20,7 +20,8 @@
 #define REJECT_LOG_BURST 20
 #define REJECT_LOG_PERIOD_S 60.0
 
-static const char *const input_name[REJECT_NINPUTS] = {"accel", "vehicle", "truth"};
+static const char *const input_name[REJECT_NINPUTS] = {"accel", "vehicle", "truth",
+                                                         "environment"};
 
 const char *reject_reason_name(int reason)
 {
@@ -36,6 +37,7 @@ static const char *channel_of(const daemon_s *d, int input)
     switch (input) {
     case REJECT_ACCEL: return d->cfg.daemon.ch_accel;
     case REJECT_VEHICLE: return d->cfg.daemon.ch_vehicle;
+    case REJECT_ENVIRONMENT: return d->cfg.daemon.ch_environment;
     default: return d->cfg.daemon.ch_truth;
     }
 }

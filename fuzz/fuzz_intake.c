@@ -7,7 +7,8 @@
  * so that an input reproduces alone.
  *
  * Input: records [u8 channel][u16 length, little-endian][length bytes]; the
- * channel byte modulo 3 picks AMFI_ACCEL, AMFI_VEHICLE or AMFI_TRUTH; a
+ * channel byte modulo 4 picks AMFI_ACCEL, AMFI_VEHICLE, AMFI_TRUTH or
+ * AMFI_ENVIRONMENT; a
  * record cut short is published as far as it goes. After each message amfid
  * does what its loop does (handle, release windows, complete results, retry).
  * Seeds: fuzz/corpus/intake/ (fuzz/make_corpus.sh: sim_publisher traffic
@@ -74,10 +75,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     remove_store();
     if (amfid_start(&d, &o) != 0)
         finding("amfid_start failed", 0, 0);
-    const char *ch[3] = {d.cfg.daemon.ch_accel, d.cfg.daemon.ch_vehicle, d.cfg.daemon.ch_truth};
+    const char *ch[4] = {d.cfg.daemon.ch_accel, d.cfg.daemon.ch_vehicle, d.cfg.daemon.ch_truth,
+                         d.cfg.daemon.ch_environment};
     size_t at = 0;
     while (at < size) {
-        int c = data[at] % 3;
+        int c = data[at] % 4;
         size_t len = at + 2 < size ? (size_t)data[at + 1] | (size_t)data[at + 2] << 8 : 0;
         at += 3;
         if (at > size)

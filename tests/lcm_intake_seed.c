@@ -2,7 +2,8 @@
 /*
  * lcm_intake_seed: turn an LCM log (sim_publisher --log) into a seed of the
  * fuzz target fuzz_intake (fuzz/fuzz_intake.c): one record per AMFI_ACCEL,
- * AMFI_VEHICLE or AMFI_TRUTH event, [u8 channel 0/1/2][u16 length LE][bytes],
+ * AMFI_VEHICLE, AMFI_TRUTH or AMFI_ENVIRONMENT event, [u8 channel 0/1/2/3]
+ * [u16 length LE][bytes],
  * in log order; other channels and events over 65535 bytes are skipped.
  * Used by fuzz/make_corpus.sh.
  *
@@ -31,11 +32,12 @@ int main(int argc, char **argv)
         lcm_eventlog_destroy(in);
         return 1;
     }
-    static const char *const names[3] = {"AMFI_ACCEL", "AMFI_VEHICLE", "AMFI_TRUTH"};
+    static const char *const names[4] = {"AMFI_ACCEL", "AMFI_VEHICLE", "AMFI_TRUTH",
+                                         "AMFI_ENVIRONMENT"};
     lcm_eventlog_event_t *e;
     long n = 0;
     while ((max < 0 || n < max) && (e = lcm_eventlog_read_next_event(in)) != NULL) {
-        for (int c = 0; c < 3; c++) {
+        for (int c = 0; c < 4; c++) {
             if (strcmp(e->channel, names[c]) || e->datalen < 0 || e->datalen > 65535)
                 continue;
             unsigned char h[3] = {(unsigned char)c, (unsigned char)(e->datalen & 0xff),

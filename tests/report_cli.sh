@@ -40,9 +40,12 @@ awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
     cat "$tmp/ddl.sql"
     cat <<'EOF'
 PRAGMA journal_mode = WAL;
-PRAGMA user_version = 4;
+PRAGMA user_version = 5;
 INSERT INTO schema_migrations (version, description) VALUES (1, 'report_cli fixture'), (2, 'runs'),
-    (3, 'speed_given_mps'), (4, 'n_vehicles');
+    (3, 'speed_given_mps'), (4, 'n_vehicles'), (5, 'environment');
+WITH RECURSIVE k(i) AS (SELECT 0 UNION ALL SELECT i + 1 FROM k WHERE i < 11)
+INSERT INTO environment (utime, deck_c, air_c, received_utime)
+SELECT 1763769600000000 + i * 7200000000, -3.25 + i, -6.0 + 0.5 * i, 1763769600000000 FROM k;
 WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 40)
 INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status,
                       reason, lambda, residual_rms, formulation, solve_ms, speed_given_mps)
@@ -129,6 +132,7 @@ if ok summary --db "$db" --summary; then
     has "^GVW, ok +n 36, mean $mean kg, STD $std kg, min 15000, median [0-9]+, max 21000 kg$"
     has '^time span +2025-11-22 01:00:00 \.\. 2025-11-23 16:00:00 UTC \(39\.0 h\)$'
     has '^baseline +mean 17800 kg, STD 1900 kg, n 30, auto, from 2025-11-22 00:00:00 UTC$'
+    has '^temperature +deck -3\.2 \.\. 7\.8 °C, air -6\.0 \.\. -0\.5 °C, 12 readings, 2025-11-22 00:00:00 \.\. 2025-11-22 22:00:00 UTC$'
     hasnt '^== indicators'
 fi
 
@@ -415,7 +419,7 @@ bad foreign 1 'not an amfi store' --db "$tmp/recipes.db"
 
 cp "$tmp/pristine.db" "$tmp/newer.db"
 sqlite3 "$tmp/newer.db" "PRAGMA user_version = 7"
-bad newer 1 'schema version 7 is newer than this program.s 4' --db "$tmp/newer.db"
+bad newer 1 'schema version 7 is newer than this program.s 5' --db "$tmp/newer.db"
 
 cp "$tmp/pristine.db" "$tmp/damaged.db"
 sqlite3 "$tmp/damaged.db" "PRAGMA ignore_check_constraints = ON; UPDATE passages SET gvw_kg = -1 WHERE id = 3"
@@ -477,7 +481,7 @@ if command -v gnuplot > /dev/null; then
     fi
     # an empty store still draws (empty plots saying so), a missing dir parent fails
     sqlite3 "$tmp/empty.db" < "$tmp/ddl.sql"
-    sqlite3 "$tmp/empty.db" "PRAGMA user_version = 4; INSERT INTO schema_migrations (version, description) VALUES (1, 'e'), (2, 'e'), (3, 'e'), (4, 'e')"
+    sqlite3 "$tmp/empty.db" "PRAGMA user_version = 5; INSERT INTO schema_migrations (version, description) VALUES (1, 'e'), (2, 'e'), (3, 'e'), (4, 'e'), (5, 'e')"
     if ok plot-empty --db "$tmp/empty.db" --plot "$tmp/plots-empty"; then
         for p in gvw trend gvw_histogram passages_per_hour speed; do png_ok "$tmp/plots-empty/$p.png"; done
     fi

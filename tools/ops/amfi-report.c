@@ -487,6 +487,14 @@ static int section_summary(amfi_store *s)
         out("bus          run %lld (as of %s): %lld messages received, %lld refused, "
             "%lld kernel drops, %lld samples missing, %lld passages not stored\n",
             in.run, in.as_of, in.received, in.refused, in.dropped, in.missing, in.lost);
+    amfi_environment_summary env;
+    if (amfi_store_environment_summary(s, &env, err, sizeof err) != 0)
+        return data_error("%s", err);
+    if (env.n > 0)
+        out("temperature  deck %.1f .. %.1f °C, air %.1f .. %.1f °C, %lld readings, "
+            "%s .. %s UTC\n",
+            env.deck_min_c, env.deck_max_c, env.air_min_c, env.air_max_c, (long long)env.n,
+            utc(env.utime_first, a), utc(env.utime_last, b));
     return print_baseline(s);
 }
 

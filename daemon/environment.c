@@ -1,0 +1,103 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * environment.c: amfid's environment input (issue 14): the environment_t
+ * readings (deck and air temperature) on daemon.channels.environment,
+ * checked where they enter (the raw bytes against the type, then every
+ * field: finite, -60 .. 80 °C, utime in the store's range and within
+ * daemon.environment_max_skew_s of the stream's newest data time); a refused
+ * one is counted and logged as the other inputs' (reject.c). Accepted ones
+ * wait in a small buffer and are stored in batches, one transaction each,
+ * from the heartbeat (every daemon.status_period_s), when the buffer is
+ * full, and at stop: intake never waits for more than one batch.
+ *
+ * Thread: the main thread only (the bus handler inside lcm_handle, the
+ * heartbeat, the drain). Owns d->env (the buffer and its counters).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+#include "amfi_environment_t.h"
+#include "amfid.h"
+
+static int64_t wall_now_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+static int temp_ok(double c)
+{
+    return isfinite(c) && c >= AMFI_STORE_MIN_TEMP_C && c <= AMFI_STORE_MAX_TEMP_C;
+}
+
+void environment_flush(daemon_s *d)
+{
+    env_state *e = &d->env;
+    if (e->n == 0 || !d->store)
+        return;
+    char err[256];
+    int rc = amfi_store_add_environment(d->store, e->buf, e->n, err, sizeof err);
+    if (rc == 0) {
+        e->stored += e->n;
+        e->n = 0;
+        e->failing = 0;
+    } else if (!e->failing) { /* kept and retried at the next flush; logged once */
+        e->failing = 1;
+        LOG_WARN("store: %d environment readings not stored yet (retried): %s", e->n, err);
+    }
+}
+
+void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    daemon_s *d = user;
+    env_state *e = &d->env;
+    d->messages_in++;
+    amfi_environment_t m;
+    char cwhy[160];
+    int cr = amfi_msg_decode_checked(AMFI_MSG_ENVIRONMENT_T, rb->data, rb->data_size, &m, cwhy,
+                                     sizeof cwhy);
+    if (cr != AMFI_MSG_OK) { /* nothing decoded, nothing allocated */
+        d->messages_malformed++;
+        e->rejected++;
+        reject_note(d, REJECT_ENVIRONMENT, cr,
+                    "%s: malformed environment_t (%u bytes) rejected: %s", ch, rb->data_size,
+                    cwhy);
+        return;
+    }
+    e->received++;
+    const double skew_s = d->cfg.daemon.environment_max_skew_s;
+    char why[160] = "";
+    if (m.utime <= 0 || m.utime > AMFI_STORE_MAX_UTIME)
+        snprintf(why, sizeof why, "utime %lld out of (0, year 9999]", (long long)m.utime);
+    else if (d->newest_utime > 0 && fabs((double)m.utime - (double)d->newest_utime) > 1e6 * skew_s)
+        snprintf(why, sizeof why,
+                 "utime %lld is %.0f s from the stream's newest data time (more than "
+                 "daemon.environment_max_skew_s %.0f s)",
+                 (long long)m.utime, 1e-6 * ((double)m.utime - (double)d->newest_utime), skew_s);
+    else if (!temp_ok(m.deck_c))
+        snprintf(why, sizeof why, "deck_c %.6g is not a temperature in [-60, 80] °C", m.deck_c);
+    else if (!temp_ok(m.air_c))
+        snprintf(why, sizeof why, "air_c %.6g is not a temperature in [-60, 80] °C", m.air_c);
+    if (why[0]) {
+        e->rejected++;
+        reject_note(d, REJECT_ENVIRONMENT, REJECT_INVALID, "%s: environment_t rejected: %s", ch,
+                    why);
+        return;
+    }
+    if (e->n == ENV_BUF) {
+        environment_flush(d);
+        if (e->n == ENV_BUF) { /* the store refuses: the oldest reading goes */
+            memmove(e->buf, e->buf + 1, sizeof e->buf[0] * (ENV_BUF - 1));
+            e->n--;
+            e->lost++;
+        }
+    }
+    amfi_environment_row *r = &e->buf[e->n++];
+    r->utime = m.utime;
+    r->deck_c = m.deck_c;
+    r->air_c = m.air_c;
+    r->received_utime = wall_now_us();
+}
