@@ -320,10 +320,14 @@ int amfid_drain(daemon_s *d)
     if (d->passages_lost > 0)
         rc = 1; /* acknowledged passages are safe; these never were */
     if (d->env.received + d->env.rejected > 0)
-        LOG_INFO("environment: %lld readings received, %lld refused, %lld stored, %lld not "
-                 "stored (%d still buffered: the store refused them)",
+        LOG_INFO("environment: %lld readings decoded, %lld refused, %lld stored%s",
                  (long long)d->env.received, (long long)d->env.rejected,
-                 (long long)d->env.stored, (long long)d->env.lost, d->env.n);
+                 (long long)d->env.stored,
+                 d->env.lost + d->env.n > 0 ? ", some not stored (the store refused them)" : "");
+    if (d->env.lost + d->env.n > 0)
+        LOG_WARN("environment: %lld readings dropped while the store refused them, %d still "
+                 "buffered at stop: not stored",
+                 (long long)d->env.lost, d->env.n);
     LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld messages received: "
              "%lld blocks, %lld vehicles, %lld rejected messages",
              (long long)d->passages_stored, (long long)d->passages_ok,

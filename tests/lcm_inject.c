@@ -21,8 +21,17 @@
  * failed, blocking every passage behind it).
  *
  *   lcm_inject --scale-accel F IN.log OUT.log
+ *
+ * With --bad-environment, OUT.log gets only environment_t messages after
+ * IN.log's last one (tests/daemon_environment.sh): 40 random bytes
+ * (malformed), a reading with deck_c NaN, one with air_c 95 °C, one dated 10
+ * days after the stream, then one good reading 1 s after IN.log's last.
+ *
+ *   lcm_inject --bad-environment IN.log OUT.log
  */
 #include <lcm/eventlog.h>
+#include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -97,14 +106,67 @@ static int scale_accel(double f, const char *inp, const char *outp)
     return rc ? 1 : 0;
 }
 
+static int put_env(lcm_eventlog_t *out, int64_t *num, int64_t ts, int64_t utime, double deck,
+                   double air)
+{
+    amfi_environment_t m = {utime, air, deck};
+    unsigned char b[64];
+    int n = amfi_environment_t_encode(b, 0, sizeof b, &m);
+    return n < 0 || put(out, num, ts, AMFI_CHANNEL_ENVIRONMENT, b, n);
+}
+
+static int bad_environment(const char *inp, const char *outp)
+{
+    lcm_eventlog_t *in = lcm_eventlog_create(inp, "r");
+    lcm_eventlog_t *out = lcm_eventlog_create(outp, "w");
+    if (!in || !out) {
+        fprintf(stderr, "lcm_inject: cannot open the logs\n");
+        return 1;
+    }
+    lcm_eventlog_event_t *e;
+    int64_t num = 0, last = -1, ts = 0;
+    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
+        amfi_environment_t m;
+        if (strcmp(e->channel, AMFI_CHANNEL_ENVIRONMENT) == 0 &&
+            amfi_environment_t_decode(e->data, 0, e->datalen, &m) >= 0) {
+            last = m.utime;
+            ts = e->timestamp;
+        }
+        lcm_eventlog_free_event(e);
+    }
+    lcm_eventlog_destroy(in);
+    int rc = 0;
+    if (last < 0) {
+        fprintf(stderr, "lcm_inject: no environment_t in %s\n", inp);
+        rc = 1;
+    } else {
+        unsigned char junk[40];
+        srand(11);
+        for (size_t k = 0; k < sizeof junk; k++)
+            junk[k] = (unsigned char)rand();
+        rc |= put(out, &num, ts, AMFI_CHANNEL_ENVIRONMENT, junk, (int)sizeof junk);
+        rc |= put_env(out, &num, ts + 1000, last, NAN, 10.0);
+        rc |= put_env(out, &num, ts + 2000, last, 10.0, 95.0);
+        rc |= put_env(out, &num, ts + 3000, last + INT64_C(864000000000), 10.0, 10.0);
+        rc |= put_env(out, &num, ts + 4000, last + 1000000, 5.5, 4.5);
+        if (rc)
+            fprintf(stderr, "lcm_inject: write failed\n");
+    }
+    lcm_eventlog_destroy(out);
+    return rc ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 4 && strcmp(argv[1], "--bad-environment") == 0)
+        return bad_environment(argv[2], argv[3]);
     if (argc == 5 && strcmp(argv[1], "--scale-accel") == 0)
         return scale_accel(atof(argv[2]), argv[3], argv[4]);
     if (argc == 4 && strcmp(argv[1], "--vehicles-only") == 0)
         return vehicles_only(argv[2], argv[3]);
     if (argc != 3) {
-        fprintf(stderr, "usage: lcm_inject [--vehicles-only] IN.log OUT.log\n");
+        fprintf(stderr, "usage: lcm_inject [--vehicles-only | --bad-environment | "
+                        "--scale-accel F] IN.log OUT.log\n");
         return 2;
     }
     lcm_eventlog_t *in = lcm_eventlog_create(argv[1], "r");
