@@ -211,6 +211,11 @@ const char *reject_reason_name(int reason);
 /* Subscribe the three inputs with queues of daemon.bus_queue messages:
  * 0, or −1 (logged). */
 int intake_subscribe(daemon_s *d);
+/* Count a message of `input` and decode it (the raw bytes checked against
+ * the type first): 0, or −1 when malformed (counted, logged, nothing left
+ * to free). tname: the type's name for the message. */
+int intake_decode(daemon_s *d, amfi_msg_type type, int input, const char *tname,
+                  const lcm_recv_buf_t *rb, const char *ch, void *m);
 /* Windows the tracker has decided: to the solvers, or straight to the store. */
 void release_windows(daemon_s *d, int flush);
 

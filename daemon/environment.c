@@ -54,17 +54,10 @@ void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user
 {
     daemon_s *d = user;
     env_state *e = &d->env;
-    d->messages_in++;
     amfi_environment_t m;
-    char cwhy[160];
-    int cr = amfi_msg_decode_checked(AMFI_MSG_ENVIRONMENT_T, rb->data, rb->data_size, &m, cwhy,
-                                     sizeof cwhy);
-    if (cr != AMFI_MSG_OK) { /* nothing decoded, nothing allocated */
-        d->messages_malformed++;
+    if (intake_decode(d, AMFI_MSG_ENVIRONMENT_T, REJECT_ENVIRONMENT, "environment_t", rb, ch,
+                      &m)) {
         e->rejected++;
-        reject_note(d, REJECT_ENVIRONMENT, cr,
-                    "%s: malformed environment_t (%u bytes) rejected: %s", ch, rb->data_size,
-                    cwhy);
         return;
     }
     e->received++;

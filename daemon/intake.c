@@ -82,6 +82,20 @@ void release_windows(daemon_s *d, int flush)
 
 /* ---- bus handlers: validate at the boundary ---------------------------- */
 
+int intake_decode(daemon_s *d, amfi_msg_type type, int input, const char *tname,
+                  const lcm_recv_buf_t *rb, const char *ch, void *m)
+{
+    d->messages_in++;
+    char cwhy[160];
+    int cr = amfi_msg_decode_checked(type, rb->data, rb->data_size, m, cwhy, sizeof cwhy);
+    if (cr == AMFI_MSG_OK)
+        return 0;
+    d->messages_malformed++; /* nothing decoded, nothing allocated */
+    reject_note(d, input, cr, "%s: malformed %s (%u bytes) rejected: %s", ch, tname,
+                rb->data_size, cwhy);
+    return -1;
+}
+
 static int sensor_index(const daemon_s *d, int id)
 {
     for (int i = 0; i < d->cfg.solver.n_sensors; i++)
@@ -93,17 +107,9 @@ static int sensor_index(const daemon_s *d, int id)
 static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     daemon_s *d = user;
-    d->messages_in++;
     amfi_accel_block_t m;
-    char cwhy[160];
-    int cr = amfi_msg_decode_checked(AMFI_MSG_ACCEL_BLOCK_T, rb->data, rb->data_size, &m, cwhy,
-                                     sizeof cwhy);
-    if (cr != AMFI_MSG_OK) { /* nothing decoded, nothing allocated */
-        d->messages_malformed++;
-        reject_note(d, REJECT_ACCEL, cr, "%s: malformed accel_block_t (%u bytes) rejected: %s", ch,
-                    rb->data_size, cwhy);
+    if (intake_decode(d, AMFI_MSG_ACCEL_BLOCK_T, REJECT_ACCEL, "accel_block_t", rb, ch, &m))
         return;
-    }
     d->blocks_received++;
     const char *why = NULL;
     int idx = sensor_index(d, m.sensor_id);
@@ -197,19 +203,11 @@ static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
 static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     daemon_s *d = user;
-    d->messages_in++;
     amfi_vehicle_t m;
-    char cwhy[160];
-    int cr = amfi_msg_decode_checked(AMFI_MSG_VEHICLE_T, rb->data, rb->data_size, &m, cwhy,
-                                     sizeof cwhy);
-    if (cr != AMFI_MSG_OK) { /* nothing decoded, nothing allocated */
-        /* Not a vehicle we can name: no row (there is no id to store it
-         * under); counted per reason and in the status message. */
-        d->messages_malformed++;
-        reject_note(d, REJECT_VEHICLE, cr, "%s: malformed vehicle_t (%u bytes) rejected: %s", ch,
-                    rb->data_size, cwhy);
+    /* A malformed one is not a vehicle we can name: no row (there is no id
+     * to store it under); counted per reason and in the status message. */
+    if (intake_decode(d, AMFI_MSG_VEHICLE_T, REJECT_VEHICLE, "vehicle_t", rb, ch, &m))
         return;
-    }
     d->vehicles_received++;
     const char *why = NULL;
     char buf[200];
@@ -251,17 +249,9 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
 static void on_truth(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     daemon_s *d = user;
-    d->messages_in++;
     amfi_truth_t m;
-    char cwhy[160];
-    int cr = amfi_msg_decode_checked(AMFI_MSG_TRUTH_T, rb->data, rb->data_size, &m, cwhy,
-                                     sizeof cwhy);
-    if (cr != AMFI_MSG_OK) { /* nothing decoded, nothing allocated */
-        d->messages_malformed++;
-        reject_note(d, REJECT_TRUTH, cr, "%s: malformed truth_t (%u bytes) rejected: %s", ch,
-                    rb->data_size, cwhy);
+    if (intake_decode(d, AMFI_MSG_TRUTH_T, REJECT_TRUTH, "truth_t", rb, ch, &m))
         return;
-    }
     char err[256];
     if (!(m.gvw_kg > 0 && m.gvw_kg < 1e6) || m.n_axles < 1 || m.n_axles > AMFI_MAX_AXLES)
         reject_note(d, REJECT_TRUTH, REJECT_INVALID,

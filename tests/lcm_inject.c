@@ -44,14 +44,27 @@ static int put(lcm_eventlog_t *out, int64_t *num, int64_t ts, const char *ch, vo
     return lcm_eventlog_write_event(out, &e);
 }
 
+/* Open IN for reading and OUT for writing: 0, or 1 (reported, both closed). */
+static int open_logs(const char *inp, const char *outp, lcm_eventlog_t **in,
+                     lcm_eventlog_t **out)
+{
+    *in = lcm_eventlog_create(inp, "r");
+    *out = lcm_eventlog_create(outp, "w");
+    if (*in && *out)
+        return 0;
+    fprintf(stderr, "lcm_inject: cannot open the logs\n");
+    if (*in)
+        lcm_eventlog_destroy(*in);
+    if (*out)
+        lcm_eventlog_destroy(*out);
+    return 1;
+}
+
 static int vehicles_only(const char *inp, const char *outp)
 {
-    lcm_eventlog_t *in = lcm_eventlog_create(inp, "r");
-    lcm_eventlog_t *out = lcm_eventlog_create(outp, "w");
-    if (!in || !out) {
-        fprintf(stderr, "lcm_inject: cannot open the logs\n");
+    lcm_eventlog_t *in, *out;
+    if (open_logs(inp, outp, &in, &out))
         return 1;
-    }
     lcm_eventlog_event_t *e;
     int64_t num = 0;
     int rc = 0, n = 0;
@@ -73,12 +86,9 @@ static int vehicles_only(const char *inp, const char *outp)
 
 static int scale_accel(double f, const char *inp, const char *outp)
 {
-    lcm_eventlog_t *in = lcm_eventlog_create(inp, "r");
-    lcm_eventlog_t *out = lcm_eventlog_create(outp, "w");
-    if (!in || !out) {
-        fprintf(stderr, "lcm_inject: cannot open the logs\n");
+    lcm_eventlog_t *in, *out;
+    if (open_logs(inp, outp, &in, &out))
         return 1;
-    }
     lcm_eventlog_event_t *e;
     int64_t num = 0;
     int rc = 0;
@@ -117,12 +127,9 @@ static int put_env(lcm_eventlog_t *out, int64_t *num, int64_t ts, int64_t utime,
 
 static int bad_environment(const char *inp, const char *outp)
 {
-    lcm_eventlog_t *in = lcm_eventlog_create(inp, "r");
-    lcm_eventlog_t *out = lcm_eventlog_create(outp, "w");
-    if (!in || !out) {
-        fprintf(stderr, "lcm_inject: cannot open the logs\n");
+    lcm_eventlog_t *in, *out;
+    if (open_logs(inp, outp, &in, &out))
         return 1;
-    }
     lcm_eventlog_event_t *e;
     int64_t num = 0, last = -1, ts = 0;
     while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
@@ -169,12 +176,9 @@ int main(int argc, char **argv)
                         "--scale-accel F] IN.log OUT.log\n");
         return 2;
     }
-    lcm_eventlog_t *in = lcm_eventlog_create(argv[1], "r");
-    lcm_eventlog_t *out = lcm_eventlog_create(argv[2], "w");
-    if (!in || !out) {
-        fprintf(stderr, "lcm_inject: cannot open the logs\n");
+    lcm_eventlog_t *in, *out;
+    if (open_logs(argv[1], argv[2], &in, &out))
         return 1;
-    }
     lcm_eventlog_event_t *e, *held = NULL;
     int64_t num = 0;
     int accel = 0, rc = 0;
