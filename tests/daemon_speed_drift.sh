@@ -32,7 +32,10 @@ grep -q "^    window: 4 " "$dir/amfid.yaml" || fail "the test's alerts.speed_dri
 
 # start NAME: amfid on $dir/NAME.db, logging to $dir/NAME.log; sets apid
 start() {
-  "$amfid" --config "$dir/amfid.yaml" --db "$dir/$1.db" 2> "$dir/$1.log" &
+  # emptied here, not by the background job's redirection: that runs
+  # asynchronously, and the wait below would find the previous run's lines
+  : > "$dir/$1.log"
+  "$amfid" --config "$dir/amfid.yaml" --db "$dir/$1.db" 2>> "$dir/$1.log" &
   apid=$!; pids="$pids $apid"
   i=0; until grep -q "running" "$dir/$1.log"; do
     i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start ($1)"; sleep 0.1; done
