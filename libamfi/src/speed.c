@@ -217,6 +217,18 @@ static void trend_span(const amfi_speed_prior *pr, int *k0, int *k1)
     *k1 = 2 * *k0;
 }
 
+double amfi_speed_dip_at(const amfi_speed_prior *p, const double *j, int n, int k)
+{
+    int k0, k1;
+    trend_span(p, &k0, &k1);
+    if (!j || k < k1 || k + k1 >= n)
+        return NAN;
+    double sl = 0.0, sr = 0.0;
+    for (int i = k0; i <= k1; i++)
+        sl += j[k - i], sr += j[k + i];
+    return j[k] - 0.5 * (sl + sr) / (k1 - k0 + 1);
+}
+
 static grid_best grid(search *q, double glo, double ghi, double lo, double hi, double g,
                       double *fv)
 {
@@ -242,14 +254,10 @@ static grid_best grid(search *q, double glo, double ghi, double lo, double hi, d
         if (fv[k] < fv[best])
             best = k;
     if (q->pr->pick == AMFI_SPEED_PICK_DIP) {
-        int k0, k1, pick = -1;
-        trend_span(q->pr, &k0, &k1);
+        int pick = -1;
         double rmin = 0.0;
-        for (int k = c_lo > k1 ? c_lo : k1; k <= c_hi && k + k1 < n; k++) {
-            double sl = 0.0, sr = 0.0;
-            for (int j = k0; j <= k1; j++)
-                sl += fv[k - j], sr += fv[k + j];
-            double dip = fv[k] - 0.5 * (sl + sr) / (k1 - k0 + 1);
+        for (int k = c_lo; k <= c_hi; k++) {
+            double dip = amfi_speed_dip_at(q->pr, fv, n, k); /* NAN: no trend */
             if (dip < rmin)
                 rmin = dip, pick = k;
         }

@@ -401,27 +401,19 @@ static int write_lcurve(const char *path, const amfi_result *r)
 
 /* The speed search's grid: the trial speed, J, and J minus its trend
  * (solver.speed_pick dip's measure; empty where the trend is not defined). */
-static int write_speed_trace(const char *path, const amfi_speed_result *sr, double grid_rel)
+static int write_speed_trace(const char *path, const amfi_speed_result *sr,
+                             const amfi_speed_prior *prior)
 {
     FILE *f = open_out("--speed-trace", path);
     if (!f)
         return -1;
     fputs("speed_mps,J,dip\n", f);
-    int k0 = (int)lround(0.006 / grid_rel);
-    if (k0 < 2)
-        k0 = 2;
-    const int k1 = 2 * k0;
     for (int k = 0; k < sr->grid_n; k++) {
         csv_num(f, sr->grid_lo_mps + k * sr->grid_step_mps);
         fputc(',', f);
         csv_num(f, sr->grid_j[k]);
         fputc(',', f);
-        if (k >= k1 && k + k1 < sr->grid_n) {
-            double sl = 0, sh = 0;
-            for (int j = k0; j <= k1; j++)
-                sl += sr->grid_j[k - j], sh += sr->grid_j[k + j];
-            csv_num(f, sr->grid_j[k] - 0.5 * (sl + sh) / (k1 - k0 + 1));
-        }
+        csv_num(f, amfi_speed_dip_at(prior, sr->grid_j, sr->grid_n, k));
         fputc('\n', f);
     }
     return finish_file(f, "--speed-trace", path);
@@ -647,7 +639,7 @@ int main(int argc, char **argv)
         goto done;
     if (o.lcurve && write_lcurve(o.lcurve, &res) != 0)
         goto done;
-    if (o.speed_trace && write_speed_trace(o.speed_trace, &sres, cfg.speed_prior.grid_rel) != 0)
+    if (o.speed_trace && write_speed_trace(o.speed_trace, &sres, &cfg.speed_prior) != 0)
         goto done;
     if (print_json(&cfg, &res, &sres, cfg.speed_estimate, o.n_vehicles ? &mres : NULL,
                    csv.rate_hz,

@@ -390,6 +390,12 @@ const char *amfi_speed_pick_name(amfi_speed_pick p); /* "min", "dip" */
  * to be estimated should cover the window of speed·(1 − this). 0 .. 0.5. */
 double amfi_speed_slowest_frac(const amfi_speed_prior *p);
 
+/* Pick dip's measure at point k of a grid of J (j[0 .. n), the prior's
+ * grid step): j[k] minus the mean of the means of j over the points
+ * 0.6-1.2 % slower and 0.6-1.2 % faster; NAN where those points are not
+ * all on the grid (amfi-solve --speed-trace writes it beside J). */
+double amfi_speed_dip_at(const amfi_speed_prior *p, const double *j, int n, int k);
+
 /* ---- several vehicles on the span, solved jointly (multi.c) ------------ */
 
 #define AMFI_MAX_VEHICLES 8
