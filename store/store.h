@@ -66,7 +66,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 5
+#define AMFI_STORE_SCHEMA_VERSION 6
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -148,7 +148,16 @@ typedef struct amfi_passage_row {
     double quality;      /* its weight's separability from the event's other
                             vehicles (amfi_vehicle_result.quality), 1 .. 1e9;
                             NaN or 0: unknown (not solved jointly), NULL */
+    double reference_gvw_kg; /* a calibration truck's pre-weighed GVW
+                            (vehicle_t.reference_gvw_kg), AMFI_STORE_MIN_REF_KG
+                            .. AMFI_STORE_MAX_REF_KG; NaN or 0: none, NULL */
+    int has_deck_c;      /* 1: deck_c holds the deck temperature taken for the
+                            passage; 0: none (NULL) */
+    double deck_c;       /* °C, AMFI_STORE_MIN_TEMP_C .. AMFI_STORE_MAX_TEMP_C */
 } amfi_passage_row;
+/* The range of a reference GVW (a calibration truck), kg. */
+#define AMFI_STORE_MIN_REF_KG 1000.0
+#define AMFI_STORE_MAX_REF_KG 100000.0
 /* Status "ok" further needs 1 <= n_axles, 0 < gvw_kg, 0 < speed_mps and
  * every spacing and axle load known. */
 
@@ -203,6 +212,55 @@ typedef struct amfi_environment_summary {
 /* Count, time span and temperature ranges of the stored readings. */
 int amfi_store_environment_summary(amfi_store *s, amfi_environment_summary *out, char *err,
                                    size_t errlen);
+
+/* ---- scale and known-truck indicators (store_scale.c) ------------------- */
+
+/* One input of the scale or known-truck indicator: an ok passage with the
+ * deck temperature amfid took for it (passages.deck_c not NULL). */
+typedef struct amfi_scale_input {
+    int64_t id;              /* passages.id */
+    int64_t utime;           /* µs */
+    double gvw_kg;           /* inferred, > 0 */
+    double deck_c;           /* °C */
+    double reference_gvw_kg; /* NaN: not a calibration truck */
+    int n_vehicles;          /* of the event it was weighed in, 1 alone */
+} amfi_scale_input;
+
+/* Up to max (>= 1) such passages with id > after_id, by id, into *out
+ * (malloc'd, the caller frees; NULL when *n is 0). Pages through a long
+ * history: the next call passes the last id. 0, or a status. */
+int amfi_store_scale_inputs(amfi_store *s, int64_t after_id, int max, amfi_scale_input **out,
+                            size_t *n, char *err, size_t errlen);
+
+/* One scale block or known-truck run (AMFI_SCALE_EVAL). NaN: unknown. */
+typedef struct amfi_scale_eval_row {
+    int64_t utime;     /* µs */
+    const char *kind;  /* "scale_shift" | "known_truck" */
+    int n;             /* vehicles in the block / runs so far, >= 0 */
+    double value;      /* compensated scale / ratio, (0, 100], or NaN */
+    double raw;        /* uncompensated, (0, 100], or NaN */
+    double deck_c;     /* °C, -60 .. 80, or NaN */
+    double z;          /* |z| <= 1e6, or NaN */
+    double cusum, h;   /* 0 .. 1e6, or NaN */
+    const char *state; /* "baseline" | "normal" | "watch" | "alert" */
+} amfi_scale_eval_row;
+
+int amfi_store_add_scale_eval(amfi_store *s, const amfi_scale_eval_row *r, int64_t *id,
+                              char *err, size_t errlen);
+
+/* A stored evaluation as read back (kind and state copied). */
+typedef struct amfi_scale_eval_rec {
+    int64_t id, utime;
+    char kind[16];
+    int n;
+    double value, raw, deck_c, z, cusum, h;
+    char state[12];
+} amfi_scale_eval_rec;
+
+/* Every stored evaluation of kind ("scale_shift" | "known_truck"), by
+ * utime, into *out (malloc'd; NULL when *n is 0). 0, or a status. */
+int amfi_store_scale_evals(amfi_store *s, const char *kind, amfi_scale_eval_rec **out,
+                           size_t *n, char *err, size_t errlen);
 
 /* ---- indicators and alerts --------------------------------------------- */
 

@@ -248,6 +248,17 @@ void st_rollback(amfi_store *s)
 /* One-off statement (open and migration only): run sql, every row ignored
  * except that the first row's first column goes to *ival / text (when not
  * NULL). */
+int st_prepare(amfi_store *s, const char *sql, sqlite3_stmt **st, const char *what, char *err,
+               size_t errlen)
+{
+    int src = sqlite3_prepare_v2(s->db, sql, -1, st, NULL);
+    if (src != SQLITE_OK) {
+        *st = NULL;
+        return st_db_fail(s, src, what, err, errlen);
+    }
+    return 0;
+}
+
 int st_one_off(amfi_store *s, const char *sql, const char *what,
                    int64_t *ival, char *text, size_t textlen, char *err,
                    size_t errlen)

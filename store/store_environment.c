@@ -15,19 +15,6 @@
 
 #include "store_internal.h"
 
-static const range R_TEMP = {AMFI_STORE_MIN_TEMP_C, AMFI_STORE_MAX_TEMP_C, 0, "°C"};
-
-static int prepare(amfi_store *s, const char *sql, sqlite3_stmt **st, const char *what,
-                   char *err, size_t errlen)
-{
-    int src = sqlite3_prepare_v2(s->db, sql, -1, st, NULL);
-    if (src != SQLITE_OK) {
-        *st = NULL;
-        return st_db_fail(s, src, what, err, errlen);
-    }
-    return 0;
-}
-
 static int check_row(const amfi_environment_row *r, int k, char *err, size_t errlen)
 {
     char name[64];
@@ -39,11 +26,11 @@ static int check_row(const amfi_environment_row *r, int k, char *err, size_t err
     }
     if (rc == 0) {
         snprintf(name, sizeof name, "environment[%d].deck_c", k);
-        rc = st_check_known(name, r->deck_c, &R_TEMP, err, errlen);
+        rc = st_check_known(name, r->deck_c, &R_TEMP_C, err, errlen);
     }
     if (rc == 0) {
         snprintf(name, sizeof name, "environment[%d].air_c", k);
-        rc = st_check_known(name, r->air_c, &R_TEMP, err, errlen);
+        rc = st_check_known(name, r->air_c, &R_TEMP_C, err, errlen);
     }
     return rc;
 }
@@ -60,7 +47,7 @@ int amfi_store_add_environment(amfi_store *s, const amfi_environment_row *rows, 
         rc = check_row(&rows[k], k, err, errlen);
     if (rc != 0 || n == 0)
         return rc;
-    rc = prepare(s,
+    rc = st_prepare(s,
                  "INSERT INTO environment (utime, deck_c, air_c, received_utime) "
                  "VALUES (?1, ?2, ?3, ?4)",
                  &st, "environment: prepare insert", err, errlen);
@@ -91,7 +78,7 @@ static int one_side(amfi_store *s, int64_t t, int before, int64_t *u, double *de
                     char *err, size_t errlen)
 {
     sqlite3_stmt *st = NULL;
-    int rc = prepare(s,
+    int rc = st_prepare(s,
                      before ? "SELECT id, utime, deck_c FROM environment WHERE utime <= ?1 "
                               "ORDER BY utime DESC, id DESC LIMIT 1"
                             : "SELECT id, utime, deck_c FROM environment WHERE utime >= ?1 "
@@ -107,7 +94,7 @@ static int one_side(amfi_store *s, int64_t t, int before, int64_t *u, double *de
         origin o = {"environment", sqlite3_column_int64(st, 0)};
         rc = st_read_int(st, 1, 0, AMFI_STORE_MAX_UTIME, &o, u, err, errlen);
         if (rc == 0)
-            rc = st_read_real(st, 2, &R_TEMP, &o, deck, err, errlen);
+            rc = st_read_real(st, 2, &R_TEMP_C, &o, deck, err, errlen);
         *found = rc == 0;
     } else if (src != SQLITE_DONE) {
         rc = st_db_fail(s, src, "environment: lookup", err, errlen);
@@ -163,7 +150,7 @@ int amfi_store_environment_summary(amfi_store *s, amfi_environment_summary *out,
     if (rc == 0 && !out)
         rc = st_fail(err, errlen, AMFI_EINVAL, "environment: output is NULL");
     if (rc == 0)
-        rc = prepare(s,
+        rc = st_prepare(s,
                      "SELECT count(*), min(utime), max(utime), min(deck_c), max(deck_c), "
                      "min(air_c), max(air_c) FROM environment",
                      &st, "environment: prepare summary", err, errlen);
@@ -181,13 +168,13 @@ int amfi_store_environment_summary(amfi_store *s, amfi_environment_summary *out,
         if (rc == 0 && r.n > 0)
             rc = st_read_int(st, 2, 0, AMFI_STORE_MAX_UTIME, &o, &r.utime_last, err, errlen);
         if (rc == 0 && r.n > 0)
-            rc = st_read_real(st, 3, &R_TEMP, &o, &r.deck_min_c, err, errlen);
+            rc = st_read_real(st, 3, &R_TEMP_C, &o, &r.deck_min_c, err, errlen);
         if (rc == 0 && r.n > 0)
-            rc = st_read_real(st, 4, &R_TEMP, &o, &r.deck_max_c, err, errlen);
+            rc = st_read_real(st, 4, &R_TEMP_C, &o, &r.deck_max_c, err, errlen);
         if (rc == 0 && r.n > 0)
-            rc = st_read_real(st, 5, &R_TEMP, &o, &r.air_min_c, err, errlen);
+            rc = st_read_real(st, 5, &R_TEMP_C, &o, &r.air_min_c, err, errlen);
         if (rc == 0 && r.n > 0)
-            rc = st_read_real(st, 6, &R_TEMP, &o, &r.air_max_c, err, errlen);
+            rc = st_read_real(st, 6, &R_TEMP_C, &o, &r.air_max_c, err, errlen);
     } else {
         rc = st_db_fail(s, src, "environment: summary", err, errlen);
     }

@@ -104,6 +104,8 @@ static const range R_MS = {0.0, HUGE_VAL, 0, "ms"};
 static const range R_RATIO = {0.0, 1e6, 0, ""};
 static const range R_PROB = {0.0, 1.0, 0, ""};
 static const range R_QUALITY = {1.0, 1e9, 0, ""};
+static const range R_REF_KG = {AMFI_STORE_MIN_REF_KG, AMFI_STORE_MAX_REF_KG, 0, "kg"};
+static const range R_TEMP_C = {AMFI_STORE_MIN_TEMP_C, AMFI_STORE_MAX_TEMP_C, 0, "°C"};
 static const range R_FINITE = {-HUGE_VAL, HUGE_VAL, 0, ""};
 
 /* NULL-terminated word lists of the schema's enumerations. */
@@ -142,6 +144,9 @@ int st_run(amfi_store *s, int which, int sqlite_rc, const char *what,
 int st_begin(amfi_store *s, char *err, size_t errlen);
 int st_commit(amfi_store *s, char *err, size_t errlen);
 void st_rollback(amfi_store *s);
+/* Prepare sql on the handle's connection (*st NULL on failure). */
+int st_prepare(amfi_store *s, const char *sql, sqlite3_stmt **st, const char *what, char *err,
+               size_t errlen);
 int st_one_off(amfi_store *s, const char *sql, const char *what,
                int64_t *ival, char *text, size_t textlen, char *err,
                size_t errlen);

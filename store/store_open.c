@@ -35,8 +35,9 @@ static const char *const stmt_sql[N_STMT] = {
     [ST_INS_PASSAGE] =
         "INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, "
         "gvw_kg, status, reason, lambda, residual_rms, formulation, solve_ms, "
-        "speed_given_mps, speed_estimated, n_vehicles, quality) "
-        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16)",
+        "speed_given_mps, speed_estimated, n_vehicles, quality, reference_gvw_kg, deck_c) "
+        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, "
+        "?18)",
     [ST_INS_AXLE] =
         "INSERT INTO axles (passage_id, idx, spacing_m, load_kg) "
         "VALUES (?1, ?2, ?3, ?4)",

@@ -215,6 +215,34 @@ static const char schema_v5[] =
     ") STRICT;\n"
     "CREATE INDEX environment_utime ON environment (utime);\n";
 
+/* Version 6 (issue 14): the scale and known-truck indicators in amfid.
+ * passages.reference_gvw_kg is a calibration truck's pre-weighed GVW
+ * (vehicle_t.reference_gvw_kg), passages.deck_c the deck temperature amfid
+ * took for the passage (the environment readings around its time; NULL:
+ * none within alerts.scale.max_temp_gap_s, or the scale indicator off);
+ * scale_evals holds each scale block and each known-truck run. Rows
+ * written before have neither (NULL). */
+static const char schema_v6[] =
+    "ALTER TABLE passages ADD COLUMN reference_gvw_kg REAL\n"
+    "  CHECK (reference_gvw_kg BETWEEN 1000 AND 100000);\n"
+    "ALTER TABLE passages ADD COLUMN deck_c REAL\n"
+    "  CHECK (deck_c BETWEEN -60 AND 80);\n"
+    "CREATE TABLE scale_evals (\n"
+    "  id       INTEGER PRIMARY KEY,\n"
+    "  utime    INTEGER NOT NULL  -- data time of the block's newest passage / of the run, µs\n"
+    "           CHECK (utime BETWEEN 0 AND 253402300799999999),\n"
+    "  kind     TEXT NOT NULL CHECK (kind IN ('scale_shift', 'known_truck')),\n"
+    "  n        INTEGER NOT NULL CHECK (n >= 0),  -- vehicles in the block / runs so far\n"
+    "  value    REAL CHECK (value > 0 AND value <= 100),  -- compensated scale / ratio\n"
+    "  raw      REAL CHECK (raw > 0 AND raw <= 100),      -- the same without compensation\n"
+    "  deck_c   REAL CHECK (deck_c BETWEEN -60 AND 80),   -- block's mean / run's deck temperature\n"
+    "  z        REAL CHECK (z BETWEEN -1e6 AND 1e6),      -- standardized increment\n"
+    "  cusum    REAL CHECK (cusum BETWEEN 0 AND 1e6),     -- CUSUM statistic after it\n"
+    "  h        REAL CHECK (h BETWEEN 0 AND 1e6),         -- its threshold\n"
+    "  state    TEXT NOT NULL CHECK (state IN ('baseline', 'normal', 'watch', 'alert'))\n"
+    ") STRICT;\n"
+    "CREATE INDEX scale_evals_kind_utime ON scale_evals (kind, utime);\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
@@ -222,6 +250,8 @@ const st_migration st_migrations[] = {
     {3, "passages: speed_given_mps (the detector's) and speed_estimated", schema_v3},
     {4, "passages: n_vehicles (vehicles weighed together) and quality", schema_v4},
     {5, "environment: deck and air temperature received on the bus", schema_v5},
+    {6, "passages: reference_gvw_kg and deck_c; scale_evals (scale and known truck)",
+     schema_v6},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

@@ -42,6 +42,11 @@ static int check_passage(const amfi_passage_row *r, char *err, size_t errlen)
                      "passages.n_vehicles: %d is out of range [1, 64]", r->n_vehicles);
     if (rc == 0 && r->quality != 0.0)
         rc = st_check_num("passages.quality", r->quality, &R_QUALITY, err, errlen);
+    if (rc == 0 && r->reference_gvw_kg != 0.0)
+        rc = st_check_num("passages.reference_gvw_kg", r->reference_gvw_kg, &R_REF_KG, err,
+                          errlen);
+    if (rc == 0 && r->has_deck_c)
+        rc = st_check_known("passages.deck_c", r->deck_c, &R_TEMP_C, err, errlen);
     if (rc == 0)
         rc = st_check_num("passages.gvw_kg", r->gvw_kg, &R_KG, err, errlen);
     if (rc == 0)
@@ -116,6 +121,9 @@ int amfi_store_add_passage(amfi_store *s, const amfi_passage_row *r,
         if (b == SQLITE_OK) b = sqlite3_bind_int(st, 14, r->speed_estimated);
         if (b == SQLITE_OK) b = sqlite3_bind_int(st, 15, r->n_vehicles > 0 ? r->n_vehicles : 1);
         if (b == SQLITE_OK) b = st_bind_real(st, 16, r->quality != 0.0 ? r->quality : NAN);
+        if (b == SQLITE_OK)
+            b = st_bind_real(st, 17, r->reference_gvw_kg != 0.0 ? r->reference_gvw_kg : NAN);
+        if (b == SQLITE_OK) b = st_bind_real(st, 18, r->has_deck_c ? r->deck_c : NAN);
         rc = st_run(s, ST_INS_PASSAGE, b, "passages: insert", err, errlen);
         if (rc == 0)
             pid = sqlite3_last_insert_rowid(s->db);

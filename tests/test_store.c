@@ -813,19 +813,21 @@ static void test_runs_and_migration_from_v1(void **state)
                  "ALTER TABLE passages DROP COLUMN n_vehicles; "
                  "ALTER TABLE passages DROP COLUMN quality; "
                  "DROP TABLE environment; "
+                 "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
+                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "DELETE FROM schema_migrations WHERE version >= 2; PRAGMA user_version = 1");
     sqlite3_close(db);
 
     /* read-only openers do not migrate: they say so */
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 1 is older than this program's 5"));
+    assert_non_null(strstr(err, "schema version 1 is older than this program's 6"));
     assert_null(ro);
 
     /* read-write: migrated, the data kept */
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(5, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(5, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM runs"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
     sqlite3_close(db);
@@ -870,17 +872,19 @@ static void test_speed_given_and_migration_from_v2(void **state)
                  "ALTER TABLE passages DROP COLUMN quality; "
                  "UPDATE passages SET speed_mps = 25.0; "
                  "DROP TABLE environment; "
+                 "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
+                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "DELETE FROM schema_migrations WHERE version >= 3; PRAGMA user_version = 2");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 2 is older than this program's 5"));
+    assert_non_null(strstr(err, "schema version 2 is older than this program's 6"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(5, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(5, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE speed_given_mps = 25.0 "
                                     "AND speed_mps = 25.0 AND speed_estimated = 0"));
     sqlite3_close(db);
@@ -926,17 +930,19 @@ static void test_event_columns_and_migration_from_v3(void **state)
     raw_exec(db, "ALTER TABLE passages DROP COLUMN n_vehicles; "
                  "ALTER TABLE passages DROP COLUMN quality; "
                  "DROP TABLE environment; "
+                 "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
+                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "DELETE FROM schema_migrations WHERE version >= 4; PRAGMA user_version = 3");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 3 is older than this program's 5"));
+    assert_non_null(strstr(err, "schema version 3 is older than this program's 6"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(5, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(5, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages WHERE n_vehicles = 1 "
                                     "AND quality IS NULL"));
     sqlite3_close(db);
@@ -1024,21 +1030,169 @@ static void test_environment_and_migration_from_v4(void **state)
                                                  NULL, NULL, NULL));
     /* make it a version-4 file, as amfid before issue 14 left it */
     raw_exec(db, "DROP TABLE environment; "
+                 "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
+                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "DELETE FROM schema_migrations WHERE version >= 5; PRAGMA user_version = 4");
     sqlite3_close(db);
     amfi_store *ro = NULL;
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 4 is older than this program's 5"));
+    assert_non_null(strstr(err, "schema version 4 is older than this program's 6"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(5, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(5, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM environment"));
     sqlite3_close(db);
     assert_int_equal(0, amfi_store_add_environment(f->s, rows, 2, err, sizeof err));
     assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US + H / 2, H, &t, err, sizeof err));
     assert_float_equal(12.0, t, 1e-12);
+}
+
+
+/* ---- version 6: reference GVW, deck temperature, scale_evals; a version-5
+ * file migrates --------------------------------------------------------- */
+
+static void test_scale_rows_and_migration_from_v5(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    amfi_passage_row r;
+    amfi_scale_input *in = NULL;
+    amfi_scale_eval_rec *ev = NULL;
+    size_t n = 0;
+    int64_t id = 0;
+
+    /* passages: a plain one, one with a temperature, a calibration truck */
+    add_ok(f->s, 1, DAY_US, 18000.0, NULL);
+    ok_row(&r, 2, DAY_US + 10, 17000.0);
+    r.has_deck_c = 1;
+    r.deck_c = 0.0; /* 0 °C is a temperature, not "none" */
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    ok_row(&r, 3, DAY_US + 20, 14100.0);
+    r.has_deck_c = 1;
+    r.deck_c = -12.5;
+    r.reference_gvw_kg = 14000.0;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, &id, err, sizeof err));
+    /* refused: a reference out of [1 t, 100 t] or not finite, a temperature
+     * out of range or NaN when given; the message names the column */
+    r.reference_gvw_kg = 999.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.reference_gvw_kg"));
+    r.reference_gvw_kg = INFINITY;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.reference_gvw_kg"));
+    r.reference_gvw_kg = 14000.0;
+    r.deck_c = NAN;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.deck_c"));
+    r.deck_c = 81.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.deck_c"));
+
+    /* the inputs: ok with a temperature, by id, paged */
+    assert_int_equal(0, amfi_store_scale_inputs(f->s, 0, 10, &in, &n, err, sizeof err));
+    assert_int_equal(2, n);
+    assert_float_equal(17000.0, in[0].gvw_kg, 0);
+    assert_float_equal(0.0, in[0].deck_c, 0);
+    assert_true(isnan(in[0].reference_gvw_kg));
+    assert_int_equal(1, in[0].n_vehicles);
+    assert_int_equal(id, in[1].id);
+    assert_float_equal(-12.5, in[1].deck_c, 0);
+    assert_float_equal(14000.0, in[1].reference_gvw_kg, 0);
+    int64_t first = in[0].id;
+    free(in);
+    assert_int_equal(0, amfi_store_scale_inputs(f->s, first, 1, &in, &n, err, sizeof err));
+    assert_int_equal(1, n);
+    assert_int_equal(id, in[0].id);
+    free(in);
+    assert_int_equal(0, amfi_store_scale_inputs(f->s, id, 10, &in, &n, err, sizeof err));
+    assert_int_equal(0, n);
+    assert_null(in);
+    assert_int_equal(AMFI_EINVAL, amfi_store_scale_inputs(f->s, 0, 0, &in, &n, err, sizeof err));
+
+    /* evaluations: stored, read back by kind and time, checked */
+    amfi_scale_eval_row e = {DAY_US + 30, "scale_shift", 500, 1.01, 1.03, 12.0, 0.4, 0.0, 9.5,
+                             "normal"};
+    assert_int_equal(0, amfi_store_add_scale_eval(f->s, &e, &id, err, sizeof err));
+    amfi_scale_eval_row k = {DAY_US + 20, "known_truck", 1, 1.007, 1.02, -12.5, NAN, NAN, NAN,
+                             "baseline"};
+    assert_int_equal(0, amfi_store_add_scale_eval(f->s, &k, NULL, err, sizeof err));
+    e.utime = DAY_US + 25;
+    e.cusum = 2.5;
+    e.state = "watch";
+    assert_int_equal(0, amfi_store_add_scale_eval(f->s, &e, NULL, err, sizeof err));
+    assert_int_equal(0, amfi_store_scale_evals(f->s, "scale_shift", &ev, &n, err, sizeof err));
+    assert_int_equal(2, n);
+    assert_int_equal(DAY_US + 25, ev[0].utime); /* by time */
+    assert_string_equal("watch", ev[0].state);
+    assert_float_equal(2.5, ev[0].cusum, 0);
+    assert_int_equal(id, ev[1].id);
+    assert_float_equal(1.01, ev[1].value, 0);
+    assert_float_equal(1.03, ev[1].raw, 0);
+    assert_float_equal(12.0, ev[1].deck_c, 0);
+    assert_int_equal(500, ev[1].n);
+    assert_string_equal("scale_shift", ev[1].kind);
+    free(ev);
+    assert_int_equal(0, amfi_store_scale_evals(f->s, "known_truck", &ev, &n, err, sizeof err));
+    assert_int_equal(1, n);
+    assert_true(isnan(ev[0].cusum));
+    assert_string_equal("baseline", ev[0].state);
+    free(ev);
+    e.kind = "scale";
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_scale_eval(f->s, &e, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "scale_evals.kind"));
+    e.kind = "scale_shift";
+    e.value = 0.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_scale_eval(f->s, &e, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "scale_evals.value"));
+    e.value = 1.0;
+    e.cusum = -1.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_scale_eval(f->s, &e, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "scale_evals.cusum"));
+    e.cusum = 0.0;
+    e.state = "raised";
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_scale_eval(f->s, &e, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "scale_evals.state"));
+    assert_int_equal(AMFI_EINVAL, amfi_store_scale_evals(f->s, "std_increase", &ev, &n, err,
+                                                         sizeof err));
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    /* the schema refuses what the checks refuse */
+    sqlite3 *db = raw_open(f->path);
+    assert_int_not_equal(SQLITE_OK, sqlite3_exec(db, "UPDATE passages SET reference_gvw_kg = 500",
+                                                 NULL, NULL, NULL));
+    assert_int_not_equal(SQLITE_OK, sqlite3_exec(db, "UPDATE passages SET deck_c = -61",
+                                                 NULL, NULL, NULL));
+    /* make it a version-5 file, as amfid before this step left it */
+    raw_exec(db, "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
+                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
+                 "DELETE FROM schema_migrations WHERE version >= 6; PRAGMA user_version = 5");
+    sqlite3_close(db);
+    amfi_store *ro = NULL;
+    assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
+    assert_non_null(strstr(err, "schema version 5 is older than this program's 6"));
+    assert_null(ro);
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE deck_c IS NULL AND "
+                                    "reference_gvw_kg IS NULL"));
+    assert_int_equal(0, raw_int(db, "SELECT count(*) FROM scale_evals"));
+    sqlite3_close(db);
+    /* old rows are no inputs (no temperature); new ones are */
+    assert_int_equal(0, amfi_store_scale_inputs(f->s, 0, 10, &in, &n, err, sizeof err));
+    assert_int_equal(0, n);
+    ok_row(&r, 4, DAY_US + 40, 15000.0);
+    r.has_deck_c = 1;
+    r.deck_c = 5.0;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_int_equal(0, amfi_store_scale_inputs(f->s, 0, 10, &in, &n, err, sizeof err));
+    assert_int_equal(1, n);
+    assert_float_equal(5.0, in[0].deck_c, 0);
+    free(in);
 }
 
 /* ---- what amfid and amfi-report read back ------------------------------------ */
@@ -1476,6 +1630,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_runs_and_migration_from_v1, setup, teardown),
         cmocka_unit_test_setup_teardown(test_event_columns_and_migration_from_v3, setup, teardown),
         cmocka_unit_test_setup_teardown(test_environment_and_migration_from_v4, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_scale_rows_and_migration_from_v5, setup, teardown),
         cmocka_unit_test_setup_teardown(test_speed_given_and_migration_from_v2, setup, teardown),
         cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
