@@ -118,6 +118,11 @@ void amfi_config_defaults(amfi_site_config *c)
      * each value); set field by field, so the padding stays zero. */
     amfi_indicator_params_default(&d->indicators);
     amfi_speed_drift_params_default(&d->speed_drift);
+    amfi_scale_params_default(&d->scale);
+    d->scale_enabled = 1;
+    d->scale_max_temp_gap_s = 7200.0;
+    amfi_known_truck_params_default(&d->known_truck);
+    d->known_truck_enabled = 1;
     /* sim_publisher's ideal simulation (docs/simulator.md): every inaccuracy
      * is switched on explicitly. */
     amfi_sim_config *m = &c->sim;

@@ -23,6 +23,8 @@
 
 #include "amfi/amfi.h"
 #include "indicators.h"
+#include "known_truck.h"
+#include "scale.h"
 #include "speed_drift.h"
 
 #ifdef __cplusplus
@@ -66,6 +68,18 @@ typedef struct amfi_daemon_config {
     /* alerts.speed_drift.*: the speed-drift alert's parameters (speed_drift.h,
      * docs/indicators.md), defaults from amfi_speed_drift_params_default(). */
     amfi_speed_drift_params speed_drift;
+    /* alerts.scale.*: the scale indicator (scale.h, docs/indicators.md
+     * section 8), defaults from amfi_scale_params_default(); enabled and
+     * max_temp_gap_s are amfid's: a passage without a deck temperature
+     * within max_temp_gap_s does not feed it (counted). */
+    int scale_enabled;            /* alerts.scale.enabled: on (1) | off */
+    double scale_max_temp_gap_s;  /* alerts.scale.max_temp_gap_s, s, [1, 86400] */
+    amfi_scale_params scale;
+    /* alerts.known_truck.*: the known-truck indicator (known_truck.h), its
+     * temperature model alerts.scale's; defaults from
+     * amfi_known_truck_params_default(). */
+    int known_truck_enabled;      /* alerts.known_truck.enabled: on (1) | off */
+    amfi_known_truck_params known_truck;
     /* daemon.indicators.*: the indicator engine's own parameters
      * (indicators.h, docs/indicators.md), its defaults from
      * amfi_indicator_params_default() and checked, at load, by

@@ -5,8 +5,9 @@
  * every raised and cleared alert (alerts.command, like smartd's -M exec),
  * and its counters in Prometheus' text format for node-exporter's textfile
  * collector (metrics.textfile). Both are off by default. Also the
- * speed-drift alert's settings (alerts.speed_drift, speed_drift.h). Runs on
- * the loader's thread.
+ * speed-drift alert's settings (alerts.speed_drift, speed_drift.h), the scale
+ * indicator's (alerts.scale, scale.h) and the known truck's
+ * (alerts.known_truck, known_truck.h). Runs on the loader's thread.
  */
 #include "sections.h"
 
@@ -28,6 +29,52 @@ static const field speed_drift_fields[] = {
      .hi = AMFI_SPEED_DRIFT_MAX_THRESHOLD, .flags = F_LO_OPEN},
     {.key = NULL}};
 
+#define SCALE(m) OPS(scale.m)
+
+/* alerts.scale: the ranges are amfi_scale_params_check's (ops_check runs it
+ * too, for the cross-field rules: floor_c below knee_c, block times
+ * baseline_blocks). */
+static const field scale_fields[] = {
+    {.key = "enabled", .kind = &K_ENUM, .off = OPS(scale_enabled), .aux = onoff_names},
+    {.key = "max_temp_gap_s", .kind = &K_DOUBLE, .off = OPS(scale_max_temp_gap_s), .lo = 1,
+     .hi = 86400},
+    {.key = "block", .kind = &K_INT, .off = SCALE(block), .lo = 50, .hi = 1000000},
+    {.key = "baseline_blocks", .kind = &K_INT, .off = SCALE(baseline_blocks), .lo = 4,
+     .hi = 10000},
+    {.key = "class_split_kg", .kind = &K_DOUBLE, .off = SCALE(class_split_kg), .lo = 100,
+     .hi = AMFI_IND_MAX_GVW_KG},
+    {.key = "share_range", .kind = &K_DOUBLE, .off = SCALE(share_range), .lo = 0.01, .hi = 1},
+    {.key = "ref_c", .kind = &K_DOUBLE, .off = SCALE(ref_c), .lo = -30, .hi = 40},
+    {.key = "knee_c", .kind = &K_DOUBLE, .off = SCALE(knee_c), .lo = -30, .hi = 30},
+    {.key = "floor_c", .kind = &K_DOUBLE, .off = SCALE(floor_c), .lo = -60, .hi = 29.5},
+    {.key = "warm_slope", .kind = &K_DOUBLE, .off = SCALE(warm_slope), .lo = -0.1, .hi = 0.1},
+    {.key = "frost_slope", .kind = &K_DOUBLE, .off = SCALE(frost_slope), .lo = -0.1, .hi = 0.1},
+    {.key = "slope_prior_sd", .kind = &K_DOUBLE, .off = SCALE(slope_prior_sd), .lo = 0,
+     .hi = 0.1},
+    {.key = "design_shift", .kind = &K_DOUBLE, .off = SCALE(design_shift), .lo = 1e-4,
+     .hi = 0.5, .flags = F_HI_OPEN},
+    {.key = "false_alarms_per_year", .kind = &K_DOUBLE, .off = SCALE(false_alarms_per_year),
+     .lo = 1e-4, .hi = 1000},
+    {.key = "vehicles_per_day", .kind = &K_DOUBLE, .off = SCALE(vehicles_per_day), .lo = 1,
+     .hi = 1e7},
+    {.key = "clear_after", .kind = &K_INT, .off = SCALE(clear_after), .lo = 1, .hi = 1000000},
+    {.key = NULL}};
+
+#define TRUCK(m) OPS(known_truck.m)
+
+static const field known_truck_fields[] = {
+    {.key = "enabled", .kind = &K_ENUM, .off = OPS(known_truck_enabled), .aux = onoff_names},
+    {.key = "baseline_runs", .kind = &K_INT, .off = TRUCK(baseline_runs), .lo = 2, .hi = 1000},
+    {.key = "run_sd", .kind = &K_DOUBLE, .off = TRUCK(run_sd), .lo = 1e-4, .hi = 1},
+    {.key = "design_shift", .kind = &K_DOUBLE, .off = TRUCK(design_shift), .lo = 1e-4,
+     .hi = 0.5, .flags = F_HI_OPEN},
+    {.key = "false_alarms_per_year", .kind = &K_DOUBLE, .off = TRUCK(false_alarms_per_year),
+     .lo = 1e-4, .hi = 1000},
+    {.key = "runs_per_year", .kind = &K_DOUBLE, .off = TRUCK(runs_per_year), .lo = 1,
+     .hi = 1e5},
+    {.key = "clear_after", .kind = &K_INT, .off = TRUCK(clear_after), .lo = 1, .hi = 1000000},
+    {.key = NULL}};
+
 const field alerts_fields[] = {
     {.key = "command", .kind = &K_PATH, .off = OPS(alert_command), .hi = OPS_CAP(alert_command)},
     {.key = "command_timeout_s", .kind = &K_DOUBLE, .off = OPS(alert_timeout_s), .lo = 0,
@@ -35,6 +82,8 @@ const field alerts_fields[] = {
     {.key = "command_max_running", .kind = &K_INT, .off = OPS(alert_max_running), .lo = 1,
      .hi = 64},
     {.key = "speed_drift", .kind = &K_MAP, .aux = speed_drift_fields},
+    {.key = "scale", .kind = &K_MAP, .aux = scale_fields},
+    {.key = "known_truck", .kind = &K_MAP, .aux = known_truck_fields},
     {.key = NULL}};
 
 const field metrics_fields[] = {
@@ -58,6 +107,18 @@ int ops_check(ctx *x, amfi_site_config *c)
         pathf(path, "alerts.speed_drift.%s", blamed ? blamed : "");
         int line = noted(x, path);
         return fail(x, line ? line : first_noted(x, "alerts.speed_drift", "alerts", NULL), path,
+                    "%s", why);
+    }
+    if (amfi_scale_params_check(&c->daemon.scale, &blamed, why, sizeof why) != 0) {
+        pathf(path, "alerts.scale.%s", blamed ? blamed : "");
+        int line = noted(x, path);
+        return fail(x, line ? line : first_noted(x, "alerts.scale", "alerts", NULL), path, "%s",
+                    why);
+    }
+    if (amfi_known_truck_params_check(&c->daemon.known_truck, &blamed, why, sizeof why) != 0) {
+        pathf(path, "alerts.known_truck.%s", blamed ? blamed : "");
+        int line = noted(x, path);
+        return fail(x, line ? line : first_noted(x, "alerts.known_truck", "alerts", NULL), path,
                     "%s", why);
     }
     if (cmd[0]) {
