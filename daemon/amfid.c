@@ -101,6 +101,10 @@ static int start_config(daemon_s *d, const amfid_options *o)
         fprintf(stderr, "amfid: %s: alerts.speed_drift: %s\n", o->config, err);
         return 2;
     }
+    if (scaleind_create(d, err, sizeof err)) {
+        fprintf(stderr, "amfid: %s: alerts.scale / alerts.known_truck: %s\n", o->config, err);
+        return 2;
+    }
     /* A solver is built once here to check the solver section. */
     amfi_solver *probe = NULL;
     if (amfi_solver_create(d->bridge, &d->cfg.solver, &probe, err, sizeof err)) {
@@ -194,6 +198,7 @@ static int start_runtime(daemon_s *d)
     }
     restore_indicator_state(d);
     drift_restore(d);
+    scaleind_restore(d);
     amfi_tracker_params tp = {d->cfg.bridge.span_m,
                               d->cfg.solver.pre_roll_s + d->cfg.daemon.margin_s,
                               d->cfg.solver.post_roll_s + d->cfg.daemon.margin_s,
@@ -313,6 +318,7 @@ int amfid_drain(daemon_s *d)
     }
     heartbeat(d);
     reject_final(d);
+    scaleind_final(d);
     notify_finish(d);
     metrics_tick(d, 1);
     if (!d->degraded)
@@ -360,6 +366,7 @@ void amfid_stop(daemon_s *d)
     amfi_store_close(d->store);
     amfi_indicators_destroy(d->ind);
     drift_destroy(d);
+    scaleind_destroy(d);
     amfi_bridge_destroy(d->bridge);
 }
 

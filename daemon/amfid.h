@@ -13,7 +13,8 @@
  * line), intake.c (bus handlers, validation, windows to jobs), pool.c (job
  * queues, solver threads), pipeline.c (in-order store, indicators,
  * publish), control.c (configuration, heartbeat, reload, restart state),
- * drift.c (the speed-drift alert), environment.c (the environment input).
+ * drift.c (the speed-drift alert), environment.c (the environment input),
+ * scaleind.c (the scale indicator and the known-truck runs).
  */
 #ifndef AMFID_H
 #define AMFID_H
@@ -29,6 +30,8 @@
 #include "amfi_time.h" /* amfi_mono_s: timeouts, backoff, periods (wall time) */
 #include "amfi_version.h"
 #include "indicators.h"
+#include "known_truck.h"
+#include "scale.h"
 #include "pool.h"
 #include "ring.h"
 #include "speed_drift.h"
@@ -87,6 +90,19 @@ typedef struct env_state {
     int failing;           /* the last flush failed (logged once) */
     int64_t received, rejected, stored, lost; /* since start */
 } env_state;
+
+/* The scale indicator and the known-truck runs (scaleind.c). */
+typedef struct scale_state {
+    amfi_scale *scale;             /* NULL: alerts.scale.enabled off */
+    amfi_known_truck *truck;       /* NULL: alerts.known_truck.enabled off */
+    int enabled, truck_enabled;    /* in force (a reload reports changes) */
+    double max_gap_s;
+    amfi_scale_params params;
+    amfi_known_truck_params truck_params;
+    int64_t fed, no_temp, runs, refused; /* this run's: inputs, solved passages
+                                    without a temperature, truck runs, refused */
+    double last_scale, last_cusum; /* the newest block's (NaN: none yet) */
+} scale_state;
 
 /* Alert notices (notify.c). */
 #define NOTIFY_MAX_RUNNING 64 /* alerts.command_max_running's upper bound */
@@ -149,6 +165,7 @@ typedef struct daemon_s {
     int64_t udp_drops, udp_drops_logged; /* kernel drops on our sockets */
     reject_state rej;
     env_state env;                 /* environment readings (environment.c) */
+    scale_state sc;                /* scale indicator, known truck (scaleind.c) */
     /* passages the store could not take (disk full, I/O error, read-only):
      * held in order and retried (pipeline.c); nothing acknowledged is lost */
     job **held;
@@ -280,6 +297,26 @@ void drift_feed(daemon_s *d, int64_t utime, double speed_mps, double speed_given
 /* SIGHUP: a changed alerts.speed_drift is reported (applies at the next start). */
 void drift_reload(daemon_s *d, const amfi_site_config *n);
 void drift_destroy(daemon_s *d);
+
+/* ---- the scale indicator and known-truck runs (scaleind.c), main thread --- */
+
+/* Both from alerts.scale and alerts.known_truck (each may be off): 0, or
+ * a create code with the message in err. */
+int scaleind_create(daemon_s *d, char *err, size_t errlen);
+/* Replay the stored inputs (ok passages with a deck temperature); the open
+ * alerts from the store. */
+void scaleind_restore(daemon_s *d);
+/* A solved passage's row: its deck temperature (has_deck_c, deck_c) from
+ * the environment readings, or none (counted). */
+void scaleind_deck(daemon_s *d, amfi_passage_row *r);
+/* A stored ok passage's row: feeds the indicators when it has a
+ * temperature (and passes daemon.indicators.single_presence_only). */
+void scaleind_feed(daemon_s *d, const amfi_passage_row *r);
+/* SIGHUP: a change is reported (applies at the next start). */
+void scaleind_reload(daemon_s *d, const amfi_site_config *n);
+/* At stop: the counters in the log. */
+void scaleind_final(daemon_s *d);
+void scaleind_destroy(daemon_s *d);
 
 /* ---- configuration, state, heartbeat, reload (control.c), main thread ----- */
 

@@ -217,6 +217,7 @@ void reload(daemon_s *d)
         n.daemon.single_presence_only != d->cfg.daemon.single_presence_only)
         LOG_WARN("reload: indicator settings take effect at the next start");
     drift_reload(d, &n);
+    scaleind_reload(d, &n);
     LOG_INFO("reload: configuration %s applied", d->config_path);
 }
 

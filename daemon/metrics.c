@@ -190,6 +190,18 @@ static void write_all(daemon_s *d, FILE *f)
     head(f, "amfi_indicator_mean_ratio", "gauge",
          "Window mean over baseline mean at the newest evaluation (NaN: none yet).");
     sample(f, "amfi_indicator_mean_ratio", m->have_indicator ? m->mean_ratio : NAN);
+    head(f, "amfi_scale", "gauge",
+         "The scale indicator's newest block: temperature-compensated scale of the inferred "
+         "GVW (NaN: none yet).");
+    sample(f, "amfi_scale", d->sc.last_scale);
+    head(f, "amfi_scale_cusum", "gauge", "The scale indicator's CUSUM after the newest block.");
+    sample(f, "amfi_scale_cusum", d->sc.last_cusum);
+    head(f, "amfi_scale_passages_total", "counter",
+         "Solved passages since start by what the scale indicator did with them (fed, or "
+         "skipped without a deck temperature).");
+    fprintf(f, "amfi_scale_passages_total{use=\"fed\"} %lld\n", (long long)d->sc.fed);
+    fprintf(f, "amfi_scale_passages_total{use=\"no_temperature\"} %lld\n",
+            (long long)d->sc.no_temp);
     head(f, "amfi_alert_open", "gauge", "1 while an alert of this kind is raised.");
     for (int i = 0; i < OPEN_KINDS && m->open_kind[i][0]; i++) {
         fputs("amfi_alert_open{kind=\"", f);

@@ -5,7 +5,8 @@
  * transaction each), published on the passage channel, and the ok ones fed
  * to the indicator engine, whose baselines, indicators and alerts are
  * stored and published too; the estimated speeds feed the speed-drift
- * alert (drift.c). An event of several vehicles weighed together
+ * alert (drift.c); the solved ones get their deck temperature and feed the
+ * scale indicator and the known-truck runs (scaleind.c). An event of several vehicles weighed together
  * (tracker.h) becomes one row per vehicle, in entry order, each with the
  * event's size and its own weight and quality; with
  * daemon.indicators.single_presence_only the indicators take only the
@@ -156,12 +157,15 @@ static void job_row(const daemon_s *d, const job *j, amfi_passage_row *r)
     r->solve_ms = j->solve_ms;
     r->n_vehicles = j->w.n_vehicles > 1 ? j->w.n_vehicles : 1;
     r->quality = j->quality > 0 ? j->quality : NAN;
+    r->reference_gvw_kg = j->w.v.reference_gvw_kg;
 }
 
 static int store_now(daemon_s *d, job *j)
 {
     amfi_passage_row r;
     job_row(d, j, &r);
+    if (j->solved)
+        scaleind_deck(d, &r);
     int64_t id = 0;
     char err[256];
     int rc = amfi_store_add_passage(d->store, &r, &id, err, sizeof err);
@@ -192,6 +196,7 @@ static int store_now(daemon_s *d, job *j)
         d->passages_ok++;
         if (!d->cfg.daemon.single_presence_only || j->w.n_vehicles <= 1)
             feed_indicators(d, j);
+        scaleind_feed(d, &r);
     }
     return 0;
 }

@@ -48,6 +48,7 @@ typedef struct amfi_vehicle_ev {
     double speed_mps;
     int n_axles;
     double spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1 */
+    double reference_gvw_kg; /* a calibration truck's pre-weighed GVW, kg; 0: none */
 } amfi_vehicle_ev;
 
 typedef struct amfi_tracker_params {

@@ -51,6 +51,7 @@
 #include "report_export.h"
 #include "report_pg.h"
 #include "report_plot.h"
+#include "report_scale.h"
 #include "report_speed.h"
 #include "store.h"
 
@@ -495,6 +496,8 @@ static int section_summary(amfi_store *s)
             "%s .. %s UTC\n",
             env.deck_min_c, env.deck_max_c, env.air_min_c, env.air_max_c, (long long)env.n,
             utc(env.utime_first, a), utc(env.utime_last, b));
+    if (report_scale_summary(s, g_out, err, sizeof err) != 0)
+        return data_error("%s", err);
     return print_baseline(s);
 }
 

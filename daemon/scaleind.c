@@ -1,0 +1,282 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * scaleind.c: amfid's scale indicator and known-truck runs (issue 14,
+ * docs/indicators.md section 8). Each solved passage gets the deck
+ * temperature at its data time from the environment readings (buffered ones
+ * flushed to the store first; amfi_store_deck_c_at within
+ * alerts.scale.max_temp_gap_s), stored with it (passages.deck_c). Each ok
+ * passage with a temperature then feeds the scale indicator
+ * (indicators/scale.h: GVW and temperature) and, when its vehicle carried a
+ * reference GVW (a calibration truck), the known-truck indicator
+ * (indicators/known_truck.h). Their evaluations are stored (scale_evals),
+ * their raise and clear events go out like every alert (pipeline.c's
+ * emit_alert). A passage without a temperature feeds neither: counted
+ * (status line at stop, metrics).
+ *
+ * Restore: at start both indicators are rebuilt by replaying the stored
+ * inputs (the ok passages with a deck temperature, in id order, through the
+ * same filter), so the baseline, the temperature model, the partial block
+ * and the CUSUM's evidence survive a restart exactly; the replay stores
+ * and publishes nothing. An alert open in the store stays open (not raised
+ * twice); one the store does not have open is not held.
+ *
+ * Thread: the main thread only. Owns d->sc (the two indicators, their
+ * parameters in force and the counters); a reload reports a change, which
+ * applies at the next start.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amfid.h"
+
+int scaleind_create(daemon_s *d, char *err, size_t errlen)
+{
+    scale_state *c = &d->sc;
+    const amfi_daemon_config *dc = &d->cfg.daemon;
+    c->enabled = dc->scale_enabled;
+    c->truck_enabled = dc->known_truck_enabled;
+    c->max_gap_s = dc->scale_max_temp_gap_s;
+    c->params = dc->scale;
+    c->truck_params = dc->known_truck;
+    c->last_scale = c->last_cusum = NAN;
+    int rc = 0;
+    if (c->enabled)
+        rc = amfi_scale_create(&c->params, &c->scale, err, errlen);
+    if (rc == 0 && c->truck_enabled)
+        rc = amfi_known_truck_create(&c->truck_params, &c->params, &c->truck, err, errlen);
+    return rc;
+}
+
+/* A stored value in the scale_evals ranges, else unknown. */
+static double ratio_or_nan(double x)
+{
+    return isfinite(x) && x > 0 && x <= 100 ? x : NAN;
+}
+
+static void store_eval(daemon_s *d, const amfi_scale_eval_row *r)
+{
+    char err[256];
+    if (amfi_store_add_scale_eval(d->store, r, NULL, err, sizeof err))
+        set_error(d, "store: %s", err);
+}
+
+/* The baseline was just fitted: the known truck takes its slopes. */
+static void baseline_fitted(daemon_s *d, int64_t utime, int live)
+{
+    scale_state *c = &d->sc;
+    amfi_scale_model m;
+    if (amfi_scale_get_model(c->scale, &m) != 0)
+        return;
+    if (c->truck)
+        amfi_known_truck_set_slopes(c->truck, m.warm_slope, m.frost_slope);
+    if (!live)
+        return;
+    LOG_INFO("scale indicator: baseline of %d blocks fitted: loaded share %.3f, slopes %.5f "
+             "(warm) and %.5f (frost) per °C over %.1f .. %.1f °C, block SD %.4f, CUSUM k %.2f "
+             "h %.2f",
+             c->params.baseline_blocks, m.pi, m.warm_slope, m.frost_slope, m.t_min_c, m.t_max_c,
+             m.sigma0, m.k_ref, m.h);
+    amfi_scale_eval_row r = {utime, "scale_shift", c->params.block * c->params.baseline_blocks,
+                             1.0, 1.0, NAN, NAN, NAN, m.h, "baseline"};
+    store_eval(d, &r);
+}
+
+/* One input into both indicators; live: store, publish and count. */
+static void push(daemon_s *d, int64_t utime, double gvw_kg, double deck_c, double ref_kg,
+                 int live)
+{
+    scale_state *c = &d->sc;
+    amfi_alert_event al;
+    if (c->scale) {
+        amfi_scale_eval ev;
+        int bits = amfi_scale_push(c->scale, gvw_kg, deck_c, &ev, &al);
+        if (bits < 0) {
+            c->refused++;
+            if (live)
+                set_error(d, "scale indicator: GVW %.1f kg at deck %.2f °C refused", gvw_kg,
+                          deck_c);
+        } else {
+            c->fed++;
+            if (bits & AMFI_IND_BASELINE)
+                baseline_fitted(d, utime, live);
+            if (bits & AMFI_IND_EVAL) {
+                c->last_scale = ev.scale;
+                c->last_cusum = ev.cusum;
+                if (live) {
+                    amfi_scale_eval_row r = {utime, "scale_shift", ev.n, ratio_or_nan(ev.scale),
+                                             ratio_or_nan(ev.raw_scale), ev.deck_mean_c, ev.z,
+                                             ev.cusum, ev.h, ev.state};
+                    store_eval(d, &r);
+                }
+            }
+            if ((bits & AMFI_IND_ALERT) && live)
+                emit_alert(d, utime, &al, 0);
+        }
+    }
+    if (c->truck && isfinite(ref_kg) && ref_kg > 0) {
+        amfi_known_truck_eval ev;
+        int bits = amfi_known_truck_push(c->truck, gvw_kg, ref_kg, deck_c, &ev, &al);
+        if (bits < 0) {
+            c->refused++;
+            if (live)
+                set_error(d, "known truck: GVW %.1f kg against reference %.1f kg refused",
+                          gvw_kg, ref_kg);
+            return;
+        }
+        c->runs++;
+        if (live) {
+            int base = strcmp(ev.state, "baseline") == 0;
+            amfi_scale_eval_row r = {utime, "known_truck", ev.run, ratio_or_nan(ev.ratio_comp),
+                                     ratio_or_nan(ev.ratio), deck_c, base ? NAN : ev.z,
+                                     base ? NAN : ev.cusum, base ? NAN : ev.h, ev.state};
+            store_eval(d, &r);
+            LOG_INFO("known truck: run %d, ratio %.4f (%.4f at %.1f °C), %s", ev.run,
+                     ev.ratio_comp, ev.ratio, deck_c, ev.state);
+            if (bits & AMFI_IND_ALERT)
+                emit_alert(d, utime, &al, 0);
+        }
+    }
+}
+
+static int wanted(const daemon_s *d, int n_vehicles)
+{
+    return !d->cfg.daemon.single_presence_only || n_vehicles <= 1;
+}
+
+static int restore_open(daemon_s *d, const char *kind)
+{
+    char err[256];
+    int open = 0;
+    if (amfi_store_alert_open(d->store, kind, &open, err, sizeof err) != 0) {
+        LOG_WARN("store: %s", err);
+        open = 0;
+    }
+    metrics_alert(d, kind, open);
+    return open;
+}
+
+void scaleind_restore(daemon_s *d)
+{
+    scale_state *c = &d->sc;
+    if (!c->scale && !c->truck)
+        return;
+    char err[512];
+    int64_t after = 0;
+    int64_t replayed = 0;
+    for (;;) {
+        amfi_scale_input *in = NULL;
+        size_t n = 0;
+        if (amfi_store_scale_inputs(d->store, after, 4096, &in, &n, err, sizeof err) != 0) {
+            LOG_WARN("store: %s (the scale indicator starts from what was read)", err);
+            break;
+        }
+        for (size_t k = 0; k < n; k++)
+            if (wanted(d, in[k].n_vehicles)) {
+                push(d, in[k].utime, in[k].gvw_kg, in[k].deck_c, in[k].reference_gvw_kg, 0);
+                replayed++;
+            }
+        if (n > 0)
+            after = in[n - 1].id;
+        free(in);
+        if (n < 4096)
+            break;
+    }
+    int open_s = 0, open_t = 0;
+    if (c->scale) {
+        open_s = restore_open(d, "scale_shift");
+        amfi_scale_set_alerted(c->scale, open_s);
+    }
+    if (c->truck) {
+        open_t = restore_open(d, "known_truck");
+        amfi_known_truck_set_alerted(c->truck, open_t);
+    }
+    if (replayed > 0 || open_s || open_t)
+        LOG_INFO("scale indicator: %lld passages replayed from the store (%s, %lld known-truck "
+                 "runs)%s%s",
+                 (long long)replayed, c->scale ? amfi_scale_state(c->scale) : "off",
+                 (long long)c->runs, open_s ? "; the scale_shift alert is open" : "",
+                 open_t ? "; the known_truck alert is open" : "");
+    c->fed = c->runs = c->refused = 0; /* the counters are this run's */
+}
+
+void scaleind_deck(daemon_s *d, amfi_passage_row *r)
+{
+    scale_state *c = &d->sc;
+    r->has_deck_c = 0;
+    if (!c->scale && !c->truck)
+        return;
+    if (d->env.n > 0)
+        environment_flush(d); /* the readings up to now are in the store */
+    char err[256];
+    double t = NAN;
+    if (amfi_store_deck_c_at(d->store, r->utime, (int64_t)(1e6 * c->max_gap_s), &t, err,
+                             sizeof err) != 0) {
+        set_error(d, "store: %s", err);
+        t = NAN;
+    }
+    if (isfinite(t)) {
+        r->has_deck_c = 1;
+        r->deck_c = t;
+    } else {
+        c->no_temp++;
+    }
+}
+
+void scaleind_feed(daemon_s *d, const amfi_passage_row *r)
+{
+    if (!r->has_deck_c || !wanted(d, r->n_vehicles))
+        return;
+    push(d, r->utime, r->gvw_kg, r->deck_c,
+         r->reference_gvw_kg != 0.0 ? r->reference_gvw_kg : NAN, 1);
+}
+
+static int scale_params_equal(const amfi_scale_params *a, const amfi_scale_params *b)
+{
+    return a->block == b->block && a->baseline_blocks == b->baseline_blocks &&
+           a->class_split_kg == b->class_split_kg && a->share_range == b->share_range &&
+           a->ref_c == b->ref_c && a->knee_c == b->knee_c && a->floor_c == b->floor_c &&
+           a->warm_slope == b->warm_slope && a->frost_slope == b->frost_slope &&
+           a->slope_prior_sd == b->slope_prior_sd && a->design_shift == b->design_shift &&
+           a->false_alarms_per_year == b->false_alarms_per_year &&
+           a->vehicles_per_day == b->vehicles_per_day && a->clear_after == b->clear_after;
+}
+
+static int truck_params_equal(const amfi_known_truck_params *a, const amfi_known_truck_params *b)
+{
+    return a->baseline_runs == b->baseline_runs && a->run_sd == b->run_sd &&
+           a->design_shift == b->design_shift &&
+           a->false_alarms_per_year == b->false_alarms_per_year &&
+           a->runs_per_year == b->runs_per_year && a->clear_after == b->clear_after;
+}
+
+void scaleind_reload(daemon_s *d, const amfi_site_config *n)
+{
+    const amfi_daemon_config *a = &n->daemon;
+    if (a->scale_enabled != d->sc.enabled || a->scale_max_temp_gap_s != d->sc.max_gap_s ||
+        !scale_params_equal(&a->scale, &d->sc.params))
+        LOG_WARN("reload: alerts.scale takes effect at the next start");
+    if (a->known_truck_enabled != d->sc.truck_enabled ||
+        !truck_params_equal(&a->known_truck, &d->sc.truck_params))
+        LOG_WARN("reload: alerts.known_truck takes effect at the next start");
+}
+
+void scaleind_final(daemon_s *d)
+{
+    const scale_state *c = &d->sc;
+    if (!c->scale && !c->truck)
+        return;
+    LOG_INFO("scale indicator: %lld passages fed (%s), %lld solved passages without a deck "
+             "temperature within %.0f s (skipped), %lld known-truck runs, %lld refused",
+             (long long)c->fed, c->scale ? amfi_scale_state(c->scale) : "off",
+             (long long)c->no_temp, c->max_gap_s, (long long)c->runs, (long long)c->refused);
+}
+
+void scaleind_destroy(daemon_s *d)
+{
+    amfi_scale_destroy(d->sc.scale);
+    amfi_known_truck_destroy(d->sc.truck);
+    d->sc.scale = NULL;
+    d->sc.truck = NULL;
+}

@@ -1,0 +1,119 @@
+#!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
+# amfid runs the scale indicator (issue 14, docs/indicators.md section 8) on
+# LCM's UDP multicast inside a private network namespace, with
+# sim_publisher --environment site (the climate time-compressed 2000 times,
+# an environment_t every 10 s of data time) and a small scale block
+# (alerts.scale.block 50, baseline_blocks 4, tuned for a 10 % loss at 10
+# design false alarms a year at 500 vehicles a day, so that a test of a few
+# hundred vehicles sees it):
+#   1. 300 healthy vehicles: every solved passage gets a deck temperature
+#      (passages.deck_c, none skipped), the baseline is fitted once
+#      (scale_evals row 'baseline'), two blocks follow, no scale_shift alert;
+#   2. amfid restarts: the 300 passages are replayed from the store (no
+#      second baseline), then 200 vehicles on a bridge with 10 % less
+#      stiffness: the warning alert scale_shift is raised once (alerts
+#      table, the journal, the alert channel, the metrics file), within the
+#      four damaged blocks;
+#   3. a third start restores the open alert (not raised again);
+#   4. amfi-report shows the indicator's series.
+# Usage: daemon_scale.sh AMFID SIM_PUBLISHER AMFI_REPORT CONFIG
+set -u
+if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
+  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
+    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
+fi
+amfid=$1 sim=$2 report=$3 config=$4
+dir=$(mktemp -d)
+pids=""
+cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
+trap cleanup EXIT
+fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -15 "$f"; done; exit 1; }
+q() { sqlite3 "$dir/a.db" "$1"; }
+
+sed -e "s|^  # textfile: .*|  textfile: $dir/amfid.prom|" \
+    -e "s/^    block: 500 /    block: 50 /" -e "s/^    baseline_blocks: 40 /    baseline_blocks: 4 /" \
+    -e "/^  scale:/,/^  known_truck:/s/^    design_shift: 0.025 /    design_shift: 0.1 /" \
+    -e "/^  scale:/,/^  known_truck:/s/^    false_alarms_per_year: 0.05 /    false_alarms_per_year: 10 /" \
+    -e "s/^    vehicles_per_day: 2000 /    vehicles_per_day: 500 /" \
+    -e "s/^  queue_size: 256 /  queue_size: 4096 /" \
+    "$config" > "$dir/amfid.yaml"
+for k in "block: 50 " "baseline_blocks: 4 " "design_shift: 0.1 " "false_alarms_per_year: 10 " \
+         "vehicles_per_day: 500 "; do
+  grep -q "^    $k" "$dir/amfid.yaml" || fail "the test's alerts.scale $k did not apply"
+done
+"$amfid" --config "$dir/amfid.yaml" --check-config > /dev/null || fail "check-config"
+
+start() { # NAME: amfid on a.db, logging to NAME.log
+  : > "$dir/$1.log"
+  "$amfid" --config "$dir/amfid.yaml" --db "$dir/a.db" 2>> "$dir/$1.log" &
+  apid=$!; pids="$pids $apid"
+  i=0; until grep -q "running" "$dir/$1.log"; do
+    i=$((i + 1)); [ $i -lt 300 ] || fail "amfid did not start ($1)"; sleep 0.1; done
+}
+stop() {
+  kill -TERM $apid
+  i=0; while kill -0 $apid 2>/dev/null; do
+    i=$((i + 1)); [ $i -lt 3000 ] || fail "amfid did not stop on SIGTERM"; sleep 0.1; done
+  wait $apid || fail "amfid exit status $?"
+}
+# sim NAME ARGS...: vehicles live on the bus, the site's climate on
+sim() {
+  name=$1; shift
+  timeout 300 "$sim" --headway 3 --speedup 60 --seed 3 --dt 2.5e-4 --environment site \
+    --time-compression 2000 --environment-period 10 "$@" 2> "$dir/$name-sim.log" ||
+    fail "sim_publisher exited $? ($name)"
+  sleep 2
+}
+
+# 1. healthy
+start healthy
+sim healthy --vehicles 300
+stop
+ok=$(q "SELECT count(*) FROM passages WHERE status = 'ok'")
+[ "$ok" -ge 290 ] || fail "$ok ok passages of 300"
+[ "$(q "SELECT count(*) FROM passages WHERE status = 'ok' AND deck_c IS NULL")" -eq 0 ] ||
+  fail "ok passages without a deck temperature"
+grep -q "scale indicator: $ok passages fed (.*), 0 solved passages without a deck temperature within 7200 s (skipped)" \
+  "$dir/healthy.log" || fail "stop line: $(grep 'scale indicator:' "$dir/healthy.log")"
+grep -q "scale indicator: baseline of 4 blocks fitted" "$dir/healthy.log" || fail "no baseline"
+[ "$(q "SELECT count(*) FROM scale_evals WHERE kind = 'scale_shift' AND state = 'baseline'")" -eq 1 ] ||
+  fail "baseline rows"
+blocks=$(q "SELECT count(*) FROM scale_evals WHERE kind = 'scale_shift' AND state <> 'baseline'")
+[ "$blocks" -eq $(( (ok - 200) / 50 )) ] || fail "$blocks blocks after the baseline for $ok passages"
+[ "$(q "SELECT count(*) FROM alerts WHERE kind = 'scale_shift'")" -eq 0 ] ||
+  fail "scale_shift on a healthy bridge: $(q "SELECT message FROM alerts")"
+grep -q 'amfi_scale_passages_total{use="no_temperature"} 0$' "$dir/amfid.prom" || fail "metrics"
+last=$(q "SELECT max(utime) FROM passages")
+
+# 2. restart, 10 % stiffness loss
+start damaged
+lcm-logger -c 'AMFI_ALERT' -f "$dir/alerts.lcmlog" > "$dir/logger.log" 2>&1 &
+lpid=$!; pids="$pids $lpid"
+sleep 0.3
+grep -q "scale indicator: $ok passages replayed from the store (" "$dir/damaged.log" ||
+  fail "replay line: $(grep 'scale indicator' "$dir/damaged.log")"
+sim damaged --vehicles 200 --first 300 --damage 0.1 --start-utime $((last + 10000000))
+stop
+kill -TERM $lpid; wait $lpid 2>/dev/null
+[ "$(q "SELECT count(*) FROM scale_evals WHERE kind = 'scale_shift' AND state = 'baseline'")" -eq 1 ] ||
+  fail "the restart fitted a second baseline"
+[ "$(q "SELECT count(*) FROM alerts WHERE kind = 'scale_shift' AND raised = 1 AND level = 'warning'")" -eq 1 ] ||
+  fail "scale_shift raised $(q "SELECT count(*) FROM alerts WHERE kind = 'scale_shift' AND raised = 1") times; blocks: $(q "SELECT group_concat(printf('%.3f/%.2f', value, cusum), ' ') FROM scale_evals")"
+at=$(q "SELECT utime FROM alerts WHERE kind = 'scale_shift'")
+after=$(q "SELECT count(*) FROM passages WHERE status = 'ok' AND utime > $last AND utime <= $at")
+[ "$after" -le 200 ] && [ "$after" -ge 50 ] || fail "raised after $after damaged passages"
+grep -q "ALERT scale_shift (warning): scale of inferred GVW" "$dir/damaged.log" || fail "journal"
+grep -aq scale_shift "$dir/alerts.lcmlog" || fail "the alert is not on the alert channel"
+grep -q 'amfi_alert_open{kind="scale_shift"} 1$' "$dir/amfid.prom" || fail "metrics: alert open"
+
+# 3. the open alert survives a restart
+start third
+grep -q "the scale_shift alert is open" "$dir/third.log" || fail "open alert not restored"
+stop
+[ "$(q "SELECT count(*) FROM alerts WHERE kind = 'scale_shift'")" -eq 1 ] || fail "raised again"
+
+# 4. the report
+"$report" --db "$dir/a.db" --summary > "$dir/report.txt" || fail "amfi-report"
+grep -Eq "^scale +" "$dir/report.txt" || fail "report: $(cat "$dir/report.txt")"
+echo "scale on the bus: $ok healthy passages, $blocks blocks, raised after $after damaged passages"
