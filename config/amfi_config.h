@@ -145,6 +145,10 @@ typedef struct amfi_sim_config {
     double environment_period_s; /* environment_period_s: environment_t every
                                this much data time (environment: site), s,
                                [0.1, 86400] */
+    int calibration_every;  /* calibration_every: every this many vehicles
+                               the pre-weighed calibration truck, its static
+                               GVW as vehicle_t.reference_gvw_kg, 0 .. 10^7;
+                               0 = none */
 } amfi_sim_config;
 
 /* site.*: which bridge this is (section_site.c). */

@@ -235,6 +235,8 @@ static const field stream_fields[] = {
      .hi = 60},
     {.key = "environment_period_s", .kind = &K_DOUBLE, .off = SIM(environment_period_s),
      .lo = 0.1, .hi = 86400},
+    {.key = "calibration_every", .kind = &K_INT, .off = SIM(calibration_every), .lo = 0,
+     .hi = 1e7},
     {.key = NULL}};
 
 const field sim_fields[] = {

@@ -194,8 +194,9 @@ static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
     j->w.v.n_axles = 0;
     j->gvw_kg = NAN;
     snprintf(j->status, sizeof j->status, "invalid");
-    snprintf(j->reason, sizeof j->reason, "%.120s (speed_mps %.6g, n_axles %d, utime %lld)",
-             why, m->speed_mps, m->n_axles, (long long)m->utime);
+    snprintf(j->reason, sizeof j->reason,
+             "%.90s (speed_mps %.6g, n_axles %d, utime %lld, reference_gvw_kg %.6g)", why,
+             m->speed_mps, m->n_axles, (long long)m->utime, m->reference_gvw_kg);
     /* outside the entry order: stored now */
     pipeline_store_now(d, j); /* takes the job */
 }
@@ -222,6 +223,11 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
     for (int a = 0; !why && a < m.n_spacings; a++)
         if (!(m.axle_spacing_m[a] >= 0.5 && m.axle_spacing_m[a] <= 30.0))
             why = "axle_spacing_m out of [0.5, 30]";
+    /* a calibration truck's reference: 0 or NaN none, else finite in 1 .. 100 t */
+    const int has_ref = m.reference_gvw_kg != 0.0 && !isnan(m.reference_gvw_kg);
+    if (!why && has_ref &&
+        !(m.reference_gvw_kg >= AMFI_STORE_MIN_REF_KG && m.reference_gvw_kg <= AMFI_STORE_MAX_REF_KG))
+        why = "reference_gvw_kg out of [1000, 100000] kg";
     if (!why) {
         amfi_vehicle_ev v;
         memset(&v, 0, sizeof v);
@@ -232,6 +238,7 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
         v.n_axles = m.n_axles;
         for (int a = 0; a < m.n_spacings; a++)
             v.spacing_m[a] = m.axle_spacing_m[a];
+        v.reference_gvw_kg = has_ref ? m.reference_gvw_kg : 0.0;
         const char *twhy = NULL;
         if (amfi_tracker_add(d->tracker, &v, &twhy) != 0)
             why = twhy;

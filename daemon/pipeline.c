@@ -68,6 +68,7 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id)
     m.speed_estimated = (int8_t)j->speed_estimated;
     m.n_vehicles = (int16_t)(j->w.n_vehicles > 1 ? j->w.n_vehicles : 1);
     m.quality = j->quality > 0 ? j->quality : NAN;
+    m.reference_gvw_kg = j->w.v.reference_gvw_kg > 0 ? j->w.v.reference_gvw_kg : NAN;
     amfi_passage_t_publish(d->lcm, d->cfg.daemon.ch_passage, &m);
 }
 

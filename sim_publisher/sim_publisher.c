@@ -129,6 +129,7 @@ typedef struct opts {
     int environment;      /* 0 none, 1 site */
     double environment_period; /* s of data time between environment_t */
     double time_compression;
+    long calibration_every; /* > 0: every this many vehicles the calibration truck */
 } opts;
 
 static void usage(FILE *f)
@@ -176,6 +177,8 @@ static void usage(FILE *f)
             "      --environment none|site    streaming: site climate and drifting mix\n"
             "      --time-compression C       site time / data time, 1 .. 1000000\n"
             "      --environment-period SEC   environment_t every SEC of data time\n"
+            "      --calibration-every N      every Nth vehicle the pre-weighed calibration\n"
+            "                                 truck, its reference GVW on vehicle_t (0: none)\n"
             "  -h, --help                     this help\n"
             "  -V, --version                  print the version\n"
             "Settings: built-in defaults < the configuration file's simulation: section\n"
@@ -188,7 +191,7 @@ enum {
     O_FIRST = 256, O_PROFILE, O_TRACK_STD, O_SCAN_RATE, O_NOISE, O_SPEED_ERROR,
     O_PRECEDING_GAP, O_PRE, O_POST, O_DT, O_SPEEDUP, O_HEADWAY, O_DAMAGE_STEP_AT,
     O_NOISE_MS2, O_BLOCK, O_START_UTIME, O_DETECTOR_LEAD, O_ENVIRONMENT,
-    O_TIME_COMPRESSION, O_ENVIRONMENT_PERIOD, O_FLOW, O_MIN_HEADWAY, O_LANES
+    O_TIME_COMPRESSION, O_ENVIRONMENT_PERIOD, O_CALIBRATION_EVERY, O_FLOW, O_MIN_HEADWAY, O_LANES
 };
 
 static const struct option longopts[] = {
@@ -223,6 +226,7 @@ static const struct option longopts[] = {
     {"environment", required_argument, NULL, O_ENVIRONMENT},
     {"time-compression", required_argument, NULL, O_TIME_COMPRESSION},
     {"environment-period", required_argument, NULL, O_ENVIRONMENT_PERIOD},
+    {"calibration-every", required_argument, NULL, O_CALIBRATION_EVERY},
     AMFI_CLI_END};
 
 /* "A" or "A,B" */
@@ -311,6 +315,7 @@ static void opts_from_config(opts *o, const amfi_sim_config *c, const char *file
     o->environment = c->environment;
     o->time_compression = c->time_compression;
     o->environment_period = c->environment_period_s;
+    o->calibration_every = c->calibration_every;
 }
 
 /* The flags over the values already in *o; exits 0 after --help, 2 after a
@@ -385,6 +390,7 @@ static void apply_flags(int argc, char **argv, opts *o)
         case O_ENVIRONMENT_PERIOD:
             o->environment_period = amfi_cli_num(&c, v, 0.1, 86400);
             break;
+        case O_CALIBRATION_EVERY: o->calibration_every = amfi_cli_integer(&c, v, 0, 1e7); break;
         case O_TIME_COMPRESSION: o->time_compression = amfi_cli_num(&c, v, 1, 1e6); break;
         }
     }
@@ -530,6 +536,7 @@ typedef struct planned {
     double spacing;
     int lane;            /* 1-based */
     double start_s;      /* its approach starts (sim time) */
+    double reference_kg; /* the calibration truck: its static GVW; else 0 */
 } planned;
 
 static int by_start(const void *a, const void *b)
@@ -605,6 +612,13 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
      * the first after its full approach. */
     double t = 0.0;
     amfi_flow fl;
+    /* the calibration truck (--calibration-every): the population's heaviest
+     * record, a loaded two-axle truck, the same vehicle at every run */
+    int truck = 0;
+    for (int k = 1; k < n_recs; k++)
+        if (recs[k].axle_kg[0] + recs[k].axle_kg[1] >
+            recs[truck].axle_kg[0] + recs[truck].axle_kg[1])
+            truck = k;
     if (frng)
         gsl_rng_set(frng, o->seed ^ 0xf10bu);
     for (long i = 0; i < o->vehicles; i++) {
@@ -614,9 +628,12 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         double gap = o->headway > 0 ? o->headway
                                     : (i ? seq->timestamp_s - recs[o->first + i - 1].timestamp_s
                                          : 0.0);
-        const int ri = o->environment ? amfi_site_pick(&site, o->seed, o->first + i,
-                                                       i ? t + gap : 0.0)
-                                      : (int)(o->first + i);
+        const int calib = o->calibration_every > 0 &&
+                          (o->first + i + 1) % o->calibration_every == 0;
+        const int ri = calib            ? truck
+                       : o->environment ? amfi_site_pick(&site, o->seed, o->first + i,
+                                                         i ? t + gap : 0.0)
+                                        : (int)(o->first + i);
         const amfi_vehicle_rec *rec = &recs[ri];
         amfi_passage_spec spec;
         seed_vehicle(rng, o->seed, o->first + i);
@@ -650,6 +667,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         plan[i].start_s = t - sp.approach_m / spec.speed_mps;
         plan[i].v.track = spec.track;
         plan[i].spacing = spec.car.D1_m + spec.car.D2_m;
+        plan[i].reference_kg = calib ? rec->axle_kg[0] + rec->axle_kg[1] : 0.0;
     }
     if (o->flow > 0) {
         /* the simulator takes vehicles in the order their approach starts */
@@ -722,7 +740,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
                          (o->speed_err_std > 0 ? gsl_ran_gaussian(noise, o->speed_err_std) : 0.0);
             double spacing = p->spacing;
             amfi_vehicle_t m = {o->start_utime + (int64_t)llround(p->entry_s * 1e6), p->v.id, p->lane,
-                                speed, 2, 1, &spacing, PROG};
+                                speed, 2, 1, &spacing, PROG, p->reference_kg};
             if (EMIT(&b, amfi_vehicle_t, cfg->daemon.ch_vehicle, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
                 goto out;

@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: GPL-3.0-or-later
 # amfid on the hostile datagrams of issue 9 (an LCM log through file://, no
-# network): the 56-byte vehicle_t with a negative string length that crashed
+# network): the vehicle_t (56 bytes then, 64 with reference_gvw_kg) with a negative string length that crashed
 # amfid inside lcm-gen's decoder, negative array counts on accel, vehicle and
 # truth, a vehicle dated after year 9999, and 40 000 more refused messages.
 # amfid must keep running, weigh the real vehicles, store the far-future
@@ -20,7 +20,7 @@ fail() { echo "FAIL: $*"; tail -30 "$dir/amfid.log"; exit 1; }
 "$amfid" --config "$config" --db "$dir/a.db" --lcm-url "file://$dir/bad.log?speed=0" \
   2> "$dir/amfid.log"; rc=$?
 [ $rc -eq 0 ] || fail "amfid exit status $rc (the hostile datagrams stopped it)"
-grep -q "malformed vehicle_t (56 bytes) rejected: vehicle_t.source: string length -16" "$dir/amfid.log" ||
+grep -q "malformed vehicle_t (64 bytes) rejected: vehicle_t.source: string length -16" "$dir/amfid.log" ||
   fail "the issue 9 datagram is not refused by name"
 for what in "malformed accel_block_t .* negative" "malformed vehicle_t .* negative" \
             "malformed truth_t .* negative"; do

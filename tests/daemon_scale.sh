@@ -1,29 +1,35 @@
 #!/bin/sh
 # SPDX-License-Identifier: GPL-3.0-or-later
-# amfid runs the scale indicator (issue 14, docs/indicators.md section 8) on
+# amfid runs the scale indicator and the known-truck runs (issue 14,
+# docs/indicators.md section 8) on
 # LCM's UDP multicast inside a private network namespace, with
 # sim_publisher --environment site (the climate time-compressed 2000 times,
 # an environment_t every 10 s of data time) and a small scale block
 # (alerts.scale.block 50, baseline_blocks 4, tuned for a 10 % loss at 10
 # design false alarms a year at 500 vehicles a day, so that a test of a few
-# hundred vehicles sees it):
+# hundred vehicles sees it); every 10th vehicle is the calibration truck
+# (sim_publisher --calibration-every 10, vehicle_t.reference_gvw_kg):
 #   1. 300 healthy vehicles: every solved passage gets a deck temperature
 #      (passages.deck_c, none skipped), the baseline is fitted once
 #      (scale_evals row 'baseline'), two blocks follow, no scale_shift alert;
+#      the 30 truck runs are stored with their reference, evaluated
+#      (scale_evals 'known_truck'), no known_truck alert. Two vehicle_t with
+#      a bad reference (500 kg, infinite) are refused: stored as invalid,
+#      the reason naming the channel and the field, counted;
 #   2. amfid restarts: the 300 passages are replayed from the store (no
 #      second baseline), then 200 vehicles on a bridge with 10 % less
-#      stiffness: the warning alert scale_shift is raised once (alerts
-#      table, the journal, the alert channel, the metrics file), within the
-#      four damaged blocks;
-#   3. a third start restores the open alert (not raised again);
-#   4. amfi-report shows the indicator's series.
-# Usage: daemon_scale.sh AMFID SIM_PUBLISHER AMFI_REPORT CONFIG
+#      stiffness: the warning alerts scale_shift and known_truck are raised
+#      once each (alerts table, the journal, the alert channel, the metrics
+#      file), scale_shift within the four damaged blocks;
+#   3. a third start restores the open alerts (not raised again);
+#   4. amfi-report shows the indicators' series.
+# Usage: daemon_scale.sh AMFID SIM_PUBLISHER AMFI_REPORT LCM_INJECT CONFIG
 set -u
 if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
   exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
     AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
 fi
-amfid=$1 sim=$2 report=$3 config=$4
+amfid=$1 sim=$2 report=$3 inject=$4 config=$5
 dir=$(mktemp -d)
 pids=""
 cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
@@ -61,7 +67,8 @@ stop() {
 sim() {
   name=$1; shift
   timeout 300 "$sim" --headway 3 --speedup 60 --seed 3 --dt 2.5e-4 --environment site \
-    --time-compression 2000 --environment-period 10 "$@" 2> "$dir/$name-sim.log" ||
+    --time-compression 2000 --environment-period 10 --calibration-every 10 \
+    --log "$dir/$name.lcmlog" "$@" 2> "$dir/$name-sim.log" ||
     fail "sim_publisher exited $? ($name)"
   sleep 2
 }
@@ -69,6 +76,9 @@ sim() {
 # 1. healthy
 start healthy
 sim healthy --vehicles 300
+"$inject" --bad-reference "$dir/healthy.lcmlog" "$dir/bad.lcmlog" || fail "lcm_inject"
+lcm-logplayer -s 1 "$dir/bad.lcmlog" > "$dir/player.log" 2>&1 || fail "lcm-logplayer"
+sleep 1
 stop
 ok=$(q "SELECT count(*) FROM passages WHERE status = 'ok'")
 [ "$ok" -ge 290 ] || fail "$ok ok passages of 300"
@@ -84,6 +94,24 @@ blocks=$(q "SELECT count(*) FROM scale_evals WHERE kind = 'scale_shift' AND stat
 [ "$(q "SELECT count(*) FROM alerts WHERE kind = 'scale_shift'")" -eq 0 ] ||
   fail "scale_shift on a healthy bridge: $(q "SELECT message FROM alerts")"
 grep -q 'amfi_scale_passages_total{use="no_temperature"} 0$' "$dir/amfid.prom" || fail "metrics"
+# the truck: 30 runs stored with the population's heaviest record's GVW
+runs=$(q "SELECT count(*) FROM passages WHERE status = 'ok' AND reference_gvw_kg = 14829")
+[ "$runs" -ge 28 ] || fail "$runs known-truck runs stored of 30"
+[ "$(q "SELECT count(*) FROM passages WHERE reference_gvw_kg IS NOT NULL AND vehicle_id % 10 <> 0")" -eq 0 ] ||
+  fail "a reference on a vehicle that is not the truck"
+[ "$(q "SELECT count(*) FROM scale_evals WHERE kind = 'known_truck'")" -eq "$runs" ] ||
+  fail "known_truck rows: $(q "SELECT count(*) FROM scale_evals WHERE kind = 'known_truck'") for $runs runs"
+[ "$(q "SELECT count(*) FROM alerts WHERE kind = 'known_truck'")" -eq 0 ] ||
+  fail "known_truck on a healthy bridge: $(q "SELECT group_concat(printf('%.4f/%s', value, state), ' ') FROM scale_evals WHERE kind = 'known_truck'")"
+# the bad references: refused where they enter, stored as invalid, counted
+for id in 434343 434344; do
+  [ "$(q "SELECT count(*) FROM passages WHERE vehicle_id = $id AND status = 'invalid' AND reason LIKE 'AMFI_VEHICLE: vehicle_t $id rejected: reference_gvw_kg out of [1000, 100000] kg%' AND reference_gvw_kg IS NULL")" -eq 1 ] ||
+    fail "vehicle $id: $(q "SELECT status, reason FROM passages WHERE vehicle_id = $id")"
+  grep -q "AMFI_VEHICLE: vehicle_t $id rejected: reference_gvw_kg out of" "$dir/healthy.log" ||
+    fail "vehicle $id not logged"
+done
+grep -q 'amfi_messages_refused_total{input="vehicle",reason="invalid"} 2$' "$dir/amfid.prom" ||
+  fail "metrics: $(grep refused "$dir/amfid.prom")"
 last=$(q "SELECT max(utime) FROM passages")
 
 # 2. restart, 10 % stiffness loss
@@ -91,7 +119,7 @@ start damaged
 lcm-logger -c 'AMFI_ALERT' -f "$dir/alerts.lcmlog" > "$dir/logger.log" 2>&1 &
 lpid=$!; pids="$pids $lpid"
 sleep 0.3
-grep -q "scale indicator: $ok passages replayed from the store (" "$dir/damaged.log" ||
+grep -Eq "scale indicator: $ok passages replayed from the store \((normal|watch), $runs known-truck runs\)" "$dir/damaged.log" ||
   fail "replay line: $(grep 'scale indicator' "$dir/damaged.log")"
 sim damaged --vehicles 200 --first 300 --damage 0.1 --start-utime $((last + 10000000))
 stop
@@ -106,14 +134,23 @@ after=$(q "SELECT count(*) FROM passages WHERE status = 'ok' AND utime > $last A
 grep -q "ALERT scale_shift (warning): scale of inferred GVW" "$dir/damaged.log" || fail "journal"
 grep -aq scale_shift "$dir/alerts.lcmlog" || fail "the alert is not on the alert channel"
 grep -q 'amfi_alert_open{kind="scale_shift"} 1$' "$dir/amfid.prom" || fail "metrics: alert open"
+[ "$(q "SELECT count(*) FROM alerts WHERE kind = 'known_truck' AND raised = 1 AND level = 'warning'")" -eq 1 ] ||
+  fail "known_truck raised $(q "SELECT count(*) FROM alerts WHERE kind = 'known_truck' AND raised = 1") times; runs: $(q "SELECT group_concat(printf('%.4f/%s', value, state), ' ') FROM scale_evals WHERE kind = 'known_truck'")"
+grep -q "ALERT known_truck (warning)" "$dir/damaged.log" || fail "journal: known_truck"
+grep -aq known_truck "$dir/alerts.lcmlog" || fail "known_truck is not on the alert channel"
 
 # 3. the open alert survives a restart
 start third
-grep -q "the scale_shift alert is open" "$dir/third.log" || fail "open alert not restored"
+grep -q "the scale_shift alert is open; the known_truck alert is open" "$dir/third.log" ||
+  fail "open alerts not restored: $(grep 'scale indicator' "$dir/third.log")"
 stop
-[ "$(q "SELECT count(*) FROM alerts WHERE kind = 'scale_shift'")" -eq 1 ] || fail "raised again"
+[ "$(q "SELECT count(*) FROM alerts WHERE kind IN ('scale_shift', 'known_truck')")" -eq 2 ] ||
+  fail "raised again"
 
 # 4. the report
 "$report" --db "$dir/a.db" --summary > "$dir/report.txt" || fail "amfi-report"
-grep -Eq "^scale +" "$dir/report.txt" || fail "report: $(cat "$dir/report.txt")"
-echo "scale on the bus: $ok healthy passages, $blocks blocks, raised after $after damaged passages"
+grep -Eq "^scale +[0-9]+ blocks, newest .* CUSUM [0-9.]+ of [0-9.]+, alert; all blocks " "$dir/report.txt" ||
+  fail "report: $(cat "$dir/report.txt")"
+grep -Eq "^known truck +[0-9]+ runs, ratio inferred/reference \(compensated\) mean " "$dir/report.txt" ||
+  fail "report: $(cat "$dir/report.txt")"
+echo "scale on the bus: $ok healthy passages, $blocks blocks, raised after $after damaged passages; $runs healthy truck runs"

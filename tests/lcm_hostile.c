@@ -2,7 +2,7 @@
 /*
  * lcm_hostile: copy an LCM log, splicing in the hostile datagrams of issue 9
  * after the 50th AMFI_ACCEL event, for tests/daemon_hostile.sh:
- *   the 56-byte vehicle_t whose source string length is -16 (read from FILE,
+ *   the vehicle_t (64 bytes; 56 before reference_gvw_kg) whose source string length is -16 (read from FILE,
  *   the fuzz corpus' copy of it); an accel_block_t with n = -1; a vehicle_t
  *   with n_spacings = -1; a truth_t with n_axles = -2; a well-formed vehicle
  *   (id 777001) whose utime is past year 9999; then COUNT more refused
@@ -58,7 +58,7 @@ int main(int argc, char **argv)
     unsigned char ba[256];
     int na = amfi_accel_block_t_encode(ba, 0, sizeof ba, &a);
     double sp = 5.0;
-    amfi_vehicle_t v = {1, 1, 1, 25.0, 2, 1, &sp, "hostile"};
+    amfi_vehicle_t v = {1, 1, 1, 25.0, 2, 1, &sp, "hostile", 0.0};
     unsigned char bv[256];
     int nv = amfi_vehicle_t_encode(bv, 0, sizeof bv, &v);
     double ax[2] = {5000, 5000}, mf[2] = {49000, 49000};
@@ -83,7 +83,7 @@ int main(int argc, char **argv)
             rc |= put(out, &num, ts, AMFI_CHANNEL_VEHICLE, bv, nv);
             rc |= put(out, &num, ts, AMFI_CHANNEL_TRUTH, bt, nt);
             amfi_vehicle_t far = {INT64_C(253402300800000000) + 1000000, 777001, 1, 25.0, 2, 1,
-                                  &sp, "hostile"};
+                                  &sp, "hostile", 0.0};
             unsigned char bf[256];
             int nf = amfi_vehicle_t_encode(bf, 0, sizeof bf, &far);
             rc |= nf < 0 || put(out, &num, ts, AMFI_CHANNEL_VEHICLE, bf, nf);

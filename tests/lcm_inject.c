@@ -28,6 +28,12 @@
  * days after the stream, then one good reading 1 s after IN.log's last.
  *
  *   lcm_inject --bad-environment IN.log OUT.log
+ *
+ * With --bad-reference, OUT.log gets only two vehicle_t after IN.log's last
+ * one (tests/daemon_scale.sh), well formed but for their reference GVW (a
+ * calibration truck's): 500 kg (ids 434343) and +infinity (434344).
+ *
+ *   lcm_inject --bad-reference IN.log OUT.log
  */
 #include <lcm/eventlog.h>
 #include <math.h>
@@ -163,8 +169,48 @@ static int bad_environment(const char *inp, const char *outp)
     return rc ? 1 : 0;
 }
 
+static int bad_reference(const char *inp, const char *outp)
+{
+    lcm_eventlog_t *in, *out;
+    if (open_logs(inp, outp, &in, &out))
+        return 1;
+    lcm_eventlog_event_t *e;
+    int64_t num = 0, last = -1, ts = 0;
+    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
+        amfi_vehicle_t m;
+        if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0 &&
+            amfi_vehicle_t_decode(e->data, 0, e->datalen, &m) >= 0) {
+            last = m.utime;
+            ts = e->timestamp;
+            amfi_vehicle_t_decode_cleanup(&m);
+        }
+        lcm_eventlog_free_event(e);
+    }
+    lcm_eventlog_destroy(in);
+    int rc = 0;
+    if (last < 0) {
+        fprintf(stderr, "lcm_inject: no vehicle_t in %s\n", inp);
+        rc = 1;
+    }
+    const double ref[2] = {500.0, INFINITY};
+    for (int k = 0; rc == 0 && k < 2; k++) {
+        double spacing = 4.0;
+        amfi_vehicle_t v = {last + (k + 1) * INT64_C(3000000), 434343 + k, 1, 20.0, 2, 1,
+                            &spacing, "inject", ref[k]};
+        unsigned char buf[256];
+        int n = amfi_vehicle_t_encode(buf, 0, sizeof buf, &v);
+        rc |= n < 0 || put(out, &num, ts + 1000 * (k + 1), AMFI_CHANNEL_VEHICLE, buf, n);
+    }
+    if (rc && last >= 0)
+        fprintf(stderr, "lcm_inject: write failed\n");
+    lcm_eventlog_destroy(out);
+    return rc ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 4 && strcmp(argv[1], "--bad-reference") == 0)
+        return bad_reference(argv[2], argv[3]);
     if (argc == 4 && strcmp(argv[1], "--bad-environment") == 0)
         return bad_environment(argv[2], argv[3]);
     if (argc == 5 && strcmp(argv[1], "--scale-accel") == 0)
@@ -172,7 +218,7 @@ int main(int argc, char **argv)
     if (argc == 4 && strcmp(argv[1], "--vehicles-only") == 0)
         return vehicles_only(argv[2], argv[3]);
     if (argc != 3) {
-        fprintf(stderr, "usage: lcm_inject [--vehicles-only | --bad-environment | "
+        fprintf(stderr, "usage: lcm_inject [--vehicles-only | --bad-environment | --bad-reference | "
                         "--scale-accel F] IN.log OUT.log\n");
         return 2;
     }
@@ -207,7 +253,7 @@ int main(int argc, char **argv)
             rc |= put(out, &num, e->timestamp, AMFI_CHANNEL_VEHICLE, junk, sizeof junk);
             rc |= put(out, &num, e->timestamp, AMFI_CHANNEL_TRUTH, junk, sizeof junk);
             double spacing = 5.0;
-            amfi_vehicle_t v = {e->timestamp + 500000, 424242, 1, -3.0, 2, 1, &spacing, "inject"};
+            amfi_vehicle_t v = {e->timestamp + 500000, 424242, 1, -3.0, 2, 1, &spacing, "inject", 0.0};
             unsigned char buf[256];
             int n = amfi_vehicle_t_encode(buf, 0, sizeof buf, &v);
             rc |= n < 0 || put(out, &num, e->timestamp, AMFI_CHANNEL_VEHICLE, buf, n);

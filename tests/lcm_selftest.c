@@ -93,6 +93,7 @@ static void round_make(struct round *r, int i)
         r->spacing_m[j] = j == 0 ? 3.6 + 0.05 * (i % 10) : 1.31;
     r->vehicle.axle_spacing_m = r->spacing_m;
     r->vehicle.source = "lcm_selftest";
+    r->vehicle.reference_gvw_kg = i % 4 == 0 ? 14829.0 : 0.0; /* a calibration truck */
 
     double gvw = 0;
     for (int j = 0; j < n_axles; j++) {
@@ -131,6 +132,7 @@ static void round_make(struct round *r, int i)
     r->passage.speed_estimated = 1;
     r->passage.n_vehicles = (int16_t)(1 + i % 3);   /* weighed alone or with others */
     r->passage.quality = 1.0 + 0.5 * (i % 3);
+    r->passage.reference_gvw_kg = i % 4 == 0 ? 14829.0 : NAN;
 
     r->unsolved = r->passage;
     r->unsolved.passage_id = 100000 + i;
@@ -240,7 +242,8 @@ static void print_round(const struct round *r)
     put_i("n_axles", v->n_axles, ";");
     put_i("n_spacings", v->n_spacings, ";");
     put_da("axle_spacing_m", v->axle_spacing_m, v->n_spacings, ";");
-    put_s("source", v->source, "\n");
+    put_s("source", v->source, ";");
+    put_d("reference_gvw_kg", v->reference_gvw_kg, "\n");
 
     const amfi_truth_t *t = &r->truth;
     printf("%s\tamfi.truth_t\t", AMFI_CHANNEL_TRUTH);
@@ -272,7 +275,8 @@ static void print_round(const struct round *r)
     put_d("speed_given_mps", p->speed_given_mps, ";");
     put_i("speed_estimated", p->speed_estimated, ";");
     put_i("n_vehicles", p->n_vehicles, ";");
-    put_d("quality", p->quality, "\n");
+    put_d("quality", p->quality, ";");
+    put_d("reference_gvw_kg", p->reference_gvw_kg, "\n");
 
     const amfi_indicator_t *d = &r->indicator;
     printf("%s\tamfi.indicator_t\t", AMFI_CHANNEL_INDICATOR);
@@ -432,7 +436,8 @@ static int same_vehicle(const char *c, const amfi_vehicle_t *a, const amfi_vehic
             same_i(c, "lane", a->lane, b->lane) + same_d(c, "speed_mps", a->speed_mps, b->speed_mps) +
             same_i(c, "n_axles", a->n_axles, b->n_axles) +
             same_i(c, "n_spacings", a->n_spacings, b->n_spacings) +
-            same_s(c, "source", a->source, b->source);
+            same_s(c, "source", a->source, b->source) +
+            same_d(c, "reference_gvw_kg", a->reference_gvw_kg, b->reference_gvw_kg);
     return e ? e : same_da(c, "axle_spacing_m", a->axle_spacing_m, b->axle_spacing_m, a->n_spacings);
 }
 
@@ -458,7 +463,8 @@ static int same_passage(const char *c, const amfi_passage_t *a, const amfi_passa
             same_d(c, "lambda", a->lambda, b->lambda) +
             same_d(c, "residual_rms", a->residual_rms, b->residual_rms) +
             same_s(c, "formulation", a->formulation, b->formulation) +
-            same_d(c, "solve_ms", a->solve_ms, b->solve_ms);
+            same_d(c, "solve_ms", a->solve_ms, b->solve_ms) +
+            same_d(c, "reference_gvw_kg", a->reference_gvw_kg, b->reference_gvw_kg);
     return e ? e : same_da(c, "axle_kg", a->axle_kg, b->axle_kg, a->n_axles);
 }
 

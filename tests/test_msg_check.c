@@ -118,7 +118,7 @@ static enc random_message(amfi_msg_type t, int big)
     }
     case AMFI_MSG_VEHICLE_T: {
         amfi_vehicle_t m = {(int64_t)rnd(), (int64_t)rnd(), (int16_t)rnd(), rnd_double(),
-                            (int16_t)rnd(), 0, NULL, NULL};
+                            (int16_t)rnd(), 0, NULL, NULL, rnd_double()};
         m.n_spacings = (int16_t)(big ? AMFI_MSG_MAX_VEHICLE_N_SPACINGS
                                      : rnd_int(0, AMFI_MSG_MAX_VEHICLE_N_SPACINGS));
         m.axle_spacing_m = rnd_doubles(m.n_spacings);
@@ -144,7 +144,7 @@ static enc random_message(amfi_msg_type t, int big)
         amfi_passage_t m = {(int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(), (int16_t)rnd(),
                             rnd_double(), NULL, NULL, rnd_double(), 0, NULL, rnd_double(),
                             rnd_double(), NULL, rnd_double(), NULL, rnd_double(),
-                            (int8_t)rnd(), (int16_t)rnd(), rnd_double()};
+                            (int8_t)rnd(), (int16_t)rnd(), rnd_double(), rnd_double()};
         m.status = rnd_string(AMFI_MSG_MAX_PASSAGE_STATUS);
         m.site_id = rnd_string(AMFI_MSG_MAX_PASSAGE_SITE_ID);
         m.reason = rnd_string(AMFI_MSG_MAX_PASSAGE_REASON);
@@ -364,11 +364,12 @@ static void test_fingerprint(void **state)
     }
 }
 
-/* A vehicle_t with no spacings, source "sim_publisher": 56 bytes. */
+/* A vehicle_t with no spacings, source "sim_publisher": 64 bytes (56 before
+ * reference_gvw_kg was appended, issue 14: the source length stays at 38). */
 static enc small_vehicle(void)
 {
     double none[1] = {0};
-    amfi_vehicle_t v = {1763800000000000, 7, 1, 20.0, 1, 0, none, (char *)"sim_publisher"};
+    amfi_vehicle_t v = {1763800000000000, 7, 1, 20.0, 1, 0, none, (char *)"sim_publisher", 0.0};
     enc e;
     ENCODE(vehicle_t, v);
     return e;
@@ -381,7 +382,7 @@ static void test_issue9_negative_string_length(void **state)
 {
     (void)state;
     enc e = small_vehicle();
-    assert_int_equal(e.len, 56);
+    assert_int_equal(e.len, 64);
     put32(e.buf + VEHICLE_SOURCE_LEN_AT, -16);
     expect_reason(AMFI_MSG_VEHICLE_T, e.buf, e.len, AMFI_MSG_NEGATIVE_COUNT);
     char why[256];
@@ -419,7 +420,9 @@ static void test_bad_strings(void **state)
     expect_reason(AMFI_MSG_VEHICLE_T, e.buf, e.len, AMFI_MSG_BAD_STRING);
     s[3] = 0xE2, s[4] = 0x82, s[5] = 0xAC; /* € is fine */
     expect_reason(AMFI_MSG_VEHICLE_T, e.buf, e.len, AMFI_MSG_OK);
-    put32(e.buf + VEHICLE_SOURCE_LEN_AT, 15);
+    /* one byte more than the message has left (the string, then the
+     * 8 bytes of reference_gvw_kg) */
+    put32(e.buf + VEHICLE_SOURCE_LEN_AT, (int32_t)(e.len - VEHICLE_SOURCE_LEN_AT - 4 + 1));
     expect_reason(AMFI_MSG_VEHICLE_T, e.buf, e.len, AMFI_MSG_TRUNCATED);
     put32(e.buf + VEHICLE_SOURCE_LEN_AT, INT32_MAX);
     expect_reason(AMFI_MSG_VEHICLE_T, e.buf, e.len, AMFI_MSG_OVER_LIMIT);
@@ -430,7 +433,7 @@ static void test_bad_strings(void **state)
     memset(src, 's', AMFI_MSG_MAX_VEHICLE_SOURCE + 1);
     src[AMFI_MSG_MAX_VEHICLE_SOURCE + 1] = 0;
     double none[1] = {0};
-    amfi_vehicle_t v = {1, 2, 1, 20.0, 1, 0, none, src};
+    amfi_vehicle_t v = {1, 2, 1, 20.0, 1, 0, none, src, 0.0};
     ENCODE(vehicle_t, v);
     expect_reason(AMFI_MSG_VEHICLE_T, e.buf, e.len, AMFI_MSG_OVER_LIMIT);
     free(e.buf);
@@ -457,7 +460,7 @@ static enc empty_arrays(amfi_msg_type t)
         break;
     }
     case AMFI_MSG_VEHICLE_T: {
-        amfi_vehicle_t m = {1, 2, 1, 20.0, 1, 0, none, (char *)"x"};
+        amfi_vehicle_t m = {1, 2, 1, 20.0, 1, 0, none, (char *)"x", 14000.0};
         ENCODE(vehicle_t, m);
         break;
     }
@@ -468,7 +471,7 @@ static enc empty_arrays(amfi_msg_type t)
     }
     case AMFI_MSG_PASSAGE_T: {
         amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
-                            1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5};
+                            1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0};
         ENCODE(passage_t, m);
         break;
     }
