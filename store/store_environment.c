@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "store_internal.h"
@@ -182,4 +183,55 @@ int amfi_store_environment_summary(amfi_store *s, amfi_environment_summary *out,
     if (rc == 0)
         *out = r;
     return rc;
+}
+
+int amfi_store_environment_rows(amfi_store *s, amfi_environment_row **out, size_t *n, char *err,
+                                size_t errlen)
+{
+    sqlite3_stmt *st = NULL;
+    int rc = st_check_handle(s, 0, err, errlen);
+    if (rc == 0 && (!out || !n))
+        rc = st_fail(err, errlen, AMFI_EINVAL, "environment: output is NULL");
+    if (rc == 0)
+        rc = st_prepare(s, "SELECT id, utime, deck_c, air_c FROM environment ORDER BY utime, id",
+                        &st, "environment: prepare rows", err, errlen);
+    if (rc != 0)
+        return rc;
+    *out = NULL;
+    *n = 0;
+    amfi_environment_row *v = NULL;
+    size_t cap = 0, k = 0;
+    int src = SQLITE_DONE;
+    while (rc == 0 && (src = sqlite3_step(st)) == SQLITE_ROW) {
+        if (k == cap) {
+            size_t nc = cap ? 2 * cap : 1024;
+            amfi_environment_row *nv = realloc(v, sizeof *v * nc);
+            if (!nv) {
+                rc = st_fail(err, errlen, AMFI_ENOMEM, "environment: out of memory");
+                break;
+            }
+            v = nv;
+            cap = nc;
+        }
+        origin o = {"environment", sqlite3_column_int64(st, 0)};
+        amfi_environment_row *r = &v[k];
+        r->received_utime = 0;
+        rc = st_read_int(st, 1, 0, AMFI_STORE_MAX_UTIME, &o, &r->utime, err, errlen);
+        if (rc == 0)
+            rc = st_read_real(st, 2, &R_TEMP_C, &o, &r->deck_c, err, errlen);
+        if (rc == 0)
+            rc = st_read_real(st, 3, &R_TEMP_C, &o, &r->air_c, err, errlen);
+        k++;
+        src = SQLITE_DONE;
+    }
+    if (rc == 0 && src != SQLITE_DONE)
+        rc = st_db_fail(s, src, "environment: rows", err, errlen);
+    sqlite3_finalize(st);
+    if (rc != 0 || k == 0) {
+        free(v);
+        return rc;
+    }
+    *out = v;
+    *n = k;
+    return 0;
 }

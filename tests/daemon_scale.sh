@@ -153,4 +153,12 @@ grep -Eq "^scale +[0-9]+ blocks, newest .* CUSUM [0-9.]+ of [0-9.]+, alert; all 
   fail "report: $(cat "$dir/report.txt")"
 grep -Eq "^known truck +[0-9]+ runs, ratio inferred/reference \(compensated\) mean " "$dir/report.txt" ||
   fail "report: $(cat "$dir/report.txt")"
+if command -v gnuplot > /dev/null; then
+  "$report" --db "$dir/a.db" --plot "$dir/plots" > "$dir/plot.txt" 2>&1 || fail "--plot: $(cat "$dir/plot.txt")"
+  for p in scale known_truck temperature; do
+    [ -s "$dir/plots/$p.png" ] || fail "no $p.png: $(cat "$dir/plot.txt")"
+    grep -q "^plot  $dir/plots/$p.png  " "$dir/plot.txt" || fail "$p.png not listed"
+  done
+  [ -n "${AMFI_KEEP_PLOTS:-}" ] && cp -r "$dir/plots" "$AMFI_KEEP_PLOTS"
+fi
 echo "scale on the bus: $ok healthy passages, $blocks blocks, raised after $after damaged passages; $runs healthy truck runs"

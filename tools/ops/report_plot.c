@@ -10,7 +10,9 @@
  * alert marked; the GVW histogram of the baseline against the latest
  * window; passages per hour by status; the speed distribution; and, when
  * the store has estimated speeds (issue 12), the daily median speed
- * correction with its p5-p95 band (report_speed.c).
+ * correction with its p5-p95 band (report_speed.c); when the store has
+ * them (issue 14), the scale indicator, the known-truck runs and the
+ * temperature (report_scale.c).
  *
  * Single-threaded, the caller's thread. Memory: four doubles per passage
  * (a million passages: 32 MB).
@@ -28,6 +30,7 @@
 #include <time.h>
 
 #include "report_plot.h"
+#include "report_scale.h"
 #include "report_speed.h"
 
 extern char **environ;
@@ -515,6 +518,13 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
             "set output\nset xtics autofreq\n",
             (double)sdays[0].day_utime / 1e6 - 43200,
             (double)sdays[n_sdays - 1].day_utime / 1e6 + 43200, sub);
+    /* 7-9: the scale indicator, the known-truck runs, the temperature,
+     * when there are any (report_scale.c) */
+    int more = 0;
+    if (report_scale_plots(s, dir, f, site, &more, err, errlen) != 0) {
+        fclose(f);
+        goto out;
+    }
     if (close_data(f, dir, "plots.gp", err, errlen) != 0)
         goto out;
     f = NULL;
@@ -536,6 +546,22 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
             goto out;
         }
         printf("plot  %s  %s\n", path, png[k][1]);
+    }
+    static const char *const png2[][2] = {
+        {"scale.png", "scale indicator: raw and temperature-compensated scale, CUSUM and threshold"},
+        {"known_truck.png", "known-truck runs: ratio inferred / reference, raw and compensated"},
+        {"temperature.png", "deck and air temperature"}};
+    for (int k = 0; k < 3; k++) {
+        struct stat stt;
+        if (!(more & (1 << k)))
+            continue;
+        snprintf(path, sizeof path, "%s/%s", dir, png2[k][0]);
+        if (stat(path, &stt) != 0 || stt.st_size < 100) {
+            fail(err, errlen, "%s: gnuplot wrote no image (see %s/data/gnuplot.log)",
+                 path, dir);
+            goto out;
+        }
+        printf("plot  %s  %s\n", path, png2[k][1]);
     }
     rc = 0;
 out:

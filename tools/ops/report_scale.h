@@ -20,12 +20,17 @@
  * 0, or −1 with the store's message in err. */
 int report_scale_summary(amfi_store *s, FILE *f, char *err, size_t errlen);
 
-/* The plots' data under data_dir (scale.dat, known_truck.dat,
- * temperature.dat) and their gnuplot commands appended to gp, which draw
- * scale.png, known_truck.png and temperature.png into png_dir (a panel
- * saying "none yet" when there is nothing). 0, or −1 with the message in
- * err. */
-int report_scale_plots(amfi_store *s, const char *data_dir, const char *png_dir, FILE *gp,
+/* The plots that have data: their data files under dir/data/ (scale.dat,
+ * known_truck.dat, temperature.dat) and their gnuplot commands appended to
+ * gp (the script of report_plot.c, its variables d and o set), drawing
+ * scale.png (raw and compensated scale, CUSUM against its threshold, the
+ * alerts), known_truck.png (the runs' ratios) and temperature.png (deck and
+ * air). *which gets a bit per plot drawn (REPORT_SCALE_PNG_*). 0, or −1
+ * with the message in err. */
+#define REPORT_SCALE_PNG_SCALE 1
+#define REPORT_SCALE_PNG_TRUCK 2
+#define REPORT_SCALE_PNG_TEMPERATURE 4
+int report_scale_plots(amfi_store *s, const char *dir, FILE *gp, const char *site, int *which,
                        char *err, size_t errlen);
 
 #endif /* REPORT_SCALE_H */
