@@ -92,6 +92,17 @@ const field metrics_fields[] = {
      .hi = 3600},
     {.key = NULL}};
 
+/* A parameter check's failure under alerts.SECTION: on the blamed key's
+ * line, else the section's, else the alerts: line. */
+static int blame(ctx *x, const char *section, const char *blamed, const char *why)
+{
+    char path[PATH_LEN], sec[PATH_LEN];
+    pathf(path, "alerts.%s.%s", section, blamed ? blamed : "");
+    pathf(sec, "alerts.%s", section);
+    int line = noted(x, path);
+    return fail(x, line ? line : first_noted(x, sec, "alerts", NULL), path, "%s", why);
+}
+
 /* The command must be a program amfid can run now (absolute: amfid runs
  * from / under systemd); the metrics file must be an absolute path whose
  * folder exists (node-exporter reads *.prom files there). */
@@ -101,26 +112,14 @@ int ops_check(ctx *x, amfi_site_config *c)
     const char *prom = c->daemon.metrics_path;
     struct stat st;
     const char *blamed = NULL;
-    char why[256], path[PATH_LEN];
+    char why[256];
 
-    if (amfi_speed_drift_params_check(&c->daemon.speed_drift, &blamed, why, sizeof why) != 0) {
-        pathf(path, "alerts.speed_drift.%s", blamed ? blamed : "");
-        int line = noted(x, path);
-        return fail(x, line ? line : first_noted(x, "alerts.speed_drift", "alerts", NULL), path,
-                    "%s", why);
-    }
-    if (amfi_scale_params_check(&c->daemon.scale, &blamed, why, sizeof why) != 0) {
-        pathf(path, "alerts.scale.%s", blamed ? blamed : "");
-        int line = noted(x, path);
-        return fail(x, line ? line : first_noted(x, "alerts.scale", "alerts", NULL), path, "%s",
-                    why);
-    }
-    if (amfi_known_truck_params_check(&c->daemon.known_truck, &blamed, why, sizeof why) != 0) {
-        pathf(path, "alerts.known_truck.%s", blamed ? blamed : "");
-        int line = noted(x, path);
-        return fail(x, line ? line : first_noted(x, "alerts.known_truck", "alerts", NULL), path,
-                    "%s", why);
-    }
+    if (amfi_speed_drift_params_check(&c->daemon.speed_drift, &blamed, why, sizeof why) != 0)
+        return blame(x, "speed_drift", blamed, why);
+    if (amfi_scale_params_check(&c->daemon.scale, &blamed, why, sizeof why) != 0)
+        return blame(x, "scale", blamed, why);
+    if (amfi_known_truck_params_check(&c->daemon.known_truck, &blamed, why, sizeof why) != 0)
+        return blame(x, "known_truck", blamed, why);
     if (cmd[0]) {
         int line = noted(x, "alerts.command");
         if (cmd[0] != '/')

@@ -131,23 +131,58 @@ static int put_env(lcm_eventlog_t *out, int64_t *num, int64_t ts, int64_t utime,
     return n < 0 || put(out, num, ts, AMFI_CHANNEL_ENVIRONMENT, b, n);
 }
 
-static int bad_environment(const char *inp, const char *outp)
+/* The utime of an environment_t or a vehicle_t event (0), else −1. */
+static int environment_utime(const lcm_eventlog_event_t *e, int64_t *utime)
 {
-    lcm_eventlog_t *in, *out;
-    if (open_logs(inp, outp, &in, &out))
+    amfi_environment_t m;
+    if (strcmp(e->channel, AMFI_CHANNEL_ENVIRONMENT) != 0 ||
+        amfi_environment_t_decode(e->data, 0, e->datalen, &m) < 0)
+        return -1;
+    *utime = m.utime;
+    return 0;
+}
+
+static int vehicle_utime(const lcm_eventlog_event_t *e, int64_t *utime)
+{
+    amfi_vehicle_t m;
+    if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) != 0 ||
+        amfi_vehicle_t_decode(e->data, 0, e->datalen, &m) < 0)
+        return -1;
+    *utime = m.utime;
+    amfi_vehicle_t_decode_cleanup(&m);
+    return 0;
+}
+
+/* Read IN to its end: the utime and log timestamp of the last event
+ * utime_of recognizes (*last −1: none); IN closed, OUT opened. */
+static int scan_last(const char *inp, const char *outp, lcm_eventlog_t **out,
+                     int (*utime_of)(const lcm_eventlog_event_t *, int64_t *), int64_t *last,
+                     int64_t *ts)
+{
+    lcm_eventlog_t *in;
+    if (open_logs(inp, outp, &in, out))
         return 1;
     lcm_eventlog_event_t *e;
-    int64_t num = 0, last = -1, ts = 0;
+    *last = -1;
+    *ts = 0;
     while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
-        amfi_environment_t m;
-        if (strcmp(e->channel, AMFI_CHANNEL_ENVIRONMENT) == 0 &&
-            amfi_environment_t_decode(e->data, 0, e->datalen, &m) >= 0) {
-            last = m.utime;
-            ts = e->timestamp;
+        int64_t u;
+        if (utime_of(e, &u) == 0) {
+            *last = u;
+            *ts = e->timestamp;
         }
         lcm_eventlog_free_event(e);
     }
     lcm_eventlog_destroy(in);
+    return 0;
+}
+
+static int bad_environment(const char *inp, const char *outp)
+{
+    lcm_eventlog_t *out;
+    int64_t num = 0, last, ts;
+    if (scan_last(inp, outp, &out, environment_utime, &last, &ts))
+        return 1;
     int rc = 0;
     if (last < 0) {
         fprintf(stderr, "lcm_inject: no environment_t in %s\n", inp);
@@ -171,22 +206,10 @@ static int bad_environment(const char *inp, const char *outp)
 
 static int bad_reference(const char *inp, const char *outp)
 {
-    lcm_eventlog_t *in, *out;
-    if (open_logs(inp, outp, &in, &out))
+    lcm_eventlog_t *out;
+    int64_t num = 0, last, ts;
+    if (scan_last(inp, outp, &out, vehicle_utime, &last, &ts))
         return 1;
-    lcm_eventlog_event_t *e;
-    int64_t num = 0, last = -1, ts = 0;
-    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
-        amfi_vehicle_t m;
-        if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0 &&
-            amfi_vehicle_t_decode(e->data, 0, e->datalen, &m) >= 0) {
-            last = m.utime;
-            ts = e->timestamp;
-            amfi_vehicle_t_decode_cleanup(&m);
-        }
-        lcm_eventlog_free_event(e);
-    }
-    lcm_eventlog_destroy(in);
     int rc = 0;
     if (last < 0) {
         fprintf(stderr, "lcm_inject: no vehicle_t in %s\n", inp);

@@ -82,8 +82,7 @@ static int collect(void *ctx, int64_t id, const amfi_passage_row *r)
     return 0;
 }
 
-static FILE *open_data(const char *dir, const char *name, char *err,
-                       size_t errlen)
+FILE *report_data_open(const char *dir, const char *name, char *err, size_t errlen)
 {
     char path[4096];
     snprintf(path, sizeof path, "%s/data/%s", dir, name);
@@ -93,12 +92,24 @@ static FILE *open_data(const char *dir, const char *name, char *err,
     return f;
 }
 
-static int close_data(FILE *f, const char *dir, const char *name, char *err,
-                      size_t errlen)
+int report_data_close(FILE *f, const char *dir, const char *name, char *err, size_t errlen)
 {
     int bad = ferror(f);
     if (fclose(f) != 0 || bad)
         return fail(err, errlen, "%s/data/%s: write failed", dir, name);
+    return 0;
+}
+
+/* A PNG gnuplot should have written: listed on stdout, or −1 with err. */
+static int listed(const char *dir, const char *name, const char *what, char *err, size_t errlen)
+{
+    char path[4096];
+    struct stat stt;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    if (stat(path, &stt) != 0 || stt.st_size < 100)
+        return fail(err, errlen, "%s: gnuplot wrote no image (see %s/data/gnuplot.log)", path,
+                    dir);
+    printf("plot  %s  %s\n", path, what);
     return 0;
 }
 
@@ -234,7 +245,7 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         snprintf(sub, sizeof sub, "%s, no passages in the store", site);
 
     /* passages.dat: t gvw_t status speed_kmh */
-    if (!(f = open_data(dir, "passages.dat", err, errlen)))
+    if (!(f = report_data_open(dir, "passages.dat", err, errlen)))
         goto out;
     fprintf(f, "# time_s gvw_t status(0 ok,1 gap,2 late,3 overload,4 multiple,5 invalid,6 error) speed_kmh\n");
     size_t n_ok = 0, n_sp = 0, n_gvw = 0;
@@ -256,11 +267,11 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         if (!isnan(p->speed))
             sp[n_sp++] = p->speed * 3.6;
     }
-    if (close_data(f, dir, "passages.dat", err, errlen) != 0)
+    if (report_data_close(f, dir, "passages.dat", err, errlen) != 0)
         goto out;
 
     /* band.dat: baseline mean ± 2 STD from when it applies */
-    if (!(f = open_data(dir, "band.dat", err, errlen)))
+    if (!(f = report_data_open(dir, "band.dat", err, errlen)))
         goto out;
     if (found) {
         double tb = fmax(t0, (double)b.utime_set / 1e6);
@@ -271,11 +282,11 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     } else {
         fprintf(f, "%.3f NaN NaN NaN\n", t0);
     }
-    if (close_data(f, dir, "band.dat", err, errlen) != 0)
+    if (report_data_close(f, dir, "band.dat", err, errlen) != 0)
         goto out;
 
     /* indicators.dat, oldest first */
-    if (!(f = open_data(dir, "indicators.dat", err, errlen)))
+    if (!(f = report_data_open(dir, "indicators.dat", err, errlen)))
         goto out;
     fprintf(f, "# time_s std_ratio p_value mean_ratio n state\n");
     for (int k = n_ind - 1; k >= 0; k--) {
@@ -284,17 +295,17 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         fprintf(f, "%.3f %.5g %.5g %.5g %d %s\n", (double)r->utime / 1e6,
                 r->std_ratio, r->p_value, isfinite(mr) ? mr : NAN, r->n, r->state);
     }
-    if (close_data(f, dir, "indicators.dat", err, errlen) != 0)
+    if (report_data_close(f, dir, "indicators.dat", err, errlen) != 0)
         goto out;
 
     /* alerts.dat: one line per alert row, oldest first */
-    if (!(f = open_data(dir, "alerts.dat", err, errlen)))
+    if (!(f = report_data_open(dir, "alerts.dat", err, errlen)))
         goto out;
     fprintf(f, "# alert_id time_s raised(1)/cleared(0) level kind\n");
     for (int k = n_al - 1; k >= 0; k--)
         fprintf(f, "%lld %.3f %d %s %s\n", (long long)al[k].id,
                 (double)al[k].utime / 1e6, al[k].raised, al[k].level, al[k].kind);
-    if (close_data(f, dir, "alerts.dat", err, errlen) != 0)
+    if (report_data_close(f, dir, "alerts.dat", err, errlen) != 0)
         goto out;
 
     /* histogram.dat: baseline sample (the b.n ok passages up to the
@@ -327,13 +338,13 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     double w = (hi - lo) / nbins, hb[64], hl[64];
     hist(bl, nb, lo, w, nbins, hb);
     hist(la, nla, lo, w * (1 + 1e-12), nbins, hl);
-    if (!(f = open_data(dir, "histogram.dat", err, errlen)))
+    if (!(f = report_data_open(dir, "histogram.dat", err, errlen)))
         goto out;
     fprintf(f, "# gvw_t_bin_centre baseline_fraction latest_fraction (bin %.3f t; baseline n %zu, latest n %zu)\n",
             w, nb, nla);
     for (int k = 0; k < nbins; k++)
         fprintf(f, "%.4f %.5f %.5f\n", lo + (k + 0.5) * w, hb[k], hl[k]);
-    if (close_data(f, dir, "histogram.dat", err, errlen) != 0)
+    if (report_data_close(f, dir, "histogram.dat", err, errlen) != 0)
         goto out;
 
     /* hourly.dat: passages per hour by status, cumulative columns so the
@@ -359,7 +370,7 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         if (i >= 0 && i < nbk)
             cnt[(size_t)i * AMFI_STORE_N_STATUS + (size_t)pv.v[k].status] += 3600.0 / bw;
     }
-    if (!(f = open_data(dir, "hourly.dat", err, errlen))) {
+    if (!(f = report_data_open(dir, "hourly.dat", err, errlen))) {
         free(cnt);
         goto out;
     }
@@ -374,11 +385,11 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         fputc('\n', f);
     }
     free(cnt);
-    if (close_data(f, dir, "hourly.dat", err, errlen) != 0)
+    if (report_data_close(f, dir, "hourly.dat", err, errlen) != 0)
         goto out;
 
     /* speed.dat: 2 km/h bins */
-    if (!(f = open_data(dir, "speed.dat", err, errlen)))
+    if (!(f = report_data_open(dir, "speed.dat", err, errlen)))
         goto out;
     fprintf(f, "# speed_kmh_bin_centre passages (bin 2 km/h)\n");
     qsort(sp, n_sp, sizeof *sp, cmp_d);
@@ -393,7 +404,7 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     }
     if (n_sp == 0)
         fprintf(f, "NaN 0\n");
-    if (close_data(f, dir, "speed.dat", err, errlen) != 0)
+    if (report_data_close(f, dir, "speed.dat", err, errlen) != 0)
         goto out;
 
     /* speed_correction.dat: one line per UTC day with estimated speeds */
@@ -404,18 +415,18 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
             goto out;
     }
     if (n_sdays > 0) {
-        if (!(f = open_data(dir, "speed_correction.dat", err, errlen)))
+        if (!(f = report_data_open(dir, "speed_correction.dat", err, errlen)))
             goto out;
         fprintf(f, "# day_utc_s n median_pct p5_pct p95_pct (c = speed used / detector's - 1)\n");
         for (size_t k = 0; k < n_sdays; k++)
             fprintf(f, "%.0f %zu %.4f %.4f %.4f\n", (double)sdays[k].day_utime / 1e6,
                     sdays[k].st.n, sdays[k].st.median, sdays[k].st.p5, sdays[k].st.p95);
-        if (close_data(f, dir, "speed_correction.dat", err, errlen) != 0)
+        if (report_data_close(f, dir, "speed_correction.dat", err, errlen) != 0)
             goto out;
     }
 
     /* the script */
-    if (!(f = open_data(dir, "plots.gp", err, errlen)))
+    if (!(f = report_data_open(dir, "plots.gp", err, errlen)))
         goto out;
     fprintf(f,
         "# written by amfi-report --plot; run from anywhere: gnuplot %s/data/plots.gp\n"
@@ -525,7 +536,7 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         fclose(f);
         goto out;
     }
-    if (close_data(f, dir, "plots.gp", err, errlen) != 0)
+    if (report_data_close(f, dir, "plots.gp", err, errlen) != 0)
         goto out;
     f = NULL;
     if (run_gnuplot(dir, err, errlen) != 0)
@@ -537,32 +548,16 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         {"passages_per_hour.png", "passages per hour by status"},
         {"speed.png", "speed distribution"},
         {"speed_correction.png", "daily median speed correction, p5 .. p95"}};
-    for (int k = 0; k < (n_sdays > 0 ? 6 : 5); k++) {
-        struct stat stt;
-        snprintf(path, sizeof path, "%s/%s", dir, png[k][0]);
-        if (stat(path, &stt) != 0 || stt.st_size < 100) {
-            fail(err, errlen, "%s: gnuplot wrote no image (see %s/data/gnuplot.log)",
-                 path, dir);
+    for (int k = 0; k < (n_sdays > 0 ? 6 : 5); k++)
+        if (listed(dir, png[k][0], png[k][1], err, errlen) != 0)
             goto out;
-        }
-        printf("plot  %s  %s\n", path, png[k][1]);
-    }
     static const char *const png2[][2] = {
         {"scale.png", "scale indicator: raw and temperature-compensated scale, CUSUM and threshold"},
         {"known_truck.png", "known-truck runs: ratio inferred / reference, raw and compensated"},
         {"temperature.png", "deck and air temperature"}};
-    for (int k = 0; k < 3; k++) {
-        struct stat stt;
-        if (!(more & (1 << k)))
-            continue;
-        snprintf(path, sizeof path, "%s/%s", dir, png2[k][0]);
-        if (stat(path, &stt) != 0 || stt.st_size < 100) {
-            fail(err, errlen, "%s: gnuplot wrote no image (see %s/data/gnuplot.log)",
-                 path, dir);
+    for (int k = 0; k < 3; k++)
+        if ((more & (1 << k)) && listed(dir, png2[k][0], png2[k][1], err, errlen) != 0)
             goto out;
-        }
-        printf("plot  %s  %s\n", path, png2[k][1]);
-    }
     rc = 0;
 out:
     free(pv.v);

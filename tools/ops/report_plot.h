@@ -8,6 +8,7 @@
 #define REPORT_PLOT_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #include "indicators.h"
 #include "store.h"
@@ -23,5 +24,10 @@
  * with a one-line message in err. */
 int report_plot(amfi_store *s, const char *dir, const char *site,
                 const amfi_indicator_params *ip, char *err, size_t errlen);
+
+/* dir/data/name opened for writing, or NULL with the message in err; closed
+ * with report_data_close (0, or −1 when a write failed). */
+FILE *report_data_open(const char *dir, const char *name, char *err, size_t errlen);
+int report_data_close(FILE *f, const char *dir, const char *name, char *err, size_t errlen);
 
 #endif /* REPORT_PLOT_H */

@@ -5,12 +5,13 @@
  */
 #include "report_scale.h"
 
+#include "report_plot.h"
+
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <errno.h>
 
 static const char *utc_of(int64_t utime, char *buf, size_t n)
 {
@@ -88,32 +89,12 @@ int report_scale_summary(amfi_store *s, FILE *f, char *err, size_t errlen)
     return 0;
 }
 
-static FILE *data_file(const char *dir, const char *name, char *err, size_t errlen)
-{
-    char path[4096];
-    snprintf(path, sizeof path, "%s/data/%s", dir, name);
-    FILE *f = fopen(path, "w");
-    if (!f)
-        snprintf(err, errlen, "%s: %s", path, strerror(errno));
-    return f;
-}
-
-static int data_close(FILE *f, const char *dir, const char *name, char *err, size_t errlen)
-{
-    int bad = ferror(f);
-    if (fclose(f) != 0 || bad) {
-        snprintf(err, errlen, "%s/data/%s: write failed", dir, name);
-        return -1;
-    }
-    return 0;
-}
-
 /* scale.dat or known_truck.dat: t value raw deck z cusum h state(0 baseline,
  * 1 normal, 2 watch, 3 alert); NaN where unknown. */
 static int write_evals(const char *dir, const char *name, const amfi_scale_eval_rec *r, size_t n,
                        char *err, size_t errlen)
 {
-    FILE *f = data_file(dir, name, err, errlen);
+    FILE *f = report_data_open(dir, name, err, errlen);
     if (!f)
         return -1;
     fprintf(f, "# time_s value raw deck_c z cusum h state(0 baseline,1 normal,2 watch,3 alert)\n");
@@ -123,7 +104,15 @@ static int write_evals(const char *dir, const char *name, const amfi_scale_eval_
         fprintf(f, "%.3f %.6g %.6g %.4g %.4g %.4g %.4g %d\n", (double)r[i].utime / 1e6,
                 r[i].value, r[i].raw, r[i].deck_c, r[i].z, r[i].cusum, r[i].h, st);
     }
-    return data_close(f, dir, name, err, errlen);
+    return report_data_close(f, dir, name, err, errlen);
+}
+
+/* A time axis in data time, y autoscaled, no leftover label. */
+static void time_axis(FILE *gp)
+{
+    fputs("unset label 99\nset autoscale y\nset xdata time\nset timefmt '%s'\n"
+          "set format x \"%H:%M\\n%d %b\"\nset autoscale x\nset xlabel 'time (UTC, data time)'\n",
+          gp);
 }
 
 int report_scale_plots(amfi_store *s, const char *dir, FILE *gp, const char *site, int *which,
@@ -165,9 +154,8 @@ int report_scale_plots(amfi_store *s, const char *dir, FILE *gp, const char *sit
     if (nkt > 0) {
         if (write_evals(dir, "known_truck.dat", kt, nkt, err, errlen) != 0)
             goto out;
+        time_axis(gp);
         fprintf(gp,
-            "unset label 99\nset autoscale y\nset xdata time\nset timefmt '%%s'\n"
-            "set format x \"%%H:%%M\\n%%d %%b\"\nset autoscale x\nset xlabel 'time (UTC, data time)'\n"
             "set output o.'known_truck.png'\n"
             "set title \"Known-truck runs (known_truck): %zu runs, inferred / reference GVW\\n%s\"\n"
             "set ylabel 'ratio inferred / reference'\n"
@@ -179,7 +167,7 @@ int report_scale_plots(amfi_store *s, const char *dir, FILE *gp, const char *sit
         *which |= REPORT_SCALE_PNG_TRUCK;
     }
     if (nenv > 0) {
-        FILE *f = data_file(dir, "temperature.dat", err, errlen);
+        FILE *f = report_data_open(dir, "temperature.dat", err, errlen);
         if (!f)
             goto out;
         /* at most about 20 000 points: a year of minute readings is thinned */
@@ -188,11 +176,10 @@ int report_scale_plots(amfi_store *s, const char *dir, FILE *gp, const char *sit
         for (size_t i = 0; i < nenv; i += step)
             fprintf(f, "%.3f %.2f %.2f\n", (double)env[i].utime / 1e6, env[i].deck_c,
                     env[i].air_c);
-        if (data_close(f, dir, "temperature.dat", err, errlen) != 0)
+        if (report_data_close(f, dir, "temperature.dat", err, errlen) != 0)
             goto out;
+        time_axis(gp);
         fprintf(gp,
-            "unset label 99\nset autoscale y\nset xdata time\nset timefmt '%%s'\n"
-            "set format x \"%%H:%%M\\n%%d %%b\"\nset autoscale x\nset xlabel 'time (UTC, data time)'\n"
             "set output o.'temperature.png'\n"
             "set title \"Deck and air temperature (environment_t, %zu readings)\\n%s\"\n"
             "set ylabel 'temperature (°C)'\n"
