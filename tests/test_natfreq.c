@@ -1,0 +1,270 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * test_natfreq.c: the natural-frequency estimator (indicators/natfreq.c) on
+ * synthetic free vibration of known frequency, damping and noise (the
+ * accuracy measured over seeds, the fit against the periodogram peak
+ * alone), with a second mode, and its refusals (too short, pure noise, a
+ * flat record, bad arguments); then on the simulated bridge (sim_publisher's
+ * vehicle-bridge model, amfi_sim): the free vibration after a two-axle
+ * vehicle has left a healthy, a 5 % and a 10 % damaged paper-20m beam gives
+ * the model's first frequency (5.73 Hz · sqrt(1 − d)). Fixed seeds; about
+ * a second.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amfi/amfi.h"
+#include "natfreq.h"
+#include "vbi.h"
+#include "vehicle.h"
+
+#define TWO_PI 6.283185307179586
+
+/* Damped free vibration of modes (f Hz, zeta, amplitude, phase) plus white
+ * noise of SD noise · amp of mode 1. */
+static void synth(double *x, int n, double rate, int m, const double *f, const double *z,
+                  const double *amp, const double *ph, double noise, gsl_rng *r)
+{
+    for (int i = 0; i < n; i++) {
+        const double t = i / rate;
+        double y = 0;
+        for (int k = 0; k < m; k++) {
+            const double wn = TWO_PI * f[k], wd = wn * sqrt(1 - z[k] * z[k]);
+            y += amp[k] * exp(-z[k] * wn * t) * cos(wd * t + ph[k]);
+        }
+        x[i] = y + (r ? noise * amp[0] * gsl_ran_gaussian_ziggurat(r, 1.0) : 0.0);
+    }
+}
+
+/* Noise-free: f1 and zeta to 1e-6 relative, R² 1. */
+static void exact_signal(void **state)
+{
+    (void)state;
+    amfi_natfreq_params p;
+    amfi_natfreq_params_default(&p);
+    double x[2000];
+    const double f = 5.73, z = 0.03, a = 0.02, ph = 0.7;
+    synth(x, 2000, 1000.0, 1, &f, &z, &a, &ph, 0, NULL);
+    amfi_natfreq_result r;
+    assert_int_equal(amfi_natfreq_estimate(x, 2000, 1000.0, &p, &r), AMFI_NATFREQ_OK);
+    assert_true(fabs(r.f1_hz / f - 1) < 1e-6);
+    assert_true(fabs(r.zeta / z - 1) < 1e-5);
+    assert_true(r.r2 > 0.999999);
+    assert_true(fabs(r.amplitude - a) < 1e-6);
+    assert_true(fabs(r.periods - 2.0 * f) < 0.1);
+    assert_string_equal(r.reason, "");
+}
+
+/* 100 seeds at each noise level (2 s at 1000 Hz, zeta 3 %, random phase):
+ * the fit's RMS relative error of f1 against the periodogram peak's; the
+ * fit must be within the bounds measured (with margin) and better than the
+ * peak, and its stated standard error must match its actual error. */
+static void accuracy_vs_noise(void **state)
+{
+    (void)state;
+    static const double noise[] = {0.01, 0.05, 0.2, 0.5};
+    static const double bound_fit[] = {7.5e-5, 3.5e-4, 1.3e-3, 3.5e-3}; /* 1.5 × measured */
+    amfi_natfreq_params p;
+    amfi_natfreq_params_default(&p);
+    p.min_r2 = 0.0;
+    p.max_se_frac = 1.0;
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 14);
+    double x[2000];
+    for (size_t l = 0; l < sizeof noise / sizeof *noise; l++) {
+        double e_fit = 0, e_peak = 0, e_z = 0, se_ratio = 0;
+        const int N = 100;
+        for (int s = 0; s < N; s++) {
+            const double f = 5.73 * (1 + 0.05 * (gsl_rng_uniform(rng) - 0.5)), z = 0.03,
+                         a = 0.02, ph = TWO_PI * gsl_rng_uniform(rng);
+            synth(x, 2000, 1000.0, 1, &f, &z, &a, &ph, noise[l], rng);
+            amfi_natfreq_result r;
+            assert_int_equal(amfi_natfreq_estimate(x, 2000, 1000.0, &p, &r), AMFI_NATFREQ_OK);
+            e_fit += (r.f1_hz / f - 1) * (r.f1_hz / f - 1);
+            e_peak += (r.f_peak_hz / f - 1) * (r.f_peak_hz / f - 1);
+            e_z += (r.zeta / z - 1) * (r.zeta / z - 1);
+            se_ratio += (r.f1_hz - f) * (r.f1_hz - f) / (r.f1_se_hz * r.f1_se_hz);
+        }
+        e_fit = sqrt(e_fit / N), e_peak = sqrt(e_peak / N), e_z = sqrt(e_z / N);
+        se_ratio = sqrt(se_ratio / N);
+        printf("noise %4.2f of the amplitude: f1 RMS error fit %.2e, periodogram peak %.2e; "
+               "zeta RMS relative error %.3f; RMS error / stated SE %.2f\n",
+               noise[l], e_fit, e_peak, e_z, se_ratio);
+        assert_true(se_ratio > 0.7 && se_ratio < 1.4); /* the SE is honest */
+        assert_true(e_fit < bound_fit[l]);
+        assert_true(e_fit < e_peak);
+    }
+    gsl_rng_free(rng);
+}
+
+/* Mode 1 beside a stronger, faster-decaying mode 2 at 4 × f1 (quarter-span
+ * sensor): f1 within 0.05 %, and with n_modes 1 worse. */
+static void two_modes(void **state)
+{
+    (void)state;
+    amfi_natfreq_params p;
+    amfi_natfreq_params_default(&p);
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 2);
+    double x[1500];
+    const double f[2] = {5.73, 22.9}, z[2] = {0.03, 0.03}, a[2] = {0.01, 0.02}, ph[2] = {0.3, 1.9};
+    synth(x, 1500, 1000.0, 2, f, z, a, ph, 0.02, rng);
+    amfi_natfreq_result r;
+    assert_int_equal(amfi_natfreq_estimate(x, 1500, 1000.0, &p, &r), AMFI_NATFREQ_OK);
+    assert_int_equal(r.n_modes, 2);
+    assert_true(fabs(r.f1_hz / f[0] - 1) < 5e-4);
+    assert_true(fabs(r.zeta / z[0] - 1) < 0.05);
+    assert_true(r.r2 > 0.99);
+    p.n_modes = 1;
+    p.min_r2 = 0;
+    amfi_natfreq_result r1;
+    amfi_natfreq_estimate(x, 1500, 1000.0, &p, &r1);
+    printf("two modes: f1 error %.2e with 2 modes fitted, %.2e with 1 (R² %.3f)\n",
+           fabs(r.f1_hz / f[0] - 1), fabs(r1.f1_hz / f[0] - 1), r1.r2);
+    assert_true(!(fabs(r1.f1_hz / f[0] - 1) < fabs(r.f1_hz / f[0] - 1)));
+    gsl_rng_free(rng);
+}
+
+static void refusals(void **state)
+{
+    (void)state;
+    amfi_natfreq_params p;
+    amfi_natfreq_params_default(&p);
+    amfi_natfreq_result r;
+    double x[2000];
+    const double f = 5.73, z = 0.03, a = 0.02, ph = 0.0;
+    /* 0.5 s: 2.9 periods, fewer than 4 */
+    synth(x, 500, 1000.0, 1, &f, &z, &a, &ph, 0, NULL);
+    assert_int_equal(amfi_natfreq_estimate(x, 500, 1000.0, &p, &r), AMFI_NATFREQ_SHORT);
+    assert_true(isnan(r.f1_hz));
+    assert_true(strstr(r.reason, "min_periods") != NULL);
+    assert_true(r.periods > 2.5 && r.periods < 3.2);
+    /* pure noise */
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 5);
+    int refused = 0;
+    for (int s = 0; s < 20; s++) {
+        for (int i = 0; i < 2000; i++)
+            x[i] = gsl_ran_gaussian_ziggurat(rng, 1.0);
+        refused += amfi_natfreq_estimate(x, 2000, 1000.0, &p, &r) != AMFI_NATFREQ_OK;
+        assert_true(isnan(r.f1_hz) || r.r2 >= p.min_r2);
+    }
+    assert_int_equal(refused, 20);
+    /* buried in noise (SD 3 × the amplitude): refused as noisy */
+    synth(x, 2000, 1000.0, 1, &f, &z, &a, &ph, 3.0, rng);
+    int c = amfi_natfreq_estimate(x, 2000, 1000.0, &p, &r);
+    assert_true(c != AMFI_NATFREQ_OK);
+    /* flat */
+    for (int i = 0; i < 2000; i++)
+        x[i] = 1.0;
+    assert_int_equal(amfi_natfreq_estimate(x, 2000, 1000.0, &p, &r), AMFI_NATFREQ_NOPEAK);
+    /* arguments */
+    assert_int_equal(amfi_natfreq_estimate(x, 4, 1000.0, &p, &r), AMFI_NATFREQ_EINVAL);
+    assert_int_equal(amfi_natfreq_estimate(x, 2000, 0.0, &p, &r), AMFI_NATFREQ_EINVAL);
+    x[7] = NAN;
+    assert_int_equal(amfi_natfreq_estimate(x, 2000, 1000.0, &p, &r), AMFI_NATFREQ_EINVAL);
+    char err[128];
+    amfi_natfreq_params q = p;
+    q.f_hi_hz = q.f_lo_hz;
+    assert_int_equal(amfi_natfreq_params_check(&q, err, sizeof err), -1);
+    assert_non_null(strstr(err, "f_hi_hz"));
+    q = p;
+    q.n_modes = 4;
+    assert_int_equal(amfi_natfreq_params_check(&q, err, sizeof err), -1);
+    assert_non_null(strstr(err, "n_modes"));
+    assert_int_equal(amfi_natfreq_params_check(&p, err, sizeof err), 0);
+    assert_string_equal(amfi_natfreq_code_name(AMFI_NATFREQ_NOISY), "noisy");
+    gsl_rng_free(rng);
+}
+
+/* The simulated bridge: a two-axle vehicle at 20 m/s over the paper-20m
+ * beam (damage d), one sensor at mid-span and one at a quarter, 1000 Hz,
+ * no road profile; 2 s recorded after the rear axle leaves. f1 of each
+ * sensor against the model's first frequency. */
+static double sim_f1_error(double damage, int sensor, double *f_model, double *zeta_fit)
+{
+    amfi_bridge_params bp;
+    amfi_bridge *b = NULL;
+    amfi_bridge_params_paper20(&bp);
+    bp.damage = damage;
+    assert_int_equal(amfi_bridge_create(&bp, &b, NULL, 0), 0);
+    *f_model = amfi_bridge_omega(b)[0] / TWO_PI;
+    amfi_sim_params sp;
+    amfi_sim *s = NULL;
+    char err[256];
+    amfi_sim_params_default(&sp, 20.0);
+    sp.approach_m = 10.0;
+    sp.n_sensors = 2;
+    sp.sensor_x_m[0] = 10.0;
+    sp.sensor_x_m[1] = 5.0;
+    assert_int_equal(amfi_sim_create(b, NULL, &sp, &s, err, sizeof err), 0);
+    amfi_sim_vehicle v;
+    memset(&v, 0, sizeof v);
+    amfi_halfcar_baseline(&v.car);
+    v.speed_mps = 20.0;
+    v.t_entry_s = 0.5;
+    assert_int_equal(amfi_sim_add(s, &v, err, sizeof err), 0);
+    amfi_halfcar_finish(&v.car, NULL, 0);
+    /* from the start (approach 10 m: t = 0 is 0.5 s before entry) to the
+     * rear axle's exit, then 2 s of free vibration */
+    const double t_exit = v.t_entry_s + (20.0 + v.car.D1_m + v.car.D2_m) / v.speed_mps;
+    const int n_before = (int)ceil((t_exit - amfi_sim_time(s)) * sp.scan_rate_hz);
+    const int n_free = 2000;
+    double *buf = malloc(sizeof(double) * 2 * (size_t)(n_before + n_free));
+    assert_int_equal(amfi_sim_advance(s, n_before + n_free, buf, err, sizeof err), 0);
+    double *x = malloc(sizeof(double) * n_free);
+    for (int i = 0; i < n_free; i++)
+        x[i] = buf[2 * (n_before + i) + sensor];
+    amfi_natfreq_params p;
+    amfi_natfreq_params_default(&p);
+    amfi_natfreq_result r;
+    const int c = amfi_natfreq_estimate(x, n_free, sp.scan_rate_hz, &p, &r);
+    assert_int_equal(c, AMFI_NATFREQ_OK);
+    *zeta_fit = r.zeta;
+    free(x);
+    free(buf);
+    amfi_sim_destroy(s);
+    amfi_bridge_destroy(b);
+    return r.f1_hz / *f_model - 1;
+}
+
+static void simulated_bridge(void **state)
+{
+    (void)state;
+    static const double dmg[] = {0.0, 0.05, 0.10};
+    double f_healthy = 0;
+    for (size_t k = 0; k < 3; k++)
+        for (int sensor = 0; sensor < 2; sensor++) {
+            double fm, z;
+            const double e = sim_f1_error(dmg[k], sensor, &fm, &z);
+            if (k == 0)
+                f_healthy = fm;
+            printf("damage %4.1f %%, sensor at %s: model f1 %.4f Hz (%.4f of healthy), "
+                   "estimate error %+.2e, zeta %.4f\n",
+                   100 * dmg[k], sensor ? "L/4" : "L/2", fm, fm / f_healthy, e, z);
+            assert_true(fabs(fm / f_healthy - sqrt(1 - dmg[k])) < 1e-9);
+            assert_true(fabs(e) < 1e-3);   /* measured: below 2e-4 */
+            assert_true(fabs(z - 0.03) < 0.005); /* the model's Rayleigh 3 % at mode 1 */
+        }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(exact_signal),   cmocka_unit_test(accuracy_vs_noise),
+        cmocka_unit_test(two_modes),      cmocka_unit_test(refusals),
+        cmocka_unit_test(simulated_bridge),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
