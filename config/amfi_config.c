@@ -123,6 +123,9 @@ void amfi_config_defaults(amfi_site_config *c)
     d->scale_max_temp_gap_s = 7200.0;
     amfi_known_truck_params_default(&d->known_truck);
     d->known_truck_enabled = 1;
+    amfi_natfreq_params_default(&d->natfreq);
+    d->natfreq_free_s = 2.0;  /* 11 periods of paper-20m's 5.7 Hz (docs/indicators.md) */
+    d->natfreq_baseline_n = 200;
     /* sim_publisher's ideal simulation (docs/simulator.md): every inaccuracy
      * is switched on explicitly. */
     amfi_sim_config *m = &c->sim;

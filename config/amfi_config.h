@@ -25,6 +25,7 @@
 #include "indicators.h"
 #include "known_truck.h"
 #include "scale.h"
+#include "natfreq.h"
 #include "speed_drift.h"
 
 #ifdef __cplusplus
@@ -85,6 +86,15 @@ typedef struct amfi_daemon_config {
      * amfi_indicator_params_default() and checked, at load, by
      * amfi_indicator_params_check(). */
     amfi_indicator_params indicators;
+    /* daemon.natural_frequency.*: the bridge's first natural frequency from
+     * each passage's free vibration (natfreq.h, docs/indicators.md section
+     * 9): the estimator's own parameters (amfi_natfreq_params_default(),
+     * checked at load by amfi_natfreq_params_check()), and amfid's */
+    amfi_natfreq_params natfreq;
+    double natfreq_free_s;    /* daemon.natural_frequency.free_s: free vibration after
+                                 the last exit, s, [0, 30]; 0: off */
+    int natfreq_baseline_n;   /* daemon.natural_frequency.baseline_n: passages with an
+                                 f1 whose temperature fit is the baseline, 10 .. 100000 */
 } amfi_daemon_config;
 
 /* The simulator's section (simulation: in the site file). Only

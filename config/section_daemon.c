@@ -5,7 +5,8 @@
  * keys fill the engine's own amfi_indicator_params; the rules between them
  * (clear <= alert, ...) are the engine's, checked by
  * amfi_indicator_params_check() and reported here with the line of the key
- * the engine blames. Runs on the loader's thread.
+ * the engine blames. The natural-frequency keys fill the estimator's
+ * amfi_natfreq_params (natfreq.h). Runs on the loader's thread.
  */
 #include "sections.h"
 
@@ -61,6 +62,27 @@ static const field indicator_fields[] = {
      .aux = onoff_names},
     {.key = NULL}};
 
+/* Offsets of the estimator's amfi_natfreq_params inside the site config. */
+#define NF(m) DC(natfreq.m)
+
+static const field natfreq_fields[] = {
+    {.key = "free_s", .kind = &K_DOUBLE, .off = DC(natfreq_free_s), .lo = 0, .hi = 30},
+    {.key = "f_lo_hz", .kind = &K_DOUBLE, .off = NF(f_lo_hz), .lo = 0, .hi = 1000,
+     .flags = F_LO_OPEN},
+    {.key = "f_hi_hz", .kind = &K_DOUBLE, .off = NF(f_hi_hz), .lo = 0, .hi = 1000,
+     .flags = F_LO_OPEN},
+    {.key = "modes", .kind = &K_INT, .off = NF(n_modes), .lo = 1, .hi = AMFI_NATFREQ_MAX_MODES},
+    {.key = "min_periods", .kind = &K_DOUBLE, .off = NF(min_periods), .lo = 1, .hi = 1000},
+    {.key = "min_r2", .kind = &K_DOUBLE, .off = NF(min_r2), .lo = 0, .hi = 1,
+     .flags = F_HI_OPEN},
+    {.key = "max_zeta", .kind = &K_DOUBLE, .off = NF(max_zeta), .lo = 0, .hi = 1,
+     .flags = F_LO_OPEN | F_HI_OPEN},
+    {.key = "max_se_frac", .kind = &K_DOUBLE, .off = NF(max_se_frac), .lo = 0, .hi = 1,
+     .flags = F_LO_OPEN},
+    {.key = "baseline_n", .kind = &K_INT, .off = DC(natfreq_baseline_n), .lo = 10,
+     .hi = 100000},
+    {.key = NULL}};
+
 const field daemon_fields[] = {
     STR("lcm_url", lcm_url, 0),
     {.key = "channels", .kind = &K_MAP, .aux = channel_fields},
@@ -82,6 +104,7 @@ const field daemon_fields[] = {
     {.key = "status_period_s", .kind = &K_DOUBLE, .off = DC(status_period_s), .lo = 0.1,
      .hi = 3600},
     {.key = "indicators", .kind = &K_MAP, .aux = indicator_fields},
+    {.key = "natural_frequency", .kind = &K_MAP, .aux = natfreq_fields},
     {.key = NULL}};
 
 int daemon_check(ctx *x, amfi_site_config *c)
@@ -98,6 +121,13 @@ int daemon_check(ctx *x, amfi_site_config *c)
                     "%g s is not below daemon.ring_s (%g s): an event's samples would leave "
                     "the ring before it ends",
                     c->daemon.max_event_s, c->daemon.ring_s);
+
+    /* the band's two ends (each key's own range is the table's) */
+    if (amfi_natfreq_params_check(&c->daemon.natfreq, why, sizeof why) != 0)
+        return fail(x,
+                    first_noted(x, "daemon.natural_frequency.f_hi_hz",
+                                "daemon.natural_frequency.f_lo_hz", "daemon"),
+                    "daemon.natural_frequency.f_hi_hz", "%s", why);
 
     if (amfi_indicator_params_check(&c->daemon.indicators, &blamed, why, sizeof why) == 0)
         return 0;

@@ -206,7 +206,8 @@ static int start_runtime(daemon_s *d)
                               d->cfg.daemon.max_event_s, d->cfg.daemon.max_event_axles,
                               /* room for the speed search, also when a reload
                                  turns it on */
-                              amfi_speed_slowest_frac(&d->cfg.speed_prior)};
+                              amfi_speed_slowest_frac(&d->cfg.speed_prior),
+                              d->cfg.daemon.natfreq_free_s};
     d->tracker = amfi_tracker_create(&tp);
     d->pend_cap = d->cfg.daemon.queue_size + AMFI_TRACKER_MAX_PENDING + 16;
     d->pending = calloc((size_t)d->pend_cap, sizeof *d->pending);

@@ -32,7 +32,8 @@ amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p)
     if (!(p->span_m > 0) || !(p->pre_s >= 0) || !(p->post_s >= 0) || !(p->max_wait_s > 0) ||
         p->n_sensors < 1 || p->n_sensors > AMFI_MAX_SENSORS || !(p->max_event_s >= 0) ||
         p->max_event_axles < 0 || p->max_event_axles == 1 ||
-        p->max_event_axles > AMFI_MAX_AXLES || !(p->slow_frac >= 0) || !(p->slow_frac <= 0.5))
+        p->max_event_axles > AMFI_MAX_AXLES || !(p->slow_frac >= 0) || !(p->slow_frac <= 0.5) ||
+        !(p->free_s >= 0) || !(p->free_s <= 3600))
         return NULL;
     amfi_tracker *t = calloc(1, sizeof *t);
     if (t) {
@@ -280,8 +281,23 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
         t0 = fmin(t0, (double)out->ev[i].utime + 1e6 * w.start_s);
         t1 = fmax(t1, (double)out->ev[i].utime + 1e6 * w.end_s);
     }
+    /* The free vibration: from the last exit (at the measured speed) for
+     * free_s, cut at the next pending vehicle's entry. */
+    double fx0 = -INFINITY, fx1 = -INFINITY;
+    out->free_why = "";
+    if (t->p.free_s > 0) {
+        for (int i = 0; i < out->n_vehicles; i++)
+            fx0 = fmax(fx0, span_of(t, &out->ev[i]).t_out);
+        fx1 = fx0 + 1e6 * t->p.free_s;
+        for (int i = out->n_vehicles; i < t->n_pend; i++)
+            if ((double)t->pend[i].utime < fx1) {
+                fx1 = fmax(fx0, (double)t->pend[i].utime);
+                out->free_why = "cut at the next vehicle's entry";
+                break;
+            }
+    }
     /* Decide: all data present, data gone, or waited long enough. */
-    int complete = 1, gone = 0, jumping = 0;
+    int complete = 1, gone = 0, jumping = 0, free_complete = 1;
     const amfi_ring *gone_ring = NULL; /* a ring whose data left before t0 */
     int64_t restart_utime = 0;
     double newest_us = -INFINITY;
@@ -300,6 +316,16 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
         newest_us = fmax(newest_us, amfi_ring_utime(r, amfi_ring_newest(r)));
         if (amfi_ring_newest(r) < k1)
             complete = 0;
+        if (fx1 > fx0) {
+            const double u0 = amfi_ring_utime(r, 0), per_us = amfi_ring_rate(r) * 1e-6;
+            const int64_t f0 = (int64_t)ceil((fx0 - u0) * per_us - 1e-6),
+                          f1 = (int64_t)floor((fx1 - u0) * per_us + 1e-6);
+            out->free_k0[s] = f0;
+            if (s == 0 || f1 - f0 + 1 < out->free_n)
+                out->free_n = f1 - f0 + 1 > 0 ? (int)(f1 - f0 + 1) : 0;
+            if (amfi_ring_newest(r) < f1)
+                free_complete = 0;
+        }
         if (k0 < amfi_ring_oldest(r)) {
             gone = 1;
             gone_ring = r;
@@ -314,6 +340,13 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
     out->n = n > 0 ? n : 0;
     if (!complete && !gone && !flush && !(newest_us > t1 + 1e6 * t->p.max_wait_s))
         return 0; /* keep waiting */
+    if (complete && !free_complete && !gone && !flush &&
+        !(newest_us > fx1 + 1e6 * t->p.max_wait_s))
+        return 0; /* the passage's data is in: wait for its free vibration */
+    if (!free_complete || !complete || gone) {
+        out->free_n = 0;
+        out->free_why = fx1 > fx0 ? "the free vibration's data did not all arrive" : "";
+    }
     if (gone && restart_utime > 0 && t0 < (double)restart_utime) {
         out->status = "gap";
         snprintf(out->reason, sizeof out->reason,

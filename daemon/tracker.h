@@ -61,6 +61,8 @@ typedef struct amfi_tracker_params {
     int max_event_axles; /* axles of an event, 2 .. AMFI_MAX_AXLES (0: AMFI_MAX_AXLES) */
     double slow_frac;    /* the window ends where it would for speed·(1 − slow_frac):
                             room for the speed search's slowest trial (0 .. 0.5) */
+    double free_s;       /* free vibration wanted after the event's last exit (at the
+                            measured speed), s, >= 0; 0: none (the natural frequency) */
 } amfi_tracker_params;
 
 typedef struct amfi_window {
@@ -73,6 +75,12 @@ typedef struct amfi_window {
     double t_first_s;     /* time of the first sample relative to v's entry, sensor 0 */
     const char *status;   /* "ok", "gap", "late", "multiple", "invalid" */
     char reason[200];
+    /* free vibration (free_s > 0, status ok): samples from the event's last
+     * exit to free_s later or to the next vehicle's entry, whichever is
+     * first; free_n 0 when there is none (then free_why says why) */
+    int64_t free_k0[AMFI_MAX_SENSORS]; /* first free-vibration sample per sensor */
+    int free_n;           /* samples per sensor */
+    const char *free_why; /* "" or why there is none or it is cut short (static) */
 } amfi_window;
 
 typedef struct amfi_tracker amfi_tracker;

@@ -3,7 +3,8 @@
  * test_daemon_core.c: the sample ring (gaps, duplicates, out-of-order and
  * late blocks) and the passage tracker (windows in data time, release
  * order, gaps, late vehicle events, multiple presence; events of vehicles
- * sharing the span: chains, two lanes, the limits, contradicting events).
+ * sharing the span: chains, two lanes, the limits, contradicting events;
+ * the free vibration after the last exit).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -165,7 +166,7 @@ static void ring_outage_then_resume(void **state)
 static void tracker_after_poisoned_first_block(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0}; /* events off */
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0, 0.0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = amfi_ring_create(RATE, 60.0);
     amfi_ring *rings[1] = {r};
@@ -197,7 +198,7 @@ static void tracker_after_poisoned_first_block(void **state)
 static void tracker_windows(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0}; /* events off */
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0, 0.0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(3.0); /* samples 0 .. 2999 */
     amfi_ring *rings[1] = {r};
@@ -238,7 +239,7 @@ static void tracker_windows(void **state)
 static void tracker_slow_frac(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.2}; /* events off */
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.2, 0.0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(4.0);
     amfi_ring *rings[1] = {r};
@@ -267,10 +268,65 @@ static void tracker_slow_frac(void **state)
     assert_null(amfi_tracker_create(&bad));
 }
 
+/* Free vibration (free_s, the natural frequency): an ok window waits for
+ * free_s of data after its last exit and carries those samples; the next
+ * vehicle's entry cuts them; a flush releases the passage without them.
+ * 25 m/s, 25 m of span and axles: 1.0 s on the span. */
+static void tracker_free_vibration(void **state)
+{
+    (void)state;
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0, 2.0}; /* events off */
+    amfi_tracker *t = amfi_tracker_create(&p);
+    amfi_ring *r = filled(3.0); /* samples 0 .. 2999 */
+    amfi_ring *rings[1] = {r};
+    amfi_window w;
+    amfi_vehicle_ev a = vehicle(1, 0.5), b = vehicle(2, 5.0), c = vehicle(3, 6.6);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
+    /* a's solve window (to 1.55 s) is in, its free vibration (1.5 .. 3.5 s)
+     * not: held */
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0);
+    double x[100];
+    block(x, 100, 0);
+    for (int k = 30; k < 70; k++) /* to 7 s */
+        amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &c, NULL), 0);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_int_equal(w.v.vehicle_id, 1);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.k0[0], 150); /* the solve window as without */
+    assert_int_equal(w.n, 1401);
+    assert_int_equal(w.free_k0[0], 1500);
+    assert_int_equal(w.free_n, 2001);
+    assert_string_equal(w.free_why, "");
+    /* b leaves at 6.0 s, c enters at 6.6 s: cut there */
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
+    assert_int_equal(w.v.vehicle_id, 2);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.free_k0[0], 6000);
+    assert_int_equal(w.free_n, 601);
+    assert_string_equal(w.free_why, "cut at the next vehicle's entry");
+    /* c's solve window ends at 7.65 s: waits; a flush releases it (gap) */
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0);
+    for (int k = 70; k < 80; k++) /* to 8 s: c's data in, its free vibration not */
+        amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL);
+    assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0);
+    assert_int_equal(amfi_tracker_next(t, rings, 1, &w), 1);
+    assert_int_equal(w.v.vehicle_id, 3);
+    assert_string_equal(w.status, "ok");
+    assert_int_equal(w.free_n, 0);
+    assert_string_equal(w.free_why, "the free vibration's data did not all arrive");
+    amfi_ring_destroy(r);
+    amfi_tracker_destroy(t);
+    amfi_tracker_params bad = p;
+    bad.free_s = -1;
+    assert_null(amfi_tracker_create(&bad));
+}
+
 static void tracker_multiple_and_late(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0}; /* events off */
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 0.0, 0, 0.0, 0.0}; /* events off */
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(4.0);
     amfi_ring *rings[1] = {r};
@@ -313,7 +369,7 @@ static void tracker_multiple_and_late(void **state)
     amfi_tracker_destroy(t);
     /* two sensors, the second falls silent: given up max_wait (5 s) after
      * the window's end, as a gap */
-    amfi_tracker_params p2 = {20.0, 0.35, 0.05, 5.0, 2, 0.0, 0, 0.0};
+    amfi_tracker_params p2 = {20.0, 0.35, 0.05, 5.0, 2, 0.0, 0, 0.0, 0.0};
     t = amfi_tracker_create(&p2);
     amfi_ring *a1 = amfi_ring_create(RATE, 60.0), *a2 = amfi_ring_create(RATE, 60.0);
     amfi_ring *two[2] = {a1, a2};
@@ -373,7 +429,7 @@ static void pair_released_as(amfi_tracker *t, amfi_ring **rings, amfi_vehicle_ev
 static void tracker_events_chain_and_lanes(void **state)
 {
     (void)state;
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0, 0.0};
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0, 0.0, 0.0};
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(14.0);
     amfi_ring *rings[1] = {r};
@@ -430,7 +486,7 @@ static void tracker_events_chain_and_lanes(void **state)
 static void tracker_event_limits(void **state)
 {
     (void)state;
-    amfi_tracker_params bad = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 1, 0.0};
+    amfi_tracker_params bad = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 1, 0.0, 0.0};
     assert_null(amfi_tracker_create(&bad));
     bad.max_event_axles = AMFI_MAX_AXLES + 1;
     assert_null(amfi_tracker_create(&bad));
@@ -438,7 +494,7 @@ static void tracker_event_limits(void **state)
     bad.max_event_s = -1.0;
     assert_null(amfi_tracker_create(&bad));
 
-    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 2.0, 0, 0.0};
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 2.0, 0, 0.0, 0.0};
     amfi_tracker *t = amfi_tracker_create(&p);
     amfi_ring *r = filled(0.5); /* no data for any of them yet */
     amfi_ring *rings[1] = {r};
@@ -468,7 +524,7 @@ static void tracker_event_limits(void **state)
     amfi_tracker_destroy(t);
 
     /* axles: two three-axle vehicles, at most 5 */
-    amfi_tracker_params pa = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 5, 0.0};
+    amfi_tracker_params pa = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 5, 0.0, 0.0};
     t = amfi_tracker_create(&pa);
     pair_released_as(t, rings, vehicle_in(11, 1.0, 1, 25.0, 3), vehicle_in(12, 1.2, 2, 25.0, 3),
                      "multiple", 2, "6 axles in all: more than daemon.max_event_axles (5)");
@@ -478,7 +534,7 @@ static void tracker_event_limits(void **state)
      * 2 (on the span 2.2 .. 3.2 s) is in 1's post-roll (1.0 .. 2.0 .. 2.05 s)
      * and on the span with 3: six axles by windows, at most 4: 1 alone,
      * then 2 and 3 together */
-    amfi_tracker_params p4 = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 4, 0.0};
+    amfi_tracker_params p4 = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 4, 0.0, 0.0};
     t = amfi_tracker_create(&p4);
     amfi_vehicle_ev c1 = vehicle(31, 1.0), c2 = vehicle(32, 2.2), c3 = vehicle(33, 2.5);
     amfi_tracker_add(t, &c1, NULL);
@@ -497,7 +553,7 @@ static void tracker_event_limits(void **state)
     amfi_tracker_destroy(t);
 
     /* vehicles: nine one-axle vehicles 0.1 s apart, 8 at most together */
-    amfi_tracker_params pv = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0, 0.0};
+    amfi_tracker_params pv = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0, 0.0, 0.0};
     t = amfi_tracker_create(&pv);
     for (int i = 0; i < 9; i++) {
         amfi_vehicle_ev v = vehicle_in(20 + i, 1.0 + 0.1 * i, 1, 25.0, 1);
@@ -528,6 +584,7 @@ int main(void)
         cmocka_unit_test(tracker_events_chain_and_lanes),
         cmocka_unit_test(tracker_event_limits),
         cmocka_unit_test(tracker_slow_frac),
+        cmocka_unit_test(tracker_free_vibration),
     };
     return cmocka_run_group_tests_name("daemon core", tests, NULL, NULL);
 }
