@@ -399,3 +399,149 @@ out:
         gsl_multifit_nlinear_free(ws);
     return code;
 }
+
+/* ---- temperature compensation ---- */
+
+struct amfi_natfreq_comp {
+    amfi_scale_params tp;
+    int cap, n;
+    double *t, *y; /* the baseline: deck temperature, ln f1 */
+    int have;
+    amfi_natfreq_model m;
+};
+
+int amfi_natfreq_comp_create(const amfi_scale_params *tp, int baseline_n,
+                             amfi_natfreq_comp **out, char *err, size_t errlen)
+{
+    *out = NULL;
+    const char *field = NULL;
+    if (amfi_scale_params_check(tp, &field, err, errlen) != 0)
+        return AMFI_NATFREQ_EINVAL;
+    if (baseline_n < 10) {
+        if (err && errlen)
+            snprintf(err, errlen, "natural frequency: baseline_n %d must be >= 10", baseline_n);
+        return AMFI_NATFREQ_EINVAL;
+    }
+    amfi_natfreq_comp *c = calloc(1, sizeof *c);
+    if (c) {
+        c->t = malloc(sizeof(double) * (size_t)baseline_n);
+        c->y = malloc(sizeof(double) * (size_t)baseline_n);
+    }
+    if (!c || !c->t || !c->y) {
+        amfi_natfreq_comp_destroy(c);
+        if (err && errlen)
+            snprintf(err, errlen, "natural frequency: out of memory");
+        return AMFI_NATFREQ_EINVAL;
+    }
+    c->tp = *tp;
+    c->cap = baseline_n;
+    *out = c;
+    return AMFI_NATFREQ_OK;
+}
+
+void amfi_natfreq_comp_destroy(amfi_natfreq_comp *c)
+{
+    if (!c)
+        return;
+    free(c->t);
+    free(c->y);
+    free(c);
+}
+
+/* The ridge fit of the baseline: the corrections to the prior slopes with
+ * lam, and the residual variance. */
+static int comp_solve(const amfi_natfreq_comp *c, double pw, double pf, double lam, double d[3],
+                      double *var)
+{
+    amfi_temp_ridge tr;
+    memset(&tr, 0, sizeof tr);
+    for (int i = 0; i < c->n; i++) {
+        double g1, g2;
+        amfi_scale_temp_terms(&c->tp, c->t[i], &g1, &g2);
+        amfi_temp_ridge_add(&tr, g1, g2, c->y[i] - pw * g1 - pf * g2);
+    }
+    if (amfi_temp_ridge_solve(&tr, lam, d) != 0)
+        return -1;
+    double s2 = 0;
+    for (int i = 0; i < c->n; i++) {
+        double g1, g2;
+        amfi_scale_temp_terms(&c->tp, c->t[i], &g1, &g2);
+        const double e = c->y[i] - pw * g1 - pf * g2 - d[0] - d[1] * g1 - d[2] * g2;
+        s2 += e * e;
+    }
+    *var = s2 / (c->n > 3 ? c->n - 3 : 1);
+    return 0;
+}
+
+static int comp_fit(amfi_natfreq_comp *c)
+{
+    /* priors: f1 ∝ sqrt(E), weights ∝ 1 / E */
+    const double pw = -0.5 * c->tp.warm_slope, pf = -0.5 * c->tp.frost_slope;
+    const double tau = 0.5 * c->tp.slope_prior_sd;
+    double d[3] = {0}, var = 0;
+    /* pass 1: nearly free, for the residual variance; pass 2: the ridge
+     * weight var / tau² (tau 0: the prior slopes stand) */
+    if (comp_solve(c, pw, pf, 1e-12, d, &var) != 0)
+        var = 0;
+    if (tau > 0 && var > 0) {
+        if (comp_solve(c, pw, pf, var / (tau * tau), d, &var) != 0)
+            d[1] = d[2] = 0;
+    } else {
+        d[1] = d[2] = 0;
+    }
+    amfi_natfreq_model m;
+    memset(&m, 0, sizeof m);
+    m.n = c->n;
+    m.warm = pw + d[1];
+    m.frost = pf + d[2];
+    m.t_min_c = INFINITY;
+    m.t_max_c = -INFINITY;
+    double s1 = 0, s2 = 0;
+    for (int i = 0; i < c->n; i++) {
+        const double z = c->y[i] + log(amfi_scale_temp_factor(&c->tp, m.warm, m.frost, c->t[i]));
+        s1 += z;
+        s2 += z * z;
+        m.t_min_c = fmin(m.t_min_c, c->t[i]);
+        m.t_max_c = fmax(m.t_max_c, c->t[i]);
+    }
+    const double mean = s1 / c->n, v = (s2 - c->n * mean * mean) / (c->n - 1);
+    m.f_ref_hz = exp(mean);
+    m.sd_rel = v > 0 ? sqrt(v) : 0.0;
+    if (!isfinite(m.warm) || !isfinite(m.frost) || !isfinite(m.f_ref_hz))
+        return -1;
+    c->m = m;
+    c->have = 1;
+    return 0;
+}
+
+int amfi_natfreq_comp_push(amfi_natfreq_comp *c, double f1_hz, double deck_c)
+{
+    if (!(f1_hz > 0 && f1_hz <= 1000) || !isfinite(deck_c))
+        return AMFI_NATFREQ_EINVAL;
+    if (c->have)
+        return 0;
+    c->t[c->n] = deck_c;
+    c->y[c->n] = log(f1_hz);
+    if (++c->n < c->cap)
+        return 0;
+    if (comp_fit(c) != 0) { /* degenerate: collect again */
+        c->n = 0;
+        return 0;
+    }
+    return 1;
+}
+
+double amfi_natfreq_comp_apply(const amfi_natfreq_comp *c, double f1_hz, double deck_c)
+{
+    if (!c->have || !isfinite(deck_c) || !(f1_hz > 0))
+        return NAN;
+    return f1_hz * amfi_scale_temp_factor(&c->tp, c->m.warm, c->m.frost, deck_c);
+}
+
+int amfi_natfreq_comp_model(const amfi_natfreq_comp *c, amfi_natfreq_model *m)
+{
+    if (!c->have)
+        return 0;
+    *m = c->m;
+    return 1;
+}

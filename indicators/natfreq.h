@@ -35,6 +35,8 @@
 
 #include <stddef.h>
 
+#include "scale.h" /* the temperature model (compensation) */
+
 #define AMFI_NATFREQ_MAX_MODES 3
 
 typedef struct amfi_natfreq_params {
@@ -84,5 +86,46 @@ typedef struct amfi_natfreq_result {
  * otherwise). Returns AMFI_NATFREQ_OK or a code above. */
 int amfi_natfreq_estimate(const double *x, int n, double rate_hz, const amfi_natfreq_params *p,
                           amfi_natfreq_result *r);
+
+/* ---- temperature compensation ---- */
+
+/* The frequency's deck-temperature model is the scale indicator's (scale.h)
+ * with f1 ∝ sqrt(E) and inferred weights ∝ 1 / E: ln f1 = c + a_w g1(T) +
+ * a_f g2(T), the prior slopes −warm_slope / 2 and −frost_slope / 2 of the
+ * scale's parameters (prior SD slope_prior_sd / 2), fitted by the shared
+ * ridge regression (amfi_temp_ridge) over the first baseline_n estimates
+ * with a deck temperature, the ridge weight from the fit's own residual
+ * variance. Compensated: f1 · amfi_scale_temp_factor(tp, a_w, a_f, T), f1
+ * at the calibration temperature tp.ref_c. Allocation only at create; one
+ * handle, one thread. */
+typedef struct amfi_natfreq_comp amfi_natfreq_comp;
+
+typedef struct amfi_natfreq_model {
+    int n;                      /* estimates in the baseline */
+    double warm, frost;         /* fitted slopes of ln f1, 1/°C */
+    double f_ref_hz;            /* mean compensated f1 of the baseline, Hz */
+    double sd_rel;              /* SD of the baseline's compensated ln f1 */
+    double t_min_c, t_max_c;    /* its deck temperature range */
+} amfi_natfreq_model;
+
+/* tp: the scale indicator's parameters (knee, floor, ref, prior slopes and
+ * their SD; scale.h); baseline_n >= 10. 0, or AMFI_NATFREQ_EINVAL (err). */
+int amfi_natfreq_comp_create(const amfi_scale_params *tp, int baseline_n,
+                             amfi_natfreq_comp **out, char *err, size_t errlen);
+void amfi_natfreq_comp_destroy(amfi_natfreq_comp *c); /* NULL-safe */
+
+/* One accepted estimate and the deck temperature at its time: collected
+ * until the baseline is full, then fitted. Returns 1 when this push
+ * completed the baseline (the model exists from now on), 0 otherwise,
+ * AMFI_NATFREQ_EINVAL for f1 not in (0, 1000] or T not finite (nothing
+ * changes then). After the baseline it does nothing (0). */
+int amfi_natfreq_comp_push(amfi_natfreq_comp *c, double f1_hz, double deck_c);
+
+/* f1 at the calibration temperature; NaN before the baseline or for a T
+ * that is not finite. */
+double amfi_natfreq_comp_apply(const amfi_natfreq_comp *c, double f1_hz, double deck_c);
+
+/* 1 and *m once the baseline is fitted, else 0. */
+int amfi_natfreq_comp_model(const amfi_natfreq_comp *c, amfi_natfreq_model *m);
 
 #endif

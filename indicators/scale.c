@@ -389,6 +389,35 @@ static int solve3(double a[3][3], double r[3], double x[3])
     return 0;
 }
 
+void amfi_scale_temp_terms(const amfi_scale_params *p, double deck_c, double *g1, double *g2)
+{
+    *g1 = h1(p, deck_c);
+    *g2 = h2(p, deck_c);
+}
+
+void amfi_temp_ridge_add(amfi_temp_ridge *t, double g1, double g2, double y)
+{
+    const double v[3] = {1.0, g1, g2};
+    for (int k = 0; k < 3; k++) {
+        t->r[k] += v[k] * y;
+        for (int l = 0; l < 3; l++)
+            t->a[k][l] += v[k] * v[l];
+    }
+    t->n++;
+}
+
+int amfi_temp_ridge_solve(const amfi_temp_ridge *t, double lam, double d[3])
+{
+    double a[3][3], r[3];
+    memcpy(a, t->a, sizeof a);
+    memcpy(r, t->r, sizeof r);
+    a[1][1] += lam;
+    a[2][2] += lam;
+    if (solve3(a, r, d) != 0 || !isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]))
+        return AMFI_IND_EINVAL;
+    return AMFI_IND_OK;
+}
+
 /* Fit the baseline model from bx/bt; 0 or AMFI_IND_EINVAL (degenerate
  * baseline: the caller starts a new collection). */
 static int fit_baseline(amfi_scale *s)
@@ -412,24 +441,18 @@ static int fit_baseline(amfi_scale *s)
          * the corrections to the prior slopes, prior N(0, tau²) */
         const double sb = bootstrap_sd(s->bw, n, b, s->xw, &s->ref);
         const double lam = sb > 0 ? (sb * sb) / (p->slope_prior_sd * p->slope_prior_sd) : 0.0;
-        double a[3][3] = {{0}}, r[3] = {0}, d[3] = {0};
+        amfi_temp_ridge tr;
+        double d[3] = {0};
+        memset(&tr, 0, sizeof tr);
         for (int j = 0; j < nblk; j++) {
             double g1 = 0, g2 = 0;
             for (int i = 0; i < b; i++) {
                 g1 += h1(p, s->bt[(size_t)j * b + i]);
                 g2 += h2(p, s->bt[(size_t)j * b + i]);
             }
-            const double v[3] = {1.0, g1 / b, g2 / b};
-            const double y = base_block(s, s->bw, j, s->xw);
-            for (int k = 0; k < 3; k++) {
-                r[k] += v[k] * y;
-                for (int l = 0; l < 3; l++)
-                    a[k][l] += v[k] * v[l];
-            }
+            amfi_temp_ridge_add(&tr, g1 / b, g2 / b, base_block(s, s->bw, j, s->xw));
         }
-        a[1][1] += lam;
-        a[2][2] += lam;
-        if (solve3(a, r, d) == 0 && isfinite(d[1]) && isfinite(d[2])) {
+        if (amfi_temp_ridge_solve(&tr, lam, d) == AMFI_IND_OK) {
             bw += d[1];
             bf += d[2];
         }

@@ -144,6 +144,23 @@ int amfi_scale_push(amfi_scale *s, double gvw_kg, double deck_c, amfi_scale_eval
 double amfi_scale_temp_factor(const amfi_scale_params *p, double warm, double frost,
                               double deck_c);
 
+/* The model's two regressors at deck temperature deck_c (p's knee_c and
+ * floor_c): g1 = max(T − knee, 0), g2 = clamp(T − knee, floor − knee, 0). */
+void amfi_scale_temp_terms(const amfi_scale_params *p, double deck_c, double *g1, double *g2);
+
+/* The ridge regression of the temperature model, shared by the indicators
+ * that compensate for it (the scale's baseline blocks, the natural
+ * frequency): y = d0 + d1 g1 + d2 g2 by least squares with lam added to the
+ * slopes' diagonal (shrinking d1, d2 towards 0: fit y as the residual of
+ * the prior slopes to shrink towards the prior). Zero it, add the points,
+ * solve: AMFI_IND_OK, or AMFI_IND_EINVAL when singular. */
+typedef struct amfi_temp_ridge {
+    double a[3][3], r[3]; /* normal equations */
+    int n;
+} amfi_temp_ridge;
+void amfi_temp_ridge_add(amfi_temp_ridge *t, double g1, double g2, double y);
+int amfi_temp_ridge_solve(const amfi_temp_ridge *t, double lam, double d[3]);
+
 /* The baseline's two classes (empty: compensated GVW below class_split_kg,
  * loaded: above), their empirical CDFs tabulated on a grid, and the share
  * of loaded vehicles. A value type (about 16 kB). */

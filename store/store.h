@@ -16,7 +16,8 @@
  * (argument checks, statement helpers), store_write.c (inserts),
  * store_read.c (what amfid reads back, maintenance), store_report.c (the
  * queries of reports), store_export.c (the passage listing), store_speed.c
- * (the estimated speeds), store_environment.c (the environment readings);
+ * (the estimated speeds), store_environment.c (the environment readings),
+ * store_natfreq.c (the natural frequencies);
  * store_internal.h is shared by them only.
  *
  * Workload: one writer thread in amfid opens one handle at start-up, adds one
@@ -66,7 +67,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 6
+#define AMFI_STORE_SCHEMA_VERSION 7
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -154,6 +155,13 @@ typedef struct amfi_passage_row {
     int has_deck_c;      /* 1: deck_c holds the deck temperature taken for the
                             passage; 0: none (NULL) */
     double deck_c;       /* °C, AMFI_STORE_MIN_TEMP_C .. AMFI_STORE_MAX_TEMP_C */
+    double f1_hz;        /* the bridge's first natural frequency from the free
+                            vibration after it, Hz, (0, 1000]; NaN or 0: none
+                            (NULL, and so are the three below) */
+    double f1_comp_hz;   /* f1 at the calibration temperature, (0, 1000]; NaN or
+                            0: NULL */
+    double f1_zeta;      /* its damping ratio, [0, 1); NaN: NULL */
+    double f1_r2;        /* the fit's R², [0, 1]; NaN: NULL */
 } amfi_passage_row;
 /* The range of a reference GVW (a calibration truck), kg. */
 #define AMFI_STORE_MIN_REF_KG 1000.0
@@ -473,6 +481,23 @@ int amfi_store_speed_pairs(amfi_store *s, const amfi_passage_filter *f, amfi_spe
    first: refills amfid's speed-drift window after a restart. max >= 1. */
 int amfi_store_recent_speed_pairs(amfi_store *s, int max, amfi_speed_pair **out, size_t *n,
                                   char *err, size_t errlen);
+
+/* ---- natural frequencies (store_natfreq.c) ------------------------------ */
+
+/* One passage's natural frequency (f1_hz not NULL). */
+typedef struct amfi_f1_rec {
+    int64_t passage_id;
+    int64_t utime;          /* data time, µs */
+    double f1_hz;           /* as estimated, Hz */
+    double f1_comp_hz;      /* at the calibration temperature, Hz; NaN: NULL */
+    double f1_zeta, f1_r2;  /* damping ratio and the fit's R²; NaN: NULL */
+} amfi_f1_rec;
+
+/* The passages with an f1 and from <= utime <= to, oldest first (utime, id),
+   at most max (0: all): *out is malloc'd (free it; NULL when *n is 0). A
+   value outside the schema's range is AMFI_STORE_ECORRUPT. */
+int amfi_store_f1_series(amfi_store *s, int64_t from, int64_t to, int max, amfi_f1_rec **out,
+                         size_t *n, char *err, size_t errlen);
 
 /* ---- maintenance ------------------------------------------------------- */
 

@@ -106,6 +106,8 @@ static const range R_PROB = {0.0, 1.0, 0, ""};
 static const range R_QUALITY = {1.0, 1e9, 0, ""};
 static const range R_REF_KG = {AMFI_STORE_MIN_REF_KG, AMFI_STORE_MAX_REF_KG, 0, "kg"};
 static const range R_TEMP_C = {AMFI_STORE_MIN_TEMP_C, AMFI_STORE_MAX_TEMP_C, 0, "°C"};
+static const range R_HZ = {0.0, 1000.0, 1, "Hz"};
+static const range R_ZETA = {0.0, 1.0 - 1e-12, 0, ""};
 static const range R_FINITE = {-HUGE_VAL, HUGE_VAL, 0, ""};
 
 /* NULL-terminated word lists of the schema's enumerations. */

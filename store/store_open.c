@@ -35,9 +35,10 @@ static const char *const stmt_sql[N_STMT] = {
     [ST_INS_PASSAGE] =
         "INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, "
         "gvw_kg, status, reason, lambda, residual_rms, formulation, solve_ms, "
-        "speed_given_mps, speed_estimated, n_vehicles, quality, reference_gvw_kg, deck_c) "
+        "speed_given_mps, speed_estimated, n_vehicles, quality, reference_gvw_kg, deck_c, "
+        "f1_hz, f1_comp_hz, f1_zeta, f1_r2) "
         "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, "
-        "?18)",
+        "?18, ?19, ?20, ?21, ?22)",
     [ST_INS_AXLE] =
         "INSERT INTO axles (passage_id, idx, spacing_m, load_kg) "
         "VALUES (?1, ?2, ?3, ?4)",

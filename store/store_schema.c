@@ -242,6 +242,21 @@ static const char schema_v6[] =
     "  state    TEXT NOT NULL CHECK (state IN ('baseline', 'normal', 'watch', 'alert'))\n"
     ") STRICT;\n"
     "CREATE INDEX scale_evals_kind_utime ON scale_evals (kind, utime);\n";
+/* Version 7 (issue 14, item 4): the bridge's first natural frequency from
+ * the passage's free vibration after the last axle left (amfid's
+ * daemon.natural_frequency): f1_hz as estimated, f1_comp_hz brought to the
+ * calibration temperature by the baseline's fit (NULL before it exists),
+ * its damping ratio and the fit's R². NULL when not estimated or refused
+ * (amfid counts the reasons), and in rows written before. */
+static const char schema_v7[] =
+    "ALTER TABLE passages ADD COLUMN f1_hz REAL\n"
+    "  CHECK (f1_hz > 0 AND f1_hz <= 1000);\n"
+    "ALTER TABLE passages ADD COLUMN f1_comp_hz REAL\n"
+    "  CHECK (f1_comp_hz > 0 AND f1_comp_hz <= 1000);\n"
+    "ALTER TABLE passages ADD COLUMN f1_zeta REAL\n"
+    "  CHECK (f1_zeta >= 0 AND f1_zeta < 1);\n"
+    "ALTER TABLE passages ADD COLUMN f1_r2 REAL\n"
+    "  CHECK (f1_r2 >= 0 AND f1_r2 <= 1);\n";
 
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
@@ -252,6 +267,7 @@ const st_migration st_migrations[] = {
     {5, "environment: deck and air temperature received on the bus", schema_v5},
     {6, "passages: reference_gvw_kg and deck_c; scale_evals (scale and known truck)",
      schema_v6},
+    {7, "passages: f1_hz, f1_comp_hz, f1_zeta, f1_r2 (natural frequency)", schema_v7},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

@@ -47,6 +47,15 @@ static int check_passage(const amfi_passage_row *r, char *err, size_t errlen)
                           errlen);
     if (rc == 0 && r->has_deck_c)
         rc = st_check_known("passages.deck_c", r->deck_c, &R_TEMP_C, err, errlen);
+    if (rc == 0 && r->f1_hz != 0.0 && !isnan(r->f1_hz)) {
+        rc = st_check_num("passages.f1_hz", r->f1_hz, &R_HZ, err, errlen);
+        if (rc == 0 && r->f1_comp_hz != 0.0)
+            rc = st_check_num("passages.f1_comp_hz", r->f1_comp_hz, &R_HZ, err, errlen);
+        if (rc == 0)
+            rc = st_check_num("passages.f1_zeta", r->f1_zeta, &R_ZETA, err, errlen);
+        if (rc == 0)
+            rc = st_check_num("passages.f1_r2", r->f1_r2, &R_PROB, err, errlen);
+    }
     if (rc == 0)
         rc = st_check_num("passages.gvw_kg", r->gvw_kg, &R_KG, err, errlen);
     if (rc == 0)
@@ -124,6 +133,12 @@ int amfi_store_add_passage(amfi_store *s, const amfi_passage_row *r,
         if (b == SQLITE_OK)
             b = st_bind_real(st, 17, r->reference_gvw_kg != 0.0 ? r->reference_gvw_kg : NAN);
         if (b == SQLITE_OK) b = st_bind_real(st, 18, r->has_deck_c ? r->deck_c : NAN);
+        const int f1 = r->f1_hz != 0.0 && !isnan(r->f1_hz);
+        if (b == SQLITE_OK) b = st_bind_real(st, 19, f1 ? r->f1_hz : NAN);
+        if (b == SQLITE_OK)
+            b = st_bind_real(st, 20, f1 && r->f1_comp_hz != 0.0 ? r->f1_comp_hz : NAN);
+        if (b == SQLITE_OK) b = st_bind_real(st, 21, f1 ? r->f1_zeta : NAN);
+        if (b == SQLITE_OK) b = st_bind_real(st, 22, f1 ? r->f1_r2 : NAN);
         rc = st_run(s, ST_INS_PASSAGE, b, "passages: insert", err, errlen);
         if (rc == 0)
             pid = sqlite3_last_insert_rowid(s->db);

@@ -815,19 +815,21 @@ static void test_runs_and_migration_from_v1(void **state)
                  "DROP TABLE environment; "
                  "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
+                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
+                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
                  "DELETE FROM schema_migrations WHERE version >= 2; PRAGMA user_version = 1");
     sqlite3_close(db);
 
     /* read-only openers do not migrate: they say so */
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 1 is older than this program's 6"));
+    assert_non_null(strstr(err, "schema version 1 is older than this program's 7"));
     assert_null(ro);
 
     /* read-write: migrated, the data kept */
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM runs"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
     sqlite3_close(db);
@@ -874,17 +876,19 @@ static void test_speed_given_and_migration_from_v2(void **state)
                  "DROP TABLE environment; "
                  "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
+                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
+                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
                  "DELETE FROM schema_migrations WHERE version >= 3; PRAGMA user_version = 2");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 2 is older than this program's 6"));
+    assert_non_null(strstr(err, "schema version 2 is older than this program's 7"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE speed_given_mps = 25.0 "
                                     "AND speed_mps = 25.0 AND speed_estimated = 0"));
     sqlite3_close(db);
@@ -932,17 +936,19 @@ static void test_event_columns_and_migration_from_v3(void **state)
                  "DROP TABLE environment; "
                  "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
+                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
+                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
                  "DELETE FROM schema_migrations WHERE version >= 4; PRAGMA user_version = 3");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 3 is older than this program's 6"));
+    assert_non_null(strstr(err, "schema version 3 is older than this program's 7"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages WHERE n_vehicles = 1 "
                                     "AND quality IS NULL"));
     sqlite3_close(db);
@@ -1032,16 +1038,18 @@ static void test_environment_and_migration_from_v4(void **state)
     raw_exec(db, "DROP TABLE environment; "
                  "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
+                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
+                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
                  "DELETE FROM schema_migrations WHERE version >= 5; PRAGMA user_version = 4");
     sqlite3_close(db);
     amfi_store *ro = NULL;
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 4 is older than this program's 6"));
+    assert_non_null(strstr(err, "schema version 4 is older than this program's 7"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM environment"));
     sqlite3_close(db);
     assert_int_equal(0, amfi_store_add_environment(f->s, rows, 2, err, sizeof err));
@@ -1168,16 +1176,18 @@ static void test_scale_rows_and_migration_from_v5(void **state)
     /* make it a version-5 file, as amfid before this step left it */
     raw_exec(db, "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
+                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
+                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
                  "DELETE FROM schema_migrations WHERE version >= 6; PRAGMA user_version = 5");
     sqlite3_close(db);
     amfi_store *ro = NULL;
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 5 is older than this program's 6"));
+    assert_non_null(strstr(err, "schema version 5 is older than this program's 7"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(6, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(6, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE deck_c IS NULL AND "
                                     "reference_gvw_kg IS NULL"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM scale_evals"));
@@ -1193,6 +1203,111 @@ static void test_scale_rows_and_migration_from_v5(void **state)
     assert_int_equal(1, n);
     assert_float_equal(5.0, in[0].deck_c, 0);
     free(in);
+}
+
+/* ---- version 7: the natural frequency; a version-6 file migrates ------------ */
+
+static void test_f1_and_migration_from_v6(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    amfi_passage_row r;
+    amfi_store *ro = NULL;
+    amfi_f1_rec *a = NULL;
+    size_t n = 9;
+    sqlite3 *db;
+
+    ok_row(&r, 1, DAY_US, 18000.0); /* memset: f1_hz 0, none (NULL) */
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    ok_row(&r, 2, DAY_US + 1000, 18000.0);
+    r.f1_hz = 5.73;
+    r.f1_comp_hz = 5.70;
+    r.f1_zeta = 0.03;
+    r.f1_r2 = 0.98;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    ok_row(&r, 3, DAY_US + 2000, 18000.0);
+    r.f1_hz = 5.6;
+    r.f1_comp_hz = NAN; /* before the baseline */
+    r.f1_zeta = 0.031;
+    r.f1_r2 = 0.9;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    /* refused, naming the field */
+    r.f1_hz = 2000;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.f1_hz"));
+    r.f1_hz = -1;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.f1_hz"));
+    r.f1_hz = 5.6;
+    r.f1_comp_hz = INFINITY;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.f1_comp_hz"));
+    r.f1_comp_hz = NAN;
+    r.f1_zeta = 1.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.f1_zeta"));
+    r.f1_zeta = 0.03;
+    r.f1_r2 = 1.5;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.f1_r2"));
+    /* the series: the two with an f1, oldest first; a limit */
+    assert_int_equal(0, amfi_store_f1_series(f->s, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err,
+                                             sizeof err));
+    assert_int_equal(2, n);
+    assert_float_equal(5.73, a[0].f1_hz, 0);
+    assert_float_equal(5.70, a[0].f1_comp_hz, 0);
+    assert_float_equal(0.03, a[0].f1_zeta, 0);
+    assert_float_equal(0.98, a[0].f1_r2, 0);
+    assert_true(a[0].utime == DAY_US + 1000);
+    assert_true(isnan(a[1].f1_comp_hz));
+    free(a);
+    assert_int_equal(0, amfi_store_f1_series(f->s, 0, AMFI_STORE_MAX_UTIME, 1, &a, &n, err,
+                                             sizeof err));
+    assert_int_equal(1, n);
+    assert_float_equal(5.73, a[0].f1_hz, 0);
+    free(a);
+    assert_int_equal(0, amfi_store_f1_series(f->s, 0, DAY_US, 0, &a, &n, err, sizeof err));
+    assert_int_equal(0, n);
+    assert_null(a);
+    assert_int_equal(AMFI_EINVAL,
+                     amfi_store_f1_series(f->s, 0, DAY_US, -1, &a, &n, err, sizeof err));
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    db = raw_open(f->path);
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE vehicle_id = 1 AND "
+                                    "f1_hz IS NULL AND f1_comp_hz IS NULL AND f1_zeta IS NULL "
+                                    "AND f1_r2 IS NULL"));
+    /* the schema refuses what the checks refuse */
+    assert_int_not_equal(SQLITE_OK,
+                         sqlite3_exec(db, "UPDATE passages SET f1_hz = 0 WHERE vehicle_id = 2",
+                                      NULL, NULL, NULL));
+    /* make it a version-6 file, as amfid before the natural frequency left it */
+    raw_exec(db, "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
+                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
+                 "DELETE FROM schema_migrations WHERE version >= 7; PRAGMA user_version = 6");
+    sqlite3_close(db);
+    assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
+    assert_non_null(strstr(err, "schema version 6 is older than this program's 7"));
+    assert_null(ro);
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE f1_hz IS NULL"));
+    sqlite3_close(db);
+    assert_int_equal(0, amfi_store_f1_series(f->s, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err,
+                                             sizeof err));
+    assert_int_equal(0, n);
+    ok_row(&r, 4, 2 * DAY_US, 18000.0);
+    r.f1_hz = 5.5;
+    r.f1_zeta = 0.02;
+    r.f1_r2 = 0.95;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_int_equal(0, amfi_store_f1_series(f->s, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err,
+                                             sizeof err));
+    assert_int_equal(1, n);
+    free(a);
 }
 
 /* ---- what amfid and amfi-report read back ------------------------------------ */
@@ -1632,6 +1747,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_environment_and_migration_from_v4, setup, teardown),
         cmocka_unit_test_setup_teardown(test_scale_rows_and_migration_from_v5, setup, teardown),
         cmocka_unit_test_setup_teardown(test_speed_given_and_migration_from_v2, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_f1_and_migration_from_v6, setup, teardown),
         cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
         cmocka_unit_test_setup_teardown(test_many_passages, setup, teardown),
