@@ -199,6 +199,7 @@ static int start_runtime(daemon_s *d)
     restore_indicator_state(d);
     drift_restore(d);
     scaleind_restore(d);
+    freevib_start(d);
     amfi_tracker_params tp = {d->cfg.bridge.span_m,
                               d->cfg.solver.pre_roll_s + d->cfg.daemon.margin_s,
                               d->cfg.solver.post_roll_s + d->cfg.daemon.margin_s,
@@ -320,6 +321,7 @@ int amfid_drain(daemon_s *d)
     heartbeat(d);
     reject_final(d);
     scaleind_final(d);
+    freevib_final(d);
     notify_finish(d);
     metrics_tick(d, 1);
     if (!d->degraded)
@@ -368,6 +370,7 @@ void amfid_stop(daemon_s *d)
     amfi_indicators_destroy(d->ind);
     drift_destroy(d);
     scaleind_destroy(d);
+    freevib_stop(d);
     amfi_bridge_destroy(d->bridge);
 }
 

@@ -14,7 +14,8 @@
  * queues, solver threads), pipeline.c (in-order store, indicators,
  * publish), control.c (configuration, heartbeat, reload, restart state),
  * drift.c (the speed-drift alert), environment.c (the environment input),
- * scaleind.c (the scale indicator and the known-truck runs).
+ * scaleind.c (the scale indicator and the known-truck runs),
+ * freevib.c (the natural frequency from the free vibration).
  */
 #ifndef AMFID_H
 #define AMFID_H
@@ -118,6 +119,15 @@ typedef struct notify_state {
     int64_t started_total, ok, failed, timeouts, dropped;
 } notify_state;
 
+/* The natural frequency's compensation and counters (freevib.c). */
+typedef struct freevib_state {
+    amfi_natfreq_comp *comp;  /* NULL: off (free_s 0) or not compensated */
+    int64_t estimated;        /* passages with an f1 */
+    int64_t no_segment;       /* ok passages without free vibration (cut, data missing) */
+    int64_t refused[AMFI_NATFREQ_NREFUSALS]; /* by amfi_natfreq_estimate's code; [0] invalid */
+    int64_t no_temperature;   /* baseline candidates without a deck temperature */
+} freevib_state;
+
 /* What the metrics file reports beyond the status counters (metrics.c). */
 #define SOLVE_BUCKETS 12
 #define SOLVE_RECENT 1024
@@ -166,6 +176,7 @@ typedef struct daemon_s {
     reject_state rej;
     env_state env;                 /* environment readings (environment.c) */
     scale_state sc;                /* scale indicator, known truck (scaleind.c) */
+    freevib_state fv;              /* the natural frequency (freevib.c) */
     /* passages the store could not take (disk full, I/O error, read-only):
      * held in order and retried (pipeline.c); nothing acknowledged is lost */
     job **held;
@@ -317,6 +328,20 @@ void scaleind_reload(daemon_s *d, const amfi_site_config *n);
 /* At stop: the counters in the log. */
 void scaleind_final(daemon_s *d);
 void scaleind_destroy(daemon_s *d);
+/* ---- the natural frequency (freevib.c), main thread ----------------------- */
+
+/* The compensation, its baseline refilled from the store (free_s > 0). */
+void freevib_start(daemon_s *d);
+void freevib_stop(daemon_s *d);
+/* At release: the window's free vibration into j->f1_* (NaN: none). */
+void freevib_estimate(daemon_s *d, job *j);
+/* A row's f1 columns (the event's vehicle that left last carries them). */
+void freevib_row(daemon_s *d, const job *j, amfi_passage_row *r);
+/* After the row is stored: the baseline's collection. */
+void freevib_stored(daemon_s *d, const job *j);
+/* The counters into the store's meta table (natfreq.*), and the log at stop. */
+void freevib_record(daemon_s *d);
+void freevib_final(daemon_s *d);
 
 /* ---- configuration, state, heartbeat, reload (control.c), main thread ----- */
 

@@ -122,6 +122,8 @@ void record_intake(daemon_s *d, int force)
         rc = amfi_store_meta_set(d->store, "intake.as_of", when, err, sizeof err);
     if (rc)
         LOG_WARN("store: the intake counters: %s", err);
+    else
+        freevib_record(d);
 }
 
 /* ---- heartbeat ---------------------------------------------------------- */

@@ -48,6 +48,7 @@ void release_windows(daemon_s *d, int flush)
         j->w = w;
         j->n_sensors = ns;
         j->gvw_kg = NAN;
+        j->f1_hz = j->f1_zeta = j->f1_r2 = NAN;
         /* everything the solver thread reads travels with the job */
         j->lambda = d->cfg.lambda;
         j->speed_estimate = d->cfg.speed_estimate;
@@ -64,6 +65,7 @@ void release_windows(daemon_s *d, int flush)
                 int m = amfi_ring_get(d->rings[s], w.k0[s], w.n, j->accel + (size_t)s * w.n);
                 missing += m < 0 ? w.n : m;
             }
+            freevib_estimate(d, j); /* the free vibration's samples are in the rings now */
             if (!j->accel || missing > 0) {
                 snprintf(j->status, sizeof j->status, "gap");
                 snprintf(j->reason, sizeof j->reason, "%d samples missing in the window",

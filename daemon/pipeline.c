@@ -45,7 +45,7 @@ static double speed_used(const job *j)
     return j->speed_estimated ? j->speed_used_mps : j->w.v.speed_mps;
 }
 
-static void publish_passage(daemon_s *d, const job *j, int64_t id)
+static void publish_passage(daemon_s *d, const job *j, int64_t id, const amfi_passage_row *r)
 {
     amfi_passage_t m;
     memset(&m, 0, sizeof m);
@@ -69,6 +69,8 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id)
     m.n_vehicles = (int16_t)(j->w.n_vehicles > 1 ? j->w.n_vehicles : 1);
     m.quality = j->quality > 0 ? j->quality : NAN;
     m.reference_gvw_kg = j->w.v.reference_gvw_kg > 0 ? j->w.v.reference_gvw_kg : NAN;
+    m.f1_hz = r->f1_hz;
+    m.f1_comp_hz = r->f1_comp_hz;
     amfi_passage_t_publish(d->lcm, d->cfg.daemon.ch_passage, &m);
 }
 
@@ -135,7 +137,7 @@ void emit_alert(daemon_s *d, int64_t utime, const amfi_alert_event *a, int64_t i
 }
 
 /* The row of a job. */
-static void job_row(const daemon_s *d, const job *j, amfi_passage_row *r)
+static void job_row(daemon_s *d, const job *j, amfi_passage_row *r)
 {
     memset(r, 0, sizeof *r);
     r->vehicle_id = j->w.v.vehicle_id;
@@ -159,6 +161,7 @@ static void job_row(const daemon_s *d, const job *j, amfi_passage_row *r)
     r->n_vehicles = j->w.n_vehicles > 1 ? j->w.n_vehicles : 1;
     r->quality = j->quality > 0 ? j->quality : NAN;
     r->reference_gvw_kg = j->w.v.reference_gvw_kg;
+    freevib_row(d, j, r);
 }
 
 static int store_now(daemon_s *d, job *j)
@@ -189,8 +192,9 @@ static int store_now(daemon_s *d, job *j)
         return -1;
     }
     d->passages_stored++;
+    freevib_stored(d, j);
     metrics_passage(d, j->status, j->solved, j->solve_ms);
-    publish_passage(d, j, id);
+    publish_passage(d, j, id, &r);
     if (j->speed_estimated)
         drift_feed(d, j->w.v.utime, r.speed_mps, r.speed_given_mps);
     if (j->solved) {

@@ -47,6 +47,9 @@ typedef struct job {
     char status[16];
     char reason[200];
     job_vehicle veh[AMFI_MAX_VEHICLES]; /* an event (w.n_vehicles > 1), solved: per vehicle */
+    /* the natural frequency (freevib.c), set by the main thread at release */
+    double f1_hz, f1_zeta, f1_r2; /* NaN: none */
+    int64_t f1_vehicle_id;   /* the event's vehicle that carries it (left last) */
 } job;
 
 void job_free(job *j);

@@ -133,12 +133,15 @@ static void round_make(struct round *r, int i)
     r->passage.n_vehicles = (int16_t)(1 + i % 3);   /* weighed alone or with others */
     r->passage.quality = 1.0 + 0.5 * (i % 3);
     r->passage.reference_gvw_kg = i % 4 == 0 ? 14829.0 : NAN;
+    r->passage.f1_hz = 5.7338 - 0.001 * (i % 5); /* paper-20m's first frequency */
+    r->passage.f1_comp_hz = i % 4 ? 5.7201 : NAN; /* before the baseline: NaN */
 
     r->unsolved = r->passage;
     r->unsolved.passage_id = 100000 + i;
     r->unsolved.status = "gap";
     r->unsolved.reason = "AMFI_ACCEL sensor 1: 350 samples missing during the passage";
     r->unsolved.gvw_kg = NAN;
+    r->unsolved.f1_hz = r->unsolved.f1_comp_hz = NAN;
     r->unsolved.n_axles = 0;
     r->unsolved.axle_kg = NULL;
     r->unsolved.lambda = NAN;
@@ -276,7 +279,9 @@ static void print_round(const struct round *r)
     put_i("speed_estimated", p->speed_estimated, ";");
     put_i("n_vehicles", p->n_vehicles, ";");
     put_d("quality", p->quality, ";");
-    put_d("reference_gvw_kg", p->reference_gvw_kg, "\n");
+    put_d("reference_gvw_kg", p->reference_gvw_kg, ";");
+    put_d("f1_hz", p->f1_hz, ";");
+    put_d("f1_comp_hz", p->f1_comp_hz, "\n");
 
     const amfi_indicator_t *d = &r->indicator;
     printf("%s\tamfi.indicator_t\t", AMFI_CHANNEL_INDICATOR);

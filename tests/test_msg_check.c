@@ -144,7 +144,8 @@ static enc random_message(amfi_msg_type t, int big)
         amfi_passage_t m = {(int64_t)rnd(), (int64_t)rnd(), (int64_t)rnd(), (int16_t)rnd(),
                             rnd_double(), NULL, NULL, rnd_double(), 0, NULL, rnd_double(),
                             rnd_double(), NULL, rnd_double(), NULL, rnd_double(),
-                            (int8_t)rnd(), (int16_t)rnd(), rnd_double(), rnd_double()};
+                            (int8_t)rnd(), (int16_t)rnd(), rnd_double(), rnd_double(),
+                            rnd_double(), rnd_double()};
         m.status = rnd_string(AMFI_MSG_MAX_PASSAGE_STATUS);
         m.site_id = rnd_string(AMFI_MSG_MAX_PASSAGE_SITE_ID);
         m.reason = rnd_string(AMFI_MSG_MAX_PASSAGE_REASON);
@@ -471,7 +472,8 @@ static enc empty_arrays(amfi_msg_type t)
     }
     case AMFI_MSG_PASSAGE_T: {
         amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
-                            1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0};
+                            1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0,
+                            5.73, 5.70};
         ENCODE(passage_t, m);
         break;
     }

@@ -1,0 +1,243 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * freevib.c: amfid's natural-frequency feature (issue 14, item 4): the
+ * bridge's first natural frequency from each passage's free vibration
+ * after the last axle left (the tracker hands on free_s of samples, cut at
+ * the next vehicle's entry: tracker.h), estimated when the window is
+ * released (indicators/natfreq.h, on every sensor; the one with the
+ * smallest relative standard error is kept), stored with the passage
+ * (passages.f1_hz, f1_zeta, f1_r2) and, once the baseline's fit against
+ * the deck temperature exists, compensated to the calibration temperature
+ * (f1_comp_hz). A refused estimate is stored as NULL and counted by its
+ * reason (logged at stop, in the store's meta table as natfreq.*). On an
+ * event of several vehicles, the vehicle that leaves last carries it.
+ *
+ * The deck temperature is the store's (amfi_store_deck_c_at) at the
+ * passage's time. The baseline is the first daemon.natural_frequency.
+ * baseline_n estimates with a temperature; after a restart it is read back
+ * from the store (the same estimates, so the same fit).
+ *
+ * Thread: the main thread only. Owns d->fv (the compensation and the
+ * counters); the estimate reads the rings, which the main thread owns.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amfid.h"
+
+/* Readings at most this far apart are interpolated for a passage's deck
+ * temperature (amfi_store_deck_c_at), µs of data time. */
+#define DECK_MAX_GAP_US INT64_C(7200000000)
+
+void freevib_start(daemon_s *d)
+{
+    char err[256];
+    freevib_state *fv = &d->fv;
+    memset(fv, 0, sizeof *fv);
+    if (!(d->cfg.daemon.natfreq_free_s > 0))
+        return;
+    amfi_scale_params tp;
+    amfi_scale_params_default(&tp);
+    if (amfi_natfreq_comp_create(&tp, d->cfg.daemon.natfreq_baseline_n, &fv->comp, err,
+                                 sizeof err) != 0) {
+        LOG_WARN("natural frequency: %s: not compensated for temperature", err);
+        return;
+    }
+    amfi_f1_rec *a = NULL;
+    size_t n = 0;
+    if (amfi_store_f1_series(d->store, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err, sizeof err)) {
+        LOG_WARN("store: %s", err);
+        return;
+    }
+    int used = 0, fitted = 0;
+    for (size_t k = 0; k < n && !fitted; k++) {
+        double t = NAN;
+        if (amfi_store_deck_c_at(d->store, a[k].utime, DECK_MAX_GAP_US, &t, err, sizeof err) ||
+            !isfinite(t))
+            continue;
+        used++;
+        fitted = amfi_natfreq_comp_push(fv->comp, a[k].f1_hz, t) == 1;
+    }
+    free(a);
+    amfi_natfreq_model m;
+    if (amfi_natfreq_comp_model(fv->comp, &m))
+        LOG_INFO("natural frequency: baseline from the store: %d estimates, f1 %.4f Hz at the "
+                 "calibration temperature, slopes %.5f (warm) and %.5f (frost) /°C",
+                 m.n, m.f_ref_hz, m.warm, m.frost);
+    else if (used > 0)
+        LOG_INFO("natural frequency: %d of %d baseline estimates from the store", used,
+                 d->cfg.daemon.natfreq_baseline_n);
+}
+
+void freevib_stop(daemon_s *d)
+{
+    amfi_natfreq_comp_destroy(d->fv.comp);
+    d->fv.comp = NULL;
+}
+
+/* The event's vehicle that leaves the span last (at its measured speed). */
+static int64_t last_out(const daemon_s *d, const amfi_window *w)
+{
+    int64_t id = w->v.vehicle_id;
+    double latest = -INFINITY;
+    for (int i = 0; i < w->n_vehicles; i++) {
+        const amfi_vehicle_ev *v = &w->ev[i];
+        const amfi_passage_times pt = amfi_passage_window(d->cfg.bridge.span_m, v->speed_mps,
+                                                          v->n_axles, v->spacing_m, 0.0, 0.0);
+        const double out = (double)v->utime + 1e6 * pt.on_span_s;
+        if (out > latest) {
+            latest = out;
+            id = v->vehicle_id;
+        }
+    }
+    return id;
+}
+
+void freevib_estimate(daemon_s *d, job *j)
+{
+    freevib_state *fv = &d->fv;
+    j->f1_hz = j->f1_zeta = j->f1_r2 = NAN;
+    j->f1_vehicle_id = j->w.v.vehicle_id;
+    if (!(d->cfg.daemon.natfreq_free_s > 0) || strcmp(j->w.status, "ok") != 0)
+        return;
+    j->f1_vehicle_id = last_out(d, &j->w);
+    const int n = j->w.free_n;
+    if (n < 8) {
+        fv->no_segment++;
+        return;
+    }
+    double *x = malloc(sizeof(double) * (size_t)n);
+    if (!x) {
+        set_error(d, "natural frequency: out of memory for %d samples", n);
+        return;
+    }
+    amfi_natfreq_result best;
+    memset(&best, 0, sizeof best);
+    int have = 0, first_code = AMFI_NATFREQ_EINVAL;
+    for (int s = 0; s < j->n_sensors; s++) {
+        if (!d->rings[s] || amfi_ring_get(d->rings[s], j->w.free_k0[s], n, x) != 0)
+            continue;
+        amfi_natfreq_result r;
+        const int code = amfi_natfreq_estimate(x, n, amfi_ring_rate(d->rings[s]),
+                                               &d->cfg.daemon.natfreq, &r);
+        if (s == 0 || first_code == AMFI_NATFREQ_EINVAL)
+            first_code = code;
+        if (code == AMFI_NATFREQ_OK &&
+            (!have || r.f1_se_hz / r.f1_hz < best.f1_se_hz / best.f1_hz)) {
+            best = r;
+            have = 1;
+        }
+    }
+    free(x);
+    if (!have) {
+        fv->refused[first_code > 0 && first_code < AMFI_NATFREQ_NREFUSALS ? first_code : 0]++;
+        return;
+    }
+    fv->estimated++;
+    j->f1_hz = best.f1_hz;
+    j->f1_zeta = best.zeta;
+    j->f1_r2 = best.r2;
+}
+
+/* The deck temperature at utime, or NaN. */
+static double deck_at(daemon_s *d, int64_t utime)
+{
+    char err[256];
+    double t = NAN;
+    if (amfi_store_deck_c_at(d->store, utime, DECK_MAX_GAP_US, &t, err, sizeof err) != 0) {
+        set_error(d, "store: %s", err);
+        return NAN;
+    }
+    return t;
+}
+
+/* Whether this row (of an event: one vehicle's) carries the f1. */
+static int carries(const job *j)
+{
+    return j->w.v.vehicle_id == j->f1_vehicle_id && j->f1_hz > 0;
+}
+
+void freevib_row(daemon_s *d, const job *j, amfi_passage_row *r)
+{
+    r->f1_hz = r->f1_comp_hz = r->f1_zeta = r->f1_r2 = NAN;
+    if (!carries(j))
+        return;
+    r->f1_hz = j->f1_hz;
+    r->f1_zeta = j->f1_zeta;
+    r->f1_r2 = j->f1_r2;
+    if (d->fv.comp) {
+        amfi_natfreq_model m;
+        if (amfi_natfreq_comp_model(d->fv.comp, &m))
+            r->f1_comp_hz = amfi_natfreq_comp_apply(d->fv.comp, j->f1_hz, deck_at(d, j->w.v.utime));
+    }
+}
+
+void freevib_stored(daemon_s *d, const job *j)
+{
+    freevib_state *fv = &d->fv;
+    amfi_natfreq_model m;
+    if (!carries(j) || !fv->comp || amfi_natfreq_comp_model(fv->comp, &m))
+        return;
+    const double t = deck_at(d, j->w.v.utime);
+    if (!isfinite(t)) {
+        fv->no_temperature++;
+        return;
+    }
+    if (amfi_natfreq_comp_push(fv->comp, j->f1_hz, t) == 1 &&
+        amfi_natfreq_comp_model(fv->comp, &m))
+        LOG_INFO("natural frequency: baseline of %d estimates (deck %.1f .. %.1f °C): f1 %.4f Hz "
+                 "at the calibration temperature, SD %.2f %%, slopes %.5f (warm) and %.5f "
+                 "(frost) /°C",
+                 m.n, m.t_min_c, m.t_max_c, m.f_ref_hz, 100 * m.sd_rel, m.warm, m.frost);
+}
+
+/* The counters' names: natfreq.<name> in the meta table, and the log. */
+static void counters(const daemon_s *d, const char **name, long long *v, int *n)
+{
+    const freevib_state *fv = &d->fv;
+    int k = 0;
+    name[k] = "estimated", v[k++] = (long long)fv->estimated;
+    name[k] = "no_free_vibration", v[k++] = (long long)fv->no_segment;
+    for (int c = 1; c < AMFI_NATFREQ_NREFUSALS; c++)
+        name[k] = amfi_natfreq_code_name(c), v[k++] = (long long)fv->refused[c];
+    name[k] = "invalid", v[k++] = (long long)fv->refused[0];
+    name[k] = "no_temperature", v[k++] = (long long)fv->no_temperature;
+    *n = k;
+}
+
+void freevib_record(daemon_s *d)
+{
+    if (!(d->cfg.daemon.natfreq_free_s > 0))
+        return;
+    const char *name[16];
+    long long v[16];
+    int n = 0;
+    counters(d, name, v, &n);
+    char key[64], val[32], err[256];
+    for (int i = 0; i < n; i++) {
+        snprintf(key, sizeof key, "natfreq.%s", name[i]);
+        snprintf(val, sizeof val, "%lld", v[i]);
+        if (amfi_store_meta_set(d->store, key, val, err, sizeof err) != 0) {
+            set_error(d, "store: %s", err);
+            return;
+        }
+    }
+}
+
+void freevib_final(daemon_s *d)
+{
+    if (!(d->cfg.daemon.natfreq_free_s > 0))
+        return;
+    const char *name[16];
+    long long v[16];
+    int n = 0;
+    counters(d, name, v, &n);
+    char line[512];
+    size_t at = 0;
+    for (int i = 1; i < n && at < sizeof line; i++)
+        at += (size_t)snprintf(line + at, sizeof line - at, "%s%s %lld", i > 1 ? ", " : "",
+                               name[i], v[i]);
+    LOG_INFO("natural frequency: %lld passages estimated; not: %s", v[0], line);
+}
