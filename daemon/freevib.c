@@ -13,9 +13,11 @@
  * event of several vehicles, the vehicle that leaves last carries it.
  *
  * The deck temperature is the store's (amfi_store_deck_c_at) at the
- * passage's time. The baseline is the first daemon.natural_frequency.
- * baseline_n estimates with a temperature; after a restart it is read back
- * from the store (the same estimates, so the same fit).
+ * passage's time, the readings received so far flushed first. The
+ * baseline is the first daemon.natural_frequency.baseline_n estimates with
+ * a temperature; after a restart it is read back from the store (the same
+ * estimates; a temperature interpolated then where only the reading before
+ * was known live can move the fit slightly).
  *
  * Thread: the main thread only. Owns d->fv (the compensation and the
  * counters); the estimate reads the rings, which the main thread owns.
@@ -180,6 +182,7 @@ void freevib_stored(daemon_s *d, const job *j)
     amfi_natfreq_model m;
     if (!carries(j) || !fv->comp || amfi_natfreq_comp_model(fv->comp, &m))
         return;
+    environment_flush(d); /* the readings received so far: as a restart will see them */
     const double t = deck_at(d, j->w.v.utime);
     if (!isfinite(t)) {
         fv->no_temperature++;

@@ -5,9 +5,10 @@
  * amfid acknowledged: it publishes a passage only after its commit). Every
  * message is checked before it is decoded. With --site, one line
  * "CHANNEL SITE_ID" per passage, indicator, alert and status message instead
- * (tests/daemon_site.sh).
+ * (tests/daemon_site.sh). With --f1, "PASSAGE_ID VEHICLE_ID STATUS F1_HZ
+ * F1_COMP_HZ" (%.6f, nan when none; tests/daemon_natfreq.sh).
  *
- *   lcm_passages [--site] LOG
+ *   lcm_passages [--site | --f1] LOG
  */
 #include <lcm/eventlog.h>
 #include <stdio.h>
@@ -69,8 +70,9 @@ static int print_sites(lcm_eventlog_t *in)
 int main(int argc, char **argv)
 {
     int sites = argc == 3 && strcmp(argv[1], "--site") == 0;
-    if (argc != 2 && !sites) {
-        fprintf(stderr, "usage: lcm_passages [--site] LOG\n");
+    int f1 = argc == 3 && strcmp(argv[1], "--f1") == 0;
+    if (argc != 2 && !sites && !f1) {
+        fprintf(stderr, "usage: lcm_passages [--site | --f1] LOG\n");
         return 2;
     }
     lcm_eventlog_t *in = lcm_eventlog_create(argv[argc - 1], "r");
@@ -94,8 +96,11 @@ int main(int argc, char **argv)
                 fprintf(stderr, "lcm_passages: event %lld: %s\n", (long long)e->eventnum, why);
                 bad = 1;
             } else {
-                printf("%lld %lld %s\n", (long long)m.passage_id, (long long)m.vehicle_id,
+                printf("%lld %lld %s", (long long)m.passage_id, (long long)m.vehicle_id,
                        m.status);
+                if (f1)
+                    printf(" %.6f %.6f", m.f1_hz, m.f1_comp_hz);
+                printf("\n");
                 amfi_passage_t_decode_cleanup(&m);
             }
         }
