@@ -57,6 +57,10 @@ SELECT i, 1763769600000000 + i * 3600000000, 1, 25.0, 2,
        CASE WHEN i % 10 = 0 THEN NULL ELSE 0.001 END,
        CASE WHEN i % 10 = 0 THEN NULL ELSE 'paper' END, 15.0, 25.0
 FROM k;
+UPDATE passages SET f1_hz = 5.70 + 0.01 * (vehicle_id % 3), f1_zeta = 0.03, f1_r2 = 0.95,
+       f1_comp_hz = CASE WHEN vehicle_id > 20 THEN 5.72 + 0.002 * (vehicle_id % 2) END
+WHERE status = 'ok';
+INSERT INTO meta (key, value) VALUES ('natfreq.short', '3'), ('natfreq.noisy', '1');
 INSERT INTO axles (passage_id, idx, spacing_m, load_kg)
 SELECT id, 1, NULL, 0.4 * gvw_kg FROM passages;
 INSERT INTO axles (passage_id, idx, spacing_m, load_kg)
@@ -133,6 +137,9 @@ if ok summary --db "$db" --summary; then
     has '^time span +2025-11-22 01:00:00 \.\. 2025-11-23 16:00:00 UTC \(39\.0 h\)$'
     has '^baseline +mean 17800 kg, STD 1900 kg, n 30, auto, from 2025-11-22 00:00:00 UTC$'
     has '^temperature +deck -3\.2 \.\. 7\.8 °C, air -6\.0 \.\. -0\.5 °C, 12 readings, 2025-11-22 00:00:00 \.\. 2025-11-22 22:00:00 UTC$'
+    f1=$(q "$db" "SELECT printf('%.4f', avg(f1_hz)) FROM passages")
+    has "^natural f1 +n 36, raw mean $f1 Hz \\(SD 0\\.[0-9]{2} %\\), compensated n 18, mean 5\\.7211 Hz \\(SD 0\\.02 %\\); newest 36: raw $f1 Hz, compensated 5\\.7211 Hz \\(\\+0\\.00 %\\)$"
+    has '^  not estimated \(amfid.s last run\): short 3, noisy 1$'
     hasnt '^== indicators'
 fi
 
@@ -462,7 +469,7 @@ png_ok() {
 if command -v gnuplot > /dev/null; then
     cp "$tmp/pristine.db" "$tmp/plot.db"
     if ok plot --db "$tmp/plot.db" --plot "$tmp/plots"; then
-        for p in gvw trend gvw_histogram passages_per_hour speed; do
+        for p in gvw trend gvw_histogram passages_per_hour speed natfreq; do
             png_ok "$tmp/plots/$p.png"
             has "^plot  $tmp/plots/$p\\.png  "
         done

@@ -51,6 +51,7 @@
 #include "report_export.h"
 #include "report_pg.h"
 #include "report_plot.h"
+#include "report_natfreq.h"
 #include "report_scale.h"
 #include "report_speed.h"
 #include "store.h"
@@ -498,6 +499,10 @@ static int section_summary(amfi_store *s)
             utc(env.utime_first, a), utc(env.utime_last, b));
     if (report_scale_summary(s, g_out, err, sizeof err) != 0)
         return data_error("%s", err);
+    char f1line[1024];
+    if (natfreq_summary(s, f1line, sizeof f1line, err, sizeof err) != 0)
+        return data_error("%s", err);
+    out("%s", f1line);
     return print_baseline(s);
 }
 

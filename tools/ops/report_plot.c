@@ -29,6 +29,7 @@
 #include <sys/wait.h>
 #include <time.h>
 
+#include "report_natfreq.h"
 #include "report_plot.h"
 #include "report_scale.h"
 #include "report_speed.h"
@@ -530,9 +531,11 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
             (double)sdays[0].day_utime / 1e6 - 43200,
             (double)sdays[n_sdays - 1].day_utime / 1e6 + 43200, sub);
     /* 7-9: the scale indicator, the known-truck runs, the temperature,
-     * when there are any (report_scale.c) */
-    int more = 0;
-    if (report_scale_plots(s, dir, f, site, &more, err, errlen) != 0) {
+     * when there are any (report_scale.c); 10: the natural frequency
+     * (report_natfreq.c) */
+    int more = 0, n_f1 = 0;
+    if (report_scale_plots(s, dir, f, site, &more, err, errlen) != 0 ||
+        natfreq_plot(s, dir, f, sub, &n_f1, err, errlen) != 0) {
         fclose(f);
         goto out;
     }
@@ -554,8 +557,10 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     static const char *const png2[][2] = {
         {"scale.png", "scale indicator: raw and temperature-compensated scale, CUSUM and threshold"},
         {"known_truck.png", "known-truck runs: ratio inferred / reference, raw and compensated"},
-        {"temperature.png", "deck and air temperature"}};
-    for (int k = 0; k < 3; k++)
+        {"temperature.png", "deck and air temperature"},
+        {"natfreq.png", "natural frequency per passage, raw and temperature-compensated"}};
+    more |= n_f1 ? 1 << 3 : 0;
+    for (int k = 0; k < 4; k++)
         if ((more & (1 << k)) && listed(dir, png2[k][0], png2[k][1], err, errlen) != 0)
             goto out;
     rc = 0;

@@ -17,7 +17,8 @@
  * gvw_histogram.png, passages_per_hour.png and speed.png (and
  * speed_correction.png when the store has estimated speeds; scale.png,
  * known_truck.png and temperature.png when it has scale blocks, known-truck
- * runs and environment readings, report_scale.h), plus their data
+ * runs and environment readings, report_scale.h; natfreq.png when it has
+ * natural frequencies, report_natfreq.h), plus their data
  * and the gnuplot script under dir/data/ (alerts.dat holds one line per
  * alert row). `site` titles every plot; `ip` gives the alert thresholds.
  * Prints one line per PNG ("plot  PATH  what") on stdout. Returns 0, or −1

@@ -1,0 +1,31 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * report_natfreq.h: amfi-report's natural-frequency lines (issue 14, item
+ * 4): the bridge's first natural frequency amfid estimated from each
+ * passage's free vibration, raw and compensated for the deck temperature,
+ * as a summary line (and one for the estimates amfid refused, from the
+ * meta table's natfreq.* counters) and, with --plot, natfreq.png
+ * (report_natfreq.c). Single-threaded; the store is read through store/
+ * only (amfi_store_f1_series, amfi_store_meta_get).
+ */
+#ifndef REPORT_NATFREQ_H
+#define REPORT_NATFREQ_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "store.h"
+
+/* The summary's lines into line (""when the store holds no f1): "natural
+ * f1 ..." and, when amfid recorded refusals, "  not estimated ...". 0, or
+ * −1 with the store's message in err. */
+int natfreq_summary(amfi_store *s, char *line, size_t len, char *err, size_t errlen);
+
+/* --plot: write dir/data/natfreq.dat (time, raw, compensated, damping) and
+ * append natfreq.png's commands to the gnuplot script gp (sub: the plots'
+ * subtitle). *made = 1 when the store holds an f1 (else nothing is written).
+ * 0, or −1 with a message in err. */
+int natfreq_plot(amfi_store *s, const char *dir, FILE *gp, const char *sub, int *made,
+                 char *err, size_t errlen);
+
+#endif /* REPORT_NATFREQ_H */
