@@ -143,11 +143,14 @@ void freevib_estimate(daemon_s *d, job *j)
     j->f1_r2 = best.r2;
 }
 
-/* The deck temperature at utime, or NaN. */
+/* The deck temperature at utime, or NaN; the readings received so far are
+ * stored first (the heartbeat's flush may be a second of wall time behind:
+ * many seconds of data in a fast replay). */
 static double deck_at(daemon_s *d, int64_t utime)
 {
     char err[256];
     double t = NAN;
+    environment_flush(d);
     if (amfi_store_deck_c_at(d->store, utime, DECK_MAX_GAP_US, &t, err, sizeof err) != 0) {
         set_error(d, "store: %s", err);
         return NAN;
@@ -182,7 +185,6 @@ void freevib_stored(daemon_s *d, const job *j)
     amfi_natfreq_model m;
     if (!carries(j) || !fv->comp || amfi_natfreq_comp_model(fv->comp, &m))
         return;
-    environment_flush(d); /* the readings received so far: as a restart will see them */
     const double t = deck_at(d, j->w.v.utime);
     if (!isfinite(t)) {
         fv->no_temperature++;
@@ -196,10 +198,14 @@ void freevib_stored(daemon_s *d, const job *j)
                  m.n, m.t_min_c, m.t_max_c, m.f_ref_hz, 100 * m.sd_rel, m.warm, m.frost);
 }
 
-/* The counters' names: natfreq.<name> in the meta table, and the log. */
-static void counters(const daemon_s *d, const char **name, long long *v, int *n)
+/* The counters and their names (natfreq.<name> in the meta table, and the
+ * log), "estimated" first: how many, or 0 when the feature is off. */
+#define N_COUNTERS (AMFI_NATFREQ_NREFUSALS + 3)
+static int counters(const daemon_s *d, const char **name, long long *v)
 {
     const freevib_state *fv = &d->fv;
+    if (!(d->cfg.daemon.natfreq_free_s > 0))
+        return 0;
     int k = 0;
     name[k] = "estimated", v[k++] = (long long)fv->estimated;
     name[k] = "no_free_vibration", v[k++] = (long long)fv->no_segment;
@@ -207,17 +213,14 @@ static void counters(const daemon_s *d, const char **name, long long *v, int *n)
         name[k] = amfi_natfreq_code_name(c), v[k++] = (long long)fv->refused[c];
     name[k] = "invalid", v[k++] = (long long)fv->refused[0];
     name[k] = "no_temperature", v[k++] = (long long)fv->no_temperature;
-    *n = k;
+    return k;
 }
 
 void freevib_record(daemon_s *d)
 {
-    if (!(d->cfg.daemon.natfreq_free_s > 0))
-        return;
-    const char *name[16];
-    long long v[16];
-    int n = 0;
-    counters(d, name, v, &n);
+    const char *name[N_COUNTERS];
+    long long v[N_COUNTERS];
+    const int n = counters(d, name, v);
     char key[64], val[32], err[256];
     for (int i = 0; i < n; i++) {
         snprintf(key, sizeof key, "natfreq.%s", name[i]);
@@ -231,16 +234,14 @@ void freevib_record(daemon_s *d)
 
 void freevib_final(daemon_s *d)
 {
-    if (!(d->cfg.daemon.natfreq_free_s > 0))
-        return;
-    const char *name[16];
-    long long v[16];
-    int n = 0;
-    counters(d, name, v, &n);
-    char line[512];
+    const char *name[N_COUNTERS];
+    long long v[N_COUNTERS];
+    const int n = counters(d, name, v);
+    char line[512] = "";
     size_t at = 0;
     for (int i = 1; i < n && at < sizeof line; i++)
         at += (size_t)snprintf(line + at, sizeof line - at, "%s%s %lld", i > 1 ? ", " : "",
                                name[i], v[i]);
-    LOG_INFO("natural frequency: %lld passages estimated; not: %s", v[0], line);
+    if (n > 0)
+        LOG_INFO("natural frequency: %lld passages estimated; not: %s", v[0], line);
 }

@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "amfi/amfi.h"
+#include "environment.h"
 #include "natfreq.h"
 #include "vbi.h"
 #include "vehicle.h"
@@ -260,15 +261,13 @@ static void simulated_bridge(void **state)
         }
 }
 
-/* The modulus factor E(T)/E(10 °C) of docs/simulator.md, written out again
- * here (−0.25 %/°C above 0, +2 %/°C below, flat below −10 °C). */
+/* The simulator's modulus factor E(T)/E(10 °C) (docs/simulator.md): the law
+ * the compensation must undo. */
 static double modulus(double t)
 {
-    if (t >= 0)
-        return 1.0 - 0.0025 * (t - 10.0);
-    if (t < -10)
-        t = -10;
-    return 1.025 * (1.0 - 0.02 * t);
+    amfi_env_params p;
+    amfi_env_params_site(&p);
+    return amfi_env_modulus_factor(&p, t);
 }
 
 /* Temperature compensation: f1 = 5.7338 · sqrt(E(T)/E(10)) with 0.1 %
