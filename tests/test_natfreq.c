@@ -68,7 +68,7 @@ static void exact_signal(void **state)
     assert_string_equal(r.reason, "");
 }
 
-/* 100 seeds at each noise level (2 s at 1000 Hz, zeta 3 %, random phase):
+/* 40 seeds at each noise level (2 s at 1000 Hz, zeta 3 %, random phase):
  * the fit's RMS relative error of f1 against the periodogram peak's; the
  * fit must be within the bounds measured (with margin) and better than the
  * peak, and its stated standard error must match its actual error. */
@@ -86,7 +86,7 @@ static void accuracy_vs_noise(void **state)
     double x[2000];
     for (size_t l = 0; l < sizeof noise / sizeof *noise; l++) {
         double e_fit = 0, e_peak = 0, e_z = 0, se_ratio = 0;
-        const int N = 100;
+        const int N = 40;
         for (int s = 0; s < N; s++) {
             const double f = 5.73 * (1 + 0.05 * (gsl_rng_uniform(rng) - 0.5)), z = 0.03,
                          a = 0.02, ph = TWO_PI * gsl_rng_uniform(rng);
