@@ -333,6 +333,8 @@ void scaleind_destroy(daemon_s *d);
 /* The compensation, its baseline refilled from the store (free_s > 0). */
 void freevib_start(daemon_s *d);
 void freevib_stop(daemon_s *d);
+/* SIGHUP: a changed daemon.natural_frequency is reported (applies at the next start). */
+void freevib_reload(daemon_s *d, const amfi_site_config *n);
 /* At release: the window's free vibration into j->f1_* (NaN: none). */
 void freevib_estimate(daemon_s *d, job *j);
 /* A row's f1 columns (the event's vehicle that left last carries them). */

@@ -220,6 +220,7 @@ void reload(daemon_s *d)
         LOG_WARN("reload: indicator settings take effect at the next start");
     drift_reload(d, &n);
     scaleind_reload(d, &n);
+    freevib_reload(d, &n);
     LOG_INFO("reload: configuration %s applied", d->config_path);
 }
 

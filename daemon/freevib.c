@@ -73,6 +73,17 @@ void freevib_start(daemon_s *d)
                  d->cfg.daemon.natfreq_baseline_n);
 }
 
+void freevib_reload(daemon_s *d, const amfi_site_config *n)
+{
+    const amfi_daemon_config *a = &d->cfg.daemon, *b = &n->daemon;
+    const amfi_natfreq_params *p = &a->natfreq, *q = &b->natfreq;
+    if (a->natfreq_free_s != b->natfreq_free_s || a->natfreq_baseline_n != b->natfreq_baseline_n ||
+        p->f_lo_hz != q->f_lo_hz || p->f_hi_hz != q->f_hi_hz || p->n_modes != q->n_modes ||
+        p->min_periods != q->min_periods || p->min_r2 != q->min_r2 ||
+        p->max_zeta != q->max_zeta || p->max_se_frac != q->max_se_frac)
+        LOG_WARN("reload: daemon.natural_frequency takes effect at the next start");
+}
+
 void freevib_stop(daemon_s *d)
 {
     amfi_natfreq_comp_destroy(d->fv.comp);

@@ -9,7 +9,8 @@
 # temperature (5.7338 Hz · sqrt(E(T)/E(10 °C)), docs/simulator.md), a damping
 # ratio near the model's 3 %, and the compensated f1 once the baseline is
 # fitted; passage_t carries both. A restart refits the same baseline from
-# the store. Then 4 vehicles 1.5 s apart: a free vibration cut at the next
+# the store; a reload says a changed free_s waits for the next start. Then
+# 4 vehicles 1.5 s apart: a free vibration cut at the next
 # entry (0.5 s, under 4 periods) is refused, stored NULL, counted by reason
 # in the log and the meta table.
 # Usage: daemon_natfreq.sh AMFID SIM_PUBLISHER LCM_PASSAGES CONFIG
@@ -88,6 +89,13 @@ pub=$(awk '$4 != "nan" && $4 != "-nan" { n++ } END { print n + 0 }' "$dir/publis
 start_amfid
 grep -q "natural frequency: baseline from the store: 10 estimates, f1 $base Hz" "$dir/amfid.log" ||
   fail "restart: $(grep 'natural frequency' "$dir/amfid.log")"
+# a reload reports a changed free_s, which applies at the next start
+sed -i 's/^    free_s: 2 .*/    free_s: 3/' "$dir/amfid.yaml"
+kill -HUP $apid
+i=0; until grep -q "reload: configuration .* applied" "$dir/amfid.log"; do
+  i=$((i + 1)); [ $i -lt 200 ] || fail "no reload"; sleep 0.05; done
+grep -q "reload: daemon.natural_frequency takes effect at the next start" "$dir/amfid.log" ||
+  fail "reload: $(grep reload "$dir/amfid.log")"
 # 3. vehicles 1.5 s apart: 0.5 s of free vibration each, refused as short
 timeout 120 "$sim" --vehicles 4 --headway 1.5 --speedup 20 --seed 6 --dt 2.5e-4 \
   --start-utime 1767312000000000 2> "$dir/sim2.log" || fail "sim_publisher exited $?"
