@@ -314,11 +314,15 @@ if ok summary-csv-values --db "$ex" --summary --format csv; then
     has '^passages,40$'
     has '^passages_gap,4$'
     has '^baseline_n,30$'
+    has '^f1_n,36$'
+    has '^f1_comp_n,18$'
+    has '^f1_comp_mean_hz,5\.721111$'
 fi
 if ok all-json --db "$ex" --summary --trend --alerts --errors --histogram --format json; then
     [ -z "$jcheck" ] || "$jcheck" site_id=fixture-1 < "$tmp/out" || problem "JSON does not parse"
     for k in summary trend alerts errors histogram; do has "\"$k\":"; done
     has '"by_status":\{"ok":36,"gap":4,'
+    has '"natural_frequency":\{"n":36,"mean_hz":5\.7[0-9]*,"sd_hz":0\.0[0-9]*,"compensated_n":18,"compensated_mean_hz":5\.72111'
     has '"ok_matched":36,'
 fi
 # --passages in JSON is streamed as the document's last key, after the others
@@ -330,6 +334,7 @@ if ok passages-json-mixed --db "$ex" --summary --overloads --passages --format j
     n=$(grep -o '"passage_id":' "$tmp/out" | wc -l)
     [ "$n" -eq "$want" ] || problem "$n passage objects, expected $want (gap passages + overloads at the 96/53/EC defaults)"
     has '"by_status":\{"ok":36,"gap":4,'
+    has '"natural_frequency":\{"n":36,"mean_hz":5\.7[0-9]*,"sd_hz":0\.0[0-9]*,"compensated_n":18,"compensated_mean_hz":5\.72111'
     has ',"passages":\[\{"time_utc":"2025-11-22T10:00:00Z",.*"reason":"12 samples missing in the window","speed_given_mps":25\.0,"speed_estimated":false,"n_vehicles":1,"quality":null\}.*\]\}$'
 fi
 if ok passages-json-none --db "$ex" --passages --format json --lane 7; then

@@ -9,6 +9,7 @@
  */
 #define _GNU_SOURCE
 #include "report_export.h"
+#include "report_natfreq.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -236,10 +237,11 @@ int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, siz
     double *g = NULL;
     size_t ng = 0;
     report_intake in;
+    natfreq_stats nf;
     if (amfi_store_passage_summary(s, &sum, err, errlen) ||
         amfi_store_all_ok_gvw(s, &g, &ng, err, errlen) ||
         amfi_store_get_baseline(s, &b, &found, err, errlen) ||
-        export_read_intake(s, &in, err, errlen)) {
+        export_read_intake(s, &in, err, errlen) || natfreq_read_stats(s, &nf, err, errlen)) {
         free(g);
         return -1;
     }
@@ -272,6 +274,12 @@ int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, siz
                        "intake_messages_refused,%lld\nintake_datagrams_dropped,%lld\n"
                        "intake_samples_missing,%lld\nintake_passages_lost,%lld\n",
                     in.run, in.as_of, in.received, in.refused, in.dropped, in.missing, in.lost);
+        fprintf(f, "f1_n,%zu\n", nf.n);
+        fprintf(f, "f1_mean_hz,"), csv_num(f, nf.mean_hz, "%.6f"), fputc('\n', f);
+        fprintf(f, "f1_sd_hz,"), csv_num(f, nf.sd_hz, "%.6f"), fputc('\n', f);
+        fprintf(f, "f1_comp_n,%zu\n", nf.n_comp);
+        fprintf(f, "f1_comp_mean_hz,"), csv_num(f, nf.comp_mean_hz, "%.6f"), fputc('\n', f);
+        fprintf(f, "f1_comp_sd_hz,"), csv_num(f, nf.comp_sd_hz, "%.6f"), fputc('\n', f);
         return 0;
     }
     json_t *o = json_object(), *st = json_object();
@@ -312,6 +320,14 @@ int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, siz
     } else {
         json_object_set_new(o, "intake", json_null());
     }
+    json_t *nfo = json_object();
+    json_object_set_new(nfo, "n", json_integer((json_int_t)nf.n));
+    json_object_set_new(nfo, "mean_hz", amfi_json_num(nf.mean_hz));
+    json_object_set_new(nfo, "sd_hz", amfi_json_num(nf.sd_hz));
+    json_object_set_new(nfo, "compensated_n", json_integer((json_int_t)nf.n_comp));
+    json_object_set_new(nfo, "compensated_mean_hz", amfi_json_num(nf.comp_mean_hz));
+    json_object_set_new(nfo, "compensated_sd_hz", amfi_json_num(nf.comp_sd_hz));
+    json_object_set_new(o, "natural_frequency", nfo);
     json_object_set_new(root, "summary", o);
     return 0;
 }

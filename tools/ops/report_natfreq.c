@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* mean and SD (n − 1) of the finite values of x[k].field, via a getter */
+/* n, mean and SD (n − 1) of the finite raw (comp 0) or compensated f1 */
 static void stats(const amfi_f1_rec *a, size_t n, int comp, size_t *m, double *mean, double *sd)
 {
     double s1 = 0, s2 = 0;
@@ -26,6 +26,18 @@ static void stats(const amfi_f1_rec *a, size_t n, int comp, size_t *m, double *m
     *m = k;
     *mean = k ? s1 / k : NAN;
     *sd = k > 1 ? sqrt(fmax(0.0, (s2 - k * (*mean) * (*mean)) / (k - 1))) : NAN;
+}
+
+int natfreq_read_stats(amfi_store *s, natfreq_stats *st, char *err, size_t errlen)
+{
+    amfi_f1_rec *a = NULL;
+    size_t n = 0;
+    if (amfi_store_f1_series(s, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err, errlen) != 0)
+        return -1;
+    stats(a, n, 0, &st->n, &st->mean_hz, &st->sd_hz);
+    stats(a, n, 1, &st->n_comp, &st->comp_mean_hz, &st->comp_sd_hz);
+    free(a);
+    return 0;
 }
 
 int natfreq_summary(amfi_store *s, char *line, size_t len, char *err, size_t errlen)
