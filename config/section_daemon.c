@@ -122,6 +122,15 @@ int daemon_check(ctx *x, amfi_site_config *c)
                     "the ring before it ends",
                     c->daemon.max_event_s, c->daemon.ring_s);
 
+    /* and the free vibration after it (the natural frequency) */
+    if (c->daemon.max_event_s + c->daemon.natfreq_free_s >= c->daemon.ring_s)
+        return fail(x,
+                    first_noted(x, "daemon.natural_frequency.free_s", "daemon.ring_s", "daemon"),
+                    "daemon.natural_frequency.free_s",
+                    "%g s after an event of up to daemon.max_event_s (%g s) is not below "
+                    "daemon.ring_s (%g s): the free vibration would leave the ring first",
+                    c->daemon.natfreq_free_s, c->daemon.max_event_s, c->daemon.ring_s);
+
     /* the band's two ends (each key's own range is the table's) */
     if (amfi_natfreq_params_check(&c->daemon.natfreq, why, sizeof why) != 0)
         return fail(x,
