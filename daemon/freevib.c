@@ -40,10 +40,10 @@ void freevib_start(daemon_s *d)
     memset(fv, 0, sizeof *fv);
     if (!(d->cfg.daemon.natfreq_free_s > 0))
         return;
-    amfi_scale_params tp;
-    amfi_scale_params_default(&tp);
-    if (amfi_natfreq_comp_create(&tp, d->cfg.daemon.natfreq_baseline_n, &fv->comp, err,
-                                 sizeof err) != 0) {
+    /* the site's temperature model: alerts.scale's knee, floor, calibration
+     * temperature and prior slopes (halved and turned for f1 by natfreq.c) */
+    if (amfi_natfreq_comp_create(&d->cfg.daemon.scale, d->cfg.daemon.natfreq_baseline_n,
+                                 &fv->comp, err, sizeof err) != 0) {
         LOG_WARN("natural frequency: %s: not compensated for temperature", err);
         return;
     }
