@@ -13,7 +13,8 @@
  * event of several vehicles, the vehicle that leaves last carries it.
  *
  * The deck temperature is the store's (amfi_store_deck_c_at) at the
- * passage's time, the readings received so far flushed first. The
+ * passage's time (readings up to alerts.scale.max_temp_gap_s apart, as for
+ * the scale indicator), the readings received so far flushed first. The
  * baseline is the first daemon.natural_frequency.baseline_n estimates with
  * a temperature; after a restart it is read back from the store (the same
  * estimates; a temperature interpolated then where only the reading before
@@ -29,9 +30,13 @@
 
 #include "amfid.h"
 
-/* Readings at most this far apart are interpolated for a passage's deck
- * temperature (amfi_store_deck_c_at), µs of data time. */
-#define DECK_MAX_GAP_US INT64_C(7200000000)
+/* Readings at most alerts.scale.max_temp_gap_s apart are interpolated for a
+ * passage's deck temperature (amfi_store_deck_c_at), as for the scale
+ * indicator's; µs of data time. */
+static int64_t deck_gap_us(const daemon_s *d)
+{
+    return (int64_t)llround(1e6 * d->cfg.daemon.scale_max_temp_gap_s);
+}
 
 void freevib_start(daemon_s *d)
 {
@@ -56,7 +61,7 @@ void freevib_start(daemon_s *d)
     int used = 0, fitted = 0;
     for (size_t k = 0; k < n && !fitted; k++) {
         double t = NAN;
-        if (amfi_store_deck_c_at(d->store, a[k].utime, DECK_MAX_GAP_US, &t, err, sizeof err) ||
+        if (amfi_store_deck_c_at(d->store, a[k].utime, deck_gap_us(d), &t, err, sizeof err) ||
             !isfinite(t))
             continue;
         used++;
@@ -162,7 +167,7 @@ static double deck_at(daemon_s *d, int64_t utime)
     char err[256];
     double t = NAN;
     environment_flush(d);
-    if (amfi_store_deck_c_at(d->store, utime, DECK_MAX_GAP_US, &t, err, sizeof err) != 0) {
+    if (amfi_store_deck_c_at(d->store, utime, deck_gap_us(d), &t, err, sizeof err) != 0) {
         set_error(d, "store: %s", err);
         return NAN;
     }
