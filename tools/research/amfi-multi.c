@@ -2,12 +2,17 @@
 /*
  * amfi-multi: the joint solve of two vehicles on the span, measured (issue 13).
  *
- *   amfi-multi [--events N] [--seed S] [--noise FRACTION] [--config FILE.yaml]
+ *   amfi-multi [--events N] [--seed S] [--noise FRACTION] [--min-headway S]
+ *              [--config FILE.yaml]
  *
  * Each event: two half-cars (GVW 10..40 t, front axle share 0.35..0.6,
  * spacing 3.5..6 m, Table 2 properties drawn) on one lane at the same speed
  * (20..30 m/s), the second entering while the first is on the span (delay
- * uniform from 0.15 s to the first's time on the span), simulated together
+ * between the front axles uniform from --min-headway, default 0.5 s as
+ * sim_publisher's simulation.stream.min_headway_s, to the first's time on
+ * the span; round one drew it from 0.15 s, which puts the follower's front
+ * axle on or ahead of the leader's rear axle: vehicles that overlap),
+ * simulated together
  * in the coupled vehicle-bridge model (sim_publisher/vbi.c) over an ISO 8608
  * class A road, recorded at the quarter, mid and three-quarter points. Each
  * event is solved jointly (amfi_solve_multi, speeds and spacings exact) from
@@ -16,7 +21,11 @@
  * Truth: each vehicle's mean contact forces while its axles are on the span.
  *
  * stdout: one CSV row per vehicle and condition (sensors, noise, event,
- * vehicle, delay_s, truth_kg, gvw_kg, err, quality), then '#' lines with the
+ * vehicle, delay_s, truth_kg, gvw_kg, err, quality, then the geometry:
+ * speed, the vehicle's axle spacing, the gap from the leader's rear axle to
+ * the follower's front axle, the vehicle's time on the span and the share of
+ * it the other is on the span too, and truth and inferred per axle), then
+ * '#' lines with the
  * summary per condition: mean abs and worst error per vehicle and of the
  * pair's sum, and how many of the largest errors (top decile) fall in the
  * worst decile by quality.
@@ -42,10 +51,12 @@
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: " PROG " [--events N] [--seed S] [--noise FRACTION] [--config FILE]\n"
+    fprintf(f, "usage: " PROG " [--events N] [--seed S] [--noise FRACTION] [--min-headway S]\n"
+               "       [--config FILE]\n"
                "  -n, --events N      events (vehicle pairs), 10 .. 100000 (default 100)\n"
                "  -s, --seed S        random seed (default 1)\n"
                "  -z, --noise F       noise std as a fraction of the record's RMS (0.02)\n"
+               "  -m, --min-headway S least delay between the front axles, s, 0.05 .. 5 (0.5)\n"
                "  -c, --config FILE   site configuration (default paper-20m.yaml)\n"
                "  -h, --help          this help\n"
                "  -V, --version       print the version\n");
@@ -58,7 +69,7 @@ static void die(const char *what, const char *err)
 }
 
 typedef struct row {
-    double err, q;
+    double err, q, gap;
 } row;
 
 static int by_abs_err(const void *a, const void *b)
@@ -85,6 +96,20 @@ static void summary(const char *cond, row *v, int n, const double *sum, int ns)
         sa += fabs(sum[i]);
         sx = fmax(sx, fabs(sum[i]));
     }
+    /* by the gap between the vehicles' nearest axles: under 3 m two trucks'
+     * overhangs would overlap */
+    int nc[2] = {0, 0};
+    double mc[2] = {0, 0}, xc[2] = {0, 0};
+    for (int i = 0; i < n; i++) {
+        int k = v[i].gap >= 3.0;
+        nc[k]++;
+        mc[k] += fabs(v[i].err);
+        xc[k] = fmax(xc[k], fabs(v[i].err));
+    }
+    for (int k = 0; k < 2; k++)
+        if (nc[k])
+            printf("# %s: gap %s 3 m: %d vehicles, mean abs %.2f %%, worst %.2f %%\n", cond,
+                   k ? ">=" : "<", nc[k], 100 * mc[k] / nc[k], 100 * xc[k]);
     /* the largest errors (top decile) against the worst decile by quality */
     int d = n / 10 > 0 ? n / 10 : 1;
     qsort(v, n, sizeof *v, by_abs_err);
@@ -104,11 +129,12 @@ int main(int argc, char **argv)
     static const struct option longopts[] = {{"events", required_argument, NULL, 'n'},
                                               {"seed", required_argument, NULL, 's'},
                                               {"noise", required_argument, NULL, 'z'},
+                                              {"min-headway", required_argument, NULL, 'm'},
                                               {"config", required_argument, NULL, 'c'},
                                               AMFI_CLI_END};
     int n_events = 100;
     unsigned long seed = 1;
-    double noise = 0.02;
+    double noise = 0.02, min_headway = 0.5;
     const char *config = NULL;
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -133,6 +159,13 @@ int main(int argc, char **argv)
                 return 2;
             }
             noise = x;
+            break;
+        case 'm':
+            if (!(x >= 0.05 && x <= 5)) {
+                amfi_cli_error(PROG, c.opt, "must be 0.05 .. 5");
+                return 2;
+            }
+            min_headway = x;
             break;
         case 'c': config = optarg; break;
         }
@@ -198,7 +231,8 @@ int main(int argc, char **argv)
     }
     if (!acc || !noisy)
         die("memory", "out of memory");
-    printf("sensors,noise,event,vehicle,delay_s,truth_kg,gvw_kg,err,quality\n");
+    printf("sensors,noise,event,vehicle,delay_s,truth_kg,gvw_kg,err,quality,speed_mps,"
+           "spacing_m,gap_m,on_span_s,shared,truth_axle1_kg,truth_axle2_kg,axle1_kg,axle2_kg\n");
     for (int e = 0; e < n_events; e++) {
         amfi_sim *sim;
         if (amfi_sim_create(bridge, prof, &sp, &sim, err, sizeof err))
@@ -220,7 +254,9 @@ int main(int argc, char **argv)
             veh[i].track = track;
         }
         double on1 = (L + spacing[0]) / v;
-        double delay = gsl_ran_flat(rng, 0.15, on1);
+        if (min_headway >= on1)
+            die("--min-headway", "longer than a vehicle's time on the span");
+        double delay = gsl_ran_flat(rng, min_headway, on1);
         entry[0] = sp.approach_m / v + 0.5;
         entry[1] = entry[0] + delay;
         for (int i = 0; i < 2; i++) {
@@ -234,14 +270,18 @@ int main(int argc, char **argv)
             die("simulation", "record longer than the buffer");
         if (amfi_sim_advance(sim, n, acc, err, sizeof err))
             die("simulation", err);
-        double truth[2] = {NAN, NAN};
+        double truth[2] = {NAN, NAN}, truth_ax[2][2];
         double scratch[AMFI_MAX_SENSORS];
         for (int guard = 0; guard < 100000 && amfi_sim_busy(sim); guard++)
             if (amfi_sim_advance(sim, 1, scratch, err, sizeof err))
                 die("simulation", err);
         amfi_sim_vehicle d;
         while (amfi_sim_pop_done(sim, &d))
+        {
             truth[d.id] = (d.mean_force_N[0] + d.mean_force_N[1]) / AMFI_GRAVITY;
+            truth_ax[d.id][0] = d.mean_force_N[0] / AMFI_GRAVITY;
+            truth_ax[d.id][1] = d.mean_force_N[1] / AMFI_GRAVITY;
+        }
         amfi_sim_destroy(sim);
         if (!isfinite(truth[0]) || !isfinite(truth[1]))
             die("simulation", "a vehicle did not leave");
@@ -274,12 +314,21 @@ int main(int argc, char **argv)
                 if (amfi_solve_multi(solver[k], &mp, &lam, &r, err, sizeof err))
                     die("solve", err);
                 int cond = 2 * k + z;
+                /* geometry: gap from the leader's rear axle to the follower's
+                 * front axle (same speed: constant), each vehicle's time on
+                 * the span and the share of it the other one is on too */
+                double gap = v * delay - spacing[0];
+                double on[2] = {(L + spacing[0]) / v, (L + spacing[1]) / v};
+                double both = fmin(entry[0] + on[0], entry[1] + on[1]) - entry[1];
                 for (int i = 0; i < 2; i++) {
                     double ev = r.vehicle[i].gvw_kg / truth[i] - 1.0;
-                    rows[cond][2 * e + i] = (row){ev, r.vehicle[i].quality};
-                    printf("%d,%g,%d,%d,%.4f,%.1f,%.1f,%.6f,%.4f\n", k ? 3 : 1, z ? noise : 0.0,
-                           e, i + 1, delay, truth[i], r.vehicle[i].gvw_kg, ev,
-                           r.vehicle[i].quality);
+                    rows[cond][2 * e + i] = (row){ev, r.vehicle[i].quality, gap};
+                    printf("%d,%g,%d,%d,%.4f,%.1f,%.1f,%.6f,%.4f,%.2f,%.3f,%.3f,%.4f,%.3f,%.1f,%.1f,"
+                           "%.1f,%.1f\n",
+                           k ? 3 : 1, z ? noise : 0.0, e, i + 1, delay, truth[i],
+                           r.vehicle[i].gvw_kg, ev, r.vehicle[i].quality, v, spacing[i], gap,
+                           on[i], both / on[i], truth_ax[i][0], truth_ax[i][1],
+                           r.vehicle[i].axle_kg[0], r.vehicle[i].axle_kg[1]);
                 }
                 sums[cond][e] = r.total_gvw_kg / (truth[0] + truth[1]) - 1.0;
             }
