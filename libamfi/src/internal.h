@@ -7,7 +7,7 @@
  * reads the library with nm, fails on a cycle and fails when this list
  * differs from the code:
  *   speed.c -> solver.c status.c sweep.c
- *   multi.c -> bridge.c dense.c discretise.c solver.c status.c
+ *   multi.c -> bridge.c dense.c discretise.c solver.c status.c sweep.c
  *   solver.c -> bridge.c discretise.c lcurve.c status.c sweep.c sweep_modal.c sweep_nodal.c
  *   lcurve.c -> sweep.c
  *   sweep.c -> sweep_modal.c sweep_nodal.c

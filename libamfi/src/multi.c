@@ -3,8 +3,11 @@
  * multi.c: several vehicles on the span solved together (issue 13). Every
  * vehicle's axles move at its own speed from its own entry time; all axles go
  * into one sweep (solver.c's amfi_solve_window/_lambda/_end), then each vehicle's GVW comes
- * from its own axles' mean forces, with a quality figure from the normal
- * matrix of a constant-axle-load model (see amfi_vehicle_result in amfi.h).
+ * from its own axles' mean forces, with a quality figure from a second sweep
+ * at a tenth of λ (how far the weight moves when the regularisation that
+ * decides the load split between close axles is loosened) and a
+ * separability figure from the normal matrix of a constant-axle-load model
+ * (see amfi_vehicle_result in amfi.h).
  * Pure computation; runs on the caller's thread and uses the solver handle's
  * workspace (grown here, before any time loop) plus per-call scratch for the
  * quality figure.
@@ -100,6 +103,29 @@ static int normal_matrix(const struct amfi_solver *s, double *A)
     return AMFI_OK;
 }
 
+/* Each vehicle's GVW, kg, from the sweep's forces in s->force: the sum of
+ * its axles' mean forces while on the span (as amfi_solve_end). */
+static void vehicle_gvw(const struct amfi_solver *s, const amfi_multi_passage *p, double *gvw)
+{
+    const double L = s->b->p.span_m;
+    int i = 0;
+    for (int v = 0; v < p->n_vehicles; v++) {
+        gvw[v] = 0.0;
+        for (int a = 0; a < p->vehicle[v].n_axles; a++, i++) {
+            double sum = 0.0;
+            int cnt = 0;
+            for (int j = 0; j <= s->N; j++) {
+                double x = axle_x(s, i, j);
+                if (x >= 0.0 && x <= L) {
+                    sum += s->force[(size_t)j * s->na + i];
+                    cnt++;
+                }
+            }
+            gvw[v] += cnt ? sum / cnt / AMFI_GRAVITY : NAN;
+        }
+    }
+}
+
 /* uᵀ M⁻¹ u for the SPD block M (k × k) of A at rows/cols first..first+k−1 (or
  * all of A when k == na), u = ones. */
 static int quad_inverse(const double *A, int na, int first, int k, double *out)
@@ -187,8 +213,20 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
     double lam_h;
     int n_solves = 0;
     if ((rc = amfi_solve_window(s, &samples, na, win.start_s, win.end_s, err, errlen)) != 0 ||
-        (rc = amfi_solve_lambda(s, lam, &lam_h, &n_solves, err, errlen)) != 0 ||
-        (rc = amfi_solve_end(s, lam, lam_h, n_solves, &res->all, err, errlen)) != 0)
+        (rc = amfi_solve_lambda(s, lam, &lam_h, &n_solves, err, errlen)) != 0)
+        return rc;
+    /* quality: the sweep at λ·AMFI_MULTI_QUALITY_LAMBDA first (solve_end's
+     * sweep then leaves the answer in the workspace); one vehicle alone has
+     * nothing to trade load with and needs no second sweep */
+    double loose[AMFI_MAX_VEHICLES];
+    if (p->n_vehicles > 1) {
+        double rn, sn;
+        if ((rc = amfi_sweep(s, lam_h * AMFI_MULTI_QUALITY_LAMBDA, &rn, &sn)) != 0)
+            return amfi_fail(err, errlen, rc, "quality sweep failed: %s", amfi_strerror(rc));
+        n_solves++;
+        vehicle_gvw(s, p, loose);
+    }
+    if ((rc = amfi_solve_end(s, lam, lam_h, n_solves, &res->all, err, errlen)) != 0)
         return rc;
     REQ(isfinite(res->all.gvw_kg), AMFI_ENUM, "the joint solution is not finite");
 
@@ -242,8 +280,17 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
             return amfi_fail(err, errlen, rc, "quality of vehicle %d: %s", v + 1,
                              amfi_strerror(rc));
         }
-        vr->quality = sqrt(joint / alone);
+        vr->separability = sqrt(joint / alone);
         vr->gvw_sd_kg = res->all.residual_rms * sqrt(joint) / AMFI_GRAVITY;
+        vr->quality = 1.0;
+        if (p->n_vehicles > 1) {
+            vr->quality = 1.0 + 100.0 * fabs(loose[v] - vr->gvw_kg) / fabs(vr->gvw_kg);
+            if (!isfinite(vr->quality)) {
+                free(U), free(A);
+                return amfi_fail(err, errlen, AMFI_ENUM, "quality of vehicle %d is not finite",
+                                 v + 1);
+            }
+        }
         i += vr->n_axles;
     }
     free(U), free(A);

@@ -400,6 +400,9 @@ double amfi_speed_dip_at(const amfi_speed_prior *p, const double *j, int n, int 
 
 #define AMFI_MAX_VEHICLES 8
 
+/* The factor on λ of amfi_solve_multi's second sweep (quality figure). */
+#define AMFI_MULTI_QUALITY_LAMBDA 0.1
+
 /* One vehicle of an event: its first axle reaches x = 0 at entry_s, on the
  * samples' clock (the one of amfi_multi_passage.t_first_s). */
 typedef struct amfi_vehicle {
@@ -425,17 +428,28 @@ typedef struct amfi_vehicle_result {
     int n_axles;
     double axle_kg[AMFI_MAX_AXLES]; /* mean force of its own axles on the span / g */
     double gvw_kg;
-    /* Separability of this vehicle's weight from the others': with constant
-     * axle loads as the model, A = Σ_j Gᵀ W G the normal matrix of all axles
-     * (G the sensors' response to unit loads moving with the axles) and u the
-     * vehicle's axle indicator, quality = sqrt(uᵀA⁻¹u / uᵀ(A_vv)⁻¹u): the
-     * factor by which the other vehicles inflate the standard deviation of
-     * this vehicle's weight. 1 = alone or fully separable; large = its axles
-     * trade load with another vehicle's (close axles, one sensor). */
+    /* How well this vehicle's weight is determined in the event: 1 + the
+     * change of gvw_kg, in % of it, when the event is solved again at λ ×
+     * AMFI_MULTI_QUALITY_LAMBDA. Load that close axles of different vehicles
+     * trade is decided by the regularisation, so a weight that moves with λ
+     * is one the data do not fix (docs/results/multi-vehicle.md: the worst
+     * tenth by this figure holds most of the largest errors). 1 exactly for
+     * a vehicle alone in its event (no second sweep then). */
     double quality;
     /* σ·sqrt(uᵀA⁻¹u)/g with σ the joint fit's residual RMS: the posterior
-     * standard deviation of the weight under that model, kg */
+     * standard deviation of the weight under the constant-axle-load model
+     * of separability, kg */
     double gvw_sd_kg;
+    /* Separability of this vehicle's weight from the others' (the quality
+     * figure before round four): with constant axle loads as the model,
+     * A = Σ_j Gᵀ W G the normal matrix of all axles (G the sensors' response
+     * to unit loads moving with the axles) and u the vehicle's axle
+     * indicator, sqrt(uᵀA⁻¹u / uᵀ(A_vv)⁻¹u): the factor by which the other
+     * vehicles inflate the standard deviation of this vehicle's weight.
+     * 1 = alone or fully separable; large = its axles nearly coincide with
+     * another vehicle's. It misses the trade of time-varying loads between
+     * axles a metre or two apart, hence quality above. */
+    double separability;
 } amfi_vehicle_result;
 
 typedef struct amfi_multi_result {
