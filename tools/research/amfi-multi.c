@@ -143,38 +143,12 @@ int main(int argc, char **argv)
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
     for (int k; (k = amfi_cli_next(&c)) != -1;) {
-        double x = 0.0;
-        if (k == 'a') {
-            alone = 1;
-            continue;
-        }
-        if (amfi_cli_double(optarg, &x) != 0 && k != 'c') {
-            amfi_cli_error(PROG, c.opt, "'%s' is not a number", amfi_cli_shown(optarg));
-            return 2;
-        }
         switch (k) {
-        case 'n':
-            if (!(x >= 10 && x <= 100000)) {
-                amfi_cli_error(PROG, c.opt, "must be 10 .. 100000");
-                return 2;
-            }
-            n_events = (int)x;
-            break;
-        case 's': seed = (unsigned long)fabs(x); break;
-        case 'z':
-            if (!(x >= 0 && x <= 1)) {
-                amfi_cli_error(PROG, c.opt, "must be 0 .. 1");
-                return 2;
-            }
-            noise = x;
-            break;
-        case 'm':
-            if (!(x >= 0.05 && x <= 5)) {
-                amfi_cli_error(PROG, c.opt, "must be 0.05 .. 5");
-                return 2;
-            }
-            min_headway = x;
-            break;
+        case 'a': alone = 1; break;
+        case 'n': n_events = (int)amfi_cli_integer(&c, optarg, 10, 100000); break;
+        case 's': seed = (unsigned long)amfi_cli_integer(&c, optarg, 0, 4294967295.0); break;
+        case 'z': noise = amfi_cli_num(&c, optarg, 0, 1); break;
+        case 'm': min_headway = amfi_cli_num(&c, optarg, 0.05, 5); break;
         case 'c': config = optarg; break;
         }
     }

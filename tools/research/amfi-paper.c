@@ -329,6 +329,21 @@ static int run_passage(const ctx *c, worker *w, const amfi_bridge *b, const amfi
     return 0;
 }
 
+/* The single-vehicle experiments' road: the default carpet, seed 1, long
+ * enough for the approach and the span. */
+static amfi_profile *carpet(const ctx *c)
+{
+    char err[256];
+    amfi_profile_params pp;
+    amfi_profile_params_default(&pp);
+    pp.seed = 1;
+    pp.length_m = c->sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + c->cfg.bridge.span_m + 100.0;
+    amfi_profile *prof;
+    if (amfi_profile_create(&pp, &prof, err, sizeof err))
+        die("profile: %s%s", err, "");
+    return prof;
+}
+
 /* ---- Table 5's preceding vehicle, solved jointly (issue 13) ----------- */
 
 typedef struct pj_stats {
@@ -357,13 +372,7 @@ static void preceding_joint(ctx *c)
     const int n = c->o.preceding_joint;
     const double L = c->cfg.bridge.span_m;
     char err[256];
-    amfi_profile_params pp;
-    amfi_profile_params_default(&pp);
-    pp.seed = 1;
-    pp.length_m = c->sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + L + 100.0;
-    amfi_profile *prof;
-    if (amfi_profile_create(&pp, &prof, err, sizeof err))
-        die("profile: %s%s", err, "");
+    amfi_profile *prof = carpet(c);
     worker w;
     if (worker_init(c, &w, c->cfg.solver.calc_rate_hz))
         die("worker%s%s", "", "");
@@ -927,13 +936,7 @@ static void single_vehicle(ctx *c)
 {
     const opts *o = &c->o;
     char err[256], path[4096];
-    amfi_profile_params pp;
-    amfi_profile_params_default(&pp);
-    pp.seed = 1;
-    pp.length_m = c->sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + c->cfg.bridge.span_m + 100.0;
-    amfi_profile *prof;
-    if (amfi_profile_create(&pp, &prof, err, sizeof err))
-        die("profile: %s%s", err, "");
+    amfi_profile *prof = carpet(c);
     worker w;
     if (worker_init(c, &w, c->cfg.solver.calc_rate_hz))
         die("worker%s%s", "", "");
