@@ -1,15 +1,67 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * dense.c: the small dense linear-algebra helpers of the sweeps (dense.h):
- * an SPD inverse and a ridged SPD solve, both on LAPACK's Cholesky.
+ * an SPD inverse (LAPACK's symmetric factorisation, Cholesky above 24 × 24)
+ * and a ridged SPD solve (LAPACK's Cholesky).
  * Pure functions of their arguments; no allocation.
  */
+#include <string.h>
+
 #include <lapacke.h>
 
 #include "dense.h"
 
+/* 1 if the Bunch-Kaufman factor's D (dsytrf, lower, column-major) is
+ * positive definite: by Sylvester's law of inertia, so is the matrix. */
+static int bk_positive(int n, const double *F, const lapack_int *ipiv)
+{
+    for (int k = 0; k < n;) {
+        double d11 = F[k * n + k];
+        if (ipiv[k] > 0) { /* 1 × 1 pivot */
+            if (!(d11 > 0.0))
+                return 0;
+            k++;
+        } else { /* 2 × 2 pivot in rows and columns k, k + 1 */
+            if (k + 1 >= n)
+                return 0;
+            double d21 = F[k * n + k + 1], d22 = F[(k + 1) * n + k + 1];
+            if (!(d11 > 0.0 && d22 > 0.0 && d11 * d22 - d21 * d21 > 0.0))
+                return 0;
+            k += 2;
+        }
+    }
+    return 1;
+}
+
 int amfi_spd_inverse(int na, double *A)
 {
+    /* Up to AMFI_DENSE_MAX: LAPACK's symmetric factorisation and solve
+     * (dsytrf, dsytrs) against the identity. They run on level-1/2 BLAS
+     * that OpenBLAS executes without a work buffer. OpenBLAS's own
+     * dpotrf/dpotri (the first version) take one from its global pool on
+     * every call, under a mutex all threads share: at a 2 × 2 matrix once
+     * per time step, with two solver threads, that lock cost amfid a third
+     * of its solve time (docs/solver.md, "Cost"). Positive definiteness is
+     * checked on the factor's D, as dpotrf's info would report it. */
+    if (na >= 1 && na <= AMFI_DENSE_MAX) {
+        double B[AMFI_DENSE_MAX * AMFI_DENSE_MAX], work[AMFI_DENSE_MAX];
+        lapack_int ipiv[AMFI_DENSE_MAX];
+        lapack_int info = LAPACKE_dsytrf_work(LAPACK_COL_MAJOR, 'L', na, A, na, ipiv, work, na);
+        if (info != 0)
+            return (int)(info > 0 ? info : -info);
+        if (!bk_positive(na, A, ipiv))
+            return 1;
+        memset(B, 0, sizeof(double) * (size_t)na * (size_t)na);
+        for (int i = 0; i < na; i++)
+            B[i * na + i] = 1.0;
+        info = LAPACKE_dsytrs_work(LAPACK_COL_MAJOR, 'L', na, na, A, na, ipiv, B, na);
+        if (info != 0)
+            return (int)(info > 0 ? info : -info);
+        for (int j = 0; j < na; j++) /* the lower triangle, mirrored */
+            for (int i = j; i < na; i++)
+                A[j * na + i] = A[i * na + j] = B[j * na + i];
+        return 0;
+    }
     lapack_int info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', na, A, na);
     if (info == 0)
         info = LAPACKE_dpotri_work(LAPACK_COL_MAJOR, 'L', na, A, na);

@@ -6,9 +6,14 @@
 #ifndef AMFI_DENSE_H
 #define AMFI_DENSE_H
 
-/* A ← A⁻¹ for a small SPD matrix (column-major, na ≤ 12): LAPACK dpotrf +
- * dpotri, the lower triangle mirrored to the upper. No allocation. Returns 0
- * or the LAPACK info. */
+/* Largest matrix amfi_spd_inverse inverts with its work on the stack. */
+#define AMFI_DENSE_MAX 24
+
+/* A ← A⁻¹ for a small symmetric positive definite matrix (column-major):
+ * LAPACK dsytrf + dsytrs against the identity (na ≤ AMFI_DENSE_MAX; larger:
+ * dpotrf + dpotri), symmetric to the last bit. No allocation, no OpenBLAS
+ * work buffer. Returns 0, or > 0 when A is not positive definite (or
+ * singular). */
 int amfi_spd_inverse(int na, double *A);
 
 /* Solve A x = b in place (b ← x) for a symmetric positive semi-definite A
