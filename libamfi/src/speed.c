@@ -38,9 +38,10 @@ void amfi_speed_prior_default(amfi_speed_prior *p)
     memset(p, 0, sizeof *p);
     p->rel_sd = 0.03;
     p->range_sd = 3.0;
-    p->grid_rel = 0.002;
+    p->grid_rel = 0.003;
     p->tol_rel = 2e-4;
-    p->brent_evals = 2;
+    p->brent_evals = 0;
+    p->local_half = 1;
     p->coarse_rate_hz = 1000.0;
     p->criterion = AMFI_SPEED_REGULARISED;
     p->pick = AMFI_SPEED_PICK_DIP;
@@ -99,6 +100,9 @@ int amfi_speed_prior_check(const amfi_speed_prior *p, double speed_mps, char *er
     if (p->brent_evals < 0 || p->brent_evals > 100)
         return amfi_fail(err, errlen, AMFI_EINVAL,
                          "speed prior: brent_evals %d must be 0..100", p->brent_evals);
+    if (p->local_half < 1 || p->local_half > 3)
+        return amfi_fail(err, errlen, AMFI_EINVAL,
+                         "speed prior: local_half %d must be 1..3", p->local_half);
     if (!(isfinite(p->coarse_rate_hz) &&
           (p->coarse_rate_hz == 0 || (p->coarse_rate_hz >= 100 && p->coarse_rate_hz <= 1e6))))
         return amfi_fail(err, errlen, AMFI_EINVAL,
@@ -298,6 +302,50 @@ static double *grid_buffer(struct amfi_solver *s, int n)
     return s->grid_f;
 }
 
+/* The local grid's pick among (lx, lf)[0 .. nl) (increasing speeds, d
+ * apart around x): the point deepest below the line through the others
+ * (pick dip: the full model's J has a trend here too, the coarse pick can
+ * sit 0.8 % from the dip, on the slope, so the smallest J may be an end),
+ * then the lower of it and its neighbours (the dip spans one or two
+ * points); the smallest J for pick min or when no point lies below. */
+static int local_pick(const amfi_speed_prior *pr, const double *lx, const double *lf, int nl,
+                      double x, double d)
+{
+    int kb = 0;
+    for (int k = 1; k < nl; k++)
+        if (lf[k] < lf[kb])
+            kb = k;
+    if (pr->pick == AMFI_SPEED_PICK_DIP && nl >= 4) {
+        double rmin = 0.0;
+        int kd = -1;
+        for (int k = 0; k < nl; k++) {
+            double sx = 0, sy = 0, sxx = 0, sxy = 0;
+            int m = 0;
+            for (int i = 0; i < nl; i++) {
+                if (i == k)
+                    continue;
+                double u = (lx[i] - x) / d;
+                sx += u, sy += lf[i], sxx += u * u, sxy += u * lf[i], m++;
+            }
+            double den = m * sxx - sx * sx;
+            if (!(den > 0))
+                continue;
+            double slope = (m * sxy - sx * sy) / den, icpt = (sy - slope * sx) / m;
+            double rk = lf[k] - (icpt + slope * (lx[k] - x) / d);
+            if (rk < rmin)
+                rmin = rk, kd = k;
+        }
+        if (kd >= 0) {
+            kb = kd;
+            if (kd > 0 && lf[kd - 1] < lf[kb])
+                kb = kd - 1;
+            if (kd < nl - 1 && lf[kd + 1] < lf[kb])
+                kb = kd + 1;
+        }
+    }
+    return kb;
+}
+
 /* The coarse model: the solver's bridge, sensors and policies at `rate` Hz
  * with the observable modes that rate resolves (modal). Kept with the
  * solver; rebuilt only when the rate changes. */
@@ -407,72 +455,71 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
             return SWEEP_FAILED(qc);
         edge = r.edge, dip = r.dip;
         /* 2. The full model on a local grid around the coarse pick: x + k·d,
-         * k = −3 .. 3, d = 1.5 grid steps (±0.9 %: on simulated traffic the
+         * k = −3 .. 3, d = 0.3 % of the given speed, whatever the coarse
+         * grid's step (±0.9 %: on simulated traffic the
          * coarse model's dip lies up to 0.8 % from the full model's,
          * docs/results/speed-estimation.md; the points are closer than the
          * dip's half-width to any speed between them); the pick is, as on
          * the coarse grid, the point deepest below the others' trend (pick
          * dip) or the smallest (pick min); then Brent between the pick's
          * neighbours. Its window is that of the slowest point. */
-        const double d = 1.5 * g;
+        const double d = 0.003 * v0;
         double wlo = r.x - 3.0 * d;
         if (wlo < lo)
             wlo = lo;
         if ((rc = amfi_solve_begin(s, ps, lam, wlo, err, errlen)) != 0)
             return rc;
         q.n_eff = n_eff_of(s, ps, pr);
+        /* k from −h .. h (h = local_half), widened one point at a time on
+         * the side where the pick sits at the end, up to ±3 */
         double lx[7], lf[7];
-        int nl = 0, kb = -1;
-        for (int k = -3; k <= 3 && !q.rc; k++) {
+        int nl = 0, k_first = 0, k_last = -1;
+        for (int k = -pr->local_half; k <= pr->local_half && !q.rc; k++) {
             double v = r.x + k * d;
             if (v < wlo - 1e-9 * v0 || v > hi + 1e-9 * v0)
                 continue;
+            if (nl == 0)
+                k_first = k;
+            k_last = k;
             lx[nl] = v, lf[nl] = objective(v, &q);
-            if (kb < 0 || lf[nl] < lf[kb])
-                kb = nl;
             nl++;
         }
         if (q.rc)
             return SWEEP_FAILED(q);
-        if (pr->pick == AMFI_SPEED_PICK_DIP && nl >= 4) {
-            /* the point deepest below the line through the others: the full
-             * model's J has a trend here too (the coarse pick can sit 0.8 %
-             * from the dip, on the slope), so the smallest J may be an end */
-            double rmin = 0.0;
-            int kd = -1;
-            for (int k = 0; k < nl; k++) {
-                double sx = 0, sy = 0, sxx = 0, sxy = 0;
-                int m = 0;
-                for (int i = 0; i < nl; i++) {
-                    if (i == k)
-                        continue;
-                    double u = (lx[i] - r.x) / d;
-                    sx += u, sy += lf[i], sxx += u * u, sxy += u * lf[i], m++;
-                }
-                double den = m * sxx - sx * sx;
-                if (!(den > 0))
-                    continue;
-                double slope = (m * sxy - sx * sy) / den, icpt = (sy - slope * sx) / m;
-                double rk = lf[k] - (icpt + slope * (lx[k] - r.x) / d);
-                if (rk < rmin)
-                    rmin = rk, kd = k;
+        if (nl < 1)
+            return amfi_fail(err, errlen, AMFI_EINVAL, "speed search: no local point in range");
+        int kb = local_pick(pr, lx, lf, nl, r.x, d);
+        for (;;) {
+            double v;
+            if (kb == 0 && k_first > -3 && (v = r.x + (k_first - 1) * d) >= wlo - 1e-9 * v0) {
+                memmove(lx + 1, lx, sizeof(double) * (size_t)nl);
+                memmove(lf + 1, lf, sizeof(double) * (size_t)nl);
+                lx[0] = v, lf[0] = objective(v, &q);
+                k_first--;
+            } else if (kb == nl - 1 && k_last < 3 &&
+                       (v = r.x + (k_last + 1) * d) <= hi + 1e-9 * v0) {
+                lx[nl] = v, lf[nl] = objective(v, &q);
+                k_last++;
+            } else {
+                break;
             }
-            if (kd >= 0) {
-                /* the dip spans one or two points: the lower of the pick and
-                 * its neighbours is the dip's bottom */
-                kb = kd;
-                if (kd > 0 && lf[kd - 1] < lf[kb])
-                    kb = kd - 1;
-                if (kd < nl - 1 && lf[kd + 1] < lf[kb])
-                    kb = kd + 1;
-            }
+            nl++;
+            if (q.rc)
+                return SWEEP_FAILED(q);
+            kb = local_pick(pr, lx, lf, nl, r.x, d);
         }
         best = lx[kb], fbest = lf[kb];
-        if (kb > 0 && kb < nl - 1) {
+        if (kb > 0 && kb < nl - 1 && pr->brent_evals > 0) {
             best = brent(&q, lx[kb - 1], lf[kb - 1], lx[kb], lf[kb], lx[kb + 1], lf[kb + 1],
                          &fbest);
             if (q.rc)
                 return SWEEP_FAILED(q);
+        } else if (kb > 0 && kb < nl - 1) {
+            /* brent_evals 0: the vertex of the parabola through the pick and
+             * its neighbours (equally spaced), no sweep; J there unknown */
+            double fa = lf[kb - 1], f0 = lf[kb], fb = lf[kb + 1], den = fa - 2.0 * f0 + fb;
+            if (den > 0.0 && f0 <= fa && f0 <= fb)
+                best = lx[kb] + 0.5 * d * (fa - fb) / den;
         }
         /* J at v0 and at the minimum, both on the model of the grid. */
         j_given = r.f0, j_best = r.f;

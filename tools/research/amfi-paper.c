@@ -84,6 +84,8 @@ typedef struct opts {
     double speed_dof;     /* its data_dof (0: the samples) */
     double speed_coarse;  /* its coarse_rate_hz (0: the grid on the full model) */
     int speed_pick;       /* its pick (amfi_speed_pick) */
+    int speed_brent;      /* its brent_evals (0: the parabola's vertex, no sweep) */
+    int speed_local;      /* its local_half (-1: the library's) */
     int speed_compare;    /* 1: also the full-model grid and the residual (condition 0) */
     int free_state;       /* -1: as configured; 0 rest; 1 free */
     double pre_roll;      /* < 0: as configured */
@@ -138,10 +140,16 @@ static void usage(FILE *f)
             "      --speed-batch N             only the speed-estimation batch (issue 12):\n"
             "                                  N vehicles per condition, into speed-estimation.md\n"
             "      --speed-grid F              its search grid step, fraction of the speed\n"
+            "                                  (default the library's, 0.003)\n"
             "      --speed-dof N               its data weight n_eff (default 0: the samples)\n"
-            "      --speed-coarse HZ           its coarse model's rate (default 1000; 0: the\n"
-            "                                  grid on the full model)\n"
+            "      --speed-coarse HZ           its coarse model's rate (default the library's,\n"
+            "                                  1000; 0: the grid on the full model)\n"
             "      --speed-pick min|dip        its pick (default dip)\n"
+            "      --speed-brent N             its Brent sweeps after the local grid, 0 .. 20\n"
+            "                                  (default the library's; 0: the vertex of the\n"
+            "                                  parabola through the pick and its neighbours)\n"
+            "      --speed-local H             its local grid on the full model: +-H points\n"
+            "                                  0.3 %% apart, widened toward an end pick, 1 .. 3\n"
             "      --speed-no-compare          skip the one-level and residual solves of its\n"
             "                                  first condition (about 8x its time)\n"
             "      --preceding-joint N         only Table 5's preceding vehicle (0.5-2 s before)\n"
@@ -157,7 +165,8 @@ static void parse(int argc, char **argv, opts *o)
 {
     enum { O_LAMBDA_REF = 256, O_BATCH_LCURVE, O_BATCH_ESTIMATE, O_BATCHES_ONLY, O_INITIAL_STATE, O_PRE_ROLL,
            O_NO_PLOTS, O_SPEED_BATCH, O_SPEED_GRID, O_SPEED_DOF,
-           O_SPEED_COARSE, O_SPEED_PICK, O_SPEED_NO_COMPARE, O_PRECEDING_JOINT };
+           O_SPEED_COARSE, O_SPEED_PICK, O_SPEED_NO_COMPARE, O_PRECEDING_JOINT, O_SPEED_BRENT,
+           O_SPEED_LOCAL };
     static const struct option longopts[] = {
         {"out", required_argument, NULL, 'o'},
         {"quick", no_argument, NULL, 'q'},
@@ -178,12 +187,18 @@ static void parse(int argc, char **argv, opts *o)
         {"speed-dof", required_argument, NULL, O_SPEED_DOF},
         {"speed-coarse", required_argument, NULL, O_SPEED_COARSE},
         {"speed-pick", required_argument, NULL, O_SPEED_PICK},
+        {"speed-brent", required_argument, NULL, O_SPEED_BRENT},
+        {"speed-local", required_argument, NULL, O_SPEED_LOCAL},
         {"speed-no-compare", no_argument, NULL, O_SPEED_NO_COMPARE},
         {"preceding-joint", required_argument, NULL, O_PRECEDING_JOINT},
         AMFI_CLI_END};
     *o = (opts){.out = "docs/results", .vehicles = 500, .reps = 3, .threads = 2, .plots = 1,
                 .lambda_ref = 7.94e-9, .free_state = -1, .pre_roll = -1, .speed_grid = 0.002, .speed_coarse = 1000,
-                 .speed_pick = AMFI_SPEED_PICK_DIP, .speed_compare = 1};
+                 .speed_pick = AMFI_SPEED_PICK_DIP, .speed_brent = -1, .speed_local = -1, .speed_compare = 1};
+    amfi_speed_prior dp; /* the search's defaults are the library's */
+    amfi_speed_prior_default(&dp);
+    o->speed_grid = dp.grid_rel;
+    o->speed_coarse = dp.coarse_rate_hz;
     int vehicles_set = 0;
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -217,6 +232,8 @@ static void parse(int argc, char **argv, opts *o)
         case O_SPEED_COARSE: o->speed_coarse = amfi_cli_num(&c, v, 0, 1e6); break;
         case O_SPEED_NO_COMPARE: o->speed_compare = 0; break;
         case O_PRECEDING_JOINT: o->preceding_joint = (int)amfi_cli_num(&c, v, 3, 5000); break;
+        case O_SPEED_BRENT: o->speed_brent = (int)amfi_cli_num(&c, v, 0, 20); break;
+        case O_SPEED_LOCAL: o->speed_local = (int)amfi_cli_num(&c, v, 1, 3); break;
         case O_SPEED_PICK:
             if (strcmp(v, "min") == 0)
                 o->speed_pick = AMFI_SPEED_PICK_MIN;
@@ -298,7 +315,7 @@ static amfi_passage recorded_passage(const ctx *c, const worker *w, const amfi_p
 }
 
 /* The speed search's prior from the options (--speed-grid, --speed-dof,
- * --speed-coarse, --speed-pick). */
+ * --speed-coarse, --speed-pick, --speed-brent, --speed-local). */
 static void options_prior(const ctx *c, amfi_speed_prior *prior)
 {
     amfi_speed_prior_default(prior);
@@ -306,6 +323,10 @@ static void options_prior(const ctx *c, amfi_speed_prior *prior)
     prior->data_dof = c->o.speed_dof;
     prior->coarse_rate_hz = c->o.speed_coarse;
     prior->pick = (amfi_speed_pick)c->o.speed_pick;
+    if (c->o.speed_brent >= 0)
+        prior->brent_evals = c->o.speed_brent;
+    if (c->o.speed_local >= 0)
+        prior->local_half = c->o.speed_local;
 }
 
 /* Simulate spec on bridge `b`, then solve with the speed the detector
@@ -1517,11 +1538,17 @@ int main(int argc, char **argv)
         fprintf(c.md, "Made by `amfi-paper --preceding-joint %d`.\n", c.o.preceding_joint);
     } else if (c.o.speed_batch) {
         speed_batch(&c);
+        char brent[64] = "";
+        if (c.o.speed_brent >= 0)
+            snprintf(brent, sizeof brent, " --speed-brent %d", c.o.speed_brent);
+        if (c.o.speed_local >= 0)
+            snprintf(brent + strlen(brent), sizeof brent - strlen(brent), " --speed-local %d",
+                     c.o.speed_local);
         fprintf(c.md,
                 "Made by `amfi-paper --speed-batch %d --speed-grid %g --speed-dof %g "
-                "--speed-coarse %g --speed-pick %s -j %d`.\n",
+                "--speed-coarse %g --speed-pick %s%s -j %d`.\n",
                 c.o.speed_batch, c.o.speed_grid, c.o.speed_dof, c.o.speed_coarse,
-                amfi_speed_pick_name((amfi_speed_pick)c.o.speed_pick), c.o.threads);
+                amfi_speed_pick_name((amfi_speed_pick)c.o.speed_pick), brent, c.o.threads);
     } else {
         if (!c.o.quick && !c.o.batches_only)
             single_vehicle(&c);

@@ -331,7 +331,11 @@ typedef struct amfi_speed_prior {
     double range_sd; /* search v0·(1 ± range_sd·σ), > 0, range_sd·σ < 0.5 */
     double grid_rel; /* grid step / v0, 1e-4 .. range_sd·σ: below the cost's dip width */
     double tol_rel;  /* Brent stops when its bracket is below tol_rel·v0, 0 < tol < 0.01 */
-    int brent_evals; /* Brent sweeps after the grid (GSL's first point included), 0 .. 100 */
+    int brent_evals; /* Brent sweeps after the grid (GSL's first point included), 0 .. 100;
+                        0: the vertex of the parabola through the pick and its neighbours */
+    int local_half;  /* the full model's local grid: ±local_half points 0.3 % apart
+                        around the coarse pick, widened toward a pick at its end up
+                        to ±3; 1 .. 3 */
     double coarse_rate_hz; /* the grid's model: the same bridge at this calculation
                               rate with the modes it resolves, then the full model
                               refines; 0 (or >= the solver's rate): the grid on the
