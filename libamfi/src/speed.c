@@ -9,9 +9,10 @@
  * of speeds around v0 finer than the narrow dip the cost has at the true
  * speed, on a coarse model (the same bridge and sensors at coarse_rate_hz,
  * with the modes that rate resolves: a sweep costs ~1/13 of the full
- * model's); then the full model refines around the coarse pick (7 points
- * over ±0.9 %, then GSL's Brent minimiser: 10 sweeps with the final
- * solve); the passage is finally solved at the
+ * model's); then the full model refines around the coarse pick (3 points
+ * 0.3 % apart, widened toward a pick at an end up to ±0.9 %, then the
+ * parabola's vertex, or GSL's Brent minimiser with brent_evals > 0: 3-8
+ * sweeps with the final solve); the passage is finally solved at the
  * estimate as amfi_solve would (its own window). With coarse_rate_hz 0 (or
  * not below the calculation rate) the grid runs on the full model (the
  * first version: ~97 sweeps a passage). Sits above solver.c in libamfi's
@@ -455,14 +456,16 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
             return SWEEP_FAILED(qc);
         edge = r.edge, dip = r.dip;
         /* 2. The full model on a local grid around the coarse pick: x + k·d,
-         * k = −3 .. 3, d = 0.3 % of the given speed, whatever the coarse
-         * grid's step (±0.9 %: on simulated traffic the
-         * coarse model's dip lies up to 0.8 % from the full model's,
-         * docs/results/speed-estimation.md; the points are closer than the
-         * dip's half-width to any speed between them); the pick is, as on
-         * the coarse grid, the point deepest below the others' trend (pick
-         * dip) or the smallest (pick min); then Brent between the pick's
-         * neighbours. Its window is that of the slowest point. */
+         * d = 0.3 % of the given speed whatever the coarse grid's step (the
+         * points are closer than the full model's dip half-width to any
+         * speed between them), k = −local_half .. local_half, widened to
+         * ±3 (±0.9 %: on simulated traffic the coarse model's dip lies up
+         * to 0.8 % from the full model's, docs/results/speed-estimation.md)
+         * while the pick sits at an end; the pick is, as on the coarse
+         * grid, the point deepest below the others' trend (pick dip, from
+         * 4 points) or the smallest; then the parabola's vertex or Brent
+         * between the pick's neighbours. Its window is that of the slowest
+         * point it may try. */
         const double d = 0.003 * v0;
         double wlo = r.x - 3.0 * d;
         if (wlo < lo)
