@@ -149,6 +149,22 @@ static void recovers_biased_speed(void **state)
                 double g_est = est.gvw_kg;
                 assert_int_equal(amfi_solve(s, &pv, &lam, &plain, err, sizeof err), 0);
                 assert_true(fabs(plain.gvw_kg - g_est) <= 1e-9 * g_est);
+                if (pr.coarse_rate_hz > 0) {
+                    /* round four's refinement (7 local points, 2 Brent
+                     * sweeps) lands within a local step's third (0.1 %) of
+                     * the widening 3-point grid and the parabola's vertex */
+                    amfi_speed_prior p7 = pr;
+                    amfi_speed_result s7;
+                    p7.local_half = 3;
+                    p7.brent_evals = 2;
+                    assert_int_equal(amfi_solve_speed(s, &p, &lam, &p7, &plain, &s7, err,
+                                                      sizeof err),
+                                     0);
+                    print_message("  7 local points + Brent: speed %+.3f%% in %d sweeps\n",
+                                  100 * (s7.speed_mps / TRUE_SPEED - 1), plain.n_solves);
+                    assert_true(fabs(s7.speed_mps / sr.speed_mps - 1) < 0.001);
+                    assert_true(plain.n_solves > est.n_solves);
+                }
             }
         free(acc);
     }
@@ -231,6 +247,14 @@ static void refuses_bad_priors(void **state)
                          AMFI_EINVAL);
         assert_non_null(strstr(err, bad[i].msg));
         assert_int_equal(amfi_speed_prior_check(&pr, bad[i].speed, NULL, 0), AMFI_EINVAL);
+    }
+    /* the local grid's half-width: 1 .. 3 points */
+    for (int h = -1; h <= 4; h += 5) {
+        amfi_speed_prior ph;
+        amfi_speed_prior_default(&ph);
+        ph.local_half = h == -1 ? 0 : h;
+        assert_int_equal(amfi_speed_prior_check(&ph, 25.0, err, sizeof err), AMFI_EINVAL);
+        assert_non_null(strstr(err, "local_half"));
     }
     /* range × SD >= 0.5 would search speeds near 0 */
     amfi_speed_prior pr;
