@@ -190,9 +190,10 @@ static const char schema_v3[] =
 
 /* Version 4 (issue 13): vehicles that shared the span are weighed together
  * (amfid's event solve, amfi_solve_multi). n_vehicles is the size of the
- * event a passage was weighed in (1 alone); quality the separability figure
- * of its weight (amfi_vehicle_result.quality: 1 alone or fully separable,
- * larger when its axles trade load with another vehicle's). Rows written
+ * event a passage was weighed in (1 alone); quality the figure of how well
+ * its weight is separated from the others' (amfi_vehicle_result.quality:
+ * since issue 13's fourth round 1 + the % change of the weight at λ/10, 1
+ * alone; at first the separability figure, now its own field). Rows written
  * before were single-vehicle passages: n_vehicles 1, quality NULL. */
 static const char schema_v4[] =
     "ALTER TABLE passages ADD COLUMN n_vehicles INTEGER NOT NULL DEFAULT 1\n"
