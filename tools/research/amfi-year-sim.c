@@ -12,6 +12,7 @@
  *   amfi-year-sim [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]
  *                 [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]
  *                 [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]
+ *                 [--std-compensated]
  *
  * Stream model (kg). A run starts on a random day of the year (commissioning)
  * and lasts 365 days. Vehicles arrive uniformly within each day, --flow a
@@ -87,6 +88,9 @@ typedef struct {
     int mix_probe;   /* --mix-probe */
     double prior_scale; /* --prior-scale: the temperature model's prior slopes × this */
     int truck_runs;     /* --truck-runs: known-truck runs a week */
+    int std_comp;       /* --std-compensated: the STD/mean engine gets temperature-
+                           compensated weights (the scale model's slopes once
+                           fitted, its prior slopes before) */
 } opts;
 
 /* One run's world: the climate, the calendar, the damage. */
@@ -157,6 +161,8 @@ typedef struct {
     amfi_indicators *ind;
     amfi_scale *scale;
     amfi_known_truck *truck;
+    amfi_scale_params sp; /* the scale indicator's parameters (its temperature model) */
+    int std_comp;         /* feed the STD/mean engine compensated weights */
 } engines;
 
 static engines make(const opts *o)
@@ -182,6 +188,8 @@ static engines make(const opts *o)
         fprintf(stderr, "%s: %s\n", PROG, err);
         exit(2);
     }
+    e.sp = sp;
+    e.std_comp = o->std_comp;
     return e;
 }
 
@@ -215,7 +223,15 @@ static int push(engines *e, double gvw, double deck_c)
 {
     amfi_alert_event ev[2], sev;
     int n = 0, r = 0;
-    if (amfi_indicators_push(e->ind, gvw, NULL, ev, &n) < 0) {
+    double g_std = gvw;
+    if (e->std_comp) { /* the weight brought to the calibration temperature */
+        amfi_scale_model m;
+        double warm = e->sp.warm_slope, frost = e->sp.frost_slope;
+        if (amfi_scale_get_model(e->scale, &m) == AMFI_IND_OK)
+            warm = m.warm_slope, frost = m.frost_slope;
+        g_std = gvw * amfi_scale_temp_factor(&e->sp, warm, frost, deck_c);
+    }
+    if (amfi_indicators_push(e->ind, g_std, NULL, ev, &n) < 0) {
         fprintf(stderr, "%s: push rejected %g kg\n", PROG, gvw);
         exit(1);
     }
@@ -593,6 +609,7 @@ static void usage(FILE *f)
             "usage: %s [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]\n"
             "       [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]\n"
             "       [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]\n"
+            "       [--std-compensated]\n"
             "A year of traffic with the site climate and the drifting mix, watched by\n"
             "amfid's indicator engine: false alarms per healthy year, detection delays.\n"
             "  --seed S          generator seed (default 1)\n"
@@ -607,6 +624,8 @@ static void usage(FILE *f)
             "  --prior-scale F   temperature model's prior slopes × F (default 1: the\n"
             "                    simulator's own law)\n"
             "  --truck-runs N    known-truck runs a week, 1 .. 7 (default 1)\n"
+            "  --std-compensated the STD and mean rules get temperature-compensated\n"
+            "                    weights (the scale model's slopes; its prior before)\n"
             "  -h, --help        this help\n"
             "  -V, --version     print the version\n",
             PROG);
@@ -619,7 +638,7 @@ int main(int argc, char **argv)
               .prior_scale = 1.0, .truck_runs = 1};
     enum {
         O_SEED = 256, O_YEARS, O_DET_RUNS, O_FLOW, O_DAMAGE, O_MEAS_SD, O_DRIFT, O_SCALE_FA,
-        O_MIX_PROBE, O_PRIOR_SCALE, O_TRUCK_RUNS
+        O_MIX_PROBE, O_PRIOR_SCALE, O_TRUCK_RUNS, O_STD_COMP
     };
     static const struct option longopts[] = {
         {"seed", required_argument, NULL, O_SEED},
@@ -633,6 +652,7 @@ int main(int argc, char **argv)
         {"mix-probe", no_argument, NULL, O_MIX_PROBE},
         {"prior-scale", required_argument, NULL, O_PRIOR_SCALE},
         {"truck-runs", required_argument, NULL, O_TRUCK_RUNS},
+        {"std-compensated", no_argument, NULL, O_STD_COMP},
         AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -649,6 +669,7 @@ int main(int argc, char **argv)
         case O_MEAS_SD: o.meas_sd = 1000.0 * amfi_cli_num(&c, v, 0, 10); break;
         case O_SCALE_FA: o.scale_fa = amfi_cli_num(&c, v, 1e-4, 1000); break;
         case O_MIX_PROBE: o.mix_probe = 1; break;
+        case O_STD_COMP: o.std_comp = 1; break;
         case O_PRIOR_SCALE: o.prior_scale = amfi_cli_num(&c, v, 0, 5); break;
         case O_TRUCK_RUNS: o.truck_runs = (int)amfi_cli_integer(&c, v, 1, 7); break;
         case O_DRIFT:
