@@ -16,16 +16,8 @@
 # with the paper's own Table 4 statistics is printed beside it.
 # Usage: daemon_alert.sh AMFID SIM_PUBLISHER AMFI_INDICATOR_SIM CONFIG
 set -u
-if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
-  # Re-run inside a new network namespace with multicast routed on loopback.
-  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
-    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
-fi
+. "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 indsim=$3 config=$4
-dir=$(mktemp -d)
-pids=""
-cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
-trap cleanup EXIT
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
 
 # Test-sized indicator settings (the shipped ones need > 10 000 vehicles).

@@ -15,15 +15,8 @@
 # summary ("bus ... kernel drops").
 # Usage: daemon_drops.sh AMFID SIM_PUBLISHER CONFIG AMFI_REPORT
 set -u
-if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
-  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
-    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
-fi
+. "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 config=$3 report=$4
-dir=$(mktemp -d)
-pids=""
-cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
-trap cleanup EXIT
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 cap=$(cat /proc/sys/net/core/rmem_max)
 # (1) more than the kernel allows

@@ -9,16 +9,8 @@
 # recorded live with lcm-logger, one written by sim_publisher --log).
 # Usage: daemon_e2e.sh AMFID SIM_PUBLISHER AMFI_REPORT CONFIG
 set -u
-if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
-  # Re-run inside a new network namespace with multicast routed on loopback.
-  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
-    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
-fi
+. "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 report=$3 config=$4
-dir=$(mktemp -d)
-pids=""
-cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
-trap cleanup EXIT
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
 N=12
 

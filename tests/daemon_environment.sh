@@ -11,16 +11,9 @@
 # good reading after them is. amfi-report prints the temperature line.
 # Usage: daemon_environment.sh AMFID SIM_PUBLISHER LCM_ENVIRONMENT LCM_INJECT AMFI_REPORT CONFIG
 set -u
-if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
-  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
-    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
-fi
+. "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 envsum=$3 inject=$4 report=$5 config=$6
 N=6
-dir=$(mktemp -d)
-pids=""
-cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
-trap cleanup EXIT
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 
 # a metrics file written at stop, to read the refusal counters from

@@ -9,15 +9,8 @@
 # acknowledged passage is in it with the same id, vehicle and status.
 # Usage: daemon_kill9.sh AMFID SIM_PUBLISHER LCM_PASSAGES CONFIG [KILLS]
 set -u
-if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
-  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
-    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
-fi
+. "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 passages=$3 config=$4 kills=${5:-20}
-dir=$(mktemp -d)
-pids=""
-cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
-trap cleanup EXIT
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 # 120 vehicles, one every 2 s of data: 240 s played at 8x = 30 s of wall time
 "$sim" --lcm-url none --log "$dir/traffic.log" --vehicles 120 --headway 2 --speedup max --seed 5 \

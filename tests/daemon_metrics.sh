@@ -7,15 +7,8 @@
 # At the end its counters equal the store's and the simulator's.
 # Usage: daemon_metrics.sh AMFID SIM_PUBLISHER CONFIG PROM_CHECK_AWK
 set -u
-if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
-  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
-    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
-fi
+. "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 config=$3 check=$4
-dir=$(mktemp -d)
-pids=""
-cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
-trap cleanup EXIT
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 sed -e "s|^  # textfile: .*|  textfile: $dir/m/amfid.prom|" -e "s/^  interval_s: 15 /  interval_s: 1 /" \
   "$config" > "$dir/a.yaml"

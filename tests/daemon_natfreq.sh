@@ -15,16 +15,9 @@
 # in the log and the meta table.
 # Usage: daemon_natfreq.sh AMFID SIM_PUBLISHER LCM_PASSAGES CONFIG
 set -u
-if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
-  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
-    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
-fi
+. "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 listen=$3 config=$4
 N=16
-dir=$(mktemp -d)
-pids=""
-cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
-trap cleanup EXIT
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 q() { sqlite3 "$dir/a.db" "$1"; }
 

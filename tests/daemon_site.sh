@@ -8,15 +8,8 @@
 # site.name is written over the stored one.
 # Usage: daemon_site.sh AMFID SIM_PUBLISHER LCM_PASSAGES CONFIG
 set -u
-if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
-  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
-    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
-fi
+. "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 passages=$3 config=$4
-dir=$(mktemp -d)
-pids=""
-cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
-trap cleanup EXIT
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 meta() { sqlite3 "$dir/a.db" "SELECT value FROM meta WHERE key = '$1'"; }
 

@@ -13,15 +13,8 @@
 #     within 0.5 % of zero.
 # Usage: daemon_speed_drift.sh AMFID SIM_PUBLISHER AMFI_REPORT LCM_PASSAGES CONFIG
 set -u
-if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
-  exec unshare --net sh -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo &&
-    AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
-fi
+. "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 report=$3 lcmp=$4 config=$5
-dir=$(mktemp -d)
-pids=""
-cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
-trap cleanup EXIT
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
 N=4
 
