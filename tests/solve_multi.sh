@@ -9,7 +9,8 @@
 # differ in the last one where the two paths' axle positions differ by
 # round-off; a solve this ill-conditioned amplifies that, LAPACK's
 # factorisation choosing its pivots by it), plus each vehicle's GVW
-# (truth 18000 and 15000 kg) within 1 % and a quality figure >= 1, in the
+# (truth 18000 and 15000 kg) within 1 % and a quality figure and a
+# separability >= 1, in the
 # order the vehicles were given.
 #
 # usage: solve_multi.sh AMFI_SOLVE AMFI_MKCASE CONFIG_DIR
@@ -61,14 +62,14 @@ paste -d ' ' "$tmp/one.tok" "$tmp/joint.tok" | awk '
     END { exit bad }' ||
     fail "the joint solve differs from the one-vehicle solve of the same axles"
 
-# "vehicles":[{"gvw_kg":G,...,"quality":Q,...},{...}] -> "G Q" per line
+# "vehicles":[{"gvw_kg":G,...,"quality":Q,...,"separability":S},{...}] -> "G Q S" per line
 vehicles() {
     sed 's/.*"vehicles":\[//' "$1" | tr '}' '\n' |
-        sed -n 's/.*"gvw_kg":\([^,]*\),.*"quality":\([^,]*\),.*/\1 \2/p'
+        sed -n 's/.*"gvw_kg":\([^,]*\),.*"quality":\([^,]*\),.*"separability":\([^,]*\)$/\1 \2 \3/p'
 }
 check() { # FILE TRUTH1 TRUTH2
     vehicles "$1" | awk -v t1="$2" -v t2="$3" '
-        { n++; g[n] = $1; q[n] = $2 }
+        { n++; g[n] = $1; q[n] = $2; sp[n] = $3 }
         END {
             if (n != 2) { print "expected 2 vehicles, got " n; exit 1 }
             t[1] = t1; t[2] = t2
@@ -76,6 +77,7 @@ check() { # FILE TRUTH1 TRUTH2
                 e = g[i] / t[i] - 1
                 if (e < -0.01 || e > 0.01) { printf "vehicle %d: GVW %g vs %g\n", i, g[i], t[i]; exit 1 }
                 if (!(q[i] >= 1)) { printf "vehicle %d: quality %s < 1\n", i, q[i]; exit 1 }
+                if (!(sp[i] >= 1)) { printf "vehicle %d: separability %s < 1\n", i, sp[i]; exit 1 }
             }
         }' || fail "$1"
 }

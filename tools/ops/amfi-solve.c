@@ -458,9 +458,10 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
             for (int a = 0; a < vr->n_axles; a++)
                 json_array_append_new(ak, amfi_json_num(vr->axle_kg[a]));
             json_array_append_new(
-                vs, json_pack("{s:o, s:o, s:o, s:o}", "gvw_kg", amfi_json_num(vr->gvw_kg),
+                vs, json_pack("{s:o, s:o, s:o, s:o, s:o}", "gvw_kg", amfi_json_num(vr->gvw_kg),
                               "axle_kg", ak, "quality", amfi_json_num(vr->quality),
-                              "gvw_sd_kg", amfi_json_num(vr->gvw_sd_kg)));
+                              "gvw_sd_kg", amfi_json_num(vr->gvw_sd_kg), "separability",
+                              amfi_json_num(vr->separability)));
         }
         json_object_set_new(o, "vehicles", vs);
     }
