@@ -65,13 +65,17 @@ awk -v e="$err" 'BEGIN { exit !(e < 0.08) }' || fail "GVW error $err over 8 %"
 apid=$!; pids="$pids $apid"
 i=0; until grep -q "running" "$dir/term.log"; do
   i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
-timeout 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 5 2> "$dir/simterm.log" &
+# -k 10: sim_publisher once did not exit after its SIGTERM summary under
+# ASan and the test hung at the wait below until ctest's 600 s (not
+# diagnosed); amfid is what this section tests
+timeout -k 10 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 5 2> "$dir/simterm.log" &
 spid=$!; pids="$pids $spid"
 sleep 1.2  # about half the traffic
 kill -TERM $apid
 wait $apid; rc=$?
 [ $rc -eq 0 ] || fail "amfid exit status $rc after SIGTERM mid-stream"
 kill $spid 2>/dev/null; wait $spid 2>/dev/null
+[ $? -ne 137 ] || echo "note: sim_publisher needed SIGKILL 10 s after SIGTERM"
 received=$(sed -n 's/.*stopped: .* blocks, \([0-9]*\) vehicles.*/\1/p' "$dir/term.log")
 rows=$(sqlite3 "$dir/term.db" "SELECT count(*) FROM passages")
 echo "SIGTERM mid-stream: $received vehicles received, $rows rows ($(sqlite3 "$dir/term.db" \
