@@ -198,6 +198,22 @@ static double brent(search *q, double a, double fa, double x, double fx, double 
     return best;
 }
 
+/* The refinement between a pick x and its equally spaced neighbours a < x
+ * < b, on either level: Brent with brent_evals > 0, else the vertex of the
+ * parabola through the three (no sweep; *fbest stays J at x, J at the
+ * vertex is not known). */
+static double refine(search *q, double a, double fa, double x, double fx, double b, double fb,
+                     double *fbest)
+{
+    if (q->pr->brent_evals > 0)
+        return brent(q, a, fa, x, fx, b, fb, fbest);
+    *fbest = fx;
+    double den = fa - 2.0 * fx + fb;
+    if (a < x && x < b && den > 0.0 && fx <= fa && fx <= fb)
+        return x + 0.5 * (x - a) * (fa - fb) / den;
+    return x;
+}
+
 /* The grid v0 + i·g over [glo, ghi] (the range [lo, hi] and, for pick
  * dip, the trend's points beyond it): the picked point (prior->pick) among
  * the points in [lo, hi], whether it is an end of the range, and its
@@ -429,7 +445,7 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
     double best, fbest, j_given, j_best = DBL_MAX, dip;
     int edge, n_coarse = 0;
     if (!two_level) {
-        /* The grid on the full model, then Brent between the best point's neighbours. */
+        /* The grid on the full model, then refine() between the pick's neighbours. */
         q.n_eff = n_eff_of(s, ps, pr);
         grid_best r = grid(&q, glo, ghi, lo, hi, g, fv);
         if (q.rc)
@@ -437,7 +453,7 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
         best = r.x, fbest = r.f, edge = r.edge, dip = r.dip;
         j_given = r.f0;
         if (!edge) {
-            best = brent(&q, r.xa, r.fa, r.x, r.f, r.xb, r.fb, &fbest);
+            best = refine(&q, r.xa, r.fa, r.x, r.f, r.xb, r.fb, &fbest);
             if (q.rc)
                 return SWEEP_FAILED(q);
         }
@@ -512,17 +528,11 @@ int amfi_solve_speed(amfi_solver *s, const amfi_passage *ps, const amfi_lambda *
             kb = local_pick(pr, lx, lf, nl, r.x, d);
         }
         best = lx[kb], fbest = lf[kb];
-        if (kb > 0 && kb < nl - 1 && pr->brent_evals > 0) {
-            best = brent(&q, lx[kb - 1], lf[kb - 1], lx[kb], lf[kb], lx[kb + 1], lf[kb + 1],
-                         &fbest);
+        if (kb > 0 && kb < nl - 1) {
+            best = refine(&q, lx[kb - 1], lf[kb - 1], lx[kb], lf[kb], lx[kb + 1], lf[kb + 1],
+                          &fbest);
             if (q.rc)
                 return SWEEP_FAILED(q);
-        } else if (kb > 0 && kb < nl - 1) {
-            /* brent_evals 0: the vertex of the parabola through the pick and
-             * its neighbours (equally spaced), no sweep; J there unknown */
-            double fa = lf[kb - 1], f0 = lf[kb], fb = lf[kb + 1], den = fa - 2.0 * f0 + fb;
-            if (den > 0.0 && f0 <= fa && f0 <= fb)
-                best = lx[kb] + 0.5 * d * (fa - fb) / den;
         }
         /* J at v0 and at the minimum, both on the model of the grid. */
         j_given = r.f0, j_best = r.f;
