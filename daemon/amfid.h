@@ -254,6 +254,13 @@ void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user
 /* Store the buffered readings in one transaction (heartbeat, full, stop);
  * on failure they stay buffered and the next flush retries. */
 void environment_flush(daemon_s *d);
+/* The deck temperature at utime (µs, data time) interpolated between the
+ * stored readings at most max_gap_s apart (the ones received so far are
+ * stored first: the heartbeat's flush may be a second of wall time behind,
+ * many seconds of data in a fast replay); NaN when there is none, or on a
+ * store error (set_error). Shared by the scale indicator and the natural
+ * frequency. */
+double environment_deck_at(daemon_s *d, int64_t utime, double max_gap_s);
 
 /* ---- in-order pipeline (pipeline.c), main thread -------------------------- */
 

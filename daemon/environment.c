@@ -50,6 +50,19 @@ void environment_flush(daemon_s *d)
     }
 }
 
+double environment_deck_at(daemon_s *d, int64_t utime, double max_gap_s)
+{
+    environment_flush(d); /* the readings received so far are in the store */
+    char err[256];
+    double t = NAN;
+    if (amfi_store_deck_c_at(d->store, utime, (int64_t)llround(1e6 * max_gap_s), &t, err,
+                             sizeof err) != 0) {
+        set_error(d, "store: %s", err);
+        return NAN;
+    }
+    return t;
+}
+
 void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     daemon_s *d = user;

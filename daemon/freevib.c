@@ -30,7 +30,8 @@
 
 #include "amfid.h"
 
-/* Readings at most alerts.scale.max_temp_gap_s apart are interpolated for a
+/* At start (the baseline from the store): readings at most
+ * alerts.scale.max_temp_gap_s apart are interpolated for a
  * passage's deck temperature (amfi_store_deck_c_at), as for the scale
  * indicator's; µs of data time. */
 static int64_t deck_gap_us(const daemon_s *d)
@@ -159,19 +160,10 @@ void freevib_estimate(daemon_s *d, job *j)
     j->f1_r2 = best.r2;
 }
 
-/* The deck temperature at utime, or NaN; the readings received so far are
- * stored first (the heartbeat's flush may be a second of wall time behind:
- * many seconds of data in a fast replay). */
+/* The deck temperature at utime, or NaN (environment_deck_at). */
 static double deck_at(daemon_s *d, int64_t utime)
 {
-    char err[256];
-    double t = NAN;
-    environment_flush(d);
-    if (amfi_store_deck_c_at(d->store, utime, deck_gap_us(d), &t, err, sizeof err) != 0) {
-        set_error(d, "store: %s", err);
-        return NAN;
-    }
-    return t;
+    return environment_deck_at(d, utime, d->cfg.daemon.scale_max_temp_gap_s);
 }
 
 /* Whether this row (of an event: one vehicle's) carries the f1. */

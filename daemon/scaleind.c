@@ -207,15 +207,7 @@ void scaleind_deck(daemon_s *d, amfi_passage_row *r)
     r->has_deck_c = 0;
     if (!c->scale && !c->truck)
         return;
-    if (d->env.n > 0)
-        environment_flush(d); /* the readings up to now are in the store */
-    char err[256];
-    double t = NAN;
-    if (amfi_store_deck_c_at(d->store, r->utime, (int64_t)(1e6 * c->max_gap_s), &t, err,
-                             sizeof err) != 0) {
-        set_error(d, "store: %s", err);
-        t = NAN;
-    }
+    double t = environment_deck_at(d, r->utime, c->max_gap_s);
     if (isfinite(t)) {
         r->has_deck_c = 1;
         r->deck_c = t;
