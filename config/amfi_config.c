@@ -105,6 +105,7 @@ void amfi_config_defaults(amfi_site_config *c)
     d->max_event_s = 10.0;
     d->max_event_axles = AMFI_MAX_AXLES;
     d->single_presence_only = 0;
+    d->ind_temp_compensated = 1;
     d->status_period_s = 1.0;
     d->alert_timeout_s = 30.0;
     d->alert_max_running = 4;

@@ -59,6 +59,9 @@ typedef struct amfi_daemon_config {
                                  2 .. AMFI_MAX_AXLES */
     int single_presence_only; /* daemon.indicators.single_presence_only: the
                                  indicators take only passages weighed alone */
+    int ind_temp_compensated; /* daemon.indicators.temperature: 1 compensated
+                                 (the STD and mean rules get each GVW at the
+                                 calibration temperature), 0 raw */
     double status_period_s;   /* daemon.status_period_s: heartbeat, wall time */
     char alert_command[512];  /* alerts.command: run for each raised and cleared alert;
                                  "" none */

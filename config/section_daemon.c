@@ -37,6 +37,7 @@ static const field store_fields[] = {
 #define IND(m) DC(indicators.m)
 
 const enum_name onoff_names[] = {{"off", 0}, {"on", 1}, {NULL, 0}};
+static const enum_name temperature_names[] = {{"raw", 0}, {"compensated", 1}, {NULL, 0}};
 
 static const field indicator_fields[] = {
     {.key = "window", .kind = &K_INT, .off = IND(window), .lo = 10, .hi = 1000000},
@@ -60,6 +61,8 @@ static const field indicator_fields[] = {
     /* amfid's filter in front of the engine (pipeline.c), not an engine parameter */
     {.key = "single_presence_only", .kind = &K_ENUM, .off = DC(single_presence_only),
      .aux = onoff_names},
+    {.key = "temperature", .kind = &K_ENUM, .off = DC(ind_temp_compensated),
+     .aux = temperature_names},
     {.key = NULL}};
 
 /* Offsets of the estimator's amfi_natfreq_params inside the site config. */

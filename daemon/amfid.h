@@ -97,11 +97,15 @@ typedef struct scale_state {
     amfi_scale *scale;             /* NULL: alerts.scale.enabled off */
     amfi_known_truck *truck;       /* NULL: alerts.known_truck.enabled off */
     int enabled, truck_enabled;    /* in force (a reload reports changes) */
+    int compensate;                /* daemon.indicators.temperature: compensated */
     double max_gap_s;
     amfi_scale_params params;
     amfi_known_truck_params truck_params;
     int64_t fed, no_temp, runs, refused; /* this run's: inputs, solved passages
                                     without a temperature, truck runs, refused */
+    int64_t comp_fed, comp_raw;    /* this run's passages fed to the STD and mean
+                                    rules compensated, and raw for want of a
+                                    deck temperature (compensate on) */
     double last_scale, last_cusum; /* the newest block's (NaN: none yet) */
 } scale_state;
 
@@ -327,6 +331,14 @@ void scaleind_restore(daemon_s *d);
 /* A solved passage's row: its deck temperature (has_deck_c, deck_c) from
  * the environment readings, or none (counted). */
 void scaleind_deck(daemon_s *d, amfi_passage_row *r);
+/* A solved passage's row, its deck taken: r->gvw_comp_kg, the weight the
+ * STD and mean rules are fed. With daemon.indicators.temperature
+ * compensated and a deck temperature: the GVW brought to the calibration
+ * temperature by the scale indicator's temperature model (its fitted slopes
+ * once its baseline exists, alerts.scale's prior slopes before, also with
+ * the scale indicator off); else the GVW (counted when for want of a
+ * temperature). */
+void scaleind_comp(daemon_s *d, amfi_passage_row *r);
 /* A stored ok passage's row: feeds the indicators when it has a
  * temperature (and passes daemon.indicators.single_presence_only). */
 void scaleind_feed(daemon_s *d, const amfi_passage_row *r);

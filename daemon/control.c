@@ -216,7 +216,8 @@ void reload(daemon_s *d)
     amfi_indicator_params ip;
     indicator_params(&n.daemon, &ip);
     if (!amfi_indicator_params_equal(&ip, &d->ind_params) ||
-        n.daemon.single_presence_only != d->cfg.daemon.single_presence_only)
+        n.daemon.single_presence_only != d->cfg.daemon.single_presence_only ||
+        n.daemon.ind_temp_compensated != d->sc.compensate)
         LOG_WARN("reload: indicator settings take effect at the next start");
     drift_reload(d, &n);
     scaleind_reload(d, &n);

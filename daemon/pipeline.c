@@ -74,14 +74,16 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id, const amfi_pa
     amfi_passage_t_publish(d->lcm, d->cfg.daemon.ch_passage, &m);
 }
 
-static void feed_indicators(daemon_s *d, const job *j)
+/* The STD and mean rules get gvw_kg: the passage's GVW, at the calibration
+ * temperature where it is compensated (scaleind_comp). */
+static void feed_indicators(daemon_s *d, const job *j, double gvw_kg)
 {
     amfi_indicator_eval ev;
     amfi_alert_event al[2];
     int n_al = 0;
-    int bits = amfi_indicators_push(d->ind, j->gvw_kg, &ev, al, &n_al);
+    int bits = amfi_indicators_push(d->ind, gvw_kg, &ev, al, &n_al);
     if (bits < 0) {
-        set_error(d, "indicators: GVW %.1f kg of vehicle %lld refused", j->gvw_kg,
+        set_error(d, "indicators: GVW %.1f kg of vehicle %lld refused", gvw_kg,
                   (long long)j->w.v.vehicle_id);
         return;
     }
@@ -168,8 +170,12 @@ static int store_now(daemon_s *d, job *j)
 {
     amfi_passage_row r;
     job_row(d, j, &r);
-    if (j->solved)
+    const int feeds = !d->cfg.daemon.single_presence_only || j->w.n_vehicles <= 1;
+    if (j->solved) {
         scaleind_deck(d, &r);
+        if (feeds)
+            scaleind_comp(d, &r);
+    }
     int64_t id = 0;
     char err[256];
     int rc = amfi_store_add_passage(d->store, &r, &id, err, sizeof err);
@@ -199,8 +205,8 @@ static int store_now(daemon_s *d, job *j)
         drift_feed(d, j->w.v.utime, r.speed_mps, r.speed_given_mps);
     if (j->solved) {
         d->passages_ok++;
-        if (!d->cfg.daemon.single_presence_only || j->w.n_vehicles <= 1)
-            feed_indicators(d, j);
+        if (feeds)
+            feed_indicators(d, j, r.gvw_comp_kg);
         scaleind_feed(d, &r);
     }
     return 0;

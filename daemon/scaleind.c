@@ -13,6 +13,12 @@
  * emit_alert). A passage without a temperature feeds neither: counted
  * (status line at stop, metrics).
  *
+ * The STD and mean rules (pipeline.c) are fed each GVW brought to the
+ * calibration temperature by the same temperature model
+ * (daemon.indicators.temperature: compensated, docs/indicators.md 8.8); the
+ * weight fed is stored with the passage (passages.gvw_comp_kg), which is
+ * what their rolling window is refilled from at a restart.
+ *
  * Restore: at start both indicators are rebuilt by replaying the stored
  * inputs (the ok passages with a deck temperature, in id order, through the
  * same filter), so the baseline, the temperature model, the partial block
@@ -37,6 +43,7 @@ int scaleind_create(daemon_s *d, char *err, size_t errlen)
     const amfi_daemon_config *dc = &d->cfg.daemon;
     c->enabled = dc->scale_enabled;
     c->truck_enabled = dc->known_truck_enabled;
+    c->compensate = dc->ind_temp_compensated;
     c->max_gap_s = dc->scale_max_temp_gap_s;
     c->params = dc->scale;
     c->truck_params = dc->known_truck;
@@ -205,7 +212,7 @@ void scaleind_deck(daemon_s *d, amfi_passage_row *r)
 {
     scale_state *c = &d->sc;
     r->has_deck_c = 0;
-    if (!c->scale && !c->truck)
+    if (!c->scale && !c->truck && !c->compensate)
         return;
     double t = environment_deck_at(d, r->utime, c->max_gap_s);
     if (isfinite(t)) {
@@ -213,6 +220,36 @@ void scaleind_deck(daemon_s *d, amfi_passage_row *r)
         r->deck_c = t;
     } else {
         c->no_temp++;
+    }
+}
+
+/* A compensation factor outside this range is not used (the passage feeds
+ * its raw GVW, counted): the model's own range at -60 .. 80 °C with the
+ * prior slopes is 0.84 .. 1.18. */
+#define COMP_FACTOR_MIN 0.5
+#define COMP_FACTOR_MAX 2.0
+
+void scaleind_comp(daemon_s *d, amfi_passage_row *r)
+{
+    scale_state *c = &d->sc;
+    r->gvw_comp_kg = r->gvw_kg;
+    if (!c->compensate)
+        return;
+    double f = NAN;
+    if (r->has_deck_c) {
+        double warm = c->params.warm_slope, frost = c->params.frost_slope;
+        amfi_scale_model m;
+        if (c->scale && amfi_scale_get_model(c->scale, &m) == AMFI_IND_OK) {
+            warm = m.warm_slope;
+            frost = m.frost_slope;
+        }
+        f = amfi_scale_temp_factor(&c->params, warm, frost, r->deck_c);
+    }
+    if (isfinite(f) && f >= COMP_FACTOR_MIN && f <= COMP_FACTOR_MAX) {
+        r->gvw_comp_kg = r->gvw_kg * f;
+        c->comp_fed++;
+    } else {
+        c->comp_raw++;
     }
 }
 
@@ -257,6 +294,10 @@ void scaleind_reload(daemon_s *d, const amfi_site_config *n)
 void scaleind_final(daemon_s *d)
 {
     const scale_state *c = &d->sc;
+    if (c->compensate && (c->comp_fed > 0 || c->comp_raw > 0))
+        LOG_INFO("STD and mean rules: %lld passages fed at the calibration temperature "
+                 "(%.1f °C), %lld raw (no deck temperature within %.0f s)",
+                 (long long)c->comp_fed, c->params.ref_c, (long long)c->comp_raw, c->max_gap_s);
     if (!c->scale && !c->truck)
         return;
     LOG_INFO("scale indicator: %lld passages fed (%s), %lld solved passages without a deck "

@@ -67,7 +67,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 7
+#define AMFI_STORE_SCHEMA_VERSION 8
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -162,6 +162,9 @@ typedef struct amfi_passage_row {
                             0: NULL */
     double f1_zeta;      /* its damping ratio, [0, 1); NaN: NULL */
     double f1_r2;        /* the fit's R², [0, 1]; NaN: NULL */
+    double gvw_comp_kg;  /* the weight the STD and mean rules were fed (the GVW
+                            at the calibration temperature, or the GVW itself),
+                            (0, 1e6] kg; NaN or 0: did not feed them, NULL */
 } amfi_passage_row;
 /* The range of a reference GVW (a calibration truck), kg. */
 #define AMFI_STORE_MIN_REF_KG 1000.0
@@ -322,9 +325,11 @@ int amfi_store_get_baseline(amfi_store *s, amfi_baseline *b, int *found,
 int amfi_store_set_baseline(amfi_store *s, const amfi_baseline *b, char *err,
                             size_t errlen);
 
-/* GVW of the newest (by utime, then id) `max` passages with status ok,
- * oldest first, into gvw[0 .. *n − 1] (*n <= max; gvw holds max values):
- * refills the rolling window after a restart. max >= 1. */
+/* The weight the STD and mean rules were fed (passages.gvw_comp_kg; the
+ * GVW where that is NULL: rows written before version 8) of the newest (by
+ * utime, then id) `max` passages with status ok, oldest first, into
+ * gvw[0 .. *n − 1] (*n <= max; gvw holds max values): refills the rolling
+ * window after a restart. max >= 1. */
 int amfi_store_recent_ok_gvw(amfi_store *s, int max, double *gvw, int *n,
                              char *err, size_t errlen);
 

@@ -36,9 +36,9 @@ static const char *const stmt_sql[N_STMT] = {
         "INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, "
         "gvw_kg, status, reason, lambda, residual_rms, formulation, solve_ms, "
         "speed_given_mps, speed_estimated, n_vehicles, quality, reference_gvw_kg, deck_c, "
-        "f1_hz, f1_comp_hz, f1_zeta, f1_r2) "
+        "f1_hz, f1_comp_hz, f1_zeta, f1_r2, gvw_comp_kg) "
         "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, "
-        "?18, ?19, ?20, ?21, ?22)",
+        "?18, ?19, ?20, ?21, ?22, ?23)",
     [ST_INS_AXLE] =
         "INSERT INTO axles (passage_id, idx, spacing_m, load_kg) "
         "VALUES (?1, ?2, ?3, ?4)",
@@ -63,7 +63,7 @@ static const char *const stmt_sql[N_STMT] = {
         "VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
     /* index passages_status_utime, walked backwards */
     [ST_RECENT_OK] =
-        "SELECT id, gvw_kg FROM passages WHERE status = 'ok' "
+        "SELECT id, gvw_kg, gvw_comp_kg FROM passages WHERE status = 'ok' "
         "ORDER BY utime DESC, id DESC LIMIT ?1",
     [ST_META_GET] = "SELECT rowid, value FROM meta WHERE key = ?1",
     [ST_META_SET] =

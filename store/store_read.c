@@ -201,8 +201,9 @@ int amfi_store_recent_ok_gvw(amfi_store *s, int max, double *gvw, int *n,
         if (count >= max)
             rc = st_fail(err, errlen, AMFI_STORE_EDB,
                       "recent ok GVW: more rows than the LIMIT");
-        else
-            rc = st_read_real(st, 1, &R_KG_POS, &o, &gvw[count], err, errlen);
+        else /* the weight fed (version 8), else the GVW, each by its own name */
+            rc = st_read_real(st, sqlite3_column_type(st, 2) == SQLITE_NULL ? 1 : 2, &R_KG_POS,
+                              &o, &gvw[count], err, errlen);
         if (rc == 0)
             count++;
         src = SQLITE_OK;

@@ -259,6 +259,16 @@ static const char schema_v7[] =
     "ALTER TABLE passages ADD COLUMN f1_r2 REAL\n"
     "  CHECK (f1_r2 >= 0 AND f1_r2 <= 1);\n";
 
+/* Version 8 (issue 14): the weight the STD and mean rules were fed
+ * (daemon.indicators.temperature: compensated): the inferred GVW brought to
+ * the calibration temperature by the scale indicator's temperature model;
+ * the GVW itself when the passage had no deck temperature or the rules take
+ * raw weights. NULL for passages that did not feed the rules and in rows
+ * written before (whose GVW is what the rules were fed). */
+static const char schema_v8[] =
+    "ALTER TABLE passages ADD COLUMN gvw_comp_kg REAL\n"
+    "  CHECK (gvw_comp_kg > 0 AND gvw_comp_kg <= 1000000);\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
@@ -269,6 +279,7 @@ const st_migration st_migrations[] = {
     {6, "passages: reference_gvw_kg and deck_c; scale_evals (scale and known truck)",
      schema_v6},
     {7, "passages: f1_hz, f1_comp_hz, f1_zeta, f1_r2 (natural frequency)", schema_v7},
+    {8, "passages: gvw_comp_kg (the weight the STD and mean rules were fed)", schema_v8},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

@@ -58,6 +58,8 @@ static int check_passage(const amfi_passage_row *r, char *err, size_t errlen)
     }
     if (rc == 0)
         rc = st_check_num("passages.gvw_kg", r->gvw_kg, &R_KG, err, errlen);
+    if (rc == 0 && r->gvw_comp_kg != 0.0)
+        rc = st_check_num("passages.gvw_comp_kg", r->gvw_comp_kg, &R_KG_POS, err, errlen);
     if (rc == 0)
         rc = st_check_num("passages.lambda", r->lambda, &R_POS, err, errlen);
     if (rc == 0)
@@ -139,6 +141,8 @@ int amfi_store_add_passage(amfi_store *s, const amfi_passage_row *r,
             b = st_bind_real(st, 20, f1 && r->f1_comp_hz != 0.0 ? r->f1_comp_hz : NAN);
         if (b == SQLITE_OK) b = st_bind_real(st, 21, f1 ? r->f1_zeta : NAN);
         if (b == SQLITE_OK) b = st_bind_real(st, 22, f1 ? r->f1_r2 : NAN);
+        if (b == SQLITE_OK)
+            b = st_bind_real(st, 23, r->gvw_comp_kg != 0.0 ? r->gvw_comp_kg : NAN);
         rc = st_run(s, ST_INS_PASSAGE, b, "passages: insert", err, errlen);
         if (rc == 0)
             pid = sqlite3_last_insert_rowid(s->db);

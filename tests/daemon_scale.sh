@@ -21,6 +21,9 @@
 #      stiffness: the warning alerts scale_shift and known_truck are raised
 #      once each (alerts table, the journal, the alert channel, the metrics
 #      file), scale_shift within the four damaged blocks;
+#      Every ok passage fed the STD and mean rules its GVW at the
+#      calibration temperature (passages.gvw_comp_kg; the prior slopes of
+#      the temperature model before the scale baseline, checked to 1e-9);
 #   3. a third start restores the open alerts (not raised again);
 #   4. amfi-report shows the indicators' series.
 # Usage: daemon_scale.sh AMFID SIM_PUBLISHER AMFI_REPORT LCM_INJECT CONFIG
@@ -80,6 +83,19 @@ ok=$(q "SELECT count(*) FROM passages WHERE status = 'ok'")
 grep -q "scale indicator: $ok passages fed (.*), 0 solved passages without a deck temperature within 7200 s (skipped)" \
   "$dir/healthy.log" || fail "stop line: $(grep 'scale indicator:' "$dir/healthy.log")"
 grep -q "scale indicator: baseline of 4 blocks fitted" "$dir/healthy.log" || fail "no baseline"
+# the STD and mean rules' input: compensated (daemon.indicators.temperature);
+# the first 200 (the scale baseline's) by the prior slopes 0.0025 and 0.018
+# per °C (knee 0, floor -10, calibration 10 °C)
+[ "$(q "SELECT count(*) FROM passages WHERE status = 'ok' AND gvw_comp_kg IS NULL")" -eq 0 ] ||
+  fail "ok passages without the weight fed to the STD rule"
+bad=$(q "SELECT count(*) FROM (SELECT gvw_kg, gvw_comp_kg, deck_c FROM passages WHERE status = 'ok' ORDER BY id LIMIT 200)
+         WHERE abs(gvw_comp_kg / (gvw_kg * exp(-(0.0025 * (max(deck_c, 0) - 10) + 0.018 * min(max(deck_c, -10), 0))))
+                   - 1) > 1e-9")
+[ "$bad" -eq 0 ] || fail "$bad of the first 200 passages not compensated by the prior slopes"
+[ "$(q "SELECT count(*) FROM passages WHERE status = 'ok' AND abs(deck_c - 10) > 1 AND gvw_comp_kg = gvw_kg")" -eq 0 ] ||
+  fail "passages away from 10 °C fed raw"
+grep -q "STD and mean rules: $ok passages fed at the calibration temperature (10.0 °C), 0 raw" \
+  "$dir/healthy.log" || fail "stop line: $(grep 'STD and mean rules' "$dir/healthy.log")"
 [ "$(q "SELECT count(*) FROM scale_evals WHERE kind = 'scale_shift' AND state = 'baseline'")" -eq 1 ] ||
   fail "baseline rows"
 blocks=$(q "SELECT count(*) FROM scale_evals WHERE kind = 'scale_shift' AND state <> 'baseline'")

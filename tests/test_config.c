@@ -462,12 +462,14 @@ static void test_indicator_defaults_are_the_engines(void **state)
     assert_true(c.daemon.indicators.std_clear_ratio == 1.08); /* = alert: allowed */
     /* amfid's filter in front of the engine, and the event limits (issue 13) */
     assert_int_equal(0, c.daemon.single_presence_only);
+    assert_int_equal(1, c.daemon.ind_temp_compensated); /* issue 14: compensated */
     assert_true(c.daemon.max_event_s == 10.0);
     assert_int_equal(AMFI_MAX_AXLES, c.daemon.max_event_axles);
     if (load_text("daemon:\n  max_event_s: 0\n  max_event_axles: 6\n"
-                  "  indicators: {single_presence_only: on}\n", &c, err))
+                  "  indicators: {single_presence_only: on, temperature: raw}\n", &c, err))
         fail_msg("%s", err);
     assert_int_equal(1, c.daemon.single_presence_only);
+    assert_int_equal(0, c.daemon.ind_temp_compensated);
     assert_true(c.daemon.max_event_s == 0.0);
     assert_int_equal(6, c.daemon.max_event_axles);
 }
@@ -701,6 +703,8 @@ static const bad_case bad_cases[] = {
      "daemon.natural_frequency.modes", "1 .. 3"},
     {"daemon_single_presence_bad", "daemon:\n  indicators: {single_presence_only: yes}\n", 2,
      "daemon.indicators.single_presence_only", "off"},
+    {"daemon_temperature_bad", "daemon:\n  indicators: {temperature: on}\n", 2,
+     "daemon.indicators.temperature", "compensated"},
     {"daemon_clear_above_alert",
      "daemon:\n  indicators: {std_alert_ratio: 1.05, std_clear_ratio: 1.2}\n", 2,
      "daemon.indicators.std_clear_ratio", "must not exceed"},

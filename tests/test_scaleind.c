@@ -279,10 +279,17 @@ static void test_no_temperature_is_skipped(void **state)
     scaleind_deck(&d, &r);
     assert_int_equal(0, d.env.n);
     assert_float_equal(21.5, r.deck_c, 1e-9);
-    /* off: no lookup, nothing counted */
+    /* the scale indicator and the known truck off: the lookup is still made
+     * for the STD and mean rules' compensation (daemon.indicators.temperature) */
     close_daemon(&d);
     open_daemon(&d, f->dir, "off", 0);
     scaleind_destroy(&d);
+    d.sc.no_temp = 0;
+    scaleind_deck(&d, &r);
+    assert_int_equal(0, r.has_deck_c);
+    assert_int_equal(1, d.sc.no_temp);
+    /* all three off: no lookup, nothing counted */
+    d.sc.compensate = 0;
     d.sc.no_temp = 0;
     scaleind_deck(&d, &r);
     assert_int_equal(0, r.has_deck_c);
@@ -291,11 +298,73 @@ static void test_no_temperature_is_skipped(void **state)
     close_daemon(&d);
 }
 
+/* The weight the STD and mean rules are fed (daemon.indicators.temperature):
+ * the GVW at the calibration temperature by the prior slopes before the
+ * scale indicator's baseline, by its fitted slopes after; raw without a
+ * deck temperature (counted) and when the setting is raw. */
+static void test_std_rules_compensated(void **state)
+{
+    fixture *f = *state;
+    daemon_s d;
+    open_daemon(&d, f->dir, "comp", 1);
+    const amfi_scale_params *p = &d.sc.params;
+    assert_int_equal(1, d.sc.compensate); /* the default */
+    amfi_passage_row r;
+    memset(&r, 0, sizeof r);
+    r.gvw_kg = 10000.0;
+    r.has_deck_c = 1;
+    /* prior slopes (0.0025 warm, 0.018 frost, knee 0, floor -10, ref 10 °C) */
+    const double t[5] = {30.0, 10.0, 0.0, -5.0, -25.0};
+    const double want[5] = {10000.0 * exp(-0.0025 * 20.0), 10000.0,
+                            10000.0 * exp(0.0025 * 10.0),
+                            10000.0 * exp(0.0025 * 10.0 + 0.018 * 5.0),
+                            10000.0 * exp(0.0025 * 10.0 + 0.018 * 10.0)};
+    for (int k = 0; k < 5; k++) {
+        r.deck_c = t[k];
+        scaleind_comp(&d, &r);
+        assert_float_equal(want[k], r.gvw_comp_kg, 1e-6);
+    }
+    assert_true(fabs(p->warm_slope - 0.0025) < 1e-12 && fabs(p->frost_slope - 0.018) < 1e-12);
+    assert_int_equal(5, d.sc.comp_fed);
+    /* no deck temperature: raw, counted */
+    r.has_deck_c = 0;
+    scaleind_comp(&d, &r);
+    assert_float_equal(10000.0, r.gvw_comp_kg, 0);
+    assert_int_equal(1, d.sc.comp_raw);
+    /* after the scale baseline: the fitted slopes */
+    amfi_passage_row q;
+    for (int64_t k = 0; !amfi_scale_has_baseline(d.sc.scale); k++) {
+        memset(&q, 0, sizeof q);
+        q.utime = T0 + k * MIN_US;
+        q.n_vehicles = 1;
+        q.gvw_kg = (k % 2 ? 12000.0 : 6000.0) + 300.0 * gauss((uint64_t)k);
+        scaleind_deck(&d, &q);
+        assert_int_equal(1, q.has_deck_c);
+        scaleind_feed(&d, &q);
+        assert_true(k < 1000);
+    }
+    amfi_scale_model m;
+    assert_int_equal(AMFI_IND_OK, amfi_scale_get_model(d.sc.scale, &m));
+    r.has_deck_c = 1;
+    r.deck_c = -5.0;
+    scaleind_comp(&d, &r);
+    assert_float_equal(amfi_scale_temp_factor(p, m.warm_slope, m.frost_slope, -5.0) * 10000.0,
+                       r.gvw_comp_kg, 1e-6);
+    /* raw: the GVW, nothing counted */
+    d.sc.compensate = 0;
+    scaleind_comp(&d, &r);
+    assert_float_equal(10000.0, r.gvw_comp_kg, 0);
+    assert_int_equal(6, d.sc.comp_fed);
+    assert_int_equal(1, d.sc.comp_raw);
+    close_daemon(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_restart_continues_exactly, setup, teardown),
         cmocka_unit_test_setup_teardown(test_no_temperature_is_skipped, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_std_rules_compensated, setup, teardown),
     };
     amfid_log_stream = fopen("/dev/null", "w");
     int rc = cmocka_run_group_tests(tests, NULL, NULL);

@@ -817,19 +817,20 @@ static void test_runs_and_migration_from_v1(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
                  "DELETE FROM schema_migrations WHERE version >= 2; PRAGMA user_version = 1");
     sqlite3_close(db);
 
     /* read-only openers do not migrate: they say so */
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 1 is older than this program's 7"));
+    assert_non_null(strstr(err, "schema version 1 is older than this program's 8"));
     assert_null(ro);
 
     /* read-write: migrated, the data kept */
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM runs"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
     sqlite3_close(db);
@@ -878,17 +879,18 @@ static void test_speed_given_and_migration_from_v2(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
                  "DELETE FROM schema_migrations WHERE version >= 3; PRAGMA user_version = 2");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 2 is older than this program's 7"));
+    assert_non_null(strstr(err, "schema version 2 is older than this program's 8"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE speed_given_mps = 25.0 "
                                     "AND speed_mps = 25.0 AND speed_estimated = 0"));
     sqlite3_close(db);
@@ -938,17 +940,18 @@ static void test_event_columns_and_migration_from_v3(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
                  "DELETE FROM schema_migrations WHERE version >= 4; PRAGMA user_version = 3");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 3 is older than this program's 7"));
+    assert_non_null(strstr(err, "schema version 3 is older than this program's 8"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages WHERE n_vehicles = 1 "
                                     "AND quality IS NULL"));
     sqlite3_close(db);
@@ -1040,16 +1043,17 @@ static void test_environment_and_migration_from_v4(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
                  "DELETE FROM schema_migrations WHERE version >= 5; PRAGMA user_version = 4");
     sqlite3_close(db);
     amfi_store *ro = NULL;
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 4 is older than this program's 7"));
+    assert_non_null(strstr(err, "schema version 4 is older than this program's 8"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM environment"));
     sqlite3_close(db);
     assert_int_equal(0, amfi_store_add_environment(f->s, rows, 2, err, sizeof err));
@@ -1178,16 +1182,17 @@ static void test_scale_rows_and_migration_from_v5(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
                  "DELETE FROM schema_migrations WHERE version >= 6; PRAGMA user_version = 5");
     sqlite3_close(db);
     amfi_store *ro = NULL;
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 5 is older than this program's 7"));
+    assert_non_null(strstr(err, "schema version 5 is older than this program's 8"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE deck_c IS NULL AND "
                                     "reference_gvw_kg IS NULL"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM scale_evals"));
@@ -1285,15 +1290,16 @@ static void test_f1_and_migration_from_v6(void **state)
     /* make it a version-6 file, as amfid before the natural frequency left it */
     raw_exec(db, "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
                  "DELETE FROM schema_migrations WHERE version >= 7; PRAGMA user_version = 6");
     sqlite3_close(db);
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 6 is older than this program's 7"));
+    assert_non_null(strstr(err, "schema version 6 is older than this program's 8"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(7, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(7, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE f1_hz IS NULL"));
     sqlite3_close(db);
     assert_int_equal(0, amfi_store_f1_series(f->s, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err,
@@ -1308,6 +1314,65 @@ static void test_f1_and_migration_from_v6(void **state)
                                              sizeof err));
     assert_int_equal(1, n);
     free(a);
+}
+
+/* ---- version 8: the weight the STD and mean rules were fed; a version-7 file --- */
+
+static void test_gvw_comp_and_migration_from_v7(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    amfi_passage_row r;
+    double g[8];
+    int n = -1;
+    sqlite3 *db;
+
+    ok_row(&r, 1, DAY_US, 10000.0); /* memset: gvw_comp_kg 0, did not feed (NULL) */
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    ok_row(&r, 2, DAY_US + 1000, 11000.0);
+    r.gvw_comp_kg = 10890.0; /* compensated */
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    ok_row(&r, 3, DAY_US + 2000, 12000.0);
+    r.gvw_comp_kg = NAN; /* NaN: NULL as well */
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    /* refused, naming the field */
+    r.gvw_comp_kg = -5.0;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.gvw_comp_kg"));
+    r.gvw_comp_kg = 2e6;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.gvw_comp_kg"));
+    r.gvw_comp_kg = INFINITY;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.gvw_comp_kg"));
+    /* the rolling window's refill: the weight fed where stored, else the GVW */
+    assert_int_equal(0, amfi_store_recent_ok_gvw(f->s, 8, g, &n, err, sizeof err));
+    assert_int_equal(3, n);
+    assert_float_equal(10000.0, g[0], 0);
+    assert_float_equal(10890.0, g[1], 0);
+    assert_float_equal(12000.0, g[2], 0);
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    db = raw_open(f->path);
+    assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages WHERE gvw_comp_kg IS NULL"));
+    /* the schema refuses what the checks refuse */
+    assert_int_not_equal(SQLITE_OK,
+                         sqlite3_exec(db, "UPDATE passages SET gvw_comp_kg = 0 WHERE vehicle_id = 2",
+                                      NULL, NULL, NULL));
+    /* make it a version-7 file, as amfid before compensated rules left it */
+    raw_exec(db, "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
+                 "DELETE FROM schema_migrations WHERE version >= 8; PRAGMA user_version = 7");
+    sqlite3_close(db);
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE gvw_comp_kg IS NULL"));
+    sqlite3_close(db);
+    /* rows of before: their GVW is what the rules were fed */
+    assert_int_equal(0, amfi_store_recent_ok_gvw(f->s, 8, g, &n, err, sizeof err));
+    assert_int_equal(3, n);
+    assert_float_equal(11000.0, g[1], 0);
 }
 
 /* ---- what amfid and amfi-report read back ------------------------------------ */
@@ -1748,6 +1813,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_scale_rows_and_migration_from_v5, setup, teardown),
         cmocka_unit_test_setup_teardown(test_speed_given_and_migration_from_v2, setup, teardown),
         cmocka_unit_test_setup_teardown(test_f1_and_migration_from_v6, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_gvw_comp_and_migration_from_v7, setup, teardown),
         cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
         cmocka_unit_test_setup_teardown(test_many_passages, setup, teardown),
