@@ -12,7 +12,8 @@
  *   amfi-year-sim [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]
  *                 [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]
  *                 [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]
- *                 [--std-compensated]
+ *                 [--std-raw] [--scale-block B] [--scale-baseline-blocks N]
+ *                 [--scale-design D] [--baseline-n N]
  *
  * Stream model (kg). A run starts on a random day of the year (commissioning)
  * and lasts 365 days. Vehicles arrive uniformly within each day, --flow a
@@ -30,22 +31,34 @@
  * (issue 14).
  *
  * Indicators: amfid's engine with amfi_indicator_params_default (the STD
- * rule "std_increase", warning, and the mean rule "mean_shift", info); the
- * automatic baseline is the first baseline_n vehicles after commissioning.
+ * rule "std_increase", warning, and the mean rule "mean_shift", info; the
+ * automatic baseline is the first baseline_n vehicles after commissioning,
+ * --baseline-n), fed as amfid feeds them by default
+ * (daemon.indicators.temperature: compensated): each weight brought to the
+ * calibration temperature by the scale indicator's temperature model, its
+ * fitted slopes once its baseline exists, its prior slopes before; --std-raw
+ * feeds them the raw weights (the paper's rule as it stood).
  * The scale indicator with amfi_scale_params_default (vehicles_per_day =
- * --flow; --scale-fa its target), fed each vehicle's deck temperature (drift
- * off: a constant 10 °C). Known truck: --truck-runs runs a week (default 1;
+ * --flow; --scale-fa its target; --scale-block, --scale-baseline-blocks and
+ * --scale-design as a site or a test sets them), fed each vehicle's deck
+ * temperature (drift off: a constant 10 °C). Known truck: --truck-runs runs a week (default 1;
  * every 7 / N days from the third day, between 8 and 16 h) of a 14 t truck, inferred = (14 t + e) / ((1 − d) ·
  * f(T_deck)) with the same e, amfi_known_truck_params_default with run_sd =
  * --meas-sd / 14 t, the prior temperature slopes.
  *
- * False alarms: --years healthy runs; every raise of a kind is a false alarm
- * of that kind; printed per healthy year (the mean over runs).
+ * Baselines take T0 days: the larger of 30 days (the known truck's 4 weekly
+ * runs) and 1.2 × the vehicles of the longer baseline (the STD rule's
+ * baseline_n, the scale indicator's block × baseline blocks) / --flow (30 at
+ * the default 2000 a day; 436 at 55 a day).
+ * False alarms: --years healthy runs of T0 + 335 days (365 at the default
+ * flow: the baselines and at least a year watched after them); every raise
+ * of a kind is a false alarm of that kind; printed per healthy run (a year
+ * watched; the mean over runs).
  * Detection: --det-runs runs per damage level, the damage starting at a
- * uniformly random time in days [30, 335) of the run (after the baseline);
- * delay = vehicles (known truck: runs) and days from the damage to each
- * warning kind's first raise after it, or "not within" the rest of the run
- * plus 120 days. A run whose alert is raised before the damage is counted
+ * uniformly random time in days [T0, T0 + 305) of the run (after the
+ * baselines); delay = vehicles (known truck: runs) and days from the damage
+ * to each warning kind's first raise after it, or "not within" the rest of
+ * the run (T0 + 455 days). A run whose alert is raised before the damage is counted
  * as false and still runs on (the raise must happen again after a clear to
  * count).
  *
@@ -88,9 +101,12 @@ typedef struct {
     int mix_probe;   /* --mix-probe */
     double prior_scale; /* --prior-scale: the temperature model's prior slopes × this */
     int truck_runs;     /* --truck-runs: known-truck runs a week */
-    int std_comp;       /* --std-compensated: the STD/mean engine gets temperature-
-                           compensated weights (the scale model's slopes once
-                           fitted, its prior slopes before) */
+    int std_comp;       /* the STD/mean engine gets temperature-compensated weights
+                           (the scale model's slopes once fitted, its prior
+                           slopes before); 0: --std-raw */
+    int scale_block, scale_blocks; /* --scale-block, --scale-baseline-blocks (0: default) */
+    double scale_design;           /* --scale-design (0: default) */
+    int baseline_n;                /* --baseline-n: the STD rule's baseline (0: default) */
 } opts;
 
 /* One run's world: the climate, the calendar, the damage. */
@@ -174,6 +190,14 @@ static engines make(const opts *o)
     amfi_indicator_params_default(&p);
     amfi_scale_params_default(&sp);
     sp.vehicles_per_day = o->flow;
+    if (o->baseline_n > 0)
+        p.baseline_n = o->baseline_n;
+    if (o->scale_block > 0)
+        sp.block = o->scale_block;
+    if (o->scale_blocks > 0)
+        sp.baseline_blocks = o->scale_blocks;
+    if (o->scale_design > 0)
+        sp.design_shift = o->scale_design;
     if (o->scale_fa > 0)
         sp.false_alarms_per_year = o->scale_fa;
     sp.warm_slope *= o->prior_scale;
@@ -334,20 +358,35 @@ static double quantile(double *v, long n, double q) /* v sorted; nearest rank */
     return v[k];
 }
 
+/* T0: the days the baselines take (see the head of the file). */
+static double baseline_days(const opts *o)
+{
+    amfi_indicator_params p;
+    amfi_scale_params sp;
+    amfi_indicator_params_default(&p);
+    amfi_scale_params_default(&sp);
+    const double nb = o->baseline_n > 0 ? o->baseline_n : p.baseline_n;
+    const double ns = (double)(o->scale_block > 0 ? o->scale_block : sp.block) *
+                      (o->scale_blocks > 0 ? o->scale_blocks : sp.baseline_blocks);
+    const double d = 1.2 * (nb > ns ? nb : ns) / o->flow;
+    return d > 30.0 ? ceil(d) : 30.0;
+}
+
 static void evaluate(const opts *o, gsl_rng *rng, int drift)
 {
+    const double t0 = baseline_days(o);
     long fa[N_KIND] = {0}, vehicles = 0;
     world w;
     outcome oc;
     const char *dn = drift ? "on" : "off";
     for (long y = 0; y < o->years; y++) {
         world_start(&w, rng, drift);
-        vehicles += run(&w, o, 365.0, &oc);
+        vehicles += run(&w, o, t0 + 335.0, &oc);
         for (int k = 0; k < N_KIND; k++)
             fa[k] += oc.fa[k];
     }
     for (int k = 0; k < N_KIND; k++)
-        printf("| %s | %s | healthy | %ld years, %.0f vehicles/year | %.2f/year | | | | |\n",
+        printf("| %s | %s | healthy | %ld years, %.0f vehicles/run | %.2f/year | | | | |\n",
                kind_name[k], dn, o->years, (double)vehicles / (double)o->years,
                (double)fa[k] / (double)o->years);
     fflush(stdout);
@@ -367,8 +406,8 @@ static void evaluate(const opts *o, gsl_rng *rng, int drift)
         for (long r = 0; r < o->det_runs; r++) {
             world_start(&w, rng, drift);
             w.damage = o->damage[d];
-            w.damage_t_s = (30.0 + gsl_rng_uniform(rng) * 305.0) * DAY_S;
-            (void)run(&w, o, 365.0 + 120.0, &oc);
+            w.damage_t_s = (t0 + gsl_rng_uniform(rng) * 305.0) * DAY_S;
+            (void)run(&w, o, t0 + 455.0, &oc);
             for (int j = 0; j < NK; j++) {
                 const int k = kinds[j];
                 early[j] += oc.fa[k] > 0;
@@ -609,7 +648,8 @@ static void usage(FILE *f)
             "usage: %s [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]\n"
             "       [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]\n"
             "       [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]\n"
-            "       [--std-compensated]\n"
+            "       [--std-raw] [--scale-block B] [--scale-baseline-blocks N]\n"
+            "       [--scale-design D] [--baseline-n N]\n"
             "A year of traffic with the site climate and the drifting mix, watched by\n"
             "amfid's indicator engine: false alarms per healthy year, detection delays.\n"
             "  --seed S          generator seed (default 1)\n"
@@ -624,8 +664,12 @@ static void usage(FILE *f)
             "  --prior-scale F   temperature model's prior slopes × F (default 1: the\n"
             "                    simulator's own law)\n"
             "  --truck-runs N    known-truck runs a week, 1 .. 7 (default 1)\n"
-            "  --std-compensated the STD and mean rules get temperature-compensated\n"
-            "                    weights (the scale model's slopes; its prior before)\n"
+            "  --std-raw         the STD and mean rules get the raw weights (default: as\n"
+            "                    amfid, weights at the calibration temperature)\n"
+            "  --scale-block B   the scale indicator's block (default: its own, 500)\n"
+            "  --scale-baseline-blocks N  its baseline blocks (default 40)\n"
+            "  --scale-design D  the stiffness loss its CUSUM is tuned for (default 0.025)\n"
+            "  --baseline-n N    the STD rule's baseline, vehicles (default 10000)\n"
             "  -h, --help        this help\n"
             "  -V, --version     print the version\n",
             PROG);
@@ -635,10 +679,11 @@ int main(int argc, char **argv)
 {
     opts o = {.seed = 1, .years = 20, .det_runs = 20, .flow = 2000, .meas_sd = 300.0,
               .n_damage = 3, .damage = {0.025, 0.05, 0.10}, .drift_on = 1, .drift_off = 1,
-              .prior_scale = 1.0, .truck_runs = 1};
+              .prior_scale = 1.0, .truck_runs = 1, .std_comp = 1};
     enum {
         O_SEED = 256, O_YEARS, O_DET_RUNS, O_FLOW, O_DAMAGE, O_MEAS_SD, O_DRIFT, O_SCALE_FA,
-        O_MIX_PROBE, O_PRIOR_SCALE, O_TRUCK_RUNS, O_STD_COMP
+        O_MIX_PROBE, O_PRIOR_SCALE, O_TRUCK_RUNS, O_STD_RAW, O_SCALE_BLOCK, O_SCALE_BLOCKS,
+        O_SCALE_DESIGN, O_BASELINE_N
     };
     static const struct option longopts[] = {
         {"seed", required_argument, NULL, O_SEED},
@@ -652,7 +697,11 @@ int main(int argc, char **argv)
         {"mix-probe", no_argument, NULL, O_MIX_PROBE},
         {"prior-scale", required_argument, NULL, O_PRIOR_SCALE},
         {"truck-runs", required_argument, NULL, O_TRUCK_RUNS},
-        {"std-compensated", no_argument, NULL, O_STD_COMP},
+        {"std-raw", no_argument, NULL, O_STD_RAW},
+        {"scale-block", required_argument, NULL, O_SCALE_BLOCK},
+        {"scale-baseline-blocks", required_argument, NULL, O_SCALE_BLOCKS},
+        {"scale-design", required_argument, NULL, O_SCALE_DESIGN},
+        {"baseline-n", required_argument, NULL, O_BASELINE_N},
         AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -669,7 +718,11 @@ int main(int argc, char **argv)
         case O_MEAS_SD: o.meas_sd = 1000.0 * amfi_cli_num(&c, v, 0, 10); break;
         case O_SCALE_FA: o.scale_fa = amfi_cli_num(&c, v, 1e-4, 1000); break;
         case O_MIX_PROBE: o.mix_probe = 1; break;
-        case O_STD_COMP: o.std_comp = 1; break;
+        case O_STD_RAW: o.std_comp = 0; break;
+        case O_SCALE_BLOCK: o.scale_block = (int)amfi_cli_integer(&c, v, 50, 1e6); break;
+        case O_SCALE_BLOCKS: o.scale_blocks = (int)amfi_cli_integer(&c, v, 4, 1e5); break;
+        case O_SCALE_DESIGN: o.scale_design = amfi_cli_num(&c, v, 1e-3, 0.49); break;
+        case O_BASELINE_N: o.baseline_n = (int)amfi_cli_integer(&c, v, 10, 1e6); break;
         case O_PRIOR_SCALE: o.prior_scale = amfi_cli_num(&c, v, 0, 5); break;
         case O_TRUCK_RUNS: o.truck_runs = (int)amfi_cli_integer(&c, v, 1, 7); break;
         case O_DRIFT:
