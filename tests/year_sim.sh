@@ -33,6 +33,11 @@ for d in off on; do
   runs=$(echo "$row" | awk -F'|' '{gsub(/ /, "", $8); print $8}')
   awk -v x="$runs" 'BEGIN { exit !(x >= 1 && x <= 3) }' || fail "known_truck, drift $d: p95 $runs runs"
 done
+# one drift at a time: the rows say which
+for d in temperature mix; do
+  "$ys" --years 1 --det-runs 1 --damage 0.1 --seed 3 --drift $d >"$work/$d.md" 2>/dev/null || fail "--drift $d"
+  [ "$(grep -c "^| [a-z_]* | $d | " "$work/$d.md")" -eq 7 ] || fail "--drift $d: $(cat "$work/$d.md")"
+done
 "$ys" --years 1 --det-runs 3 --damage 0.1 --seed 3 >"$work/b.md" 2>/dev/null
 cmp -s "$work/a.md" "$work/b.md" || fail "the same seed gave another table"
 for bad in "--drift sideways" "--damage 0.9" "--years 0" "--scale-fa 0" "--truck-runs 8" "--scale-block 10" \

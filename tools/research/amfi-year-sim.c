@@ -10,7 +10,8 @@
  * the environment on and off (issue 14, docs/results/year-evaluation.md).
  *
  *   amfi-year-sim [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]
- *                 [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]
+ *                 [--damage P1,P2,...] [--meas-sd T]
+ *                 [--drift on|off|both|temperature|mix]
  *                 [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]
  *                 [--std-raw] [--scale-block B] [--scale-baseline-blocks N]
  *                 [--scale-design D] [--baseline-n N]
@@ -89,6 +90,10 @@
 #define DAY_S 86400.0
 #define TRUCK_KG 14000.0 /* the known truck's reference GVW: a loaded two-axle truck */
 #define DECK_OFF_C 10.0 /* drift off: a constant deck at the modulus law's reference */
+/* What drifts in a run (--drift): the deck temperature (the bridge's
+ * modulus), the traffic mix (the loaded share and the weekday flow). */
+#define DRIFT_TEMP 1
+#define DRIFT_MIX 2
 
 typedef struct {
     unsigned long seed;
@@ -96,7 +101,7 @@ typedef struct {
     double flow, meas_sd;
     int n_damage;
     double damage[MAX_DAMAGE];
-    int drift_on, drift_off;
+    int n_modes, modes[2];  /* --drift: the drift masks evaluated, in order */
     double scale_fa; /* --scale-fa: the scale indicator's target false alarms a year (0: default) */
     int mix_probe;   /* --mix-probe */
     double prior_scale; /* --prior-scale: the temperature model's prior slopes × this */
@@ -112,7 +117,7 @@ typedef struct {
 /* One run's world: the climate, the calendar, the damage. */
 typedef struct {
     gsl_rng *rng;
-    int drift;
+    int drift;         /* DRIFT_TEMP | DRIFT_MIX */
     amfi_env_state env;
     amfi_mix_params mix;
     double day0;       /* day of the year at run time 0 */
@@ -135,14 +140,15 @@ static double draw_gvw(gsl_rng *rng, double share)
 static double true_gvw(world *w, double t_s)
 {
     return draw_gvw(w->rng,
-                    w->drift ? amfi_mix_loaded_share(&w->mix, w->day0 + t_s / DAY_S) : 0.5);
+                    (w->drift & DRIFT_MIX) ? amfi_mix_loaded_share(&w->mix, w->day0 + t_s / DAY_S)
+                                           : 0.5);
 }
 
 static double inferred(world *w, double t_s, double meas_sd)
 {
     double f = 1.0;
     w->deck_c = DECK_OFF_C;
-    if (w->drift) {
+    if (w->drift & DRIFT_TEMP) {
         amfi_env_advance(&w->env, t_s);
         f = amfi_env_modulus_factor(&w->env.p, w->env.deck_c);
         w->deck_c = w->env.deck_c;
@@ -229,7 +235,7 @@ static void unmake(engines *e)
 static int truck_run(engines *e, world *w, double t_s, double meas_sd)
 {
     double f = 1.0;
-    if (w->drift)
+    if (w->drift & DRIFT_TEMP)
         f = amfi_env_modulus_factor(&w->env.p, w->env.deck_c);
     const double d = t_s >= w->damage_t_s ? w->damage : 0.0;
     const double g = (TRUCK_KG + gsl_ran_gaussian_ziggurat(w->rng, meas_sd)) / ((1.0 - d) * f);
@@ -300,7 +306,7 @@ static long run(world *w, const opts *o, double days, outcome *out)
         /* --flow is the mean over a week: with drift on the weekdays carry
          * more, the weekend days the mix's weekend factor of a weekday */
         const double flow =
-            w->drift ? o->flow * 7.0 / (5.0 + 2.0 * w->mix.weekend_flow) *
+            (w->drift & DRIFT_MIX) ? o->flow * 7.0 / (5.0 + 2.0 * w->mix.weekend_flow) *
                            amfi_mix_flow_factor(&w->mix, w->day0 + day)
                      : o->flow;
         const long n = (long)floor(flow + gsl_rng_uniform(w->rng));
@@ -378,7 +384,8 @@ static void evaluate(const opts *o, gsl_rng *rng, int drift)
     long fa[N_KIND] = {0}, vehicles = 0;
     world w;
     outcome oc;
-    const char *dn = drift ? "on" : "off";
+    static const char *const names[4] = {"off", "temperature", "mix", "on"};
+    const char *dn = names[drift & 3];
     for (long y = 0; y < o->years; y++) {
         world_start(&w, rng, drift);
         vehicles += run(&w, o, t0 + 335.0, &oc);
@@ -646,7 +653,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: %s [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]\n"
-            "       [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both]\n"
+            "       [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both|temperature|mix]\n"
             "       [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]\n"
             "       [--std-raw] [--scale-block B] [--scale-baseline-blocks N]\n"
             "       [--scale-design D] [--baseline-n N]\n"
@@ -658,7 +665,8 @@ static void usage(FILE *f)
             "  --flow N          vehicles per weekday (default 2000)\n"
             "  --damage LIST     stiffness losses, fractions (default 0.025,0.05,0.10)\n"
             "  --meas-sd T       per-vehicle error, t (default 0.3)\n"
-            "  --drift WHICH     temperature and mix drift on, off or both (default both)\n"
+            "  --drift WHICH     temperature and mix drift on, off or both (default both);\n"
+            "                    temperature or mix: only that one drifts\n"
             "  --scale-fa F      scale indicator's target false alarms a year (default: its own)\n"
             "  --mix-probe       only: how each scale estimator moves with the loaded share\n"
             "  --prior-scale F   temperature model's prior slopes × F (default 1: the\n"
@@ -678,7 +686,7 @@ static void usage(FILE *f)
 int main(int argc, char **argv)
 {
     opts o = {.seed = 1, .years = 20, .det_runs = 20, .flow = 2000, .meas_sd = 300.0,
-              .n_damage = 3, .damage = {0.025, 0.05, 0.10}, .drift_on = 1, .drift_off = 1,
+              .n_damage = 3, .damage = {0.025, 0.05, 0.10}, .n_modes = 2, .modes = {0, DRIFT_TEMP | DRIFT_MIX},
               .prior_scale = 1.0, .truck_runs = 1, .std_comp = 1};
     enum {
         O_SEED = 256, O_YEARS, O_DET_RUNS, O_FLOW, O_DAMAGE, O_MEAS_SD, O_DRIFT, O_SCALE_FA,
@@ -726,11 +734,23 @@ int main(int argc, char **argv)
         case O_PRIOR_SCALE: o.prior_scale = amfi_cli_num(&c, v, 0, 5); break;
         case O_TRUCK_RUNS: o.truck_runs = (int)amfi_cli_integer(&c, v, 1, 7); break;
         case O_DRIFT:
-            if (!strcmp(v, "on") || !strcmp(v, "off") || !strcmp(v, "both")) {
-                o.drift_on = strcmp(v, "off") != 0;
-                o.drift_off = strcmp(v, "on") != 0;
-            } else {
-                amfi_cli_fail(&c, "'%s' is not on, off or both", amfi_cli_shown(v));
+            o.n_modes = 1;
+            if (!strcmp(v, "both"))
+                o.n_modes = 2; /* off, then on */
+            else if (!strcmp(v, "on"))
+                o.modes[0] = DRIFT_TEMP | DRIFT_MIX;
+            else if (!strcmp(v, "off"))
+                o.modes[0] = 0;
+            else if (!strcmp(v, "temperature"))
+                o.modes[0] = DRIFT_TEMP;
+            else if (!strcmp(v, "mix"))
+                o.modes[0] = DRIFT_MIX;
+            else
+                amfi_cli_fail(&c, "'%s' is not on, off, both, temperature or mix",
+                              amfi_cli_shown(v));
+            if (o.n_modes == 2) {
+                o.modes[0] = 0;
+                o.modes[1] = DRIFT_TEMP | DRIFT_MIX;
             }
             break;
         }
@@ -748,10 +768,8 @@ int main(int argc, char **argv)
     printf("| indicator | drift | damage | runs | false alarms | median delay (vehicles; "
            "known_truck: runs) | p95 (vehicles; runs) | median delay (days) | p95 (days) |\n"
            "|---|---|---|---|---|---|---|---|---|\n");
-    if (o.drift_off)
-        evaluate(&o, rng, 0);
-    if (o.drift_on)
-        evaluate(&o, rng, 1);
+    for (int m = 0; m < o.n_modes; m++)
+        evaluate(&o, rng, o.modes[m]);
     fprintf(stderr, "%s: %.1f s CPU\n", PROG, (double)(clock() - c0) / CLOCKS_PER_SEC);
     gsl_rng_free(rng);
     return 0;
