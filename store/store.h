@@ -395,6 +395,10 @@ int amfi_store_passage_summary(amfi_store *s, amfi_passage_summary *out,
  * when *n is 0). A value outside (0, 1e6] kg is AMFI_STORE_ECORRUPT. */
 int amfi_store_all_ok_gvw(amfi_store *s, double **gvw, size_t *n, char *err,
                           size_t errlen);
+/* The same of the weights the STD and mean rules were fed
+ * (passages.gvw_comp_kg not NULL, store version 8). */
+int amfi_store_all_fed_gvw(amfi_store *s, double **gvw, size_t *n, char *err,
+                           size_t errlen);
 
 /* An indicator row read back: row.state is a static string. */
 typedef struct amfi_indicator_rec {

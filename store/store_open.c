@@ -82,6 +82,8 @@ static const char *const stmt_sql[N_STMT] = {
     [ST_PASSAGE_SPAN] = "SELECT count(*), min(utime), max(utime) FROM passages",
     [ST_PASSAGE_BY_STATUS] = "SELECT status, count(*) FROM passages GROUP BY status",
     [ST_ALL_OK_GVW] = "SELECT id, gvw_kg FROM passages WHERE status = 'ok'",
+    [ST_ALL_FED_GVW] = "SELECT id, gvw_comp_kg FROM passages WHERE status = 'ok' "
+                       "AND gvw_comp_kg IS NOT NULL",
     [ST_RECENT_INDICATORS] =
         "SELECT id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, "
         "std_ratio, p_value, state FROM indicators ORDER BY utime DESC, id DESC "

@@ -148,8 +148,9 @@ int amfi_store_passage_summary(amfi_store *s, amfi_passage_summary *out,
     return rc;
 }
 
-int amfi_store_all_ok_gvw(amfi_store *s, double **gvw, size_t *n, char *err,
-                          size_t errlen)
+/* The weights of statement `which` (id, weight), each in (0, 1e6] kg. */
+static int all_weights(amfi_store *s, int which, double **gvw, size_t *n, char *err,
+                       size_t errlen)
 {
     vec g = {0};
     int rc = st_check_handle(s, 0, err, errlen), src = SQLITE_DONE;
@@ -157,7 +158,7 @@ int amfi_store_all_ok_gvw(amfi_store *s, double **gvw, size_t *n, char *err,
         rc = st_fail(err, errlen, AMFI_EINVAL, "ok GVW: output is NULL");
     if (rc != 0)
         return rc;
-    sqlite3_stmt *st = s->st[ST_ALL_OK_GVW];
+    sqlite3_stmt *st = s->st[which];
     while (rc == 0 && (src = sqlite3_step(st)) == SQLITE_ROW) {
         origin o = {"passages", sqlite3_column_int64(st, 0)};
         double x = 0;
@@ -171,6 +172,18 @@ int amfi_store_all_ok_gvw(amfi_store *s, double **gvw, size_t *n, char *err,
     rc = end_of(s, rc, src, "passages: read ok GVW", err, errlen);
     st_done_with(st);
     return vec_hand_over(&g, rc, gvw, n);
+}
+
+int amfi_store_all_ok_gvw(amfi_store *s, double **gvw, size_t *n, char *err,
+                          size_t errlen)
+{
+    return all_weights(s, ST_ALL_OK_GVW, gvw, n, err, errlen);
+}
+
+int amfi_store_all_fed_gvw(amfi_store *s, double **gvw, size_t *n, char *err,
+                           size_t errlen)
+{
+    return all_weights(s, ST_ALL_FED_GVW, gvw, n, err, errlen);
 }
 
 int amfi_store_recent_indicators(amfi_store *s, int max,

@@ -162,6 +162,9 @@ grep -Eq "^scale +[0-9]+ blocks, newest .* CUSUM [0-9.]+ of [0-9.]+, alert; all 
   fail "report: $(cat "$dir/report.txt")"
 grep -Eq "^known truck +[0-9]+ runs, ratio inferred/reference \(compensated\) mean " "$dir/report.txt" ||
   fail "report: $(cat "$dir/report.txt")"
+fed=$(q "SELECT count(*) FROM passages WHERE status = 'ok'")
+grep -Eq "^GVW, fed +n $fed, mean [0-9]+ kg, STD [0-9]+ kg, .*\(the STD and mean rules' input" "$dir/report.txt" ||
+  fail "report: no line of the STD rule's input: $(cat "$dir/report.txt")"
 if command -v gnuplot > /dev/null; then
   "$report" --db "$dir/a.db" --plot "$dir/plots" > "$dir/plot.txt" 2>&1 || fail "--plot: $(cat "$dir/plot.txt")"
   for p in scale known_truck temperature; do

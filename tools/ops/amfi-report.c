@@ -470,7 +470,8 @@ static int section_summary(amfi_store *s)
                sum.total ? 100.0 * (double)sum.by_status[k] / (double)sum.total : 0.0);
     if (amfi_store_all_ok_gvw(s, &g, &ng, err, sizeof err) != 0)
         return data_error("%s", err);
-    double mean, std;
+    double mean = 0, std = 0;
+    const size_t n_ok = ng;
     if (ng == 0) {
         out("GVW, ok      (no ok passages)\n");
     } else {
@@ -480,6 +481,21 @@ static int section_summary(amfi_store *s)
                "median %.0f, max %.0f kg\n",
                ng, mean, num(std, "%.0f", a), g[0],
                report_percentile(g, ng, 50), g[ng - 1]);
+    }
+    free(g);
+    /* what the STD and mean rules were fed (at the calibration temperature
+     * with daemon.indicators.temperature: compensated), when it is not the
+     * raw GVW itself (no deck temperature, or raw) */
+    const double raw_mean = mean, raw_std = std;
+    if (amfi_store_all_fed_gvw(s, &g, &ng, err, sizeof err) != 0)
+        return data_error("%s", err);
+    if (ng > 0)
+        report_mean_std(g, ng, &mean, &std);
+    if (ng > 0 && (ng != n_ok || mean != raw_mean || !(std == raw_std || isnan(std)))) {
+        report_sort(g, ng);
+        out("GVW, fed     n %zu, mean %.0f kg, STD %s kg, min %.0f, median %.0f, max %.0f kg "
+            "(the STD and mean rules' input: compensated to the calibration temperature)\n",
+            ng, mean, num(std, "%.0f", a), g[0], report_percentile(g, ng, 50), g[ng - 1]);
     }
     free(g);
     report_intake in;
