@@ -57,6 +57,13 @@ typedef struct amfi_daemon_config {
                                  is at most this, s, [0, 600]; 0 = never (multiple) */
     int max_event_axles;      /* daemon.max_event_axles: axles of such an event,
                                  2 .. AMFI_MAX_AXLES */
+    double inseparable_gap_m; /* daemon.inseparable_gap_m: axles of two vehicles
+                                 closer than this load the beam at one point, m */
+    double inseparable_share; /* daemon.inseparable_share: a vehicle with an axle that
+                                 close to another's for at least this share of its
+                                 crossing is not separable (multiple), 0 .. 1 */
+    double inseparable_quality; /* daemon.inseparable_quality: a vehicle of an event
+                                 with a quality figure above this is not separable */
     int single_presence_only; /* daemon.indicators.single_presence_only: the
                                  indicators take only passages weighed alone */
     int ind_temp_compensated; /* daemon.indicators.temperature: 1 compensated

@@ -203,7 +203,7 @@ static int store_now(daemon_s *d, job *j)
     publish_passage(d, j, id, &r);
     if (j->speed_estimated)
         drift_feed(d, j->w.v.utime, r.speed_mps, r.speed_given_mps);
-    if (j->solved) {
+    if (j->solved && strcmp(j->status, "ok") == 0) { /* not an inseparable one's estimate */
         d->passages_ok++;
         if (feeds)
             feed_indicators(d, j, r.gvw_comp_kg);
@@ -334,14 +334,65 @@ static job *vehicle_job(const job *e, int i)
     return j;
 }
 
+/* Vehicle i of the solved event (or passage) e, weighed as j: when the
+ * data do not fix its own weight, status "multiple" with the reason, the
+ * joint estimate kept in the row (gvw, axles, quality: the sum is not lost)
+ * but not fed to the indicators. In order: another vehicle on the span in
+ * its window but outside its solve (the event cut down at a limit); an
+ * axle within daemon.inseparable_gap_m of another vehicle's for at least
+ * daemon.inseparable_share of its crossing (one point of the beam: only
+ * the two vehicles' sum is fixed, and it is given); a quality figure above
+ * daemon.inseparable_quality (its weight moves when λ is loosened). */
+static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
+{
+    if (!j->solved || strcmp(j->status, "ok") != 0)
+        return;
+    const amfi_daemon_config *c = &d->cfg.daemon;
+    if (e->w.outside[i]) {
+        snprintf(j->reason, sizeof j->reason,
+                 "inseparable: vehicle %lld was on the span inside its window but not weighed "
+                 "with it (event cut down at a limit); the weight misses that load",
+                 (long long)e->w.outside_id[i]);
+    } else if (e->w.n_vehicles > 1) {
+        amfi_nearness nr;
+        amfi_window_nearness(&e->w, d->cfg.bridge.span_m, c->inseparable_gap_m, i, &nr);
+        if (nr.other >= 0 && nr.share >= c->inseparable_share) {
+            const job_vehicle *o = &e->veh[nr.other];
+            char sum[64] = "";
+            if (o->solved)
+                snprintf(sum, sizeof sum, "; %.0f kg the two together", j->gvw_kg + o->gvw_kg);
+            snprintf(j->reason, sizeof j->reason,
+                     "inseparable: axles within %.2g m of vehicle %lld's for %.0f %% of its "
+                     "crossing (closest %.2f m)%s; the weight is the joint estimate",
+                     c->inseparable_gap_m, (long long)e->w.ev[nr.other].vehicle_id,
+                     100.0 * nr.share, nr.min_gap_m, sum);
+        } else if (j->quality > c->inseparable_quality) {
+            snprintf(j->reason, sizeof j->reason,
+                     "inseparable: its weight moves %.1f %% when λ is loosened tenfold (quality "
+                     "%.2f > %.2g); the %d vehicles weigh %.0f kg together",
+                     j->quality - 1.0, j->quality, c->inseparable_quality, e->w.n_vehicles,
+                     e->gvw_kg);
+        } else {
+            return;
+        }
+    } else {
+        return;
+    }
+    snprintf(j->status, sizeof j->status, "multiple");
+}
+
 /* Store a passage, or each vehicle of an event in entry order. Takes the job. */
 static int store_job(daemon_s *d, job *e)
 {
-    if (e->w.n_vehicles <= 1)
+    if (e->w.n_vehicles <= 1) {
+        mark_inseparable(d, e, 0, e);
         return store_one(d, e);
+    }
     int rc = 0;
     for (int i = 0; i < e->w.n_vehicles; i++) {
         job *j = vehicle_job(e, i);
+        if (j)
+            mark_inseparable(d, e, i, j);
         if (!j) {
             d->passages_lost++;
             set_error(d, "out of memory: passage of vehicle %lld at utime %lld LOST",

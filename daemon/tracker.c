@@ -143,6 +143,31 @@ static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, const am
     return 0;
 }
 
+/* A vehicle not of the event w on the span inside v's window (reach_of):
+ * a force v's solve does not know. */
+static int outside_window(const amfi_tracker *t, const amfi_vehicle_ev *v, const amfi_window *w,
+                          int64_t *other)
+{
+    span me = reach_of(t, v);
+    for (int i = 0; i < t->n_pend; i++) {
+        if (in_event(w, t->pend[i].vehicle_id))
+            continue;
+        span o = span_of(t, &t->pend[i]);
+        if (o.t_in < me.t_out && me.t_in < o.t_out) {
+            *other = o.id;
+            return 1;
+        }
+    }
+    for (int i = 0; i < t->n_recent; i++) {
+        const span *o = &t->recent[i];
+        if (!in_event(w, o->id) && o->t_in < me.t_out && me.t_in < o->t_out) {
+            *other = o->id;
+            return 1;
+        }
+    }
+    return 0;
+}
+
 /* Front axle position of v at time t_us (µs), m from the entry. */
 static double front_m(const amfi_vehicle_ev *v, double t_us)
 {
@@ -374,9 +399,69 @@ int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_
                          t->p.max_event_s > 0 ? ", already stored without it" : "");
                 break;
             }
+        if (t->p.max_event_s > 0 && strcmp(out->status, "ok") == 0)
+            for (int i = 0; i < out->n_vehicles; i++)
+                out->outside[i] = outside_window(t, &out->ev[i], out, &out->outside_id[i]);
     }
     if (rings[0] && amfi_ring_started(rings[0]))
         out->t_first_s = (amfi_ring_utime(rings[0], out->k0[0]) - (double)v->utime) * 1e-6;
     release(t, out);
     return 1;
+}
+
+/* Axle a's distance from the entry at time ts (s after w->v's entry). */
+static double axle_x(const amfi_vehicle_ev *v, double entry_s, const double *off, int a, double ts)
+{
+    return v->speed_mps * (ts - entry_s) - off[a];
+}
+
+void amfi_window_nearness(const amfi_window *w, double span_m, double gap_m, int i,
+                          amfi_nearness *out)
+{
+    out->other = -1;
+    out->share = 0.0;
+    out->min_gap_m = INFINITY;
+    if (i < 0 || i >= w->n_vehicles)
+        return;
+    double entry[AMFI_MAX_VEHICLES], off[AMFI_MAX_VEHICLES][AMFI_MAX_AXLES];
+    double t_in[AMFI_MAX_VEHICLES], t_out[AMFI_MAX_VEHICLES];
+    for (int k = 0; k < w->n_vehicles; k++) {
+        const amfi_vehicle_ev *v = &w->ev[k];
+        entry[k] = 1e-6 * (double)(v->utime - w->v.utime);
+        off[k][0] = 0.0;
+        for (int a = 1; a < v->n_axles; a++)
+            off[k][a] = off[k][a - 1] + v->spacing_m[a - 1];
+        t_in[k] = entry[k];
+        t_out[k] = entry[k] + (span_m + off[k][v->n_axles - 1]) / v->speed_mps;
+    }
+    const amfi_vehicle_ev *me = &w->ev[i];
+    const double dt = 1e-3, crossing = t_out[i] - t_in[i];
+    for (int k = 0; k < w->n_vehicles; k++) {
+        if (k == i || t_out[k] <= t_in[i] || t_in[k] >= t_out[i])
+            continue;
+        const amfi_vehicle_ev *o = &w->ev[k];
+        const double lo = fmax(t_in[i], t_in[k]), hi = fmin(t_out[i], t_out[k]);
+        long near = 0;
+        for (long s = 0; lo + ((double)s + 0.5) * dt < hi; s++) {
+            const double ts = lo + ((double)s + 0.5) * dt;
+            double best = INFINITY;
+            for (int a = 0; a < me->n_axles; a++) {
+                const double xa = axle_x(me, entry[i], off[i], a, ts);
+                if (xa < 0.0 || xa > span_m)
+                    continue;
+                for (int b = 0; b < o->n_axles; b++) {
+                    const double xb = axle_x(o, entry[k], off[k], b, ts);
+                    if (xb >= 0.0 && xb <= span_m)
+                        best = fmin(best, fabs(xa - xb));
+                }
+            }
+            out->min_gap_m = fmin(out->min_gap_m, best);
+            near += best < gap_m;
+        }
+        const double share = crossing > 0 ? fmin(1.0, (double)near * dt / crossing) : 0.0;
+        if (share > out->share || (out->other < 0 && near > 0)) {
+            out->share = share;
+            out->other = k;
+        }
+    }
 }

@@ -81,7 +81,23 @@ typedef struct amfi_window {
     int64_t free_k0[AMFI_MAX_SENSORS]; /* first free-vibration sample per sensor */
     int free_n;           /* samples per sensor */
     const char *free_why; /* "" or why there is none or it is cut short (static) */
+    /* per vehicle of an "ok" window (events on): 1 when a vehicle not weighed
+     * with it (outside_id) is on the span inside its window, a force its
+     * solve does not know (the event was cut down at a limit); else 0 */
+    int outside[AMFI_MAX_VEHICLES];
+    int64_t outside_id[AMFI_MAX_VEHICLES];
 } amfi_window;
+
+/* How close vehicle i of an event came to the others, axle by axle, while
+ * on the span (amfi_window_nearness). */
+typedef struct amfi_nearness {
+    int other;        /* index in ev[] of the vehicle with the largest share; −1 none */
+    double share;     /* of i's time on the span (first axle on to last off), 0 .. 1,
+                         during which one of its axles on the span is within gap_m of
+                         one of `other`'s on the span */
+    double min_gap_m; /* the least distance between an axle of i and one of another
+                         vehicle of the event, both on the span, m; INFINITY: never */
+} amfi_nearness;
 
 typedef struct amfi_tracker amfi_tracker;
 
@@ -99,5 +115,13 @@ int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, const char **why
 int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_window *out);
 
 int amfi_tracker_pending(const amfi_tracker *t);
+
+/* Vehicle i of window w against the event's other vehicles: axles of two
+ * vehicles within gap_m of each other load the beam at one point, which no
+ * sensor separates (only their sum): the share of i's crossing that lasts,
+ * for the worst other vehicle. Geometry only (the detector's entry times,
+ * speeds and spacings), sampled every millisecond. Pure; any thread. */
+void amfi_window_nearness(const amfi_window *w, double span_m, double gap_m, int i,
+                          amfi_nearness *out);
 
 #endif
