@@ -107,6 +107,7 @@ void amfi_config_defaults(amfi_site_config *c)
     d->inseparable_gap_m = 1.0;
     d->inseparable_share = 0.3;
     d->inseparable_quality = 5.0;
+    d->inseparable_quality_lanes = 3.0;
     d->single_presence_only = 0;
     d->ind_temp_compensated = 1;
     d->status_period_s = 1.0;

@@ -64,6 +64,8 @@ typedef struct amfi_daemon_config {
                                  crossing is not separable (multiple), 0 .. 1 */
     double inseparable_quality; /* daemon.inseparable_quality: a vehicle of an event
                                  with a quality figure above this is not separable */
+    double inseparable_quality_lanes; /* daemon.inseparable_quality_lanes: the same for
+                                 a vehicle of an event with vehicles of several lanes */
     int single_presence_only; /* daemon.indicators.single_presence_only: the
                                  indicators take only passages weighed alone */
     int ind_temp_compensated; /* daemon.indicators.temperature: 1 compensated

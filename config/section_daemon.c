@@ -110,6 +110,8 @@ const field daemon_fields[] = {
      .hi = 1, .flags = F_LO_OPEN},
     {.key = "inseparable_quality", .kind = &K_DOUBLE, .off = DC(inseparable_quality), .lo = 1,
      .hi = 1e9},
+    {.key = "inseparable_quality_lanes", .kind = &K_DOUBLE,
+     .off = DC(inseparable_quality_lanes), .lo = 1, .hi = 1e9},
     {.key = "status_period_s", .kind = &K_DOUBLE, .off = DC(status_period_s), .lo = 0.1,
      .hi = 3600},
     {.key = "indicators", .kind = &K_MAP, .aux = indicator_fields},

@@ -342,7 +342,9 @@ static job *vehicle_job(const job *e, int i)
  * axle within daemon.inseparable_gap_m of another vehicle's for at least
  * daemon.inseparable_share of its crossing (one point of the beam: only
  * the two vehicles' sum is fixed, and it is given); a quality figure above
- * daemon.inseparable_quality (its weight moves when λ is loosened). */
+ * daemon.inseparable_quality, or daemon.inseparable_quality_lanes in an
+ * event with vehicles of several lanes (its weight moves when λ is
+ * loosened). */
 static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
 {
     if (!j->solved || strcmp(j->status, "ok") != 0)
@@ -356,6 +358,10 @@ static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
     } else if (e->w.n_vehicles > 1) {
         amfi_nearness nr;
         amfi_window_nearness(&e->w, d->cfg.bridge.span_m, c->inseparable_gap_m, i, &nr);
+        int lanes = 1; /* 2: the event has vehicles of more than one lane */
+        for (int k = 1; k < e->w.n_vehicles; k++)
+            if (e->w.ev[k].lane != e->w.ev[0].lane)
+                lanes = 2;
         if (nr.other >= 0 && nr.share >= c->inseparable_share) {
             const job_vehicle *o = &e->veh[nr.other];
             char sum[64] = "";
@@ -366,12 +372,14 @@ static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
                      "crossing (closest %.2f m)%s; the weight is the joint estimate",
                      c->inseparable_gap_m, (long long)e->w.ev[nr.other].vehicle_id,
                      100.0 * nr.share, nr.min_gap_m, sum);
-        } else if (j->quality > c->inseparable_quality) {
+        } else if (j->quality > (lanes > 1 ? c->inseparable_quality_lanes
+                                           : c->inseparable_quality)) {
             snprintf(j->reason, sizeof j->reason,
                      "inseparable: its weight moves %.1f %% when λ is loosened tenfold (quality "
-                     "%.2f > %.2g); the %d vehicles weigh %.0f kg together",
-                     j->quality - 1.0, j->quality, c->inseparable_quality, e->w.n_vehicles,
-                     e->gvw_kg);
+                     "%.2f > %.2g%s); the %d vehicles weigh %.0f kg together",
+                     j->quality - 1.0, j->quality,
+                     lanes > 1 ? c->inseparable_quality_lanes : c->inseparable_quality,
+                     lanes > 1 ? ", vehicles of several lanes" : "", e->w.n_vehicles, e->gvw_kg);
         } else {
             return;
         }
