@@ -119,11 +119,9 @@ static int in_event(const amfi_window *w, int64_t id)
 }
 
 /* Another vehicle (pending or recently released), not of the event w, on
- * the span at the same time as v. */
-static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, const amfi_window *w,
-                       int64_t *other)
+ * the span during `me` (µs). */
+static int foreign_during(const amfi_tracker *t, span me, const amfi_window *w, int64_t *other)
 {
-    span me = span_of(t, v);
     for (int i = 0; i < t->n_pend; i++) {
         if (in_event(w, t->pend[i].vehicle_id))
             continue;
@@ -143,29 +141,19 @@ static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, const am
     return 0;
 }
 
-/* A vehicle not of the event w on the span inside v's window (reach_of):
- * a force v's solve does not know. */
+/* ... on the span at the same time as v. */
+static int overlapping(const amfi_tracker *t, const amfi_vehicle_ev *v, const amfi_window *w,
+                       int64_t *other)
+{
+    return foreign_during(t, span_of(t, v), w, other);
+}
+
+/* ... on the span inside v's window (reach_of): a force v's solve does not
+ * know. */
 static int outside_window(const amfi_tracker *t, const amfi_vehicle_ev *v, const amfi_window *w,
                           int64_t *other)
 {
-    span me = reach_of(t, v);
-    for (int i = 0; i < t->n_pend; i++) {
-        if (in_event(w, t->pend[i].vehicle_id))
-            continue;
-        span o = span_of(t, &t->pend[i]);
-        if (o.t_in < me.t_out && me.t_in < o.t_out) {
-            *other = o.id;
-            return 1;
-        }
-    }
-    for (int i = 0; i < t->n_recent; i++) {
-        const span *o = &t->recent[i];
-        if (!in_event(w, o->id) && o->t_in < me.t_out && me.t_in < o->t_out) {
-            *other = o->id;
-            return 1;
-        }
-    }
-    return 0;
+    return foreign_during(t, reach_of(t, v), w, other);
 }
 
 /* Front axle position of v at time t_us (µs), m from the entry. */

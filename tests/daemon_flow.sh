@@ -14,17 +14,11 @@ amfid=$1 sim=$2 config=$3
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
 N=60
 
-"$amfid" --config "$config" --db "$dir/s.db" 2> "$dir/amfid.log" &
-apid=$!; pids="$pids $apid"
-i=0; until grep -q "running" "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+amfid_start "$amfid" "$config"
 timeout 300 "$sim" --vehicles $N --flow 1200 --lanes 1 --speedup 20 --seed 5 \
   2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1
-kill -TERM $apid
-i=0; while kill -0 $apid 2>/dev/null; do
-  i=$((i + 1)); [ $i -lt 3000 ] || fail "amfid did not stop on SIGTERM"; sleep 0.1; done
-wait $apid || fail "amfid exit status $?"
+amfid_stop
 
 q() { sqlite3 "$dir/s.db" "$1"; }
 rows=$(q "SELECT count(DISTINCT vehicle_id) FROM passages")

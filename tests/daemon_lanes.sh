@@ -20,17 +20,11 @@ sed -e 's/^    window: 500 /    window: 10 /' -e 's/^    every: 100 /    every: 
     -e 's/^    baseline_n: 10000 /    baseline_n: 10 /' "$config" > "$dir/amfid.yaml"
 grep -q "^    window: 10 " "$dir/amfid.yaml" && grep -q "^    every: 1 " "$dir/amfid.yaml" &&
   grep -q "^    baseline_n: 10 " "$dir/amfid.yaml" || fail "could not set the indicator window"
-"$amfid" --config "$dir/amfid.yaml" --db "$dir/s.db" 2> "$dir/amfid.log" &
-apid=$!; pids="$pids $apid"
-i=0; until grep -q "running" "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+amfid_start "$amfid" "$dir/amfid.yaml"
 timeout 300 "$sim" --vehicles $N --flow 1200 --lanes 2 --speedup 20 --seed 3 \
   2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1
-kill -TERM $apid
-i=0; while kill -0 $apid 2>/dev/null; do
-  i=$((i + 1)); [ $i -lt 3000 ] || fail "amfid did not stop on SIGTERM"; sleep 0.1; done
-wait $apid || fail "amfid exit status $?"
+amfid_stop
 
 q() { sqlite3 "$dir/s.db" "$1"; }
 rows=$(q "SELECT count(DISTINCT vehicle_id) FROM passages")

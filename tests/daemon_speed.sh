@@ -15,18 +15,12 @@ N=4
 
 sed -e "s/^  speed: measured /  speed: estimate /" "$config" > "$dir/amfid.yaml"
 grep -q "^  speed: estimate " "$dir/amfid.yaml" || fail "the test's solver.speed did not apply"
-"$amfid" --config "$dir/amfid.yaml" --db "$dir/s.db" 2> "$dir/amfid.log" &
-apid=$!; pids="$pids $apid"
-i=0; until grep -q "running" "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+amfid_start "$amfid" "$dir/amfid.yaml"
 timeout 120 "$sim" --vehicles $N --headway 3 --speedup 10 --seed 7 --speed-error 0.04,0 \
   2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1
-kill -TERM $apid
 # an estimated passage is ~100 sweeps: the drain takes minutes under ASan
-i=0; while kill -0 $apid 2>/dev/null; do
-  i=$((i + 1)); [ $i -lt 3000 ] || fail "amfid did not stop on SIGTERM"; sleep 0.1; done
-wait $apid || fail "amfid exit status $?"
+amfid_stop
 
 q() { sqlite3 "$dir/s.db" "$1"; }
 rows=$(q "SELECT count(*) FROM passages")
