@@ -170,7 +170,9 @@ static int store_now(daemon_s *d, job *j)
 {
     amfi_passage_row r;
     job_row(d, j, &r);
-    const int feeds = !d->cfg.daemon.single_presence_only || j->w.n_vehicles <= 1;
+    /* an inseparable vehicle's joint estimate (status multiple) is not fed */
+    const int feeds = strcmp(j->status, "ok") == 0 &&
+                      (!d->cfg.daemon.single_presence_only || j->w.n_vehicles <= 1);
     if (j->solved) {
         scaleind_deck(d, &r);
         if (feeds)
@@ -203,7 +205,7 @@ static int store_now(daemon_s *d, job *j)
     publish_passage(d, j, id, &r);
     if (j->speed_estimated)
         drift_feed(d, j->w.v.utime, r.speed_mps, r.speed_given_mps);
-    if (j->solved && strcmp(j->status, "ok") == 0) { /* not an inseparable one's estimate */
+    if (j->solved && strcmp(j->status, "ok") == 0) {
         d->passages_ok++;
         if (feeds)
             feed_indicators(d, j, r.gvw_comp_kg);

@@ -44,6 +44,9 @@ bad=$(q "SELECT count(*) FROM passages p WHERE status = 'multiple' AND reason LI
          AND (gvw_kg IS NULL OR gvw_kg <= 0 OR quality IS NULL OR n_vehicles < 2
               OR (SELECT count(load_kg) FROM axles a WHERE a.passage_id = p.id) <> n_axles)")
 [ "$bad" -eq 0 ] || fail "$bad inseparable rows without their joint estimate"
+# ... but no weight fed to the STD and mean rules (passages.gvw_comp_kg)
+bad=$(q "SELECT count(*) FROM passages WHERE status <> 'ok' AND gvw_comp_kg IS NOT NULL")
+[ "$bad" -eq 0 ] || fail "$bad rows not ok with a weight fed to the indicators"
 # the reason names the other vehicle and the share, or the quality figure
 bad=$(q "SELECT count(*) FROM passages WHERE status = 'multiple' AND reason LIKE 'inseparable: %'
          AND NOT (reason GLOB 'inseparable: axles within * m of vehicle [0-9]*''s for [0-9]* % of its crossing*kg the two together*'
