@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /* amfi-sync: ships a site store's new rows (passages with axles, indicators,
- * alerts, baseline, runs) into the central PostgreSQL (issue 15).
+ * alerts, baseline, runs, environment, scale_evals) into the central
+ * PostgreSQL (issues 15 and 14). Every value is checked against the site
+ * store's rules (fleet_col) before anything of a pass is shipped.
  *
  * Single-threaded. Reads the SQLite store read-only (SQLITE_OPEN_READONLY; in
  * WAL mode a reader never blocks amfid's writer) and writes the central
@@ -229,9 +231,60 @@ static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst,
     return bad ? EX_RETRY : 0;
 }
 
+/* Every value of the rows SELECT sel gives (ids above hwm) against the
+ * site store's rules (fleet_col): a store that breaks its own schema (a
+ * damaged file, a row written around amfid) is refused before anything of
+ * the pass is shipped, naming the table, the row and the column. */
+static int check_rows(sqlite3 *db, const char *site, const char *store, const char *table,
+                      const struct fleet_col *rules, int key_cols, const char *sel, int64_t hwm)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(db, sel, -1, &st, NULL) != SQLITE_OK) {
+        fprintf(stderr, "amfi-sync: store: %s: %s\n", table, sqlite3_errmsg(db));
+        return EX_RETRY;
+    }
+    int ncols = sqlite3_column_count(st);
+    for (int i = 0; i <= ncols; i++)
+        if ((i == ncols) != (rules[i].name == NULL)
+            || (i < ncols && strcmp(rules[i].name, sqlite3_column_name(st, i)) != 0)) {
+            fprintf(stderr, "amfi-sync: internal: %s: the rules do not match the columns shipped\n", table);
+            sqlite3_finalize(st);
+            return EX_USAGE;
+        }
+    sqlite3_bind_int64(st, 1, hwm);
+    int rc;
+    long n = 0;
+    char msg[200];
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        for (int i = 0; i < ncols; i++) {
+            int type = sqlite3_column_type(st, i);
+            const char *text = type == SQLITE_TEXT ? (const char *)sqlite3_column_text(st, i) : NULL;
+            const char *why = fleet_col_problem(&rules[i], type, sqlite3_column_int64(st, i),
+                                                sqlite3_column_double(st, i), text,
+                                                text ? sqlite3_column_bytes(st, i) : 0, msg, sizeof msg);
+            if (!why) continue;
+            char key[96] = "";
+            for (int k = 0; k < key_cols; k++)
+                snprintf(key + strlen(key), sizeof key - strlen(key), "%s%s %lld", k ? ", " : "",
+                         rules[k].name, (long long)sqlite3_column_int64(st, k));
+            fprintf(stderr,
+                    "amfi-sync: refused: site '%s' store %s: table %s, %s, column %s: %s "
+                    "(the site store's rules, docs/schema.md). Nothing shipped "
+                    "(see docs/fleet.md, 'Bad values')\n",
+                    site, store, table, key, rules[i].name, why);
+            sqlite3_finalize(st);
+            return EX_REFUSED;
+        }
+        if (++n % 4096 == 0) keepalive();
+    }
+    if (rc != SQLITE_DONE) fprintf(stderr, "amfi-sync: store: reading %s: %s\n", table, sqlite3_errmsg(db));
+    sqlite3_finalize(st);
+    return rc == SQLITE_DONE ? 0 : EX_RETRY;
+}
+
 /* Ship one table until it has no more new rows. */
-static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const struct fleet_table *t, int check_only,
-                      long *total)
+static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const char *store,
+                      const struct fleet_table *t, int check_only, long *total)
 {
     char sql[1024];
     const char *pv[2] = {site, t->name};
@@ -266,7 +319,17 @@ static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const struct fl
             return EX_REFUSED;
         }
     }
-    if (check_only) return 0;
+    if (check_only) {
+        /* the rows to ship: every value as the site store's rules say */
+        snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE id > ?1 ORDER BY id", t->cols, t->name);
+        int rc = check_rows(db, site, store, t->name, t->rules, 1, sql, hwm);
+        if (!rc && t->child) {
+            snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE %s > ?1 ORDER BY %s", t->child_cols,
+                     t->child, t->child_parent, t->child_parent);
+            rc = check_rows(db, site, store, t->child, t->child_rules, 2, sql, hwm);
+        }
+        return rc;
+    }
     for (;;) {
         if (stop_requested) return 0;
         if (pg_exec(pg, "BEGIN", "BEGIN")) return EX_RETRY;
@@ -348,7 +411,6 @@ static int store_site_id(sqlite3 *db, char out[SITE_ID_MAX + 1])
     return found;
 }
 
-/* One pass: connect, migrate, check, ship every table. */
 /* One pass: connect, create or migrate the central schema, check and ship
  * every table. site_opt: the site id the caller expects (site_src names
  * where it came from, for the messages); *shipped (if not NULL) gets the
@@ -420,10 +482,12 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
     sqlite3_exec(db, "BEGIN", NULL, NULL, NULL);
     rc = check_backwards(pg, db, site);
     long total = 0;
-    for (int i = 0; !rc && i < fleet_n_tables; i++) /* every table checked before any is shipped */
-        rc = sync_table(pg, db, site, &fleet_tables[i], 1, &total);
+    /* every table checked (its mark, then its new rows' values) before any
+     * is shipped */
+    for (int i = 0; !rc && i < fleet_n_tables; i++)
+        rc = sync_table(pg, db, site, store, &fleet_tables[i], 1, &total);
     for (int i = 0; !rc && i < fleet_n_tables && !stop_requested; i++)
-        rc = sync_table(pg, db, site, &fleet_tables[i], 0, &total);
+        rc = sync_table(pg, db, site, store, &fleet_tables[i], 0, &total);
     sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
     if (shipped) *shipped = total;
     if (!rc && !quiet && total > 0)

@@ -73,13 +73,16 @@ same() {
 
 case=init
 "$sync" --pg "$PG_CONNINFO" --init-schema 2> "$tmp/init.log" || fail "--init-schema: $(cat "$tmp/init.log")"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 4 ] || fail "schema version"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 5 ] || fail "schema version"
 # a central database of version 1 migrates on the next contact
-pg_q "DROP VIEW fleet_window_trend; ALTER TABLE passages DROP COLUMN speed_given_mps,
+v5_down="DROP VIEW fleet_latest_scale; DROP TABLE environment, scale_evals;
+      ALTER TABLE passages DROP COLUMN reference_gvw_kg, DROP COLUMN deck_c, DROP COLUMN f1_hz,
+      DROP COLUMN f1_comp_hz, DROP COLUMN f1_zeta, DROP COLUMN f1_r2;"
+pg_q "$v5_down DROP VIEW fleet_window_trend; ALTER TABLE passages DROP COLUMN speed_given_mps,
       DROP COLUMN speed_estimated, DROP COLUMN n_vehicles, DROP COLUMN quality;
       DELETE FROM fleet_migrations WHERE version > 1"
-"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 4"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 4 ] || fail "not migrated to 4"
+"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 5"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 5 ] || fail "not migrated to 5"
 pg_q "SELECT count(*) FROM fleet_window_trend" > /dev/null || fail "no fleet_window_trend after migration"
 grep -q password "$tmp/init.log" && fail "log mentions a password"
 
@@ -90,6 +93,84 @@ wait
 for s in a b c; do same "$tmp/$s.db" "site-$s"; done
 "$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --once || fail "second --once failed"
 same "$tmp/a.db" site-a
+
+case=issue14
+# issue 14's data (temperatures, scale blocks, known-truck runs, natural
+# frequency) shipped: every central row equal to the store's, column by column
+mkstore "$tmp/i.db" site-i 3000
+fleet_issue14_rows "$tmp/i.db"
+"$sync" --db "$tmp/i.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync: exit $?"
+same "$tmp/i.db" site-i
+for t in passages axles indicators alerts baseline runs environment scale_evals; do
+    fleet_columns_same "$tmp/i.db" site-i $t
+done
+[ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-i' AND f1_hz IS NOT NULL")" = \
+  "$(sqlite3 "$tmp/i.db" "SELECT count(*) FROM passages WHERE f1_hz IS NOT NULL")" ] &&
+    [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-i' AND reference_gvw_kg IS NOT NULL")" -gt 10 ] ||
+    fail "natural frequencies or known trucks not shipped"
+[ "$(pg_q "SELECT string_agg(kind || ' ' || state || ' ' || n, ', ' ORDER BY kind) FROM fleet_latest_scale
+           WHERE site_id = 'site-i'")" = "known_truck normal 6, scale_shift alert 200" ] ||
+    fail "fleet_latest_scale: $(pg_q "SELECT * FROM fleet_latest_scale WHERE site_id = 'site-i'")"
+# more of everything: the second pass ships only the new rows
+add_rows "$tmp/i.db" 500
+fleet_issue14_rows "$tmp/i.db" 3000
+"$sync" --db "$tmp/i.db" --pg "$PG_CONNINFO" --once --quiet || fail "second sync: exit $?"
+same "$tmp/i.db" site-i
+for t in passages environment scale_evals; do fleet_columns_same "$tmp/i.db" site-i $t; done
+
+case=bad-values
+# A store that breaks its own rules (values written around amfid's checks):
+# refused (exit 3) naming the table, the row and the column, and nothing of
+# the pass shipped, not even the good rows of the other tables.
+mkstore "$tmp/v.db" site-v 200
+fleet_issue14_rows "$tmp/v.db"
+"$sync" --db "$tmp/v.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync: exit $?"
+add_rows "$tmp/v.db" 100
+fleet_issue14_rows "$tmp/v.db" 200
+counts() {
+    pg_q "SELECT (SELECT count(*) FROM passages WHERE site_id = 'site-v') || ' ' ||
+                 (SELECT count(*) FROM axles WHERE site_id = 'site-v') || ' ' ||
+                 (SELECT count(*) FROM indicators WHERE site_id = 'site-v') || ' ' ||
+                 (SELECT count(*) FROM environment WHERE site_id = 'site-v') || ' ' ||
+                 (SELECT count(*) FROM scale_evals WHERE site_id = 'site-v')"
+}
+before=$(counts)
+env_last=$(sqlite3 "$tmp/v.db" "SELECT max(id) FROM environment")
+scale_last=$(sqlite3 "$tmp/v.db" "SELECT max(id) FROM scale_evals")
+# bad_case WANT SQL [SQL2]: the SQL run on a copy of the store (checks off;
+# SQL2 in a second session), then the copy refused with WANT in the message
+bad_case() {
+    cp "$tmp/v.db" "$tmp/vb.db"
+    rm -f "$tmp/vb.db-wal" "$tmp/vb.db-shm"
+    sqlite3 "$tmp/vb.db" "PRAGMA ignore_check_constraints = 1; $2" &&
+        { [ -z "${3:-}" ] || sqlite3 "$tmp/vb.db" "PRAGMA ignore_check_constraints = 1; $3"; } ||
+        fail "cannot make the bad row: $2 ${3:-}"
+    "$sync" --db "$tmp/vb.db" --pg "$PG_CONNINFO" --once 2> "$tmp/bad.log"
+    rc=$?
+    [ $rc = 3 ] || fail "$2 ${3:-}: exit $rc, expected 3"
+    grep -Fq "refused: site 'site-v' store $tmp/vb.db: $1" "$tmp/bad.log" ||
+        fail "$2 ${3:-}: message: $(cat "$tmp/bad.log")"
+    [ "$(counts)" = "$before" ] || fail "$2 ${3:-}: rows shipped: $before -> $(counts)"
+}
+bad_case "table passages, id 251, column deck_c: 1000000000 is not in [-60, 80]" \
+    "UPDATE passages SET deck_c = 1e9 WHERE id = 251"
+bad_case "table passages, id 252, column f1_hz: inf is not in (0, 1000]" \
+    "UPDATE passages SET f1_hz = 1e999 WHERE id = 252"
+# a NaN cannot be a REAL in SQLite: it comes as text, once the table is not STRICT
+bad_case "table passages, id 255, column f1_hz: text, but it must be a number" \
+    "PRAGMA writable_schema = ON;
+     UPDATE sqlite_schema SET sql = replace(sql, ') STRICT', ')') WHERE name = 'passages'" \
+    "UPDATE passages SET f1_hz = 'NaN' WHERE id = 255"
+bad_case "table axles, passage_id 260, idx 2, column load_kg: 2000000 is not in [-1000000, 1000000]" \
+    "UPDATE axles SET load_kg = 2e6 WHERE passage_id = 260 AND idx = 2"
+bad_case "table environment, id $env_last, column air_c: -inf is not in [-60, 80]" \
+    "UPDATE environment SET air_c = -1e999 WHERE id = $env_last"
+bad_case "table scale_evals, id $scale_last, column kind: 'bogus' is not one of scale_shift|known_truck" \
+    "UPDATE scale_evals SET kind = 'bogus' WHERE id = $scale_last"
+bad_case "table passages, id 280, column status: 'fine' is not one of ok|gap|late|overload|multiple|invalid|error" \
+    "UPDATE passages SET status = 'fine' WHERE id = 280"
+"$sync" --db "$tmp/v.db" --pg "$PG_CONNINFO" --once --quiet || fail "the good store after the bad ones: exit $?"
+same "$tmp/v.db" site-v
 
 case=writer
 ( for i in 1 2 3 4 5 6 7 8; do add_rows "$tmp/b.db" 500; done ) &

@@ -42,7 +42,7 @@ pg_q() { psql -X -q -At -v ON_ERROR_STOP=1 "$PG_CONNINFO" -c "$1"; }
 # table (count and newest id: no gap, no duplicate), axles by count; calls
 # the caller's fail for each difference.
 fleet_same() {
-    for t in passages indicators alerts baseline runs; do
+    for t in passages indicators alerts baseline runs environment scale_evals; do
         l=$(sqlite3 "$1" "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t")
         c=$(pg_q "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t WHERE site_id = '$2'")
         [ "$l" = "$c" ] || fail "$2 $t: store '$l' central '$c'"
@@ -50,4 +50,52 @@ fleet_same() {
     l=$(sqlite3 "$1" "SELECT count(*) FROM axles")
     c=$(pg_q "SELECT count(*) FROM axles WHERE site_id = '$2'")
     [ "$l" = "$c" ] || fail "$2 axles: store '$l' central '$c'"
+}
+# fleet_columns_same DB SITE TABLE [WHERE]: every row of TABLE (the store's
+# columns, in its order; WHERE on both sides) equal in the store and the
+# central database, column by column. Both print reals with 15 significant
+# digits (sqlite3's %!.15g; PostgreSQL with extra_float_digits 0), the
+# store's integral reals with a ".0" that is dropped.
+fleet_columns_same() {
+    cols=$(sqlite3 "$1" "SELECT group_concat(name, ', ') FROM pragma_table_info('$3')")
+    key=id
+    [ "$3" = axles ] && key="passage_id, idx"
+    sqlite3 "$1" "SELECT $cols FROM $3 ${4:+WHERE $4} ORDER BY $key" |
+        sed -E 's/([0-9])\.0(\||$)/\1\2/g; s/([0-9])\.0(\||$)/\1\2/g' > "$tmp/cols.store"
+    PGOPTIONS='-c extra_float_digits=0' \
+        pg_q "SELECT $cols FROM $3 WHERE site_id = '$2' ${4:+AND $4} ORDER BY $key" > "$tmp/cols.central"
+    [ -s "$tmp/cols.store" ] || fail "$2 $3: no rows to compare"
+    cmp -s "$tmp/cols.store" "$tmp/cols.central" ||
+        fail "$2 $3: central rows differ from the store's: $(diff "$tmp/cols.store" "$tmp/cols.central" | head -4)"
+}
+# fleet_issue14_rows DB [ID]: issue 14's data added to a site store of
+# version 7: deck and air temperature readings, scale blocks and known-truck
+# runs (scale_evals), and on its passages above ID (default all) a deck
+# temperature, natural frequency and now and then a known truck's weight.
+# The reals are binary fractions, printed alike by sqlite3 and psql.
+fleet_issue14_rows() {
+    sqlite3 "$1" <<SQL > /dev/null
+PRAGMA busy_timeout = 5000;
+BEGIN;
+WITH RECURSIVE k(i) AS (SELECT 0 UNION ALL SELECT i + 1 FROM k WHERE i < 47)
+INSERT INTO environment (utime, deck_c, air_c, received_utime)
+SELECT b + i * 1800000000, -20.25 + 0.5 * i, -21.75 + 0.5 * i, b + i * 1800000000 + 250000
+FROM k, (SELECT coalesce(max(utime) + 1800000000, 1763769600000000) AS b FROM environment);
+UPDATE passages SET deck_c = -5.25 + 0.5 * (id % 40) WHERE status = 'ok' AND id > ${2:-0};
+UPDATE passages SET f1_hz = 3.125 + 0.0625 * (id % 8), f1_zeta = 0.015625 * (1 + id % 3),
+       f1_r2 = 0.96875, f1_comp_hz = CASE WHEN id % 2 = 0 THEN 3.140625 + 0.0625 * (id % 8) END
+ WHERE status = 'ok' AND id % 3 = 0 AND id > ${2:-0};
+UPDATE passages SET reference_gvw_kg = 40000.5 WHERE status = 'ok' AND id % 97 = 0 AND id > ${2:-0};
+WITH RECURSIVE k(i) AS (SELECT 0 UNION ALL SELECT i + 1 FROM k WHERE i < 23)
+INSERT INTO scale_evals (utime, kind, n, value, raw, deck_c, z, cusum, h, state)
+SELECT 1763769600000000 + i * 3600000000, 'scale_shift', 200, 1.0078125 + 0.0009765625 * i,
+       1.0234375 + 0.0009765625 * i, -4.75 + 0.5 * i, 0.25 * i - 1.125, 0.125 * i + 0.0625, 5.5,
+       CASE WHEN i < 4 THEN 'baseline' WHEN i < 20 THEN 'normal' WHEN i < 23 THEN 'watch' ELSE 'alert' END
+FROM k;
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 6)
+INSERT INTO scale_evals (utime, kind, n, value, raw, deck_c, z, cusum, h, state)
+SELECT 1763769600000000 + i * 86400000000 + 1, 'known_truck', i, 0.9921875 + 0.001953125 * i,
+       0.9765625 + 0.001953125 * i, 2.25 + i, 0.5 * i - 0.875, 0.0625, 4.5, 'normal' FROM k;
+COMMIT;
+SQL
 }
