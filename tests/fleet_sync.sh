@@ -8,7 +8,11 @@
 # Then --config (amfid's YAML: store and site from it) and follow mode under a
 # stand-in systemd notification socket (READY, STATUS, WATCHDOG, STOPPING).
 # The roles of docs/fleet.md (its SQL block run as written): the writer role
-# syncs, the analysts' role reads the views and cannot write.
+# syncs, the analysts' role reads the views and cannot write. Issue 14's data
+# (environment, scale_evals, the passages' temperature, known-truck weight and
+# natural frequency) shipped and compared column by column; values that break
+# the site store's rules refused (exit 3, named, nothing shipped); a central
+# database of version 4 migrated to 5 by the owner, then synced by the writer.
 # Usage: fleet_sync.sh AMFI_SYNC SCHEMA_MD NOTIFY_LISTEN FLEET_MD. Exit 77
 # without sqlite3/PostgreSQL.
 set -u
@@ -311,6 +315,48 @@ add_rows "$tmp/w.db" 100
 grep -q "permission denied" "$tmp/reader.log" || fail "reader sync: $(cat "$tmp/reader.log")"
 "$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the writer role: after the reader"
 same "$tmp/w.db" site-w
+
+case=upgrade
+# A central database of version 4 (as amfi-sync of version 4 left it, its
+# roles set up without default privileges) with a site shipped. The writer
+# role cannot migrate: it asks for --init-schema, ships nothing; the owner
+# migrates; the writer's next pass ships the new passages with their new
+# columns and every environment and scale_evals row. The passages shipped
+# before keep NULL in the new columns.
+pg_q "CREATE DATABASE up4"
+up="host=$PG_DIR dbname=up4 user=postgres"
+main_db=$PG_CONNINFO
+PG_CONNINFO=$up
+"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema"
+grep -v '^CREATE ROLE\|^ALTER DEFAULT' "$tmp/roles.sql" | psql -X -q -v ON_ERROR_STOP=1 "$up" > "$tmp/up.log" 2>&1 ||
+    fail "roles: $(cat "$tmp/up.log")"
+mkstore "$tmp/u.db" site-u 1000
+fleet_issue14_rows "$tmp/u.db"
+"$sync" --db "$tmp/u.db" --pg "$up" --once --quiet || fail "first sync: exit $?"
+pg_q "$v5_down DELETE FROM fleet_sync_state WHERE tbl IN ('environment', 'scale_evals');
+      DELETE FROM fleet_migrations WHERE version > 4"
+add_rows "$tmp/u.db" 500
+fleet_issue14_rows "$tmp/u.db" 1000
+upw="host=$PG_DIR dbname=up4 user=amfi_sync"
+"$sync" --db "$tmp/u.db" --pg "$upw" --once 2> "$tmp/up.log"
+rc=$?
+[ $rc = 1 ] || fail "the writer role at version 4: exit $rc, expected 1"
+grep -q "central schema is at version 4, this program needs 5: run 'amfi-sync --init-schema'" "$tmp/up.log" ||
+    fail "the writer role at version 4: $(cat "$tmp/up.log")"
+[ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-u'")" = 1000 ] || fail "the writer shipped at version 4"
+"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 4 -> 5"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 5 ] || fail "not migrated to 5"
+"$sync" --db "$tmp/u.db" --pg "$upw" --once --quiet || fail "the writer after the migration: exit $?"
+same "$tmp/u.db" site-u
+fleet_columns_same "$tmp/u.db" site-u passages "id > 1000"
+fleet_columns_same "$tmp/u.db" site-u environment
+fleet_columns_same "$tmp/u.db" site-u scale_evals
+[ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-u' AND id <= 1000 AND
+           (deck_c IS NOT NULL OR f1_hz IS NOT NULL OR reference_gvw_kg IS NOT NULL)")" = 0 ] ||
+    fail "passages shipped before the migration have values in its columns"
+[ "$(psql -X -At "host=$PG_DIR dbname=up4 user=analyst" -c "SELECT count(*) FROM fleet_latest_scale")" = 2 ] ||
+    fail "the reader role cannot read fleet_latest_scale"
+PG_CONNINFO=$main_db
 
 case=notify
 # Follow mode with a 0.4 s watchdog and a 30 s interval: READY after the
