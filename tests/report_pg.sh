@@ -5,7 +5,10 @@
 # shipped with amfi-sync; then the fleet summary has one line per site with
 # its counts, and the report of one site from the central database equals
 # the report of its store: the default sections, the CSV and JSON exports,
-# the histogram, the plots. An unknown site (exit 2, the sites listed), a
+# the histogram, the plots. A third site with issue 14's data (temperatures,
+# scale blocks, known-truck runs, natural frequency) gives the same
+# temperature, scale, known-truck and natural-frequency lines, exports and
+# plot data from the central database as from its store. An unknown site (exit 2, the sites listed), a
 # central row the store schema refuses (exit 1, named), a stopped server
 # (exit 1, one line, no password) and the options that make no sense
 # centrally (exit 2) are refused.
@@ -13,6 +16,7 @@
 # Usage: report_pg.sh AMFI_REPORT AMFI_SYNC AMFI_FLEET_BENCH. Exit 77 without PostgreSQL.
 set -u
 report=$1 sync=$2 bench=$3
+command -v sqlite3 > /dev/null || { echo "report_pg.sh: no sqlite3: skipped"; exit 77; }
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/pg_server.sh"
 pg_tmp report_pg
@@ -36,9 +40,10 @@ grep -Eq "^bench-001 +1200 .* 0 +[0-9]{4}-" "$tmp/fleet.txt" || fail "fleet summ
 
 # one site: the same report as from its store (up to the 'Next' hints,
 # which name sqlite3 and the file there, psql and the views here)
+site=bench-000
 same() {
     "$report" --db "$a" "$@" > "$tmp/db.out" 2>&1 || fail "--db $*: exit $?"
-    "$report" --pg "$PG_CONNINFO" --site bench-000 "$@" > "$tmp/pg.out" 2>&1 || fail "--pg $*: exit $?"
+    "$report" --pg "$PG_CONNINFO" --site $site "$@" > "$tmp/pg.out" 2>&1 || fail "--pg $*: exit $?"
     sed '/^Next, with/,$d' "$tmp/db.out" > "$tmp/db.cut"
     sed '/^Next, with/,$d' "$tmp/pg.out" > "$tmp/pg.cut"
     cmp -s "$tmp/db.cut" "$tmp/pg.cut" || { diff "$tmp/db.cut" "$tmp/pg.cut" | head; fail "--pg differs: $*"; }
@@ -60,11 +65,43 @@ if command -v gnuplot > /dev/null; then
         fail "plots: '$(ls "$tmp/p1" | tr '\n' ' ')' vs '$(ls "$tmp/p2" | tr '\n' ' ')'"
 fi
 
+# issue 14's data (tables environment and scale_evals, the passages' deck
+# temperature, known-truck weight, natural frequency): a copy of bench-000's
+# store as site-14 with them added, shipped; its report from the central
+# database has the same temperature, scale, known-truck and natural-frequency
+# lines and plots as from the store.
+cp "$a" "$tmp/i14.db"
+sqlite3 "$tmp/i14.db" "UPDATE meta SET value = 'site-14' WHERE key = 'site.id'" || fail "site-14 store"
+fleet_issue14_rows "$tmp/i14.db"
+"$sync" --db "$tmp/i14.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync of site-14: exit $?"
+a=$tmp/i14.db site=site-14
+same
+same --summary
+same --format json
+same --summary --format csv
+"$report" --pg "$PG_CONNINFO" --site site-14 --summary > "$tmp/pg14.out" 2>&1
+for line in '^temperature  deck -20\.2 \.\. 3\.2 °C, air -21\.8 \.\. 1\.8 °C, 48 readings' \
+            '^scale        20 blocks, newest 2025-11-22 23:00 UTC: 1\.0303 compensated' \
+            '^known truck  6 runs, ratio inferred/reference' '^natural f1   n [1-9][0-9]*, raw mean 3\.'; do
+    grep -q "$line" "$tmp/pg14.out" || fail "site-14 --pg: no line /$line/: $(cat "$tmp/pg14.out")"
+done
+if command -v gnuplot > /dev/null; then
+    "$report" --db "$a" --plot "$tmp/p3" > /dev/null 2>&1 || fail "site-14 --db --plot"
+    "$report" --pg "$PG_CONNINFO" --site site-14 --plot "$tmp/p4" > /dev/null 2>&1 || fail "site-14 --pg --plot"
+    # the plots' data (the PNGs name the source in their titles)
+    for f in scale known_truck natfreq temperature; do
+        [ -s "$tmp/p4/$f.png" ] && [ -s "$tmp/p4/data/$f.dat" ] &&
+            cmp -s "$tmp/p3/data/$f.dat" "$tmp/p4/data/$f.dat" || fail "site-14 plots: $f differs or is missing"
+    done
+    [ "$(ls "$tmp/p3")" = "$(ls "$tmp/p4")" ] || fail "site-14 plots: '$(ls "$tmp/p3" | tr '\n' ' ')' vs '$(ls "$tmp/p4" | tr '\n' ' ')'"
+fi
+a=$tmp/st/bench-000.db site=bench-000
+
 # refusals
 "$report" --pg "$PG_CONNINFO" --site nope 2> "$tmp/e1"
 rc=$?
 [ $rc = 2 ] || fail "unknown site: exit $rc"
-grep -q "no site 'nope' in the central database (sites: bench-000, bench-001)" "$tmp/e1" ||
+grep -q "no site 'nope' in the central database (sites: bench-000, bench-001, site-14)" "$tmp/e1" ||
     fail "unknown site: $(cat "$tmp/e1")"
 for args in "--site bench-000" "--pg x --db $a" "--pg x --site bench-000 --set-baseline-last 10" \
             "--pg x --site bench-000 --check" "--pg x --summary" "--pg x --site 'bad id'"; do
