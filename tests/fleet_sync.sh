@@ -89,6 +89,24 @@ pg_q "$v5_down DROP VIEW fleet_window_trend; ALTER TABLE passages DROP COLUMN sp
 [ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 5 ] || fail "not migrated to 5"
 pg_q "SELECT count(*) FROM fleet_window_trend" > /dev/null || fail "no fleet_window_trend after migration"
 grep -q password "$tmp/init.log" && fail "log mentions a password"
+# docs/fleet.md's DDL of version 5 is what amfi-sync applies: a database
+# migrated by it and one taken back to version 4 and given the document's
+# block have the same schema
+awk '/^<!-- fleet-v5:begin -->/ { on = 1; next } /^<!-- fleet-v5:end -->/ { on = 0 }
+     on && !/^```/' "$fleetdoc" > "$tmp/v5.sql"
+[ -s "$tmp/v5.sql" ] || fail "no version 5 block in $fleetdoc"
+for d in docv5a docv5b; do
+    pg_q "CREATE DATABASE $d"
+    "$sync" --pg "host=$PG_DIR dbname=$d user=postgres" --init-schema --quiet || fail "$d: --init-schema"
+done
+psql -X -q -v ON_ERROR_STOP=1 "host=$PG_DIR dbname=docv5b user=postgres" -c "$v5_down" -f "$tmp/v5.sql" \
+    > "$tmp/v5.log" 2>&1 || fail "docs/fleet.md's version 5 block: $(cat "$tmp/v5.log")"
+for d in docv5a docv5b; do
+    pg_dump -s -T fleet_migrations "host=$PG_DIR dbname=$d user=postgres" > "$tmp/$d.dump" || fail "pg_dump $d"
+    grep -v "^\\\\\(un\)\?restrict " "$tmp/$d.dump" > "$tmp/$d.sql"  # a random key per dump
+done
+cmp -s "$tmp/docv5a.sql" "$tmp/docv5b.sql" ||
+    fail "docs/fleet.md's version 5 differs from amfi-sync's: $(diff "$tmp/docv5a.sql" "$tmp/docv5b.sql" | head -6)"
 
 case=three-sites
 for s in a b c; do mkstore "$tmp/$s.db" "site-$s" 3000; done
