@@ -6,7 +6,9 @@
 # amfi-sync in follow mode every 0.2 s on amfid's own configuration. amfid
 # is never blocked (every vehicle the simulator sent is stored), amfi-sync
 # ships while the rows arrive, and after both stop the central rows equal
-# the store's: no gap, no duplicate.
+# the store's: no gap, no duplicate. The simulator's site climate is on:
+# the temperature readings, the passages' deck temperatures and natural
+# frequencies are shipped too.
 # Usage: fleet_amfid.sh AMFI_SYNC AMFID SIM_PUBLISHER CONFIG. Exit 77 without
 # sqlite3/PostgreSQL.
 set -u
@@ -35,8 +37,10 @@ i=0; until grep -q running "$tmp/amfid.log"; do
   i=$((i + 1)); [ $i -lt 200 ] || die "amfid did not start"; sleep 0.05; done
 "$sync" --config "$tmp/live.yaml" --pg "$PG_CONNINFO" --interval 0.2 2> "$tmp/sync.log" &
 spid=$!
-# 120 vehicles 2 s apart, 12 times faster than real time: about 20 s
-"$sim" --vehicles 120 --headway 2 --speedup 12 --seed 11 2> "$tmp/sim.log" || die "sim_publisher"
+# 120 vehicles 2 s apart, 12 times faster than real time: about 20 s; the
+# site's climate (issue 14) on, time-compressed, a reading every second
+"$sim" --vehicles 120 --headway 2 --speedup 12 --seed 11 \
+    --environment site --time-compression 73000 --environment-period 1 2> "$tmp/sim.log" || die "sim_publisher"
 sleep 2
 mid=$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'live-1'")
 kill -TERM $apid; wait $apid; rc=$?
@@ -51,6 +55,14 @@ stored=$(sqlite3 "$tmp/live.db" "SELECT count(*) FROM passages")
 passes=$(grep -c "rows shipped" "$tmp/sync.log")
 [ "$passes" -ge 3 ] || fail "amfi-sync shipped in $passes passes while amfid wrote, expected several"
 fleet_same "$tmp/live.db" live-1
-echo "fleet_amfid: amfid stored $stored, $mid shipped before amfid stopped, in $passes passes"
+# issue 14's data as amfid wrote it: temperature readings, the passages'
+# deck temperature and natural frequency, all of it in the central rows
+env=$(sqlite3 "$tmp/live.db" "SELECT count(*) FROM environment")
+[ "$env" -ge 10 ] || fail "amfid stored $env environment readings"
+l=$(sqlite3 "$tmp/live.db" "SELECT count(deck_c) || ' ' || count(f1_hz) || ' ' || count(f1_r2) FROM passages")
+c=$(pg_q "SELECT count(deck_c) || ' ' || count(f1_hz) || ' ' || count(f1_r2) FROM passages WHERE site_id = 'live-1'")
+[ "$l" = "$c" ] || fail "deck_c, f1_hz, f1_r2 values: store $l, central $c"
+[ "${l%% *}" -gt 0 ] || fail "no passage with a deck temperature: $l"
+echo "fleet_amfid: amfid stored $stored, $mid shipped before amfid stopped, in $passes passes; $env temperature readings, passages with deck_c, f1_hz, f1_r2: $l"
 [ $failures = 0 ] && echo "fleet_amfid.sh: all cases pass"
 exit $((failures != 0))
