@@ -259,9 +259,10 @@ static int check_rows(sqlite3 *db, const char *site, const char *store, const ch
         for (int i = 0; i < ncols; i++) {
             int type = sqlite3_column_type(st, i);
             const char *text = type == SQLITE_TEXT ? (const char *)sqlite3_column_text(st, i) : NULL;
-            const char *why = fleet_col_problem(&rules[i], type, sqlite3_column_int64(st, i),
-                                                sqlite3_column_double(st, i), text,
-                                                text ? sqlite3_column_bytes(st, i) : 0, msg, sizeof msg);
+            const char *why = fleet_col_problem(
+                &rules[i], type, type == SQLITE_INTEGER ? sqlite3_column_int64(st, i) : 0,
+                type == SQLITE_FLOAT ? sqlite3_column_double(st, i) : 0, text,
+                text ? sqlite3_column_bytes(st, i) : 0, msg, sizeof msg);
             if (!why) continue;
             char key[96] = "";
             for (int k = 0; k < key_cols; k++)
