@@ -189,6 +189,8 @@ bad_case "table environment, id $env_last, column air_c: -inf is not in [-60, 80
     "UPDATE environment SET air_c = -1e999 WHERE id = $env_last"
 bad_case "table scale_evals, id $scale_last, column kind: 'bogus' is not one of scale_shift|known_truck" \
     "UPDATE scale_evals SET kind = 'bogus' WHERE id = $scale_last"
+bad_case "table alerts, id 6, column message: text that is not valid UTF-8 (or holds a NUL byte)" \
+    "UPDATE alerts SET message = CAST(X'41C328' AS TEXT) WHERE id = 6"
 bad_case "table passages, id 280, column status: 'fine' is not one of ok|gap|late|overload|multiple|invalid|error" \
     "UPDATE passages SET status = 'fine' WHERE id = 280"
 "$sync" --db "$tmp/v.db" --pg "$PG_CONNINFO" --once --quiet || fail "the good store after the bad ones: exit $?"
