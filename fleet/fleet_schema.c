@@ -98,13 +98,14 @@ static const char fleet_v4[] =
     "ALTER TABLE passages ADD COLUMN n_vehicles integer NOT NULL DEFAULT 1,\n"
     "  ADD COLUMN quality double precision;\n";
 
-/* Version 5 (issue 14; site store versions 5-7): the passages' known-truck
- * reference weight, deck temperature and natural frequency; the site's
+/* Version 5 (issue 14; site store versions 5-8): the passages' known-truck
+ * reference weight, deck temperature, natural frequency and the weight the
+ * STD and mean rules were fed (temperature-compensated); the site's
  * temperature readings (environment) and its scale indicator's blocks and
  * known-truck runs (scale_evals); the newest of those per site and kind.
  * Rows shipped before keep NULL in the new passage columns (the site store
  * says NULL of rows written before its migrations; a store already at
- * version 7 before this step had its values, which amfi-sync cannot update
+ * version 8 before this step had its values, which amfi-sync cannot update
  * centrally: docs/fleet.md). The roles of docs/fleet.md, where they exist,
  * get the same rights on the new tables as on the others (their default
  * privileges only cover tables created by the role that set them). */
@@ -112,7 +113,7 @@ static const char fleet_v5[] =
     "ALTER TABLE passages ADD COLUMN reference_gvw_kg double precision,\n"
     "  ADD COLUMN deck_c double precision, ADD COLUMN f1_hz double precision,\n"
     "  ADD COLUMN f1_comp_hz double precision, ADD COLUMN f1_zeta double precision,\n"
-    "  ADD COLUMN f1_r2 double precision;\n"
+    "  ADD COLUMN f1_r2 double precision, ADD COLUMN gvw_comp_kg double precision;\n"
     "CREATE TABLE environment (\n"
     "  site_id text NOT NULL, id bigint NOT NULL, utime bigint NOT NULL,\n"
     "  deck_c double precision NOT NULL, air_c double precision NOT NULL,\n"
@@ -142,7 +143,7 @@ const struct fleet_migration fleet_migrations[] = {
     {2, "fleet_window_trend: indicators with their alerts, per site", fleet_v2},
     {3, "passages: speed_given_mps and speed_estimated", fleet_v3},
     {4, "passages: n_vehicles and quality", fleet_v4},
-    {5, "passages: reference_gvw_kg, deck_c, f1_hz, f1_comp_hz, f1_zeta, f1_r2; "
+    {5, "passages: reference_gvw_kg, deck_c, f1_hz, f1_comp_hz, f1_zeta, f1_r2, gvw_comp_kg; "
         "environment, scale_evals, fleet_latest_scale", fleet_v5},
 };
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
@@ -170,7 +171,7 @@ static const struct fleet_col passages_rules[] = {
     RN("speed_given_mps", 0, 0, AMFI_STORE_MAX_SPEED_MPS), I_("speed_estimated", 0, 1),
     I_("n_vehicles", 1, 64), RN("quality", 0, 1, 1e9), RN("reference_gvw_kg", 0, 1000, 100000),
     RN("deck_c", 0, -60, 80), RN("f1_hz", 1, 0, 1000), RN("f1_comp_hz", 1, 0, 1000),
-    RN("f1_zeta", 2, 0, 1), RN("f1_r2", 0, 0, 1), END_};
+    RN("f1_zeta", 2, 0, 1), RN("f1_r2", 0, 0, 1), RN("gvw_comp_kg", 1, 0, KG), END_};
 static const struct fleet_col axles_rules[] = {
     I_("passage_id", 1, INT64_MAX), I_("idx", 1, 12),
     RN("spacing_m", 1, 0, AMFI_STORE_MAX_SPACING_M), RN("load_kg", 0, -KG, KG), END_};
@@ -199,7 +200,7 @@ const struct fleet_table fleet_tables[] = {
     {"passages",
      "id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason, lambda, "
      "residual_rms, formulation, solve_ms, stored_at, speed_given_mps, speed_estimated, "
-     "n_vehicles, quality, reference_gvw_kg, deck_c, f1_hz, f1_comp_hz, f1_zeta, f1_r2",
+     "n_vehicles, quality, reference_gvw_kg, deck_c, f1_hz, f1_comp_hz, f1_zeta, f1_r2, gvw_comp_kg",
      passages_rules, axles_rules, 14,
      "axles", "passage_id, idx, spacing_m, load_kg", "passage_id"},
     {"indicators",

@@ -62,6 +62,6 @@ extern const int fleet_n_tables;
 
 /* The oldest site store schema (PRAGMA user_version) whose columns
  * fleet_tables names: amfid migrates older stores when it starts. */
-#define FLEET_MIN_STORE_VERSION 7
+#define FLEET_MIN_STORE_VERSION 8
 
 #endif

@@ -59,10 +59,11 @@ fleet_same "$tmp/live.db" live-1
 # deck temperature and natural frequency, all of it in the central rows
 env=$(sqlite3 "$tmp/live.db" "SELECT count(*) FROM environment")
 [ "$env" -ge 10 ] || fail "amfid stored $env environment readings"
-l=$(sqlite3 "$tmp/live.db" "SELECT count(deck_c) || ' ' || count(f1_hz) || ' ' || count(f1_r2) FROM passages")
-c=$(pg_q "SELECT count(deck_c) || ' ' || count(f1_hz) || ' ' || count(f1_r2) FROM passages WHERE site_id = 'live-1'")
-[ "$l" = "$c" ] || fail "deck_c, f1_hz, f1_r2 values: store $l, central $c"
+n14="count(deck_c) || ' ' || count(f1_hz) || ' ' || count(f1_r2) || ' ' || count(gvw_comp_kg)"
+l=$(sqlite3 "$tmp/live.db" "SELECT $n14 FROM passages")
+c=$(pg_q "SELECT $n14 FROM passages WHERE site_id = 'live-1'")
+[ "$l" = "$c" ] || fail "deck_c, f1_hz, f1_r2, gvw_comp_kg values: store $l, central $c"
 [ "${l%% *}" -gt 0 ] || fail "no passage with a deck temperature: $l"
-echo "fleet_amfid: amfid stored $stored, $mid shipped before amfid stopped, in $passes passes; $env temperature readings, passages with deck_c, f1_hz, f1_r2: $l"
+echo "fleet_amfid: amfid stored $stored, $mid shipped before amfid stopped, in $passes passes; $env temperature readings, passages with deck_c, f1_hz, f1_r2, gvw_comp_kg: $l"
 [ $failures = 0 ] && echo "fleet_amfid.sh: all cases pass"
 exit $((failures != 0))

@@ -81,7 +81,7 @@ case=init
 # a central database of version 1 migrates on the next contact
 v5_down="DROP VIEW fleet_latest_scale; DROP TABLE environment, scale_evals;
       ALTER TABLE passages DROP COLUMN reference_gvw_kg, DROP COLUMN deck_c, DROP COLUMN f1_hz,
-      DROP COLUMN f1_comp_hz, DROP COLUMN f1_zeta, DROP COLUMN f1_r2;"
+      DROP COLUMN f1_comp_hz, DROP COLUMN f1_zeta, DROP COLUMN f1_r2, DROP COLUMN gvw_comp_kg;"
 pg_q "$v5_down DROP VIEW fleet_window_trend; ALTER TABLE passages DROP COLUMN speed_given_mps,
       DROP COLUMN speed_estimated, DROP COLUMN n_vehicles, DROP COLUMN quality;
       DELETE FROM fleet_migrations WHERE version > 1"
@@ -372,7 +372,8 @@ fleet_columns_same "$tmp/u.db" site-u passages "id > 1000"
 fleet_columns_same "$tmp/u.db" site-u environment
 fleet_columns_same "$tmp/u.db" site-u scale_evals
 [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-u' AND id <= 1000 AND
-           (deck_c IS NOT NULL OR f1_hz IS NOT NULL OR reference_gvw_kg IS NOT NULL)")" = 0 ] ||
+           (deck_c IS NOT NULL OR f1_hz IS NOT NULL OR reference_gvw_kg IS NOT NULL OR
+            gvw_comp_kg IS NOT NULL)")" = 0 ] ||
     fail "passages shipped before the migration have values in its columns"
 [ "$(psql -X -At "host=$PG_DIR dbname=up4 user=analyst" -c "SELECT count(*) FROM fleet_latest_scale")" = 2 ] ||
     fail "the reader role cannot read fleet_latest_scale"

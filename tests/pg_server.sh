@@ -69,9 +69,10 @@ fleet_columns_same() {
         fail "$2 $3: central rows differ from the store's: $(diff "$tmp/cols.store" "$tmp/cols.central" | head -4)"
 }
 # fleet_issue14_rows DB [ID]: issue 14's data added to a site store of
-# version 7: deck and air temperature readings, scale blocks and known-truck
+# version 8: deck and air temperature readings, scale blocks and known-truck
 # runs (scale_evals), and on its passages above ID (default all) a deck
-# temperature, natural frequency and now and then a known truck's weight.
+# temperature, the weight the STD rule was fed, natural frequency and now
+# and then a known truck's weight.
 # The reals are binary fractions, printed alike by sqlite3 and psql.
 fleet_issue14_rows() {
     sqlite3 "$1" <<SQL > /dev/null
@@ -81,7 +82,8 @@ WITH RECURSIVE k(i) AS (SELECT 0 UNION ALL SELECT i + 1 FROM k WHERE i < 47)
 INSERT INTO environment (utime, deck_c, air_c, received_utime)
 SELECT b + i * 1800000000, -20.25 + 0.5 * i, -21.75 + 0.5 * i, b + i * 1800000000 + 250000
 FROM k, (SELECT coalesce(max(utime) + 1800000000, 1763769600000000) AS b FROM environment);
-UPDATE passages SET deck_c = -5.25 + 0.5 * (id % 40) WHERE status = 'ok' AND id > ${2:-0};
+UPDATE passages SET deck_c = -5.25 + 0.5 * (id % 40), gvw_comp_kg = 14999.5 + 1000 * (id % 7)
+ WHERE status = 'ok' AND id > ${2:-0};
 UPDATE passages SET f1_hz = 3.125 + 0.0625 * (id % 8), f1_zeta = 0.015625 * (1 + id % 3),
        f1_r2 = 0.96875, f1_comp_hz = CASE WHEN id % 2 = 0 THEN 3.140625 + 0.0625 * (id % 8) END
  WHERE status = 'ok' AND id % 3 = 0 AND id > ${2:-0};

@@ -6,9 +6,10 @@
 # its counts, and the report of one site from the central database equals
 # the report of its store: the default sections, the CSV and JSON exports,
 # the histogram, the plots. A third site with issue 14's data (temperatures,
-# scale blocks, known-truck runs, natural frequency) gives the same
-# temperature, scale, known-truck and natural-frequency lines, exports and
-# plot data from the central database as from its store. An unknown site (exit 2, the sites listed), a
+# scale blocks, known-truck runs, natural frequency, the weight the STD rule
+# was fed) gives the same temperature, scale, known-truck, natural-frequency
+# and fed-GVW lines, exports and plot data from the central database as from
+# its store. An unknown site (exit 2, the sites listed), a
 # central row the store schema refuses (exit 1, named), a stopped server
 # (exit 1, one line, no password) and the options that make no sense
 # centrally (exit 2) are refused.
@@ -82,7 +83,8 @@ same --summary --format csv
 "$report" --pg "$PG_CONNINFO" --site site-14 --summary > "$tmp/pg14.out" 2>&1
 for line in '^temperature  deck -20\.2 \.\. 3\.2 °C, air -21\.8 \.\. 1\.8 °C, 48 readings' \
             '^scale        20 blocks, newest 2025-11-22 23:00 UTC: 1\.0303 compensated' \
-            '^known truck  6 runs, ratio inferred/reference' '^natural f1   n [1-9][0-9]*, raw mean 3\.'; do
+            '^known truck  6 runs, ratio inferred/reference' '^natural f1   n [1-9][0-9]*, raw mean 3\.' \
+            '^GVW, fed     n [1-9][0-9]*, mean [0-9]* kg'; do
     grep -q "$line" "$tmp/pg14.out" || fail "site-14 --pg: no line /$line/: $(cat "$tmp/pg14.out")"
 done
 if command -v gnuplot > /dev/null; then
