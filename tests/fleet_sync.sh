@@ -133,6 +133,17 @@ done
 [ "$(pg_q "SELECT string_agg(kind || ' ' || state || ' ' || n, ', ' ORDER BY kind) FROM fleet_latest_scale
            WHERE site_id = 'site-i'")" = "known_truck normal 6, scale_shift alert 200" ] ||
     fail "fleet_latest_scale: $(pg_q "SELECT * FROM fleet_latest_scale WHERE site_id = 'site-i'")"
+# the new tables' marks hold as the old ones: a copy whose environment or
+# scale_evals row at the mark differs is refused, nothing merged
+for t in environment scale_evals; do
+    cp "$tmp/i.db" "$tmp/i-restored.db"
+    sqlite3 "$tmp/i-restored.db" "UPDATE $t SET deck_c = deck_c + 0.5 WHERE id = (SELECT max(id) FROM $t)"
+    "$sync" --db "$tmp/i-restored.db" --pg "$PG_CONNINFO" --once 2> "$tmp/i-restored.log"
+    rc=$?
+    [ $rc = 3 ] && grep -q "refused: site 'site-i' table $t: .* different row at that id" "$tmp/i-restored.log" ||
+        fail "$t: a different row at the mark: exit $rc, $(cat "$tmp/i-restored.log")"
+done
+same "$tmp/i.db" site-i
 # more of everything: the second pass ships only the new rows
 add_rows "$tmp/i.db" 500
 fleet_issue14_rows "$tmp/i.db" 3000
