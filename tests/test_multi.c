@@ -309,6 +309,69 @@ static double bounce_force(double t, int a, void *user)
     return b->f0[a] * (1.0 + 0.1 * sin(6.283185307179586 * b->hz[a] * t + b->phase[a]));
 }
 
+/* The bouncing pair: two two-axle vehicles at one sensor, the follower's
+ * front axle `gap` m behind the leader's rear axle, solved with
+ * amfi_multi_passage.lambda_factor = factor; each vehicle's GVW error
+ * against its axles' mean forces on the span, and its quality. */
+static void bounce_pair(amfi_solver *s, double gap, double factor, double *e, double *q,
+                        double *sep)
+{
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    bounce b = {{102000.0, 74600.0, 60000.0, 90000.0},
+                {2.2, 3.1, 2.6, 2.9},
+                {0.0, 1.9, 4.1, 0.7}};
+    const double sp[1] = {5.0};
+    amfi_multi_passage *p = calloc(1, sizeof *p);
+    /* x = v·t − off: the leader enters at 0, the follower (5 + gap)/v later */
+    const double off[4] = {0.0, 5.0, 5.0 + gap, 10.0 + gap};
+    for (int v = 0; v < 2; v++) {
+        p->vehicle[v].entry_s = off[2 * v] / SPEED;
+        p->vehicle[v].speed_mps = SPEED;
+        p->vehicle[v].n_axles = 2;
+        p->vehicle[v].axle_spacing_m[0] = sp[0];
+    }
+    p->n_vehicles = 2;
+    p->lambda_factor = factor;
+    amfi_passage_times w = amfi_multi_window(20.0, p, 0.0, 0.0);
+    int n = (int)((w.end_s + 0.05) * RATE) + 1;
+    double *acc = malloc(sizeof(double) * n);
+    char err[256];
+    assert_int_equal(amfi_forward_newmark(bridge, SPEED, 4, off, bounce_force, &b, 1, sensors,
+                                          2e-5, RATE, n, acc, err, sizeof err),
+                     0);
+    p->n_samples = n;
+    p->scan_rate_hz = RATE;
+    p->accel[0] = acc;
+    amfi_multi_result *r = malloc(sizeof *r);
+    assert_int_equal(amfi_solve_multi(s, p, &lam, r, err, sizeof err), 0);
+    for (int v = 0; v < 2; v++) {
+        /* truth: the mean of each axle's force over its steps on the span */
+        double truth = 0.0;
+        for (int a = 2 * v; a < 2 * v + 2; a++) {
+            double sum = 0.0;
+            int cnt = 0;
+            for (int k = 0; k < 100000; k++) {
+                double t = k / 5000.0, x = SPEED * t - off[a];
+                if (x > 20.0)
+                    break;
+                if (x >= 0.0) {
+                    sum += bounce_force(t, a, &b);
+                    cnt++;
+                }
+            }
+            truth += sum / cnt / AMFI_GRAVITY;
+        }
+        e[v] = r->vehicle[v].gvw_kg / truth - 1.0;
+        q[v] = r->vehicle[v].quality;
+        sep[v] = r->vehicle[v].separability;
+        printf("# bouncing pair, gap %.0f m, λ factor %g: vehicle %d %+.3f %% (quality %.3f, "
+               "separability %.3f)\n",
+               gap, factor, v + 1, 100 * e[v], q[v], sep[v]);
+    }
+    free(r), free(acc), free(p);
+}
+
 /* Two two-axle vehicles at one sensor with bouncing axles: the follower's
  * front axle 1 m behind the leader's rear axle (most of the crossing
  * together: they trade load) and 15 m behind it (0.2 s together). The
@@ -320,67 +383,62 @@ static void quality_ranks_traded_load(void **state)
 {
     (void)state;
     amfi_solver *s = make_solver(1, 4, AMFI_COORDS_MODAL);
-    amfi_lambda lam;
-    amfi_lambda_default(&lam);
     const double gap[2] = {1.0, 15.0};
     double q[2], e_max[2];
-    bounce b = {{102000.0, 74600.0, 60000.0, 90000.0},
-                {2.2, 3.1, 2.6, 2.9},
-                {0.0, 1.9, 4.1, 0.7}};
     for (int c = 0; c < 2; c++) {
-        const double sp[1] = {5.0};
-        amfi_multi_passage *p = calloc(1, sizeof *p);
-        /* x = v·t − off: the leader enters at 0, the follower (5 + gap)/v later */
-        const double off[4] = {0.0, 5.0, 5.0 + gap[c], 10.0 + gap[c]};
-        for (int v = 0; v < 2; v++) {
-            p->vehicle[v].entry_s = off[2 * v] / SPEED;
-            p->vehicle[v].speed_mps = SPEED;
-            p->vehicle[v].n_axles = 2;
-            p->vehicle[v].axle_spacing_m[0] = sp[0];
-        }
-        p->n_vehicles = 2;
-        amfi_passage_times w = amfi_multi_window(20.0, p, 0.0, 0.0);
-        int n = (int)((w.end_s + 0.05) * RATE) + 1;
-        double *acc = malloc(sizeof(double) * n);
-        char err[256];
-        assert_int_equal(amfi_forward_newmark(bridge, SPEED, 4, off, bounce_force, &b, 1,
-                                              sensors, 2e-5, RATE, n, acc, err, sizeof err),
-                         0);
-        p->n_samples = n;
-        p->scan_rate_hz = RATE;
-        p->accel[0] = acc;
-        amfi_multi_result *r = malloc(sizeof *r);
-        assert_int_equal(amfi_solve_multi(s, p, &lam, r, err, sizeof err), 0);
-        e_max[c] = 0.0;
-        q[c] = 0.0;
-        for (int v = 0; v < 2; v++) {
-            /* truth: the mean of each axle's force over its steps on the span */
-            double truth = 0.0;
-            for (int a = 2 * v; a < 2 * v + 2; a++) {
-                double sum = 0.0;
-                int cnt = 0;
-                for (int k = 0; k < 100000; k++) {
-                    double t = k / 5000.0, x = SPEED * t - off[a];
-                    if (x > 20.0)
-                        break;
-                    if (x >= 0.0) {
-                        sum += bounce_force(t, a, &b);
-                        cnt++;
-                    }
-                }
-                truth += sum / cnt / AMFI_GRAVITY;
-            }
-            double e = r->vehicle[v].gvw_kg / truth - 1.0;
-            printf("# bouncing pair, gap %.0f m: vehicle %d %+.3f %% (quality %.3f, "
-                   "separability %.3f)\n",
-                   gap[c], v + 1, 100 * e, r->vehicle[v].quality, r->vehicle[v].separability);
-            e_max[c] = fmax(e_max[c], fabs(e));
-            q[c] = fmax(q[c], r->vehicle[v].quality);
-        }
-        free(r), free(acc), free(p);
+        double e[2], qv[2], sep[2];
+        bounce_pair(s, gap[c], 0.0, e, qv, sep);
+        e_max[c] = fmax(fabs(e[0]), fabs(e[1]));
+        q[c] = fmax(qv[0], qv[1]);
     }
     assert_true(q[0] > q[1]);
     assert_true(e_max[0] > e_max[1]);
+    amfi_solver_destroy(s);
+}
+
+/* amfi_multi_passage.lambda_factor: 1 is the same as 0 (off); 0.1 gives
+ * the weights of the quality sweep (λ/10), so the quality of the solve at λ
+ * is 1 + 100·|GVW(0.1) − GVW(λ)|/GVW(λ) exactly; a vehicle alone is solved
+ * at λ whatever the factor. On these synthetic pairs (a pure sinusoidal 10 %
+ * bounce) the solve at λ/10 errs MORE (1 m: −3.22 / +2.39 % against −2.83 /
+ * +2.24 %), unlike the coupled-model pairs of amfi-multi (round five,
+ * docs/results/multi-vehicle.md), which is one reason the factor is off by
+ * default. */
+static void lambda_factor_solves_pairs_looser(void **state)
+{
+    (void)state;
+    amfi_solver *s = make_solver(1, 4, AMFI_COORDS_MODAL);
+    const double gap[1] = {1.0};
+    for (int c = 0; c < 1; c++) {
+        double e0[2], e1[2], e10[2], q0[2], q1[2], q10[2], sep[2];
+        bounce_pair(s, gap[c], 0.0, e0, q0, sep);
+        bounce_pair(s, gap[c], 1.0, e1, q1, sep);
+        bounce_pair(s, gap[c], 0.1, e10, q10, sep);
+        for (int v = 0; v < 2; v++) {
+            assert_true(e1[v] == e0[v] && q1[v] == q0[v]);
+            assert_true(e10[v] != e0[v]);
+            double moved = 1.0 + 100.0 * fabs((1.0 + e10[v]) / (1.0 + e0[v]) - 1.0);
+            assert_true(fabs(q0[v] - moved) <= 1e-6 * q0[v]);
+            /* the quality sweep of the looser solve is at λ/100 */
+            assert_true(q10[v] != q0[v] && q10[v] >= 1.0);
+        }
+    }
+    /* one vehicle: the factor does not apply */
+    event ev;
+    memset(&ev, 0, sizeof ev);
+    add_vehicle(&ev, 0.0, 2, sp2, f2);
+    record(&ev, 1, 0.0);
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    amfi_multi_result *r0 = malloc(sizeof *r0), *r1 = malloc(sizeof *r1);
+    char err[256];
+    assert_int_equal(amfi_solve_multi(s, &ev.p, &lam, r0, err, sizeof err), 0);
+    ev.p.lambda_factor = 0.1;
+    assert_int_equal(amfi_solve_multi(s, &ev.p, &lam, r1, err, sizeof err), 0);
+    assert_true(r1->vehicle[0].gvw_kg == r0->vehicle[0].gvw_kg);
+    assert_true(r1->all.lambda_h == r0->all.lambda_h);
+    free(r0), free(r1);
+    event_free(&ev);
     amfi_solver_destroy(s);
 }
 
@@ -422,6 +480,14 @@ static void rejects_bad_events(void **state)
     p = ev.p;
     p.vehicle[1].entry_s = 0.9;
     assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_ERANGE);
+    /* the λ factor: 0 (off) or 1e-4 .. 1 */
+    const double bad_factor[3] = {-0.1, 2.0, NAN};
+    for (int k = 0; k < 3; k++) {
+        p = ev.p;
+        p.lambda_factor = bad_factor[k];
+        assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
+        assert_non_null(strstr(err, "lambda_factor"));
+    }
     p = ev.p;
     p.n_vehicles = AMFI_MAX_VEHICLES + 1;
     assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
@@ -439,6 +505,7 @@ int main(void)
         cmocka_unit_test(three_vehicles_three_sensors),
         cmocka_unit_test(separability_ranks_close_axles),
         cmocka_unit_test(quality_ranks_traded_load),
+        cmocka_unit_test(lambda_factor_solves_pairs_looser),
         cmocka_unit_test(rejects_bad_events),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -7,7 +7,8 @@
  * at a tenth of λ (how far the weight moves when the regularisation that
  * decides the load split between close axles is loosened) and a
  * separability figure from the normal matrix of a constant-axle-load model
- * (see amfi_vehicle_result in amfi.h).
+ * (see amfi_vehicle_result in amfi.h). An event of several vehicles may be
+ * solved at a fraction of λ (amfi_multi_passage.lambda_factor, round five).
  * Pure computation; runs on the caller's thread and uses the solver handle's
  * workspace (grown here, before any time loop) plus per-call scratch for the
  * quality figure.
@@ -175,6 +176,8 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
                 "vehicle %d: axle spacing %d must be > 0", v + 1, a + 1);
         na += ve->n_axles;
     }
+    REQ(p->lambda_factor == 0.0 || (p->lambda_factor >= 1e-4 && p->lambda_factor <= 1.0),
+        AMFI_EINVAL, "lambda_factor %g: 0 (off) or 1e-4 .. 1", p->lambda_factor);
     REQ(na <= AMFI_MAX_AXLES, AMFI_EINVAL, "%d axles in all: at most %d in one event", na,
         AMFI_MAX_AXLES);
     amfi_passage samples;
@@ -215,6 +218,8 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
     if ((rc = amfi_solve_window(s, &samples, na, win.start_s, win.end_s, err, errlen)) != 0 ||
         (rc = amfi_solve_lambda(s, lam, &lam_h, &n_solves, err, errlen)) != 0)
         return rc;
+    if (p->n_vehicles > 1 && p->lambda_factor > 0.0)
+        lam_h *= p->lambda_factor;
     /* quality: the sweep at λ·AMFI_MULTI_QUALITY_LAMBDA first (solve_end's
      * sweep then leaves the answer in the workspace); one vehicle alone has
      * nothing to trade load with and needs no second sweep */

@@ -3,7 +3,7 @@
  * amfi-multi: the joint solve of two vehicles on the span, measured (issue 13).
  *
  *   amfi-multi [--events N] [--seed S] [--noise FRACTION] [--min-headway S]
- *              [--config FILE.yaml]
+ *              [--alone] [--loose] [--config FILE.yaml]
  *
  * Each event: two half-cars (GVW 10..40 t, front axle share 0.35..0.6,
  * spacing 3.5..6 m, Table 2 properties drawn) on one lane at the same speed
@@ -30,6 +30,12 @@
  * pair's sum, and how many of the largest errors (top decile) fall in the
  * worst decile by quality; with --alone, the same vehicles simulated and
  * solved one at a time (the single-vehicle reference on the same pairs).
+ * --loose (round five) solves every pair once more at a tenth of λ (the
+ * quality figure's sweep, here as a whole solve) and appends each vehicle's
+ * loose axle loads and both solves' time to the rows (the direction the data
+ * leave open, for the figures and the split prior measured offline);
+ * --lambda-factor F solves the pairs at λ·F (amfi_multi_passage.lambda_factor;
+ * the loose solve then at λ·F/10).
  *
  * Single-threaded; everything is created once and freed at the end.
  */
@@ -39,6 +45,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "amfi/amfi.h"
 #include "amfi_cli.h"
@@ -53,15 +60,26 @@
 static void usage(FILE *f)
 {
     fprintf(f, "usage: " PROG " [--events N] [--seed S] [--noise FRACTION] [--min-headway S]\n"
-               "       [--alone] [--config FILE]\n"
+               "       [--alone] [--loose] [--lambda-factor F] [--config FILE]\n"
                "  -n, --events N      events (vehicle pairs), 10 .. 100000 (default 100)\n"
                "  -s, --seed S        random seed (default 1)\n"
                "  -z, --noise F       noise std as a fraction of the record's RMS (0.02)\n"
                "  -m, --min-headway S least delay between the front axles, s, 0.05 .. 5 (0.5)\n"
                "  -a, --alone         also simulate and solve each vehicle without the other\n"
+               "  -l, --loose         also solve each pair at λ/10: loose axle loads and the\n"
+               "                      solves' times as extra columns\n"
+               "  -f, --lambda-factor F  pairs solved at λ·F (amfi_multi_passage.lambda_factor),\n"
+               "                      1e-4 .. 1 (default 1: λ)\n"
                "  -c, --config FILE   site configuration (default paper-20m.yaml)\n"
                "  -h, --help          this help\n"
                "  -V, --version       print the version\n");
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 static void die(const char *what, const char *err)
@@ -133,18 +151,22 @@ int main(int argc, char **argv)
                                               {"noise", required_argument, NULL, 'z'},
                                               {"min-headway", required_argument, NULL, 'm'},
                                               {"alone", no_argument, NULL, 'a'},
+                                              {"loose", no_argument, NULL, 'l'},
+                                              {"lambda-factor", required_argument, NULL, 'f'},
                                               {"config", required_argument, NULL, 'c'},
                                               AMFI_CLI_END};
     int n_events = 100;
     unsigned long seed = 1;
-    double noise = 0.02, min_headway = 0.5;
-    int alone = 0;
+    double noise = 0.02, min_headway = 0.5, lambda_factor = 1.0;
+    int alone = 0, loose = 0;
     const char *config = NULL;
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
     for (int k; (k = amfi_cli_next(&c)) != -1;) {
         switch (k) {
         case 'a': alone = 1; break;
+        case 'l': loose = 1; break;
+        case 'f': lambda_factor = amfi_cli_num(&c, optarg, 1e-4, 1); break;
         case 'n': n_events = (int)amfi_cli_integer(&c, optarg, 10, 100000); break;
         case 's': seed = (unsigned long)amfi_cli_integer(&c, optarg, 0, 4294967295.0); break;
         case 'z': noise = amfi_cli_num(&c, optarg, 0, 1); break;
@@ -222,7 +244,12 @@ int main(int argc, char **argv)
     if (!acc || !noisy)
         die("memory", "out of memory");
     printf("sensors,noise,event,vehicle,delay_s,truth_kg,gvw_kg,err,quality,speed_mps,"
-           "spacing_m,gap_m,on_span_s,shared,truth_axle1_kg,truth_axle2_kg,axle1_kg,axle2_kg\n");
+           "spacing_m,gap_m,on_span_s,shared,truth_axle1_kg,truth_axle2_kg,axle1_kg,axle2_kg%s\n",
+           loose ? ",loose_axle1_kg,loose_axle2_kg,solve_ms,loose_ms" : "");
+    amfi_lambda lam_loose = lam;
+    lam_loose.lambda_ref *= AMFI_MULTI_QUALITY_LAMBDA;
+    if (loose && lam.automatic)
+        die("--loose", "needs a fixed λ in the configuration");
     for (int e = 0; e < n_events; e++) {
         amfi_sim *sim;
         if (amfi_sim_create(bridge, prof, &sp, &sim, err, sizeof err))
@@ -342,9 +369,15 @@ int main(int argc, char **argv)
                     mp.vehicle[i].n_axles = 2;
                     mp.vehicle[i].axle_spacing_m[0] = spacing[i];
                 }
-                static amfi_multi_result r;
+                mp.lambda_factor = lambda_factor;
+                static amfi_multi_result r, rl;
+                double t0 = now_s();
                 if (amfi_solve_multi(solver[k], &mp, &lam, &r, err, sizeof err))
                     die("solve", err);
+                double t1 = now_s();
+                if (loose && amfi_solve_multi(solver[k], &mp, &lam_loose, &rl, err, sizeof err))
+                    die("solve", err);
+                double t2 = now_s();
                 int cond = 2 * k + z;
                 /* geometry: gap from the leader's rear axle to the follower's
                  * front axle (same speed: constant), each vehicle's time on
@@ -356,11 +389,15 @@ int main(int argc, char **argv)
                     double ev = r.vehicle[i].gvw_kg / truth[i] - 1.0;
                     rows[cond][2 * e + i] = (row){ev, r.vehicle[i].quality, gap};
                     printf("%d,%g,%d,%d,%.4f,%.1f,%.1f,%.6f,%.4f,%.2f,%.3f,%.3f,%.4f,%.3f,%.1f,%.1f,"
-                           "%.1f,%.1f\n",
+                           "%.1f,%.1f",
                            k ? 3 : 1, z ? noise : 0.0, e, i + 1, delay, truth[i],
                            r.vehicle[i].gvw_kg, ev, r.vehicle[i].quality, v, spacing[i], gap,
                            on[i], both / on[i], truth_ax[i][0], truth_ax[i][1],
                            r.vehicle[i].axle_kg[0], r.vehicle[i].axle_kg[1]);
+                    if (loose)
+                        printf(",%.1f,%.1f,%.3f,%.3f", rl.vehicle[i].axle_kg[0],
+                               rl.vehicle[i].axle_kg[1], 1e3 * (t1 - t0), 1e3 * (t2 - t1));
+                    printf("\n");
                 }
                 sums[cond][e] = r.total_gvw_kg / (truth[0] + truth[1]) - 1.0;
             }

@@ -425,6 +425,14 @@ typedef struct amfi_multi_passage {
     const double *accel[AMFI_MAX_SENSORS];
     int n_vehicles; /* 1 .. AMFI_MAX_VEHICLES */
     amfi_vehicle vehicle[AMFI_MAX_VEHICLES];
+    /* 0 (the default: a zeroed struct) or 1: the event is solved at the λ of
+     * the call; f in [1e-4, 1): an event of two or more vehicles is solved
+     * at λ·f (and its quality sweep at λ·f·AMFI_MULTI_QUALITY_LAMBDA); a
+     * vehicle alone always at λ. Round five (docs/results/multi-vehicle.md):
+     * the joint solve's error lies mostly along the direction the weights
+     * move when λ is loosened, and 0.1 lowers each vehicle's error on every
+     * condition measured; off by default (amfid does not set it). */
+    double lambda_factor;
 } amfi_multi_passage;
 
 typedef struct amfi_vehicle_result {
