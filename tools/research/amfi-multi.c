@@ -35,7 +35,9 @@
  * loose axle loads and both solves' time to the rows (the direction the data
  * leave open, for the figures and the split prior measured offline);
  * --lambda-factor F solves the pairs at λ·F (amfi_multi_passage.lambda_factor;
- * the loose solve then at λ·F/10).
+ * the loose solve then at λ·F/10); --quarter makes the one-sensor solve use
+ * the quarter-point sensor (which sees the antisymmetric modes the mid-span
+ * one does not).
  *
  * Single-threaded; everything is created once and freed at the end.
  */
@@ -60,7 +62,7 @@
 static void usage(FILE *f)
 {
     fprintf(f, "usage: " PROG " [--events N] [--seed S] [--noise FRACTION] [--min-headway S]\n"
-               "       [--alone] [--loose] [--lambda-factor F] [--config FILE]\n"
+               "       [--alone] [--loose] [--lambda-factor F] [--quarter] [--config FILE]\n"
                "  -n, --events N      events (vehicle pairs), 10 .. 100000 (default 100)\n"
                "  -s, --seed S        random seed (default 1)\n"
                "  -z, --noise F       noise std as a fraction of the record's RMS (0.02)\n"
@@ -70,6 +72,8 @@ static void usage(FILE *f)
                "                      solves' times as extra columns\n"
                "  -f, --lambda-factor F  pairs solved at λ·F (amfi_multi_passage.lambda_factor),\n"
                "                      1e-4 .. 1 (default 1: λ)\n"
+               "  -q, --quarter       the one-sensor solve from the quarter-point sensor\n"
+               "                      instead of the mid-span one\n"
                "  -c, --config FILE   site configuration (default paper-20m.yaml)\n"
                "  -h, --help          this help\n"
                "  -V, --version       print the version\n");
@@ -153,12 +157,13 @@ int main(int argc, char **argv)
                                               {"alone", no_argument, NULL, 'a'},
                                               {"loose", no_argument, NULL, 'l'},
                                               {"lambda-factor", required_argument, NULL, 'f'},
+                                              {"quarter", no_argument, NULL, 'q'},
                                               {"config", required_argument, NULL, 'c'},
                                               AMFI_CLI_END};
     int n_events = 100;
     unsigned long seed = 1;
     double noise = 0.02, min_headway = 0.5, lambda_factor = 1.0;
-    int alone = 0, loose = 0;
+    int alone = 0, loose = 0, quarter = 0;
     const char *config = NULL;
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -166,6 +171,7 @@ int main(int argc, char **argv)
         switch (k) {
         case 'a': alone = 1; break;
         case 'l': loose = 1; break;
+        case 'q': quarter = 1; break;
         case 'f': lambda_factor = amfi_cli_num(&c, optarg, 1e-4, 1); break;
         case 'n': n_events = (int)amfi_cli_integer(&c, optarg, 10, 100000); break;
         case 's': seed = (unsigned long)amfi_cli_integer(&c, optarg, 0, 4294967295.0); break;
@@ -207,7 +213,7 @@ int main(int argc, char **argv)
         amfi_solver_params p = cfg.solver;
         p.n_sensors = k ? 3 : 1;
         for (int i = 0; i < p.n_sensors; i++) {
-            p.sensor_x_m[i] = sp.sensor_x_m[i];
+            p.sensor_x_m[i] = sp.sensor_x_m[k == 0 && quarter ? 1 : i];
             p.sensor_weight[i] = 1.0;
         }
         p.max_axles = 4;
@@ -331,6 +337,8 @@ int main(int argc, char **argv)
                         ch[1][c3][j] = noisy[j * 3 + c3];
                     mp.accel[c3] = ch[1][c3];
                 }
+                if (k == 0 && quarter)
+                    mp.accel[0] = ch[1][1];
                 mp.n_vehicles = 1;
                 mp.vehicle[0].entry_s = entry[i];
                 mp.vehicle[0].speed_mps = v;
@@ -362,6 +370,8 @@ int main(int argc, char **argv)
                 mp.t_first_s = 0.0;
                 for (int i = 0; i < 3; i++)
                     mp.accel[i] = ch[z][i];
+                if (k == 0 && quarter)
+                    mp.accel[0] = ch[z][1];
                 mp.n_vehicles = 2;
                 for (int i = 0; i < 2; i++) {
                     mp.vehicle[i].entry_s = entry[i];
