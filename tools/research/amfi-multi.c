@@ -3,7 +3,8 @@
  * amfi-multi: the joint solve of two vehicles on the span, measured (issue 13).
  *
  *   amfi-multi [--events N] [--seed S] [--noise FRACTION] [--min-headway S]
- *              [--alone] [--loose] [--config FILE.yaml]
+ *              [--alone] [--loose] [--lambda-factor F] [--quarter]
+ *              [--config FILE.yaml]
  *
  * Each event: two half-cars (GVW 10..40 t, front axle share 0.35..0.6,
  * spacing 3.5..6 m, Table 2 properties drawn) on one lane at the same speed
@@ -36,8 +37,8 @@
  * leave open, for the figures and the split prior measured offline);
  * --lambda-factor F solves the pairs at λ·F (amfi_multi_passage.lambda_factor;
  * the loose solve then at λ·F/10); --quarter makes the one-sensor solve use
- * the quarter-point sensor (which sees the antisymmetric modes the mid-span
- * one does not).
+ * the quarter-point sensor (which sees mode 2, antisymmetric, that the
+ * mid-span one does not).
  *
  * Single-threaded; everything is created once and freed at the end.
  */
@@ -72,8 +73,8 @@ static void usage(FILE *f)
                "                      solves' times as extra columns\n"
                "  -f, --lambda-factor F  pairs solved at λ·F (amfi_multi_passage.lambda_factor),\n"
                "                      1e-4 .. 1 (default 1: λ)\n"
-               "  -q, --quarter       the one-sensor solve from the quarter-point sensor\n"
-               "                      instead of the mid-span one\n"
+               "  -q, --quarter       the one-sensor solves (pairs and --alone) from the\n"
+               "                      quarter-point sensor instead of the mid-span one\n"
                "  -c, --config FILE   site configuration (default paper-20m.yaml)\n"
                "  -h, --help          this help\n"
                "  -V, --version       print the version\n");

@@ -429,9 +429,11 @@ typedef struct amfi_multi_passage {
      * the call; f in [1e-4, 1): an event of two or more vehicles is solved
      * at λ·f (and its quality sweep at λ·f·AMFI_MULTI_QUALITY_LAMBDA); a
      * vehicle alone always at λ. Round five (docs/results/multi-vehicle.md):
-     * the joint solve's error lies mostly along the direction the weights
-     * move when λ is loosened, and 0.1 lowers each vehicle's error on every
-     * condition measured; off by default (amfid does not set it). */
+     * the joint solve's error lies largely against the direction the
+     * weights move when λ is loosened, and 0.1 lowers the mean error in
+     * every condition measured, but the worst of coincident axles rises and
+     * `quality` then no longer ranks the errors; off by default (amfid does
+     * not set it). */
     double lambda_factor;
 } amfi_multi_passage;
 
