@@ -216,6 +216,55 @@ static void two_vehicles_one_sensor(void **state)
     event_free(&ev);
 }
 
+/* Two vehicles side by side on two lanes (the beam has no width: both load
+ * it at the same positions), entering together at one speed: the front
+ * axles coincide for the whole crossing. The looser quality sweep is then
+ * singular (it once failed the whole event: "quality sweep failed"); the
+ * answer at λ stands, the event's total is fixed, and both vehicles get
+ * quality AMFI_MULTI_QUALITY_UNFIXED and a separability far above that of
+ * a pair entering 0.7 s apart. */
+static void side_by_side_two_lanes(void **state)
+{
+    (void)state;
+    amfi_solver *s = make_solver(1, 5, AMFI_COORDS_MODAL);
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    double sep[2][2], qual[2][2];
+    for (int c = 0; c < 2; c++) {
+        event ev;
+        memset(&ev, 0, sizeof ev);
+        add_vehicle(&ev, 0.0, 2, sp2, f2);            /* lane 1 */
+        add_vehicle(&ev, c ? 0.7 : 0.0, 3, sp3, f3);  /* lane 2: beside it, or 0.7 s later */
+        ev.na = 0;
+        record(&ev, 1, 0.0);
+        amfi_multi_result r;
+        char err[256];
+        int rc = amfi_solve_multi(s, &ev.p, &lam, &r, err, sizeof err);
+        if (rc != 0)
+            fail_msg("%s", err);
+        double e[2];
+        double et = errors(&ev, &r, e);
+        printf("# side by side %s: total %+.3f %%, v1 %+.3f %% (sep %.3g, q %.3g), "
+               "v2 %+.3f %% (sep %.3g, q %.3g)\n",
+               c ? "0.7 s apart" : "together", 100 * et, 100 * e[0], r.vehicle[0].separability,
+               r.vehicle[0].quality, 100 * e[1], r.vehicle[1].separability,
+               r.vehicle[1].quality);
+        assert_true(fabs(et) < 0.01); /* the sum: as a vehicle alone (-0.21 %) */
+        for (int v = 0; v < 2; v++) {
+            sep[c][v] = r.vehicle[v].separability;
+            qual[c][v] = r.vehicle[v].quality;
+            assert_true(isfinite(r.vehicle[v].quality) && r.vehicle[v].quality >= 1.0);
+        }
+        event_free(&ev);
+    }
+    for (int v = 0; v < 2; v++) {
+        assert_true(sep[0][v] > 2.0 * sep[1][v]);
+        assert_true(qual[0][v] == AMFI_MULTI_QUALITY_UNFIXED);
+        assert_true(qual[1][v] < 10.0);
+    }
+    amfi_solver_destroy(s);
+}
+
 /* Three vehicles in a chain (A-B-C: A and C never meet), at three sensors,
  * modal and dense nodal paths agree. */
 static void three_vehicles_three_sensors(void **state)
@@ -502,6 +551,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(single_equals_solve),
         cmocka_unit_test(two_vehicles_one_sensor),
+        cmocka_unit_test(side_by_side_two_lanes),
         cmocka_unit_test(three_vehicles_three_sensors),
         cmocka_unit_test(separability_ranks_close_axles),
         cmocka_unit_test(quality_ranks_traded_load),

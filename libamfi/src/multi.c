@@ -224,14 +224,31 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
      * sweep then leaves the answer in the workspace); one vehicle alone has
      * nothing to trade load with and needs no second sweep */
     double loose[AMFI_MAX_VEHICLES];
+    int unfixed = 0; /* a sweep failed numerically: quality AMFI_MULTI_QUALITY_UNFIXED */
     if (p->n_vehicles > 1) {
         double rn, sn;
-        if ((rc = amfi_sweep(s, lam_h * AMFI_MULTI_QUALITY_LAMBDA, &rn, &sn)) != 0)
+        rc = amfi_sweep(s, lam_h * AMFI_MULTI_QUALITY_LAMBDA, &rn, &sn);
+        if (rc == AMFI_ENUM) /* axles of two vehicles at one point all along (side by
+                                side, entering together): the looser problem is
+                                singular; the answer at λ still stands */
+            unfixed = 1;
+        else if (rc != 0)
             return amfi_fail(err, errlen, rc, "quality sweep failed: %s", amfi_strerror(rc));
         n_solves++;
-        vehicle_gvw(s, p, loose);
+        if (!unfixed)
+            vehicle_gvw(s, p, loose);
     }
-    if ((rc = amfi_solve_end(s, lam, lam_h, n_solves, &res->all, err, errlen)) != 0)
+    rc = amfi_solve_end(s, lam, lam_h, n_solves, &res->all, err, errlen);
+    /* the same at λ itself: the sweep can be singular to round-off (which
+     * one fails depends on the BLAS's summation order); the event is then
+     * solved at 10 λ (at most 100 λ, res->all.lambda_ref says which) and its
+     * vehicles marked unfixed */
+    for (int k = 0; rc == AMFI_ENUM && p->n_vehicles > 1 && k < 2; k++) {
+        unfixed = 1;
+        lam_h *= 10.0;
+        rc = amfi_solve_end(s, lam, lam_h, n_solves + k + 1, &res->all, err, errlen);
+    }
+    if (rc != 0)
         return rc;
     REQ(isfinite(res->all.gvw_kg), AMFI_ENUM, "the joint solution is not finite");
 
@@ -288,7 +305,9 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
         vr->separability = sqrt(joint / alone);
         vr->gvw_sd_kg = res->all.residual_rms * sqrt(joint) / AMFI_GRAVITY;
         vr->quality = 1.0;
-        if (p->n_vehicles > 1) {
+        if (p->n_vehicles > 1 && unfixed) {
+            vr->quality = AMFI_MULTI_QUALITY_UNFIXED;
+        } else if (p->n_vehicles > 1) {
             vr->quality = 1.0 + 100.0 * fabs(loose[v] - vr->gvw_kg) / fabs(vr->gvw_kg);
             if (!isfinite(vr->quality)) {
                 free(U), free(A);

@@ -404,6 +404,8 @@ double amfi_speed_dip_at(const amfi_speed_prior *p, const double *j, int n, int 
 
 #define AMFI_MAX_VEHICLES 8
 
+/* amfi_vehicle_result.quality when the second sweep failed numerically. */
+#define AMFI_MULTI_QUALITY_UNFIXED 1e6
 /* The factor on λ of amfi_solve_multi's second sweep (quality figure). */
 #define AMFI_MULTI_QUALITY_LAMBDA 0.1
 
@@ -449,7 +451,11 @@ typedef struct amfi_vehicle_result {
      * is one the data do not fix (docs/results/multi-vehicle.md: the worst
      * tenth by this figure holds 21-35 of the 60 largest errors of 300
      * pairs, separability 12-19). 1 exactly for a vehicle alone in its
-     * event (no second sweep then). */
+     * event (no second sweep then). AMFI_MULTI_QUALITY_UNFIXED for every
+     * vehicle of an event whose second sweep, or whose sweep at λ, failed
+     * numerically (axles of two vehicles at one point all along; the
+     * event is then solved at 10 λ, at most 100 λ): the weights are still
+     * returned, but the data do not fix how they split. */
     double quality;
     /* σ·sqrt(uᵀA⁻¹u)/g with σ the joint fit's residual RMS: the posterior
      * standard deviation of the weight under the constant-axle-load model
