@@ -108,22 +108,11 @@ static int normal_matrix(const struct amfi_solver *s, double *A)
  * its axles' mean forces while on the span (as amfi_solve_end). */
 static void vehicle_gvw(const struct amfi_solver *s, const amfi_multi_passage *p, double *gvw)
 {
-    const double L = s->b->p.span_m;
     int i = 0;
     for (int v = 0; v < p->n_vehicles; v++) {
         gvw[v] = 0.0;
-        for (int a = 0; a < p->vehicle[v].n_axles; a++, i++) {
-            double sum = 0.0;
-            int cnt = 0;
-            for (int j = 0; j <= s->N; j++) {
-                double x = axle_x(s, i, j);
-                if (x >= 0.0 && x <= L) {
-                    sum += s->force[(size_t)j * s->na + i];
-                    cnt++;
-                }
-            }
-            gvw[v] += cnt ? sum / cnt / AMFI_GRAVITY : NAN;
-        }
+        for (int a = 0; a < p->vehicle[v].n_axles; a++, i++)
+            gvw[v] += amfi_axle_mean_force(s, i) / AMFI_GRAVITY;
     }
 }
 

@@ -436,10 +436,24 @@ int amfi_solve_lambda(struct amfi_solver *s, const amfi_lambda *lam, double *lam
     return AMFI_OK;
 }
 
+double amfi_axle_mean_force(const struct amfi_solver *s, int a)
+{
+    const double L = s->b->p.span_m;
+    double sum = 0.0;
+    int cnt = 0;
+    for (int j = 0; j <= s->N; j++) {
+        const double x = axle_x(s, a, j);
+        if (x >= 0.0 && x <= L) {
+            sum += s->force[(size_t)j * s->na + a];
+            cnt++;
+        }
+    }
+    return cnt ? sum / cnt : NAN;
+}
+
 int amfi_solve_end(struct amfi_solver *s, const amfi_lambda *lam, double lam_h, int n_solves,
                    amfi_result *res, char *err, size_t errlen)
 {
-    const double L = s->b->p.span_m;
     const int N = s->N;
     const double scale = amfi_lambda_scale(s, lam);
     double rn, sn;
@@ -470,16 +484,7 @@ int amfi_solve_end(struct amfi_solver *s, const amfi_lambda *lam, double lam_h, 
     /* GVW = Σ_a mean of g_a while axle a is on the span, / g (paper §3.2). */
     res->gvw_kg = 0.0;
     for (int a = 0; a < s->na; a++) {
-        double sum = 0.0;
-        int cnt = 0;
-        for (int j = 0; j <= N; j++) {
-            double x = axle_x(s, a, j);
-            if (x >= 0.0 && x <= L) {
-                sum += s->force[(size_t)j * s->na + a];
-                cnt++;
-            }
-        }
-        res->mean_force_N[a] = cnt ? sum / cnt : NAN;
+        res->mean_force_N[a] = amfi_axle_mean_force(s, a);
         res->axle_kg[a] = res->mean_force_N[a] / AMFI_GRAVITY;
         res->gvw_kg += res->axle_kg[a];
     }

@@ -72,6 +72,10 @@ static inline double axle_x(const struct amfi_solver *s, int a, int j)
     return s->speed * s->vf[a] * (s->t0 + j * s->h) - s->off[a];
 }
 
+/* Mean force of axle a over the steps it is on the span after the last
+ * sweep (s->force), N; NaN when it never is (solver.c). */
+double amfi_axle_mean_force(const struct amfi_solver *s, int a);
+
 /* One backward and forward sweep at per-step λ: fills s->force (N + 1 rows),
  * s->y, and the two norms (sweep_modal.c, sweep_nodal.c). */
 int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
