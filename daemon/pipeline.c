@@ -374,6 +374,11 @@ static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
                      "crossing (closest %.2f m)%s; the weight is the joint estimate",
                      c->inseparable_gap_m, (long long)e->w.ev[nr.other].vehicle_id,
                      100.0 * nr.share, nr.min_gap_m, sum);
+        } else if (j->quality >= AMFI_MULTI_QUALITY_UNFIXED) {
+            snprintf(j->reason, sizeof j->reason,
+                     "inseparable: the event's solve was singular (axles of its vehicles at one "
+                     "point); the %d vehicles weigh %.0f kg together",
+                     e->w.n_vehicles, e->gvw_kg);
         } else if (j->quality > (lanes > 1 ? c->inseparable_quality_lanes
                                            : c->inseparable_quality)) {
             snprintf(j->reason, sizeof j->reason,
