@@ -187,12 +187,12 @@ typedef struct {
     int std_comp;         /* feed the STD/mean engine compensated weights */
 } engines;
 
-static engines make(const opts *o)
+/* The STD engine's and the scale indicator's parameters: the defaults with
+ * the options applied. */
+static void engine_params(const opts *o, amfi_indicator_params *pp, amfi_scale_params *spp)
 {
     amfi_indicator_params p;
     amfi_scale_params sp;
-    engines e;
-    char err[256];
     amfi_indicator_params_default(&p);
     amfi_scale_params_default(&sp);
     sp.vehicles_per_day = o->flow;
@@ -208,6 +208,17 @@ static engines make(const opts *o)
         sp.false_alarms_per_year = o->scale_fa;
     sp.warm_slope *= o->prior_scale;
     sp.frost_slope *= o->prior_scale;
+    *pp = p;
+    *spp = sp;
+}
+
+static engines make(const opts *o)
+{
+    amfi_indicator_params p;
+    amfi_scale_params sp;
+    engines e;
+    char err[256];
+    engine_params(o, &p, &sp);
     amfi_known_truck_params kp;
     amfi_known_truck_params_default(&kp);
     kp.run_sd = o->meas_sd / TRUCK_KG;
@@ -369,11 +380,8 @@ static double baseline_days(const opts *o)
 {
     amfi_indicator_params p;
     amfi_scale_params sp;
-    amfi_indicator_params_default(&p);
-    amfi_scale_params_default(&sp);
-    const double nb = o->baseline_n > 0 ? o->baseline_n : p.baseline_n;
-    const double ns = (double)(o->scale_block > 0 ? o->scale_block : sp.block) *
-                      (o->scale_blocks > 0 ? o->scale_blocks : sp.baseline_blocks);
+    engine_params(o, &p, &sp);
+    const double nb = p.baseline_n, ns = (double)sp.block * sp.baseline_blocks;
     const double d = 1.2 * (nb > ns ? nb : ns) / o->flow;
     return d > 30.0 ? ceil(d) : 30.0;
 }
