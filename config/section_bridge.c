@@ -92,23 +92,29 @@ static const kind K_NAME = {"string", p_name, d_name, v_name, NEST_NONE};
 static const kind K_RAYLEIGH = {"list", p_rayleigh_modes, d_modes_pair, v_modes_pair,
                                 NEST_NONE};
 
-/* bridge.supports: a list of {at_m, type} */
+/* bridge.supports: a list of {at_m, type, k_w_npm, k_theta_nmprad} */
 typedef struct support_item {
-    double at_m; /* m, >= 0 (<= span checked in check_site) */
-    int type;    /* SUPPORT_* */
+    double at_m;           /* m, >= 0 (<= span checked in check_site) */
+    int type;              /* SUPPORT_* */
+    double k_w_npm;        /* elastic: the vertical spring, N/m, > 0 */
+    double k_theta_nmprad; /* pinned, roller, elastic: a rotational spring, N·m/rad */
 } support_item;
 
-enum { SUPPORT_PINNED, SUPPORT_ROLLER, SUPPORT_FIXED };
+enum { SUPPORT_PINNED, SUPPORT_ROLLER, SUPPORT_FIXED, SUPPORT_ELASTIC };
 
 static const enum_name support_types[] = {
     {"pinned", SUPPORT_PINNED}, {"roller", SUPPORT_ROLLER}, {"fixed", SUPPORT_FIXED},
-    {NULL, 0}};
+    {"elastic", SUPPORT_ELASTIC}, {NULL, 0}};
 
 static const field support_fields[] = {
     {.key = "at_m", .kind = &K_DOUBLE, .off = offsetof(support_item, at_m), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN | F_REQUIRED},
     {.key = "type", .kind = &K_ENUM, .off = offsetof(support_item, type),
      .aux = support_types, .flags = F_REQUIRED},
+    {.key = "k_w_npm", .kind = &K_DOUBLE, .off = offsetof(support_item, k_w_npm), .lo = 0,
+     .hi = HUGE_VAL, .flags = F_HI_OPEN},
+    {.key = "k_theta_nmprad", .kind = &K_DOUBLE, .off = offsetof(support_item, k_theta_nmprad),
+     .lo = 0, .hi = HUGE_VAL, .flags = F_HI_OPEN},
     {.key = NULL}};
 
 static int p_supports(ctx *x, yaml_node_t *v, const char *path, const field *f,
@@ -127,7 +133,7 @@ static int p_supports(ctx *x, yaml_node_t *v, const char *path, const field *f,
     memset(s, 0, sizeof s);
     for (int i = 0; i < n; i++) {
         yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
-        support_item si = {0.0, SUPPORT_PINNED};
+        support_item si = {0.0, SUPPORT_PINNED, 0.0, 0.0};
 
         join_index(ip, path, (size_t)i);
         if (!it)
@@ -135,9 +141,23 @@ static int p_supports(ctx *x, yaml_node_t *v, const char *path, const field *f,
         note_line(x, ip, line_of(it));
         if (walk_map(x, it, ip, support_fields, &si))
             return -1;
+        if (si.type == SUPPORT_ELASTIC && !(si.k_w_npm > 0))
+            return fail(x, line_of(it), ip, "an elastic support needs k_w_npm > 0 "
+                        "(its vertical stiffness, N/m)");
+        if (si.type != SUPPORT_ELASTIC && si.k_w_npm > 0)
+            return fail(x, line_of(it), ip, "k_w_npm is the spring of an elastic support; "
+                        "a %s support holds the vertical displacement",
+                        si.type == SUPPORT_FIXED ? "fixed" : si.type == SUPPORT_ROLLER ? "roller"
+                                                                                   : "pinned");
+        if (si.type == SUPPORT_FIXED && si.k_theta_nmprad > 0)
+            return fail(x, line_of(it), ip, "a fixed support holds the rotation: no "
+                        "k_theta_nmprad (use pinned with k_theta_nmprad for a partly "
+                        "fixed bearing)");
         s[i].x_m = si.at_m;
-        s[i].restrain_w = 1;
+        s[i].restrain_w = si.type != SUPPORT_ELASTIC;
         s[i].restrain_theta = si.type == SUPPORT_FIXED;
+        s[i].k_w_npm = si.type == SUPPORT_ELASTIC ? si.k_w_npm : 0.0;
+        s[i].k_theta_nmprad = si.k_theta_nmprad;
     }
     memcpy(b->supports, s, sizeof s);
     b->n_supports = n;
@@ -158,9 +178,72 @@ static void v_supports(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "pinned at 0, roller at span_m");
 }
 
-static const support_item support_default = {0.0, SUPPORT_PINNED};
+static const support_item support_default = {0.0, SUPPORT_PINNED, 0.0, 0.0};
 static const list_schema support_list = {support_fields, &support_default};
 static const kind K_SUPPORTS = {"list", p_supports, d_supports, v_supports, NEST_LIST};
+
+/* bridge.segments: a list of {from_m, to_m, EI_nm2, mass_kgpm} */
+static const field segment_fields[] = {
+    {.key = "from_m", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, x0_m), .lo = 0,
+     .hi = HUGE_VAL, .flags = F_HI_OPEN | F_REQUIRED},
+    {.key = "to_m", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, x1_m), .lo = 0,
+     .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN | F_REQUIRED},
+    {.key = "EI_nm2", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, EI_nm2), .lo = 0,
+     .hi = HUGE_VAL, .flags = F_HI_OPEN},
+    {.key = "mass_kgpm", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, mass_kgpm), .lo = 0,
+     .hi = HUGE_VAL, .flags = F_HI_OPEN},
+    {.key = NULL}};
+
+static int p_segments(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    amfi_bridge_params *b = &((amfi_site_config *)base)->bridge;
+    amfi_segment g[AMFI_MAX_SEGMENTS];
+    yaml_node_item_t *items;
+    char ip[PATH_LEN];
+    int n = 0;
+
+    (void)f;
+    items = list_items(x, v, path, "segments", AMFI_MAX_SEGMENTS, &n);
+    if (!items)
+        return -1;
+    memset(g, 0, sizeof g);
+    for (int i = 0; i < n; i++) {
+        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
+
+        join_index(ip, path, (size_t)i);
+        if (!it)
+            return fail(x, line_of(v), ip, "malformed list");
+        note_line(x, ip, line_of(it));
+        if (walk_map(x, it, ip, segment_fields, &g[i]))
+            return -1;
+        if (!(g[i].x1_m > g[i].x0_m))
+            return fail(x, line_of(it), ip, "to_m (%g) must be beyond from_m (%g)", g[i].x1_m,
+                        g[i].x0_m);
+        if (g[i].EI_nm2 == 0 && g[i].mass_kgpm == 0)
+            return fail(x, line_of(it), ip, "gives neither EI_nm2 nor mass_kgpm");
+    }
+    memcpy(b->segments, g, sizeof g);
+    b->n_segments = n;
+    return 0;
+}
+
+static void d_segments(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "0 .. %d segments", AMFI_MAX_SEGMENTS);
+}
+
+static void v_segments(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "none: one section over the whole span");
+}
+
+static const amfi_segment segment_default = {0.0, 0.0, 0.0, 0.0};
+static const list_schema segment_list = {segment_fields, &segment_default};
+static const kind K_SEGMENTS = {"list", p_segments, d_segments, v_segments, NEST_LIST};
 
 static const field damping_fields[] = {
     {.key = "ratio", .kind = &K_DOUBLE, .off = SC(bridge.damping_ratio), .lo = 0,
@@ -184,6 +267,7 @@ const field bridge_fields[] = {
      .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
     {.key = "damping", .kind = &K_MAP, .aux = damping_fields},
     {.key = "supports", .kind = &K_SUPPORTS, .aux = &support_list},
+    {.key = "segments", .kind = &K_SEGMENTS, .aux = &segment_list},
     {.key = "damage", .kind = &K_DOUBLE, .off = SC(bridge.damage), .lo = 0, .hi = 1,
      .flags = F_HI_OPEN},
     {.key = NULL}};
@@ -222,10 +306,25 @@ int bridge_check(ctx *x, amfi_site_config *c)
                             "falls on node %d (of %d elements), like "
                             "bridge.supports[%d]", node[i], b->n_elements, j);
     }
-    if (b->n_supports == 1 && !b->supports[0].restrain_theta)
+    if (b->n_supports == 1 && !b->supports[0].restrain_theta &&
+        !(b->supports[0].k_theta_nmprad > 0))
         return fail(x, noted(x, "bridge.supports"), "bridge.supports",
-                    "a single pinned or roller support leaves the beam free to "
-                    "rotate; make it fixed or add a support");
+                    "a single support without a held or sprung rotation leaves the beam "
+                    "free to rotate; make it fixed or add a support");
+
+    /* Segments: on the beam, apart. */
+    for (int i = 0; i < b->n_segments; i++) {
+        pathf(p, "bridge.segments[%d]", i);
+        if (b->segments[i].x1_m > b->span_m)
+            return fail(x, first_noted(x, p, "bridge.span_m", NULL), p,
+                        "to_m %g m is beyond the span (bridge.span_m = %g m)",
+                        b->segments[i].x1_m, b->span_m);
+        for (int j = 0; j < i; j++)
+            if (b->segments[i].x0_m < b->segments[j].x1_m &&
+                b->segments[j].x0_m < b->segments[i].x1_m)
+                return fail(x, noted(x, p), p, "overlaps bridge.segments[%d] ([%g, %g) m)", j,
+                            b->segments[j].x0_m, b->segments[j].x1_m);
+    }
 
     /* Mode numbers within the model's free DOFs. */
     ndof = bridge_free_dofs(b);

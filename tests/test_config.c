@@ -780,7 +780,7 @@ static const bad_case bad_cases[] = {
      2, "bridge.supports", "got 17"},
     {"support_type", "bridge:\n  supports:\n    - {at_m: 0, type: pinned}\n"
      "    - {at_m: 20, type: hinge}\n", 4, "bridge.supports[1].type",
-     "expected one of pinned, roller, fixed; got 'hinge'"},
+     "expected one of pinned, roller, fixed, elastic; got 'hinge'"},
     {"support_no_type", "bridge:\n  supports:\n    - {at_m: 0, type: pinned}\n"
      "    - at_m: 20\n", 4, "bridge.supports[1].type", "missing"},
     {"support_off_span", "bridge:\n  supports:\n    - {at_m: 0, type: pinned}\n"
@@ -789,6 +789,26 @@ static const bad_case bad_cases[] = {
      "    - {at_m: 0.3, type: roller}\n", 4, "bridge.supports[1].at_m", "node 0"},
     {"support_mechanism", "bridge:\n  supports:\n    - {at_m: 10, type: pinned}\n", 2,
      "bridge.supports", "free to rotate"},
+    {"elastic_no_spring", "bridge:\n  supports:\n    - {at_m: 0, type: pinned}\n"
+     "    - {at_m: 20, type: elastic}\n", 4, "bridge.supports[1]", "needs k_w_npm > 0"},
+    {"pinned_k_w", "bridge:\n  supports:\n    - {at_m: 0, type: pinned, k_w_npm: 1e9}\n"
+     "    - {at_m: 20, type: roller}\n", 3, "bridge.supports[0]", "elastic support"},
+    {"fixed_k_theta", "bridge:\n  supports:\n    - {at_m: 0, type: fixed, k_theta_nmprad: 1e9}\n",
+     3, "bridge.supports[0]", "holds the rotation"},
+    {"k_theta_negative", "bridge:\n  supports:\n    - {at_m: 0, type: pinned, k_theta_nmprad: -1}\n"
+     "    - {at_m: 20, type: roller}\n", 3, "bridge.supports[0].k_theta_nmprad", ">= 0"},
+    {"elastic_alone", "bridge:\n  supports:\n    - {at_m: 0, type: elastic, k_w_npm: 1e9}\n", 2,
+     "bridge.supports", "free to rotate"},
+    {"segment_backwards", "bridge:\n  segments:\n    - {from_m: 5, to_m: 2, EI_nm2: 1e10}\n", 3,
+     "bridge.segments[0]", "must be beyond from_m"},
+    {"segment_empty", "bridge:\n  segments:\n    - {from_m: 0, to_m: 2}\n", 3,
+     "bridge.segments[0]", "neither EI_nm2 nor mass_kgpm"},
+    {"segment_off_span", "bridge:\n  segments:\n    - {from_m: 15, to_m: 25, mass_kgpm: 6000}\n",
+     3, "bridge.segments[0]", "beyond the span"},
+    {"segment_overlap", "bridge:\n  segments:\n    - {from_m: 0, to_m: 5, EI_nm2: 2e10}\n"
+     "    - {from_m: 4, to_m: 8, EI_nm2: 2e10}\n", 4, "bridge.segments[1]", "overlaps bridge.segments[0]"},
+    {"segment_no_to", "bridge:\n  segments:\n    - {from_m: 0, EI_nm2: 2e10}\n", 3,
+     "bridge.segments[0].to_m", "missing"},
     {"damage_one", "bridge:\n  damage: 1\n", 2, "bridge.damage", "[0, 1)"},
     {"name_empty", "bridge:\n  name: ''\n", 2, "bridge.name", "1 .. 63 bytes"},
     {"name_long",
@@ -911,6 +931,35 @@ static void test_bad(void **state)
         fail_msg("want '%s' in '%s'", bc->problem, err);
 }
 
+/* Bearings with springs and segments land in libamfi's parameters. */
+static void bearings_and_segments(void **state)
+{
+    amfi_site_config c;
+    char err[ERRLEN];
+
+    (void)state;
+    if (load_text("bridge:\n"
+                  "  supports:\n"
+                  "    - {at_m: 0, type: pinned, k_theta_nmprad: 5.2e8}\n"
+                  "    - {at_m: 20, type: elastic, k_w_npm: 4e9, k_theta_nmprad: 1e8}\n"
+                  "  segments:\n"
+                  "    - {from_m: 0, to_m: 3, EI_nm2: 1.6e10}\n"
+                  "    - {from_m: 3, to_m: 17, mass_kgpm: 5400}\n",
+                  &c, err))
+        fail_msg("%s", err);
+    assert_int_equal(2, c.bridge.n_supports);
+    assert_int_equal(1, c.bridge.supports[0].restrain_w);
+    assert_int_equal(0, c.bridge.supports[0].restrain_theta);
+    assert_true(c.bridge.supports[0].k_w_npm == 0 && c.bridge.supports[0].k_theta_nmprad == 5.2e8);
+    assert_int_equal(0, c.bridge.supports[1].restrain_w);
+    assert_int_equal(0, c.bridge.supports[1].restrain_theta);
+    assert_true(c.bridge.supports[1].k_w_npm == 4e9 && c.bridge.supports[1].k_theta_nmprad == 1e8);
+    assert_int_equal(2, c.bridge.n_segments);
+    assert_true(c.bridge.segments[0].x0_m == 0 && c.bridge.segments[0].x1_m == 3);
+    assert_true(c.bridge.segments[0].EI_nm2 == 1.6e10 && c.bridge.segments[0].mass_kgpm == 0);
+    assert_true(c.bridge.segments[1].mass_kgpm == 5400 && c.bridge.segments[1].EI_nm2 == 0);
+}
+
 /* ---- files and buffers ---------------------------------------------------- */
 
 static void test_missing_file(void **state)
@@ -991,6 +1040,7 @@ int main(void)
 {
     static const struct CMUnitTest fixed[] = {
         cmocka_unit_test(test_defaults),
+        cmocka_unit_test(bearings_and_segments),
         cmocka_unit_test(test_site_section),
         cmocka_unit_test(test_shipped_file_is_the_defaults),
         cmocka_unit_test(test_shipped_sim_file_is_the_defaults),

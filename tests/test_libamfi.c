@@ -171,7 +171,7 @@ static void fe_element_counts(void **state)
     amfi_bridge_params_paper20(&p);
     p.n_elements = 100;
     p.n_supports = 1;
-    p.supports[0] = (amfi_support){0.0, 1, 1};
+    p.supports[0] = (amfi_support){.x_m = 0.0, .restrain_w = 1, .restrain_theta = 1};
     assert_int_equal(amfi_bridge_create(&p, &b, err, sizeof err), AMFI_OK);
     const double bl = 1.87510407;
     assert_true(fabs(amfi_bridge_omega(b)[0] / (bl * bl / (L * L) * sqrt(EI / mu)) - 1.0) < 1e-6);
@@ -183,10 +183,10 @@ static void fe_element_counts(void **state)
         p.n_elements = 1000;
         if (k == 0) {
             p.n_supports = 1;
-            p.supports[0] = (amfi_support){10.0, 1, 0};
+            p.supports[0] = (amfi_support){.x_m = 10.0, .restrain_w = 1, .restrain_theta = 0};
         } else {
-            p.supports[0] = (amfi_support){0.0, 0, 1};
-            p.supports[1] = (amfi_support){20.0, 0, 1};
+            p.supports[0] = (amfi_support){.x_m = 0.0, .restrain_w = 0, .restrain_theta = 1};
+            p.supports[1] = (amfi_support){.x_m = 20.0, .restrain_w = 0, .restrain_theta = 1};
         }
         b = NULL;
         double t0 = now_ms();
@@ -196,6 +196,148 @@ static void fe_element_counts(void **state)
         assert_null(b);
         assert_non_null(strstr(err, "mechanism"));
         assert_non_null(strstr(err, k == 0 ? "rotate about node 500" : "up and down"));
+    }
+}
+
+/* βL/2 = a of the symmetric first mode of a beam pinned at both ends with a
+ * rotational spring k at each: −4a·cos a = κ(sin a + cos a·tanh a),
+ * κ = kL/EI (from w = A cos βx' + B cosh βx' about mid-span with w = 0 and
+ * EI w'' = −k w' at the ends); a = π/2 at κ = 0, 2.3650 (fixed) as κ → ∞. */
+static double spring_pin_a(double kappa)
+{
+    double lo = M_PI / 2, hi = 2.36502037;
+    for (int i = 0; i < 200; i++) {
+        double a = 0.5 * (lo + hi);
+        double g = -4 * a * cos(a) - kappa * (sin(a) + cos(a) * tanh(a));
+        if (g < 0)
+            lo = a;
+        else
+            hi = a;
+    }
+    return 0.5 * (lo + hi);
+}
+
+/* Bearing springs and segments against analytical results. */
+static void fe_bearings_and_segments(void **state)
+{
+    (void)state;
+    const double L = 20.0, EI = 3.5e10 * 0.2991, mu = 2400.0 * 2.046;
+    char err[256];
+    amfi_bridge_params p;
+    amfi_bridge *b = NULL;
+    /* Partly fixed bearings: rotational springs κ = kL/EI at both pins. */
+    const double kappas[] = {0.5, 2.0, 20.0};
+    double last = 0;
+    for (size_t i = 0; i < sizeof kappas / sizeof kappas[0]; i++) {
+        amfi_bridge_params_paper20(&p);
+        p.n_elements = 100;
+        p.supports[0].k_theta_nmprad = p.supports[1].k_theta_nmprad = kappas[i] * EI / L;
+        assert_int_equal(amfi_bridge_create(&p, &b, err, sizeof err), AMFI_OK);
+        double a = spring_pin_a(kappas[i]), beta = 2 * a / L;
+        double w = beta * beta * sqrt(EI / mu), got = amfi_bridge_omega(b)[0];
+        printf("rotational springs kL/EI = %g: f1 %.5f Hz, analytical %.5f Hz\n", kappas[i],
+               got / (2 * M_PI), w / (2 * M_PI));
+        assert_true(fabs(got / w - 1) < 1e-5);
+        assert_true(got > last);
+        last = got;
+        amfi_bridge_destroy(b);
+        b = NULL;
+    }
+    /* Elastic bearings under a (nearly) rigid beam: bounce ω² = 2k/(μL),
+     * rocking ω² = 6k/(μL). */
+    amfi_bridge_params_paper20(&p);
+    p.E_pa *= 1e5;
+    for (int s = 0; s < 2; s++) {
+        p.supports[s].restrain_w = 0;
+        p.supports[s].k_w_npm = 1e6;
+    }
+    assert_int_equal(amfi_bridge_create(&p, &b, err, sizeof err), AMFI_OK);
+    assert_true(fabs(amfi_bridge_omega(b)[0] / sqrt(2e6 / (mu * L)) - 1) < 1e-5);
+    assert_true(fabs(amfi_bridge_omega(b)[1] / sqrt(6e6 / (mu * L)) - 1) < 1e-5);
+    amfi_bridge_destroy(b);
+    b = NULL;
+    /* A segment over the whole span: twice the E·I gives √2 times every ω,
+     * twice the mass 1/√2; damage scales the segment's E·I. */
+    amfi_bridge *ref = NULL;
+    amfi_bridge_params_paper20(&p);
+    assert_int_equal(amfi_bridge_create(&p, &ref, err, sizeof err), AMFI_OK);
+    const double f[3][3] = {{2, 0, M_SQRT2}, {0, 2, M_SQRT1_2}, {2, 2, 1}};
+    for (int c = 0; c < 3; c++) {
+        amfi_bridge_params_paper20(&p);
+        p.n_segments = 1;
+        p.segments[0] = (amfi_segment){0.0, L, f[c][0] * EI, f[c][1] * mu};
+        assert_int_equal(amfi_bridge_create(&p, &b, err, sizeof err), AMFI_OK);
+        for (int k = 0; k < 5; k++)
+            if (!(fabs(amfi_bridge_omega(b)[k] / amfi_bridge_omega(ref)[k] - f[c][2]) < 1e-9))
+                fail_msg("segment case %d mode %d: ratio %.12f, want %.12f", c, k,
+                         amfi_bridge_omega(b)[k] / amfi_bridge_omega(ref)[k], f[c][2]);
+        amfi_bridge_destroy(b);
+        b = NULL;
+    }
+    amfi_bridge_params_paper20(&p);
+    p.n_segments = 1;
+    p.segments[0] = (amfi_segment){0.0, L, 2 * EI, 0};
+    p.damage = 0.19;
+    assert_int_equal(amfi_bridge_create(&p, &b, err, sizeof err), AMFI_OK);
+    assert_true(fabs(amfi_bridge_omega(b)[0] / amfi_bridge_omega(ref)[0] - M_SQRT2 * 0.9) < 1e-9);
+    amfi_bridge_destroy(b);
+    b = NULL;
+    /* Haunches: stiffer end thirds raise f1 but less than a stiffer span;
+     * the elements take the section at their middle. */
+    amfi_bridge_params_paper20(&p);
+    p.n_segments = 2;
+    p.segments[0] = (amfi_segment){0.0, 5.0, 2 * EI, 0};
+    p.segments[1] = (amfi_segment){15.0, 20.0, 2 * EI, 0};
+    assert_int_equal(amfi_bridge_create(&p, &b, err, sizeof err), AMFI_OK);
+    double r = amfi_bridge_omega(b)[0] / amfi_bridge_omega(ref)[0];
+    assert_true(r > 1.0 && r < M_SQRT2);
+    assert_true(amfi_bridge_params_EI(&p, 4.99) == 2 * EI && amfi_bridge_params_EI(&p, 5.0) == EI);
+    assert_true(amfi_bridge_params_mass(&p, 17.0) == mu);
+    amfi_bridge_destroy(b);
+    b = NULL;
+    amfi_bridge_destroy(ref);
+    /* Refused: a spring on a fixed DOF, a negative spring, overlapping
+     * segments, a segment off the beam, a rotational spring alone (the beam
+     * can still move up and down). A cantilever on an elastic bearing with
+     * a rotational spring is no mechanism. */
+    for (int c = 0; c < 6; c++) {
+        amfi_bridge_params_paper20(&p);
+        const char *want = NULL;
+        switch (c) {
+        case 0: p.supports[0].k_w_npm = 1e9; want = "vertical spring on a fixed"; break;
+        case 1: p.supports[1].k_theta_nmprad = -1; want = "finite and >= 0"; break;
+        case 2:
+            p.n_segments = 2;
+            p.segments[0] = (amfi_segment){0, 10, EI, 0};
+            p.segments[1] = (amfi_segment){9, 12, EI, 0};
+            want = "overlaps";
+            break;
+        case 3:
+            p.n_segments = 1;
+            p.segments[0] = (amfi_segment){10, 21, EI, 0};
+            want = "not a part of the beam";
+            break;
+        case 4:
+            p.n_supports = 1;
+            p.supports[0] = (amfi_support){.x_m = 0, .k_theta_nmprad = 1e9};
+            want = "up and down";
+            break;
+        case 5:
+            p.n_supports = 1;
+            p.supports[0] = (amfi_support){.x_m = 0, .k_w_npm = 1e9, .k_theta_nmprad = 1e11};
+            break;
+        }
+        b = NULL;
+        int rc = amfi_bridge_create(&p, &b, err, sizeof err);
+        if (!want) {
+            assert_int_equal(rc, AMFI_OK);
+            amfi_bridge_destroy(b);
+            continue;
+        }
+        assert_int_equal(rc, AMFI_EINVAL);
+        assert_null(b);
+        if (!strstr(err, want))
+            fail_msg("case %d: '%s' lacks '%s'", c, err, want);
     }
 }
 
@@ -865,6 +1007,7 @@ int main(void)
         cmocka_unit_test(fe_damage_lowers_frequency),
         cmocka_unit_test(fe_rejects_bad_params),
         cmocka_unit_test(fe_element_counts),
+        cmocka_unit_test(fe_bearings_and_segments),
         cmocka_unit_test(passage_window),
         cmocka_unit_test(load_vector),
         cmocka_unit_test(expm_known),

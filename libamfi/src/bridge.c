@@ -3,8 +3,9 @@
  * bridge.c: Euler-Bernoulli beam finite elements (docs/model.md §1).
  *
  * Equal elements, 2 DOF per node (w down, θ), consistent mass, supports that
- * remove DOFs, a uniform damage factor on E, Rayleigh damping matched at two
- * modes. The generalized eigenproblem K ψ = ω² M ψ is solved once with LAPACK
+ * remove DOFs or add bearing springs (vertical, rotational), segments with
+ * their own E·I and mass per length, a uniform damage factor on E·I,
+ * Rayleigh damping matched at two modes. The generalized eigenproblem K ψ = ω² M ψ is solved once with LAPACK
  * dsygvd (inverted, M ψ = K ψ/ω², for the wide spectra of fine meshes; see
  * modes()), giving M-orthonormal modes; supports that leave a rigid-body
  * motion are refused before it. Work: O(n³) once per site (0.5 ms at 20
@@ -64,7 +65,31 @@ static int check_params(const amfi_bridge_params *p, char *err, size_t errlen)
         const amfi_support *s = &p->supports[i];
         REQ(isfinite(s->x_m) && s->x_m >= 0 && s->x_m <= p->span_m,
             "support %d: position %g m is off the beam [0, %g]", i, s->x_m, p->span_m);
-        REQ(s->restrain_w || s->restrain_theta, "support %d restrains nothing", i);
+        REQ(isfinite(s->k_w_npm) && s->k_w_npm >= 0 && isfinite(s->k_theta_nmprad) &&
+                s->k_theta_nmprad >= 0,
+            "support %d: spring stiffnesses must be finite and >= 0", i);
+        REQ(!(s->restrain_w && s->k_w_npm > 0),
+            "support %d: a vertical spring on a fixed vertical displacement", i);
+        REQ(!(s->restrain_theta && s->k_theta_nmprad > 0),
+            "support %d: a rotational spring on a fixed rotation", i);
+        REQ(s->restrain_w || s->restrain_theta || s->k_w_npm > 0 || s->k_theta_nmprad > 0,
+            "support %d restrains nothing", i);
+    }
+    REQ(p->n_segments >= 0 && p->n_segments <= AMFI_MAX_SEGMENTS, "n_segments must be 0..%d",
+        AMFI_MAX_SEGMENTS);
+    for (int i = 0; i < p->n_segments; i++) {
+        const amfi_segment *g = &p->segments[i];
+        REQ(isfinite(g->x0_m) && isfinite(g->x1_m) && g->x0_m >= 0 && g->x0_m < g->x1_m &&
+                g->x1_m <= p->span_m,
+            "segment %d: [%g, %g) m is not a part of the beam [0, %g]", i, g->x0_m, g->x1_m,
+            p->span_m);
+        REQ(isfinite(g->EI_nm2) && g->EI_nm2 >= 0, "segment %d: EI must be > 0 (or 0: the beam's)",
+            i);
+        REQ(isfinite(g->mass_kgpm) && g->mass_kgpm >= 0,
+            "segment %d: mass per length must be > 0 (or 0: the beam's)", i);
+        for (int j = 0; j < i; j++)
+            REQ(g->x1_m <= p->segments[j].x0_m || g->x0_m >= p->segments[j].x1_m,
+                "segment %d overlaps segment %d", i, j);
     }
     REQ(isfinite(p->damage) && p->damage >= 0 && p->damage < 1, "damage must be in [0, 1)");
 #undef REQ
@@ -86,6 +111,32 @@ void amfi_bridge_destroy(amfi_bridge *b)
     free(b);
 }
 
+static const amfi_segment *segment_at(const amfi_bridge_params *p, double x)
+{
+    for (int i = 0; i < p->n_segments; i++)
+        if (x >= p->segments[i].x0_m && x < p->segments[i].x1_m)
+            return &p->segments[i];
+    return NULL;
+}
+
+double amfi_bridge_params_EI(const amfi_bridge_params *p, double x)
+{
+    const amfi_segment *g = segment_at(p, x);
+    return g && g->EI_nm2 > 0 ? g->EI_nm2 : p->E_pa * p->I_m4;
+}
+
+double amfi_bridge_params_mass(const amfi_bridge_params *p, double x)
+{
+    const amfi_segment *g = segment_at(p, x);
+    return g && g->mass_kgpm > 0 ? g->mass_kgpm : p->density_kgm3 * p->A_m2;
+}
+
+/* The node a support snaps to. */
+static int support_node(const amfi_bridge *b, const amfi_support *s)
+{
+    return (int)lround(s->x_m / b->le);
+}
+
 /* A rigid-body motion the supports leave free, or NULL. The unsupported
  * beam's stiffness (every element with EI > 0) has exactly the rigid motions
  * w(x) = a + b·x, θ = b as its null space; a restrained w at node i asks
@@ -97,11 +148,17 @@ static const char *rigid_motion(const amfi_bridge *b, char *buf, size_t len)
 {
     int w_node = -1, w_nodes = 0, theta = 0;
     for (int node = 0; node <= b->p.n_elements; node++) {
-        if (b->free_of[2 * node] < 0) {
-            if (w_nodes++ == 0)
-                w_node = node;
-        }
-        if (b->free_of[2 * node + 1] < 0)
+        int w = b->free_of[2 * node] < 0, th = b->free_of[2 * node + 1] < 0;
+        /* a spring holds a rigid motion like a restraint (its energy
+         * k·w² or k·θ² is positive on any motion that moves it) */
+        for (int s = 0; s < b->p.n_supports; s++)
+            if (support_node(b, &b->p.supports[s]) == node) {
+                w |= b->p.supports[s].k_w_npm > 0;
+                th |= b->p.supports[s].k_theta_nmprad > 0;
+            }
+        if (w && w_nodes++ == 0)
+            w_node = node;
+        if (th)
             theta = 1;
     }
     if (w_nodes >= 2 || (w_nodes == 1 && theta))
@@ -255,7 +312,7 @@ int amfi_bridge_create(const amfi_bridge_params *p, amfi_bridge **out, char *err
     for (int i = 0; i < nf; i++)
         b->free_of[i] = 0;
     for (int s = 0; s < p->n_supports; s++) {
-        int node = (int)lround(p->supports[s].x_m / l);
+        int node = support_node(b, &p->supports[s]);
         if (p->supports[s].restrain_w)
             b->free_of[2 * node] = -1;
         if (p->supports[s].restrain_theta)
@@ -293,9 +350,6 @@ int amfi_bridge_create(const amfi_bridge_params *p, amfi_bridge **out, char *err
 
     /* Element matrices (e.g. Przemieniecki 1968, §5 and §11), assembled
      * straight into the free DOFs (the same sums, element by element). */
-    const double EI = (1.0 - p->damage) * p->E_pa * p->I_m4;
-    const double mu = p->density_kgm3 * p->A_m2;
-    const double kc = EI / (l2 * l), mc = mu * l / 420.0;
     const double ke[4][4] = {{12, 6 * l, -12, 6 * l},
                              {6 * l, 4 * l2, -6 * l, 2 * l2},
                              {-12, -6 * l, 12, -6 * l},
@@ -304,7 +358,11 @@ int amfi_bridge_create(const amfi_bridge_params *p, amfi_bridge **out, char *err
                              {22 * l, 4 * l2, 13 * l, -3 * l2},
                              {54, 13 * l, 156, -22 * l},
                              {-13 * l, -3 * l2, -22 * l, 4 * l2}};
-    for (int e = 0; e < ne; e++)
+    for (int e = 0; e < ne; e++) {
+        /* the element's section: its segment's, or the beam's, at its middle */
+        const double xm = (e + 0.5) * l;
+        const double EI = (1.0 - p->damage) * amfi_bridge_params_EI(p, xm);
+        const double kc = EI / (l2 * l), mc = amfi_bridge_params_mass(p, xm) * l / 420.0;
         for (int i = 0; i < 4; i++) {
             const int fi = b->free_of[2 * e + i];
             if (fi < 0)
@@ -317,6 +375,17 @@ int amfi_bridge_create(const amfi_bridge_params *p, amfi_bridge **out, char *err
                 b->M[(size_t)fi * n + fj] += mc * me[i][j];
             }
         }
+    }
+    /* Bearing springs on the DOFs they act on (free: a spring on a fixed
+     * DOF was refused). */
+    for (int s = 0; s < p->n_supports; s++) {
+        const int node = support_node(b, &p->supports[s]);
+        const int dw = b->free_of[2 * node], dt = b->free_of[2 * node + 1];
+        if (p->supports[s].k_w_npm > 0 && dw >= 0)
+            b->K[(size_t)dw * n + dw] += p->supports[s].k_w_npm;
+        if (p->supports[s].k_theta_nmprad > 0 && dt >= 0)
+            b->K[(size_t)dt * n + dt] += p->supports[s].k_theta_nmprad;
+    }
 
     if ((rc = modes(b, Mw, err, errlen)) != 0)
         goto fail;

@@ -48,8 +48,8 @@ void amfi_bridge_params_paper20(amfi_bridge_params *p)
     p->rayleigh_mode_a = 1;
     p->rayleigh_mode_b = 2;
     p->n_supports = 2;
-    p->supports[0] = (amfi_support){0.0, 1, 0};
-    p->supports[1] = (amfi_support){20.0, 1, 0};
+    p->supports[0] = (amfi_support){.x_m = 0.0, .restrain_w = 1};
+    p->supports[1] = (amfi_support){.x_m = 20.0, .restrain_w = 1};
     p->damage = 0.0;
 }
 

@@ -52,7 +52,26 @@ typedef struct amfi_support {
     double x_m;         /* position along the beam, m, snapped to the nearest node */
     int restrain_w;     /* 1: vertical displacement fixed */
     int restrain_theta; /* 1: rotation fixed */
+    /* Finite stiffness of a DOF that is not fixed (0: none). A bearing that
+     * is not quite a pin (partly fixed by friction, elastomer, abutment) has
+     * a rotational spring; an elastomeric bearing or a soft pier a vertical
+     * one. Both >= 0 and finite; a spring on a fixed DOF is refused. A
+     * spring counts as a restraint against rigid-body motion. */
+    double k_w_npm;        /* vertical spring, N/m */
+    double k_theta_nmprad; /* rotational spring, N·m/rad */
 } amfi_support;
+
+/* A part of the beam with its own section: haunches, a thicker deck,
+ * surfacing or barriers. The elements whose mid-point lies in
+ * [x0_m, x1_m) take the segment's E·I and mass per length instead of the
+ * beam's E_pa·I_m4 and density_kgm3·A_m2 (0 keeps the beam's). Segments do
+ * not overlap; damage scales their E·I like the beam's. */
+#define AMFI_MAX_SEGMENTS 16
+typedef struct amfi_segment {
+    double x0_m, x1_m; /* 0 <= x0 < x1 <= span_m */
+    double EI_nm2;     /* flexural stiffness (healthy), N·m², > 0, or 0 */
+    double mass_kgpm;  /* mass per length, kg/m, > 0, or 0 */
+} amfi_segment;
 
 typedef struct amfi_bridge_params {
     double span_m;         /* beam length L, m, > 0 */
@@ -67,12 +86,19 @@ typedef struct amfi_bridge_params {
     int n_supports;        /* 1 .. AMFI_MAX_SUPPORTS */
     amfi_support supports[AMFI_MAX_SUPPORTS];
     double damage;         /* δ: E_used = (1 − δ)·E in every element, 0 <= δ < 1 */
+    int n_segments;        /* 0 .. AMFI_MAX_SEGMENTS */
+    amfi_segment segments[AMFI_MAX_SEGMENTS];
 } amfi_bridge_params;
 
 /* The paper-20m reference values of docs/model.md §1 (simply supported, 20 m). */
 void amfi_bridge_params_paper20(amfi_bridge_params *p);
 
 typedef struct amfi_bridge amfi_bridge; /* opaque, read-only once created */
+
+/* The E·I (healthy, before damage) and mass per length of the beam at x,
+ * from its segments or its uniform section. */
+double amfi_bridge_params_EI(const amfi_bridge_params *p, double x_m);
+double amfi_bridge_params_mass(const amfi_bridge_params *p, double x_m);
 
 /* Assemble M, K (consistent mass), apply supports, solve K ψ = ω² M ψ
  * (LAPACK dsygvd; inverted, M ψ = K ψ/ω², when the spectrum is wide enough
