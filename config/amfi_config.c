@@ -45,6 +45,7 @@ static const field top_fields[] = {
     {.key = "alerts", .kind = &K_MAP, .aux = alerts_fields},
     {.key = "metrics", .kind = &K_MAP, .aux = metrics_fields},
     {.key = "report", .kind = &K_MAP, .aux = report_fields},
+    {.key = "detector", .kind = &K_MAP, .aux = detector_fields},
     {.key = NULL}};
 
 /* Checks that involve several keys, once the whole file is read; each finds
@@ -119,6 +120,9 @@ void amfi_config_defaults(amfi_site_config *c)
     c->report.gvw_limit_kg = 40000.0;
     c->report.axle_limit_kg = 11500.0;
     c->report.bin_kg = 2000.0;
+    /* a detector in step with the accelerometers until commissioning says */
+    c->detector.clock_offset_s = 0.0;
+    c->detector.speed_scale = 1.0;
     /* The engine's defaults (docs/indicators.md has the simulation behind
      * each value); set field by field, so the padding stays zero. */
     amfi_indicator_params_default(&d->indicators);

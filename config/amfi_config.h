@@ -192,6 +192,16 @@ typedef struct amfi_report_config {
     double bin_kg;         /* report.histogram_bin_kg: GVW histogram bins, [100, 1e5] */
 } amfi_report_config;
 
+/* detector.*: what commissioning found of the vehicle detector
+ * (section_detector.c): its clock runs clock_offset_s ahead of the
+ * accelerometers' (a vehicle's true entry is its reported time minus the
+ * offset) and it reports speed_scale times the true speed (and spacings,
+ * measured from its speed, alike). Applied by amfi-solve and amfid. */
+typedef struct amfi_detector_config {
+    double clock_offset_s; /* [-1, 1], default 0 */
+    double speed_scale;    /* [0.5, 2], default 1 */
+} amfi_detector_config;
+
 typedef struct amfi_site_config {
     amfi_site_identity site;   /* site.* */
     char name[64];             /* bridge.name: 1 .. 63 bytes, NUL-terminated */
@@ -209,6 +219,7 @@ typedef struct amfi_site_config {
     amfi_speed_prior speed_prior;    /* solver.speed_sd, speed_range_sd, speed_grid,
                                         speed_coarse_rate_hz, speed_criterion,
                                         speed_pick (amfi_speed_prior_default) */
+    amfi_detector_config detector;   /* detector.* */
 } amfi_site_config;
 
 /* Fill `c` (not NULL) with the paper-20m defaults: amfi_bridge_params_paper20,

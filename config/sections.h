@@ -14,6 +14,7 @@
  *   section_site.c        site:        which bridge (id, name, position)
  *   section_ops.c         alerts:, metrics:  notices and health metrics
  *   section_report.c      report:      what amfi-report holds passages against
+ *   section_detector.c    detector:    the vehicle detector's clock offset and speed scale
  *
  * Every function runs on the loader's (caller's) thread.
  */
@@ -44,6 +45,7 @@ extern const field site_fields[];   /* site: */
 extern const field alerts_fields[]; /* alerts: */
 extern const field metrics_fields[]; /* metrics: */
 extern const field report_fields[]; /* report: */
+extern const field detector_fields[]; /* detector: */
 extern const enum_name onoff_names[]; /* off | on (section_daemon.c) */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */

@@ -1,0 +1,17 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * section_detector.c: the detector: section of a site file, what
+ * commissioning (amfi-commission, docs/commissioning.md) found of the
+ * vehicle detector against the accelerometers: its clock offset (detector
+ * time − true time, s) and its speed scale (reported / true speed; the
+ * spacings, measured from the speed, alike). amfi-solve and amfid correct
+ * every vehicle with them. Runs on the loader's thread.
+ */
+#include "sections.h"
+
+#define DET(m) offsetof(amfi_site_config, detector.m)
+
+const field detector_fields[] = {
+    {.key = "clock_offset_s", .kind = &K_DOUBLE, .off = DET(clock_offset_s), .lo = -1, .hi = 1},
+    {.key = "speed_scale", .kind = &K_DOUBLE, .off = DET(speed_scale), .lo = 0.5, .hi = 2},
+    {.key = NULL}};
