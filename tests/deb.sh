@@ -114,7 +114,7 @@ grep -q '^amfi-sync:x:[0-9]*:.*amfid' "$r/etc/group" && fail "amfid is in amfi-s
 [ "$(mode "$r/etc/amfid/bus.key")" = "600 root:root" ] || fail "bus.key is $(mode "$r/etc/amfid/bus.key" 2>&1), not 600 root:root"
 [ "$(stat -c %s "$r/etc/amfid/bus.key")" -eq 32 ] || fail "bus.key is not 32 bytes"
 key=$(od -An -tx1 "$r/etc/amfid/bus.key" | tr -d ' \n')
-[ -e "$wants/amfid.service" ] && fail "postinst enabled amfid with the example configuration"
+[ -L "$wants/amfid.service" ] && fail "postinst enabled amfid with the example configuration"
 called 'deb-systemd-invoke start amfid.service' && fail "postinst started amfid with the example configuration"
 grep -q 'still the example (site.id local)' "$x/dpkg.log" || fail "postinst does not say why amfid is not started"
 echo "postinst, example: users, /etc/amfi-sync 0700, bus key 0600 32 bytes; amfid neither enabled nor started: ok"
@@ -124,7 +124,7 @@ echo "postinst, example: users, /etc/amfi-sync 0700, bus key 0600 32 bytes; amfi
 dpkgr -i "$deb"
 [ "$(od -An -tx1 "$r/etc/amfid/bus.key" | tr -d ' \n')" = "$key" ] || fail "an upgrade replaced the bus key"
 called 'deb-systemd-invoke try-restart amfid.service amfi-sync.service' || { cat "$x/calls"; fail "upgrade: no try-restart"; }
-[ -e "$wants/amfid.service" ] && fail "upgrade enabled amfid with the example configuration"
+[ -L "$wants/amfid.service" ] && fail "upgrade enabled amfid with the example configuration"
 echo "postinst, upgrade: key kept, try-restart of both units: ok"
 
 # 3. Removal: both stopped, then masked; a configured site reinstalled from
@@ -140,7 +140,7 @@ mkdir -p "$r/etc/amfid" && printf 'host:5432:fleet:amfi_sync:secret\n' >"$r/etc/
 dpkgr -i "$deb"
 [ -L "$wants/amfid.service" ] || fail "postinst did not enable amfid for a configured site"
 called 'deb-systemd-invoke start amfid.service' || { cat "$x/calls"; fail "postinst did not start amfid for a configured site"; }
-[ -e "$wants/amfi-sync.service" ] && fail "postinst enabled amfi-sync"
+[ -L "$wants/amfi-sync.service" ] && fail "postinst enabled amfi-sync"
 [ -f "$r/etc/amfi-sync/pgpass" ] && [ ! -e "$r/etc/amfid/pgpass" ] || fail "postinst did not move /etc/amfid/pgpass to /etc/amfi-sync/"
 dpkgr -i "$deb"
 called 'deb-systemd-invoke try-restart amfid.service amfi-sync.service' || { cat "$x/calls"; fail "configured upgrade: no try-restart"; }
@@ -154,16 +154,19 @@ grep -q 'try-restart\|start' "$x/calls" && { cat "$x/calls"; fail "postinst (re)
 grep -q 'does not check' "$x/dpkg.log" || fail "postinst does not say the configuration is refused"
 echo "refused configuration: not restarted: ok"
 
-# 5. Purge: both units' enablement and state gone, the bus key and the
-# empty directories too; the operator's pgpass stays.
+# 5. Purge: both units' enablement and state gone (amfi-sync enabled by
+# the operator, as systemctl enable does it), the bus key and the empty
+# directories too; the operator's pgpass stays.
+ln -s /lib/systemd/system/amfi-sync.service "$wants/amfi-sync.service"
 dpkgr -r amfi
 dpkgr --purge amfi
-[ -e "$wants/amfid.service" ] && fail "purge left amfid enabled"
+[ -L "$wants/amfid.service" ] && fail "purge left amfid enabled"
+[ -L "$wants/amfi-sync.service" ] && fail "purge left amfi-sync enabled"
 left=$(ls "$r/var/lib/systemd/deb-systemd-helper-enabled" "$r/var/lib/systemd/deb-systemd-helper-masked" 2>/dev/null | grep 'amfi')
 [ -z "$left" ] || fail "purge left deb-systemd-helper state: $left"
 [ -e "$r/etc/amfid" ] && fail "purge left /etc/amfid: $(ls -A "$r/etc/amfid")"
 [ -f "$r/etc/amfi-sync/pgpass" ] || fail "purge removed the operator's /etc/amfi-sync/pgpass"
-[ -e "$r/etc/systemd/system/amfid.service" ] && fail "purge left amfid masked"
-[ -e "$r/etc/systemd/system/amfi-sync.service" ] && fail "purge left amfi-sync masked"
+[ -L "$r/etc/systemd/system/amfid.service" ] && fail "purge left amfid masked"
+[ -L "$r/etc/systemd/system/amfi-sync.service" ] && fail "purge left amfi-sync masked"
 echo "purge: both units' enablement, masks and state, the bus key, /etc/amfid: gone: ok"
 echo "deb: ok"
