@@ -378,8 +378,8 @@ int amfid_start(daemon_s *d, const amfid_options *o)
 {
     int rc = start_config(d, o);
     if (rc == 0 && o->check_only)
-        printf("amfid: %s: ok (bridge %s, %d sensor(s), %d worker(s), store %s)\n", o->config,
-               d->cfg.name, d->cfg.solver.n_sensors, d->cfg.daemon.workers,
+        printf("amfid: %s: ok (site %s, bridge %s, %d sensor(s), %d worker(s), store %s)\n", o->config,
+               d->cfg.site.id, d->cfg.name, d->cfg.solver.n_sensors, d->cfg.daemon.workers,
                d->cfg.daemon.db_path);
     else if (rc == 0)
         rc = start_runtime(d);

@@ -27,8 +27,9 @@ pkgs=(
   scdoc                          # man pages (man/*.scd -> roff)
   man-db                         # man -l: the install test renders every page
   systemd                        # systemd-analyze verify; pkg-config systemd (unit directories)
-  dpkg-dev                       # dpkg-shlibdeps: the .deb's runtime dependencies (cpack)
+  dpkg-dev                       # dpkg-shlibdeps (the .deb's runtime dependencies), dpkg-buildflags (scripts/package.sh)
   file                           # cpack's DEB generator needs it for dpkg-shlibdeps
+  devscripts                     # hardening-check: the deb test checks the packaged programs' hardening
   libjansson-dev                 # JSON output of the tools (common/amfi_json.c): escaped strings
   clang                          # libFuzzer builds of fuzz/ (the fuzz_* tests, docs/fuzzing.md)
   libclang-rt-14-dev             # clang 14's libFuzzer and sanitizer runtimes (-fsanitize=fuzzer)

@@ -38,10 +38,10 @@ ok help '^usage: amfid ' --help
 ok help-short '--check-config' -h
 ok version '^amfid [0-9]+\.[0-9]+' --version
 ok version-short '^amfid [0-9]+\.[0-9]+' -V
-ok check-long ': ok \(bridge' --config "$config" --check-config
-ok check-equals ': ok \(bridge' --config="$config" --check-config
-ok check-short ': ok \(bridge' -c "$config" -C
-ok check-joined ': ok \(bridge' -c"$config" -C
+ok check-long ': ok \(site local, bridge' --config "$config" --check-config
+ok check-equals ': ok \(site local, bridge' --config="$config" --check-config
+ok check-short ': ok \(site local, bridge' -c "$config" -C
+ok check-joined ': ok \(site local, bridge' -c"$config" -C
 ok db-override 'store /tmp/x\.db\)' -C -c "$config" --db=/tmp/x.db
 ok db-short 'store /tmp/y\.db\)' -C -c "$config" -d /tmp/y.db -u file:///dev/null
 ok dashdash ': ok' -c "$config" -C --

@@ -45,19 +45,46 @@ grep -qx "ExecStart=$bindir/amfid --config $sysconfdir/amfid/amfid.yaml --db %S/
 for k in '^Type=notify$' '^WatchdogSec=' '^User=amfid$' '^StateDirectory=amfid$' '^Documentation=man:amfid(8)'; do
   grep -q "$k" "$unit" || fail "unit lacks $k"
 done
+# amfid's unit: the bus key as a credential, the sandbox's IP allow list
+# (this host and the multicast bus) and the directives of a tight sandbox.
+for k in "^LoadCredential=amfi-bus-key:$sysconfdir/amfid/bus.key$" '^IPAddressDeny=any$' \
+         '^IPAddressAllow=localhost 224.0.0.0/4$' '^SystemCallFilter=~@privileged @resources$' \
+         '^ProtectProc=invisible$' '^RemoveIPC=yes$' '^PrivateMounts=yes$'; do
+  grep -q "$k" "$unit" || fail "amfid.service lacks $k"
+done
 # amfi-sync's unit: the installed binary on amfid's configuration and store,
-# the password only as a systemd credential (never in the unit).
+# as its own user in amfid's group (the store group-readable), its
+# connection and password only as systemd credentials from its own
+# directory (never in the unit), and without amfid's StateDirectory (which
+# systemd would hand to amfi-sync's user).
 sunit=$stage$unitdir/amfi-sync.service
 grep -qx "ExecStart=$bindir/amfi-sync --config $sysconfdir/amfid/amfid.yaml --db %S/amfid/amfi.db --pg service=amfi --interval 60" "$sunit" ||
   fail "amfi-sync.service ExecStart: $(grep ^ExecStart= "$sunit" 2>&1)"
-for k in '^Type=notify$' '^WatchdogSec=' '^User=amfid$' '^RestartPreventExitStatus=2 3$' \
-         "^LoadCredential=pgpass:$sysconfdir/amfid/pgpass$" '^Environment=PGPASSFILE=%d/pgpass$' \
-         '^Documentation=man:amfi-sync(1)'; do
+for k in '^Type=notify$' '^WatchdogSec=' '^User=amfi-sync$' '^Group=amfi-sync$' '^SupplementaryGroups=amfid$' \
+         '^RestartPreventExitStatus=2 3$' "^LoadCredential=amfi-sync:$sysconfdir/amfi-sync$" \
+         '^Environment=PGPASSFILE=%d/amfi-sync_pgpass$' '^Environment=PGSERVICEFILE=%d/amfi-sync_pg_service.conf$' \
+         '^SystemCallFilter=~@privileged @resources$' '^ProtectProc=invisible$' '^RemoveIPC=yes$' \
+         '^PrivateMounts=yes$' '^Documentation=man:amfi-sync(1)'; do
   grep -q "$k" "$sunit" || fail "amfi-sync.service lacks $k"
 done
+grep -q '^StateDirectory=' "$sunit" && fail "amfi-sync.service has a StateDirectory= (systemd would chown amfid's to amfi-sync)"
+grep -q '^User=amfid$' "$sunit" && fail "amfi-sync.service runs as amfid"
 grep -v '^#' "$sunit" | grep -qi 'password=' && fail "amfi-sync.service holds a password"
-grep -q "^d $sysconfdir/amfid " "$stage$tmpfilesdir/amfid.conf" || fail "tmpfiles does not create $sysconfdir/amfid"
-grep -q '^u amfid ' "$stage$sysusersdir/amfid.conf" || fail "sysusers does not declare amfid"
+# sysusers.d and tmpfiles.d, parsed and applied by systemd itself on an
+# empty root: two users, amfi-sync in amfid's group (not the reverse),
+# /etc/amfi-sync root's only.
+tmpfs=$stage/sdroot
+mkdir -p "$tmpfs/etc"
+out=$(systemd-sysusers --root="$tmpfs" "$stage$sysusersdir/amfid.conf" 2>&1) || { echo "$out"; fail "systemd-sysusers on $sysusersdir/amfid.conf"; }
+grep -q '^amfid:' "$tmpfs/etc/passwd" && grep -q '^amfi-sync:' "$tmpfs/etc/passwd" ||
+  fail "sysusers: users $(cut -d: -f1 "$tmpfs/etc/passwd" | tr '\n' ' ')"
+grep -q '^amfid:x:[0-9]*:amfi-sync$' "$tmpfs/etc/group" || fail "sysusers: amfi-sync not in amfid's group: $(cat "$tmpfs/etc/group")"
+grep -q '^amfi-sync:x:[0-9]*:$' "$tmpfs/etc/group" || fail "sysusers: amfi-sync's group has members: $(cat "$tmpfs/etc/group")"
+out=$(systemd-tmpfiles --root="$tmpfs" --create "$stage$tmpfilesdir/amfid.conf" 2>&1) || { echo "$out"; fail "systemd-tmpfiles on $tmpfilesdir/amfid.conf"; }
+[ "$(stat -c '%a %U' "$tmpfs$sysconfdir/amfi-sync")" = "700 root" ] ||
+  fail "tmpfiles: $sysconfdir/amfi-sync is $(stat -c '%a %U' "$tmpfs$sysconfdir/amfi-sync" 2>&1), not 700 root"
+[ "$(stat -c '%a %U' "$tmpfs$sysconfdir/amfid")" = "755 root" ] || fail "tmpfiles: $sysconfdir/amfid"
+echo "units, sysusers.d, tmpfiles.d: ok"
 if command -v systemd-analyze >/dev/null && [ "$prefix" != /usr ] && [ "$prefix" != / ]; then
   # Mount the staged prefix over the real one, so the unit is checked exactly
   # as installed (the binary it starts, the man page it documents).
