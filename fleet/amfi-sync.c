@@ -555,7 +555,7 @@ static int open_store(const char *store, sqlite3 **db, int *store_version)
             if (stat(store, &store_st) != 0) break;
             store_immutable = 1;
         }
-        if (sqlite3_open_v2(name, db, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, NULL) != SQLITE_OK) {
+        if (sqlite3_open_v2(name, db, SQLITE_OPEN_READONLY | (pass ? SQLITE_OPEN_URI : 0), NULL) != SQLITE_OK) {
             fprintf(stderr, "amfi-sync: %s: cannot open the store read-only: %s\n", store, sqlite3_errmsg(*db));
             sqlite3_close(*db);
             *db = NULL;

@@ -105,12 +105,11 @@ SQL
 # block at its version, with the functions below (fleet_sync.sh,
 # fleet_security.sh).
 fleet_store_setup() {
-doc=$1
-awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
-     on && !/^```/' "$doc" > "$tmp/ddl.sql"
-[ -s "$tmp/ddl.sql" ] || { echo "pg_server.sh: no DDL block in $doc" >&2; exit 1; }
-store_version=$(sed -n 's/.*PRAGMA user_version` (this document: version \([0-9]*\)).*/\1/p' "$doc")
-[ -n "$store_version" ] || { echo "pg_server.sh: no schema version in $doc" >&2; exit 1; }
+    awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
+         on && !/^```/' "$1" > "$tmp/ddl.sql"
+    [ -s "$tmp/ddl.sql" ] || { echo "pg_server.sh: no DDL block in $1" >&2; exit 1; }
+    store_version=$(sed -n 's/.*PRAGMA user_version` (this document: version \([0-9]*\)).*/\1/p' "$1")
+    [ -n "$store_version" ] || { echo "pg_server.sh: no schema version in $1" >&2; exit 1; }
 }
 # add_rows DB N: N passages (2 axles each), an indicator per 10, an alert per 50.
 add_rows() {
