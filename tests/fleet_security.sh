@@ -127,6 +127,18 @@ fleet_same "$tmp/b.db" site-b
 # the analyst reads every site
 [ "$(psql -X -At "$sock user=analyst" -c "SELECT count(DISTINCT site_id) FROM passages")" = 2 ] ||
     fail "the analyst does not read every site"
+# one site's report from the central database: the analyst's of B equals
+# the one from B's store; A's role does not even see that B exists
+"$report" --pg "$sock user=analyst" --site site-b --summary --alerts > "$tmp/rb.central" 2> "$tmp/rb.log" ||
+    fail "amfi-report --pg --site site-b as the analyst: $(cat "$tmp/rb.log")"
+"$report" --db "$tmp/b.db" --summary --alerts > "$tmp/rb.store" 2>&1 || fail "amfi-report --db b.db"
+sed -i '/^Next, with/,$d' "$tmp/rb.central" "$tmp/rb.store"
+[ -s "$tmp/rb.central" ] && cmp -s "$tmp/rb.store" "$tmp/rb.central" ||
+    fail "site-b's report from the central database differs: $(diff "$tmp/rb.store" "$tmp/rb.central" | head -6)"
+"$report" --pg "$A" --site site-b --summary > /dev/null 2> "$tmp/rab.log"
+rc=$?
+[ $rc = 2 ] && grep -q "no site 'site-b' in the central database (sites: site-a)" "$tmp/rab.log" ||
+    fail "amfi-report --site site-b as A's role: exit $rc: $(cat "$tmp/rab.log")"
 
 case=upgrade
 # version 5 as it was: the shared writer amfi_sync for every site (the
