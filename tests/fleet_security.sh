@@ -63,6 +63,17 @@ grep -q "site 'site-a' ships as the role 'amfi_sync_site-a'" "$tmp/role-a.log" |
 grep -q "already gives the role 'amfi_sync_site-a' the site 'site-a'" "$tmp/role-c.log" || fail "$(cat "$tmp/role-c.log")"
 "$sync" --pg "$PG_CONNINFO" --init-site-role site-c --role postgres 2> "$tmp/role-su.log"
 [ $? = 2 ] || fail "a superuser as a site role: not refused"
+# every central table with a site_id is bound (a table added by a later
+# version without its policy would fail here)
+unbound=$(pg_q "SELECT string_agg(c.relname, ' ' ORDER BY c.relname) FROM pg_class AS c
+                WHERE c.relnamespace = current_schema()::regnamespace AND c.relkind = 'r'
+                  AND EXISTS (SELECT 1 FROM pg_attribute AS a WHERE a.attrelid = c.oid AND a.attname = 'site_id')
+                  AND NOT (c.relrowsecurity AND EXISTS (SELECT 1 FROM pg_policy AS p
+                           WHERE p.polrelid = c.oid AND p.polname = CASE c.relname
+                                 WHEN 'fleet_site_roles' THEN 'fleet_own_role' ELSE 'fleet_site' END))")
+[ -z "$unbound" ] || fail "tables with a site_id and no row-level security: $unbound"
+[ "$(pg_q "SELECT count(*) FROM pg_class WHERE relnamespace = current_schema()::regnamespace
+           AND relkind = 'r' AND relrowsecurity")" -ge 10 ] || fail "fewer than 10 tables bound"
 pg_q "CREATE ROLE analyst LOGIN IN ROLE amfi_reader"
 A="$sock user=amfi_sync_site-a" B="$sock user=amfi_sync_site-b"
 mkstore "$tmp/a.db" site-a 1000
