@@ -6,8 +6,11 @@
  *
  * Single-threaded. Reads the SQLite store read-only (SQLITE_OPEN_READONLY; in
  * WAL mode a reader never blocks amfid's writer) and writes the central
- * database with libpq. Each batch is one PostgreSQL transaction holding the
- * rows (COPY) and the table's high-water mark in fleet_sync_state, so a crash
+ * database with libpq, as the site's own role, which row-level security
+ * binds to the site's rows (central version 6), over TLS to a server not on
+ * this machine (fleet_pg.c). Each batch is one PostgreSQL transaction holding
+ * the rows (COPY into a temporary table, then INSERT ... SELECT) and the
+ * table's high-water mark in fleet_sync_state, so a crash
  * at any moment leaves either the whole batch or none of it. The mark also
  * keeps a hash of the last shipped row: a store restored from an older backup
  * (ids going backwards, or a different row at a shipped id) is refused. */
@@ -463,10 +466,6 @@ static int store_site_id(sqlite3 *db, char out[SITE_ID_MAX + 1])
     return found;
 }
 
-/* One pass: connect, create or migrate the central schema, check and ship
- * every table. site_opt: the site id the caller expects (site_src names
- * where it came from, for the messages); *shipped (if not NULL) gets the
- * rows shipped. Returns 0 or an EX_ code. */
 /* The connection as the options say (fleet_pg_connect: TLS for a server
  * not on this machine, the password file checked). */
 static const char *opt_passfile;
@@ -474,8 +473,7 @@ static int opt_allow_plaintext;
 static PGconn *connect_central(const char *conninfo, int *rc)
 {
     char err[1024];
-    int tls = 0;
-    PGconn *pg = fleet_pg_connect(conninfo, opt_passfile, opt_allow_plaintext, &tls, rc, err, sizeof err);
+    PGconn *pg = fleet_pg_connect(conninfo, opt_passfile, opt_allow_plaintext, NULL, rc, err, sizeof err);
     if (!pg) {
         size_t n = strlen(err);
         fprintf(stderr, "amfi-sync: %s%s", err, n && err[n - 1] == '\n' ? "" : "\n");
@@ -584,6 +582,11 @@ static int open_store(const char *store, sqlite3 **db, int *store_version)
     return EX_RETRY;
 }
 
+/* One pass: connect, create or migrate the central schema, open the store,
+ * check the role against its site, check and ship every table. site_opt:
+ * the site id the caller expects (site_src names where it came from, for
+ * the messages); *shipped (if not NULL) gets the rows shipped. Returns 0 or
+ * an EX_ code. */
 static int sync_once(const char *conninfo, const char *store, const char *site_opt,
                      const char *site_src, int init_only, int quiet, long *shipped)
 {
