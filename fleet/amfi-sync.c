@@ -6,8 +6,11 @@
  *
  * Single-threaded. Reads the SQLite store read-only (SQLITE_OPEN_READONLY; in
  * WAL mode a reader never blocks amfid's writer) and writes the central
- * database with libpq. Each batch is one PostgreSQL transaction holding the
- * rows (COPY) and the table's high-water mark in fleet_sync_state, so a crash
+ * database with libpq, as the site's own role, which row-level security
+ * binds to the site's rows (central version 6), over TLS to a server not on
+ * this machine (fleet_pg.c). Each batch is one PostgreSQL transaction holding
+ * the rows (COPY into a temporary table, then INSERT ... SELECT) and the
+ * table's high-water mark in fleet_sync_state, so a crash
  * at any moment leaves either the whole batch or none of it. The mark also
  * keeps a hash of the last shipped row: a store restored from an older backup
  * (ids going backwards, or a different row at a shipped id) is refused. */
@@ -21,6 +24,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -28,6 +32,7 @@
 
 #include "amfi_cli.h"
 #include "amfi_config.h"
+#include "fleet_pg.h"
 #include "fleet_schema.h"
 #include "amfi_time.h"
 
@@ -118,6 +123,32 @@ static void keepalive(void)
     }
 }
 
+/* The store read without its -wal and -shm files (docs/fleet.md, "amfi-sync's
+ * user"): amfi-sync's user may only read the store, and SQLite cannot read a
+ * WAL database whose -shm it can neither open nor create, which is the case
+ * when amfid is stopped (it removes both at a clean close). Then the store is
+ * opened immutable (no locks, no -shm), which is right only while nobody
+ * writes it: the main file's identity, size and modification time are noted
+ * when it is opened and every batch is committed only if they have not
+ * changed and no -wal file has appeared (amfid started meanwhile); otherwise
+ * the batch is rolled back and the pass retried. */
+static int store_immutable;
+static struct stat store_st;
+static char store_wal[4200];
+static int store_moved(const char *store)
+{
+    if (!store_immutable) return 0;
+    struct stat st;
+    if (stat(store, &st) != 0 || st.st_ino != store_st.st_ino || st.st_dev != store_st.st_dev
+        || st.st_size != store_st.st_size || st.st_mtim.tv_sec != store_st.st_mtim.tv_sec
+        || st.st_mtim.tv_nsec != store_st.st_mtim.tv_nsec || access(store_wal, F_OK) == 0) {
+        fprintf(stderr, "amfi-sync: %s: the store changed while it was read without its -wal file "
+                        "(amfid started?): batch rolled back, retried\n", store);
+        return 1;
+    }
+    return 0;
+}
+
 static int pg_ok(PGresult *r, const char *what)
 {
     ExecStatusType s = PQresultStatus(r);
@@ -160,7 +191,18 @@ static int apply_schema(PGconn *pg)
         return EX_RETRY;
     }
     r = PQexec(pg, "SELECT coalesce(max(version), 0) FROM fleet_migrations");
-    if (pg_ok(r, "schema version")) { PQclear(r); pg_exec(pg, "ROLLBACK", "ROLLBACK"); return EX_RETRY; }
+    if (pg_ok(r, "schema version")) {
+        /* no right to read it: a role of no site (the shared writer of the
+         * central versions before 6, retired by version 6) */
+        const char *state = PQresultErrorField(r, PG_DIAG_SQLSTATE);
+        int denied = state && strcmp(state, "42501") == 0;
+        if (denied)
+            fprintf(stderr, "amfi-sync: this role is not a site's role: the owner creates one per site "
+                            "with 'amfi-sync --init-site-role SITE' (docs/fleet.md, Roles)\n");
+        PQclear(r);
+        pg_exec(pg, "ROLLBACK", "ROLLBACK");
+        return denied ? EX_USAGE : EX_RETRY;
+    }
     int have = atoi(PQgetvalue(r, 0, 0));
     PQclear(r);
     for (int i = have; i < fleet_n_migrations; i++) {
@@ -217,8 +259,16 @@ static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst,
     sqlite3_finalize(st);
     *nrows = n;
     if (n == 0) { free(b.p); return 0; }
-    char copy[512];
-    snprintf(copy, sizeof copy, "COPY %s (site_id, %s) FROM STDIN", dst, cols);
+    /* PostgreSQL refuses COPY FROM into a table whose row-level security
+     * binds the role (every site role, docs/fleet.md, Roles): the rows go
+     * by COPY into a temporary table of the same columns (this session's
+     * own, emptied at every commit), then by one INSERT ... SELECT into the
+     * site table, where the policies check every row. */
+    char copy[2048];
+    snprintf(copy, sizeof copy,
+             "CREATE TEMP TABLE IF NOT EXISTS amfi_in_%s (LIKE %s) ON COMMIT DELETE ROWS", dst, dst);
+    if (pg_exec(pg, copy, "temporary table")) { free(b.p); return EX_RETRY; }
+    snprintf(copy, sizeof copy, "COPY pg_temp.amfi_in_%s (site_id, %s) FROM STDIN", dst, cols);
     PGresult *r = PQexec(pg, copy);
     if (PQresultStatus(r) != PGRES_COPY_IN) { pg_ok(r, copy); PQclear(r); free(b.p); return EX_RETRY; }
     PQclear(r);
@@ -228,7 +278,10 @@ static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst,
     bad |= pg_ok(r, dst) != 0;
     PQclear(r);
     while ((r = PQgetResult(pg))) PQclear(r);
-    return bad ? EX_RETRY : 0;
+    if (bad) return EX_RETRY;
+    snprintf(copy, sizeof copy, "INSERT INTO %s (site_id, %s) SELECT site_id, %s FROM pg_temp.amfi_in_%s",
+             dst, cols, cols, dst);
+    return pg_exec(pg, copy, dst) ? EX_RETRY : 0;
 }
 
 /* Every value of the rows SELECT sel gives (ids above hwm) against the
@@ -358,6 +411,7 @@ static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const char *sto
             rc = pg_ok(r, "fleet_sync_state") ? EX_RETRY : 0;
             PQclear(r);
         }
+        if (!rc && n > 0 && store_moved(store)) rc = EX_RETRY;
         if (rc || n == 0) { pg_exec(pg, "ROLLBACK", "ROLLBACK"); return rc; }
         if (pg_exec(pg, "COMMIT", "COMMIT")) return EX_RETRY;
         hwm = last;
@@ -412,45 +466,152 @@ static int store_site_id(sqlite3 *db, char out[SITE_ID_MAX + 1])
     return found;
 }
 
-/* One pass: connect, create or migrate the central schema, check and ship
- * every table. site_opt: the site id the caller expects (site_src names
- * where it came from, for the messages); *shipped (if not NULL) gets the
- * rows shipped. Returns 0 or an EX_ code. */
+/* The connection as the options say (fleet_pg_connect: TLS for a server
+ * not on this machine, the password file checked). */
+static const char *opt_passfile;
+static int opt_allow_plaintext;
+static PGconn *connect_central(const char *conninfo, int *rc)
+{
+    char err[1024];
+    PGconn *pg = fleet_pg_connect(conninfo, opt_passfile, opt_allow_plaintext, NULL, rc, err, sizeof err);
+    if (!pg) {
+        size_t n = strlen(err);
+        fprintf(stderr, "amfi-sync: %s%s", err, n && err[n - 1] == '\n' ? "" : "\n");
+        *rc = *rc == 2 ? EX_USAGE : EX_RETRY;
+        return NULL;
+    }
+    pg_exec(pg, "SET client_min_messages = warning", "SET");
+    return pg;
+}
+
+/* "over TLS (TLSv1.3)" or "without TLS", for the pass's line */
+static const char *tls_note(PGconn *pg, char *buf, size_t len)
+{
+    const char *proto = PQsslAttribute(pg, "protocol");
+    if (!PQsslInUse(pg)) snprintf(buf, len, "without TLS");
+    else snprintf(buf, len, "over TLS (%s)", proto ? proto : "?");
+    return buf;
+}
+
+/* A role bound by row-level security (a site's login role, docs/fleet.md,
+ * Roles) ships only the site that fleet_site_roles gives it; the owner (not
+ * bound) ships any. */
+static int check_role(PGconn *pg, const char *site)
+{
+    PGresult *r = PQexec(pg, "SELECT row_security_active('passages'), current_user, "
+                             "(SELECT site_id FROM fleet_site_roles WHERE role_name = current_user)");
+    if (PQresultStatus(r) != PGRES_TUPLES_OK) {
+        fprintf(stderr, "amfi-sync: PostgreSQL: the role's site: %s"
+                        "amfi-sync: this role is not a site's role: the owner creates one per site "
+                        "with 'amfi-sync --init-site-role SITE' (docs/fleet.md, Roles)\n",
+                PQresultErrorMessage(r));
+        PQclear(r);
+        return EX_USAGE;
+    }
+    int rc = 0;
+    if (PQgetvalue(r, 0, 0)[0] == 't') {
+        if (PQgetisnull(r, 0, 2)) {
+            fprintf(stderr, "amfi-sync: the role '%s' is bound by the row-level security but is no "
+                            "site's role (fleet_site_roles): the owner creates one per site with "
+                            "'amfi-sync --init-site-role %s' (docs/fleet.md, Roles)\n",
+                    PQgetvalue(r, 0, 1), site);
+            rc = EX_USAGE;
+        } else if (strcmp(PQgetvalue(r, 0, 2), site) != 0) {
+            fprintf(stderr, "amfi-sync: the role '%s' is the role of site '%s' (fleet_site_roles), "
+                            "not of this store's site '%s': give this site its own role "
+                            "(docs/fleet.md, Roles)\n",
+                    PQgetvalue(r, 0, 1), PQgetvalue(r, 0, 2), site);
+            rc = EX_USAGE;
+        }
+    }
+    PQclear(r);
+    return rc;
+}
+
+/* The store opened read-only; without its -wal file and unable to create a
+ * -shm (amfi-sync's user only reads, amfid stopped), immutable (see
+ * store_moved). */
+static int open_store(const char *store, sqlite3 **db, int *store_version)
+{
+    store_immutable = 0;
+    snprintf(store_wal, sizeof store_wal, "%s-wal", store);
+    for (int pass = 0; pass < 2; pass++) {
+        char uri[3 * 4096 + 32];
+        const char *name = store;
+        if (pass == 1) {
+            /* a file: URI with the path percent-encoded */
+            size_t k = (size_t)snprintf(uri, sizeof uri, "file:");
+            for (const unsigned char *p = (const unsigned char *)store; *p && k + 4 < sizeof uri; p++) {
+                if ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9')
+                    || strchr("/._-~", *p))
+                    uri[k++] = (char)*p;
+                else
+                    k += (size_t)snprintf(uri + k, sizeof uri - k, "%%%02X", *p);
+            }
+            snprintf(uri + k, sizeof uri - k, "?immutable=1");
+            name = uri;
+            if (stat(store, &store_st) != 0) break;
+            store_immutable = 1;
+        }
+        if (sqlite3_open_v2(name, db, SQLITE_OPEN_READONLY | (pass ? SQLITE_OPEN_URI : 0), NULL) != SQLITE_OK) {
+            fprintf(stderr, "amfi-sync: %s: cannot open the store read-only: %s\n", store, sqlite3_errmsg(*db));
+            sqlite3_close(*db);
+            *db = NULL;
+            return EX_RETRY;
+        }
+        sqlite3_busy_timeout(*db, 5000);
+        sqlite3_stmt *uv = NULL;
+        int ok = sqlite3_prepare_v2(*db, "PRAGMA user_version", -1, &uv, NULL) == SQLITE_OK
+                 && sqlite3_step(uv) == SQLITE_ROW;
+        if (ok) *store_version = sqlite3_column_int(uv, 0);
+        sqlite3_finalize(uv);
+        if (ok) return 0;
+        int code = sqlite3_errcode(*db) & 0xff;
+        if (pass == 0 && (code == SQLITE_READONLY || code == SQLITE_CANTOPEN)
+            && access(store_wal, F_OK) != 0 && errno == ENOENT) {
+            sqlite3_close(*db);
+            *db = NULL;
+            continue;
+        }
+        fprintf(stderr, "amfi-sync: %s: cannot read the store: %s\n", store, sqlite3_errmsg(*db));
+        sqlite3_close(*db);
+        *db = NULL;
+        return EX_RETRY;
+    }
+    fprintf(stderr, "amfi-sync: %s: cannot read the store: %s\n", store, strerror(errno));
+    return EX_RETRY;
+}
+
+/* One pass: connect, create or migrate the central schema, open the store,
+ * check the role against its site, check and ship every table. site_opt:
+ * the site id the caller expects (site_src names where it came from, for
+ * the messages); *shipped (if not NULL) gets the rows shipped. Returns 0 or
+ * an EX_ code. */
 static int sync_once(const char *conninfo, const char *store, const char *site_opt,
                      const char *site_src, int init_only, int quiet, long *shipped)
 {
-    PGconn *pg = PQconnectdb(conninfo);
-    if (PQstatus(pg) != CONNECTION_OK) {
-        fprintf(stderr, "amfi-sync: cannot connect to PostgreSQL: %s", PQerrorMessage(pg));
-        PQfinish(pg);
-        return EX_RETRY;
-    }
-    pg_exec(pg, "SET client_min_messages = warning", "SET");
-    int rc = apply_schema(pg);
+    int rc;
+    PGconn *pg = connect_central(conninfo, &rc);
+    if (!pg) return rc;
+    rc = apply_schema(pg);
     if (rc || init_only) {
+        char tls[64];
         if (!rc && !quiet)
-            fprintf(stderr, "amfi-sync: central schema at version %d on %s/%s\n", fleet_n_migrations,
-                    PQhost(pg), PQdb(pg));
+            fprintf(stderr, "amfi-sync: central schema at version %d on %s/%s %s\n", fleet_n_migrations,
+                    PQhost(pg), PQdb(pg), tls_note(pg, tls, sizeof tls));
         PQfinish(pg);
         return rc;
     }
     sqlite3 *db = NULL;
-    if (sqlite3_open_v2(store, &db, SQLITE_OPEN_READONLY, NULL) != SQLITE_OK) {
-        fprintf(stderr, "amfi-sync: %s: cannot open the store read-only: %s\n", store, sqlite3_errmsg(db));
-        sqlite3_close(db);
-        PQfinish(pg);
-        return EX_RETRY;
-    }
-    sqlite3_busy_timeout(db, 5000);
     /* The columns shipped are those of the current store schema; amfid
      * migrates an older store when it starts (read-only here, amfi-sync
      * cannot). Retried: follow mode goes on once amfid has run. */
-    sqlite3_stmt *uv = NULL;
     int store_version = -1;
-    if (sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &uv, NULL) == SQLITE_OK
-        && sqlite3_step(uv) == SQLITE_ROW)
-        store_version = sqlite3_column_int(uv, 0);
-    sqlite3_finalize(uv);
+    rc = open_store(store, &db, &store_version);
+    if (rc) {
+        PQfinish(pg);
+        return rc;
+    }
     if (store_version < FLEET_MIN_STORE_VERSION) {
         fprintf(stderr, "amfi-sync: %s: store schema version %d, this amfi-sync needs %d or newer: "
                         "start the new amfid once (it migrates the store), then sync\n",
@@ -478,6 +639,8 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         rc = EX_USAGE;
         goto out;
     }
+    rc = check_role(pg, site);
+    if (rc) goto out;
     /* One read transaction for the whole pass: a consistent snapshot while
      * amfid keeps writing (WAL). */
     sqlite3_exec(db, "BEGIN", NULL, NULL, NULL);
@@ -491,10 +654,92 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         rc = sync_table(pg, db, site, store, &fleet_tables[i], 0, &total);
     sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
     if (shipped) *shipped = total;
+    char tls[64];
     if (!rc && !quiet && total > 0)
-        fprintf(stderr, "amfi-sync: site '%s': %ld rows shipped to %s/%s\n", site, total, PQhost(pg), PQdb(pg));
+        fprintf(stderr, "amfi-sync: site '%s': %ld rows shipped to %s/%s %s\n", site, total, PQhost(pg),
+                PQdb(pg), tls_note(pg, tls, sizeof tls));
 out:
     sqlite3_close(db);
+    PQfinish(pg);
+    return rc;
+}
+
+/* --init-site-role SITE [--role NAME], as the owner: the central schema
+ * brought to this version, then a login role for the site (created if it
+ * does not exist), a member of amfi_site, mapped to the site in
+ * fleet_site_roles. Run again, it changes nothing. A role that would not be
+ * bound by the row-level security (superuser, BYPASSRLS) or that reads every
+ * site (amfi_reader) is refused, as is a role or a site already mapped to
+ * another. No password is set: the owner sets one (or a certificate). */
+static int init_site_role(const char *conninfo, const char *site, const char *role_opt, int quiet)
+{
+    char role[80];
+    if (role_opt) {
+        snprintf(role, sizeof role, "%s", role_opt);
+    } else if (strlen(site) > 63 - strlen("amfi_sync_")) {
+        fprintf(stderr, "amfi-sync: --init-site-role: the role name 'amfi_sync_%s' would be longer than "
+                        "PostgreSQL's 63 bytes: give --role NAME\n", site);
+        return EX_USAGE;
+    } else {
+        snprintf(role, sizeof role, "amfi_sync_%s", site);
+    }
+    int rc;
+    PGconn *pg = connect_central(conninfo, &rc);
+    if (!pg) return rc;
+    rc = apply_schema(pg);
+    if (rc) { PQfinish(pg); return rc; }
+    char *ident = PQescapeIdentifier(pg, role, strlen(role));
+    const char *pv[2] = {role, site};
+    PGresult *r = NULL;
+    char sql[256];
+    rc = EX_RETRY;
+    if (!ident || pg_exec(pg, "BEGIN", "BEGIN")) goto out;
+    r = PQexecParams(pg, "SELECT rolsuper OR rolbypassrls, pg_has_role(oid, 'amfi_reader', 'MEMBER') "
+                         "FROM pg_roles WHERE rolname = $1", 1, NULL, pv, NULL, NULL, 0);
+    if (pg_ok(r, "the role")) goto out;
+    if (PQntuples(r) == 1 && (PQgetvalue(r, 0, 0)[0] == 't' || PQgetvalue(r, 0, 1)[0] == 't')) {
+        fprintf(stderr, "amfi-sync: --init-site-role: the role '%s' %s: it cannot be a site's role\n", role,
+                PQgetvalue(r, 0, 0)[0] == 't' ? "is a superuser or bypasses row-level security"
+                                              : "is a member of amfi_reader (reads every site)");
+        rc = EX_USAGE;
+        goto out;
+    }
+    if (PQntuples(r) == 0) {
+        snprintf(sql, sizeof sql, "CREATE ROLE %s LOGIN", ident);
+        if (pg_exec(pg, sql, "CREATE ROLE")) goto out;
+    }
+    PQclear(r);
+    snprintf(sql, sizeof sql, "GRANT amfi_site TO %s", ident);
+    r = PQexecParams(pg, "SELECT role_name, site_id FROM fleet_site_roles WHERE role_name = $1 OR site_id = $2",
+                     2, NULL, pv, NULL, NULL, 0);
+    if (pg_exec(pg, sql, "GRANT") || pg_ok(r, "fleet_site_roles")) goto out;
+    int have = 0;
+    for (int i = 0; i < PQntuples(r); i++) {
+        if (strcmp(PQgetvalue(r, i, 0), role) == 0 && strcmp(PQgetvalue(r, i, 1), site) == 0) {
+            have = 1;
+            continue;
+        }
+        fprintf(stderr, "amfi-sync: --init-site-role: fleet_site_roles already gives the role '%s' the site "
+                        "'%s': one role per site, one site per role\n",
+                PQgetvalue(r, i, 0), PQgetvalue(r, i, 1));
+        rc = EX_USAGE;
+        goto out;
+    }
+    PQclear(r);
+    r = have ? NULL
+             : PQexecParams(pg, "INSERT INTO fleet_site_roles (role_name, site_id) VALUES ($1, $2)", 2, NULL,
+                            pv, NULL, NULL, 0);
+    if ((r && pg_ok(r, "fleet_site_roles")) || pg_exec(pg, "COMMIT", "COMMIT")) goto out;
+    if (!quiet)
+        fprintf(stderr, "amfi-sync: site '%s' ships as the role '%s' on %s/%s%s; set its password "
+                        "(psql: \\password %s) or a certificate, and give the site user=%s "
+                        "(docs/fleet.md, Roles)\n",
+                site, role, PQhost(pg), PQdb(pg), have ? " (already so)" : "", ident, role);
+    rc = 0;
+out:
+    PQclear(r);
+    if (rc) pg_exec(pg, "ROLLBACK", "ROLLBACK");
+    PQfreemem(ident);
     PQfinish(pg);
     return rc;
 }
@@ -502,14 +747,17 @@ out:
 static void usage(FILE *f)
 {
     fputs("usage: amfi-sync --pg CONNINFO --init-schema\n"
+          "       amfi-sync --pg CONNINFO --init-site-role SITE [--role NAME]\n"
           "       amfi-sync [--config FILE] [--db STORE] --pg CONNINFO [--site ID] [--once]\n"
           "                 [--interval S] [--quiet]\n"
+          "  every form also takes --passfile FILE and --allow-plaintext\n"
           "Ships the site store's new rows to the central PostgreSQL (amfi-sync(1),\n"
           "docs/fleet.md). --config: amfid's YAML (store path and site.id from it;\n"
           "--db and --site win). CONNINFO is a libpq connection string ('service=amfi',\n"
           "'host=... dbname=...'); PG* environment variables, ~/.pg_service.conf and\n"
-          "~/.pgpass apply. Exit: 0 done, 1 server or store unavailable, 2 usage or\n"
-          "configuration, 3 store refused (restored backup, other site).\n",
+          "~/.pgpass apply. A server not on this machine is reached over TLS only\n"
+          "(--allow-plaintext: on a network you trust). Exit: 0 done, 1 server or store\n"
+          "unavailable, 2 usage or configuration, 3 store refused (restored backup, other site).\n",
           f);
 }
 
@@ -530,14 +778,19 @@ static void pause_s(double s)
 int main(int argc, char **argv)
 {
     const char *store = NULL, *conninfo = NULL, *site = NULL, *config = NULL;
+    const char *init_role_site = NULL, *role = NULL;
     int once = 0, init = 0, quiet = 0;
     double interval = 10;
-    enum { O_INIT = 256, O_ONCE, O_INTERVAL };
+    enum { O_INIT = 256, O_ONCE, O_INTERVAL, O_INIT_ROLE, O_ROLE, O_PASSFILE, O_PLAIN };
     static const struct option opts[] = {
         {"db", required_argument, NULL, 'd'},   {"pg", required_argument, NULL, 'p'},
         {"site", required_argument, NULL, 's'}, {"config", required_argument, NULL, 'c'},
         {"once", no_argument, NULL, O_ONCE},    {"init-schema", no_argument, NULL, O_INIT},
         {"interval", required_argument, NULL, O_INTERVAL},
+        {"init-site-role", required_argument, NULL, O_INIT_ROLE},
+        {"role", required_argument, NULL, O_ROLE},
+        {"passfile", required_argument, NULL, O_PASSFILE},
+        {"allow-plaintext", no_argument, NULL, O_PLAIN},
         {"quiet", no_argument, NULL, 'q'},      AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, "amfi-sync", argc, argv, opts, usage);
@@ -551,8 +804,34 @@ int main(int argc, char **argv)
         case O_INIT: init = 1; break;
         case 'q': quiet = 1; break;
         case O_INTERVAL: interval = amfi_cli_num(&c, optarg, 0.1, 86400); break;
+        case O_INIT_ROLE: init_role_site = optarg; break;
+        case O_ROLE: role = optarg; break;
+        case O_PASSFILE: opt_passfile = optarg; break;
+        case O_PLAIN: opt_allow_plaintext = 1; break;
         default: usage(stderr); return EX_USAGE;
         }
+    }
+    if (role && !init_role_site) {
+        amfi_cli_error("amfi-sync", "--role", "only with --init-site-role SITE");
+        return EX_USAGE;
+    }
+    if (init_role_site) {
+        if (!conninfo || init || once || store || config || site) {
+            amfi_cli_error("amfi-sync", "--init-site-role",
+                           !conninfo ? "--pg CONNINFO is required"
+                                     : "takes --pg, --role, --passfile, --allow-plaintext and --quiet only");
+            return EX_USAGE;
+        }
+        if (!amfi_site_id_valid(init_role_site)) {
+            fprintf(stderr, "amfi-sync: --init-site-role: '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n",
+                    init_role_site);
+            return EX_USAGE;
+        }
+        if (role && !amfi_site_id_valid(role)) {
+            fprintf(stderr, "amfi-sync: --role: '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n", role);
+            return EX_USAGE;
+        }
+        return init_site_role(conninfo, init_role_site, role, quiet);
     }
     /* amfid's configuration: the store it writes and the site it claims.
      * Explicit options win; the store's own meta is checked against the

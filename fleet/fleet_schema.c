@@ -138,6 +138,81 @@ static const char fleet_v5[] =
     "  END IF;\n"
     "END $$;\n";
 
+/* Version 6: each site writes and reads only its own rows. The group roles
+ * amfi_site (every site's login role is a member) and amfi_reader (analysts,
+ * amfi-report --pg) are created when missing; fleet_site_roles maps each
+ * site's login role to its site (one role per site, created by the owner's
+ * 'amfi-sync --init-site-role SITE'); row-level security on every table a
+ * site writes or reads binds a site role to the rows of its site, USING and
+ * WITH CHECK, its marks in fleet_sync_state included. The owner is not bound
+ * (ENABLE, not FORCE: it owns the tables and could lift the policies anyway;
+ * it migrates and repairs). fleet_migrations is written by the owner only:
+ * every other role's write rights on it are revoked. The shared writer of
+ * the versions before, amfi_sync, loses every right (one login for every
+ * site is what let a site forge another's rows). The views are read by the
+ * owner and amfi_reader only (a view runs with its owner's rights, so a
+ * site role reading one would see every site). */
+static const char fleet_v6[] =
+    "DO $$ BEGIN\n"
+    "  IF NOT EXISTS (SELECT 1 FROM pg_roles WHERE rolname = 'amfi_site') THEN\n"
+    "    CREATE ROLE amfi_site NOLOGIN;\n"
+    "  END IF;\n"
+    "  IF NOT EXISTS (SELECT 1 FROM pg_roles WHERE rolname = 'amfi_reader') THEN\n"
+    "    CREATE ROLE amfi_reader NOLOGIN;\n"
+    "  END IF;\n"
+    "END $$;\n"
+    "CREATE TABLE fleet_site_roles (\n"
+    "  role_name text PRIMARY KEY,  -- a login role, member of amfi_site\n"
+    "  site_id text NOT NULL UNIQUE,\n"
+    "  created_at timestamptz NOT NULL DEFAULT now());\n"
+    "REVOKE ALL ON fleet_migrations, fleet_site_roles, fleet_sync_state, passages, axles,\n"
+    "  indicators, alerts, baseline, runs, environment, scale_evals, fleet_latest_state,\n"
+    "  fleet_open_alerts, fleet_daily_trend, fleet_passages_daily, fleet_window_trend,\n"
+    "  fleet_latest_scale FROM PUBLIC;\n"
+    "DO $$ DECLARE g text; BEGIN\n"
+    "  FOR g IN SELECT DISTINCT a.grantee::regrole::text\n"
+    "           FROM pg_class AS c, aclexplode(c.relacl) AS a\n"
+    "           WHERE c.oid = 'fleet_migrations'::regclass AND a.grantee <> 0\n"
+    "             AND a.grantee <> c.relowner AND a.privilege_type <> 'SELECT' LOOP\n"
+    "    EXECUTE format('REVOKE INSERT, UPDATE, DELETE, TRUNCATE, REFERENCES, TRIGGER '\n"
+    "                   'ON fleet_migrations FROM %s', g);\n"
+    "  END LOOP;\n"
+    "  IF EXISTS (SELECT 1 FROM pg_roles WHERE rolname = 'amfi_sync') THEN\n"
+    "    EXECUTE format('REVOKE ALL ON ALL TABLES IN SCHEMA %I FROM amfi_sync', current_schema());\n"
+    "    EXECUTE format('ALTER DEFAULT PRIVILEGES IN SCHEMA %I REVOKE ALL ON TABLES FROM amfi_sync',\n"
+    "                   current_schema());\n"
+    "  END IF;\n"
+    "END $$;\n"
+    "GRANT SELECT ON fleet_migrations, fleet_site_roles TO amfi_site;\n"
+    "GRANT SELECT, INSERT ON passages, axles, indicators, alerts, baseline, runs, environment,\n"
+    "  scale_evals TO amfi_site;\n"
+    "GRANT SELECT, INSERT, UPDATE ON fleet_sync_state TO amfi_site;\n"
+    "GRANT SELECT ON fleet_migrations, fleet_site_roles, fleet_sync_state, passages, axles,\n"
+    "  indicators, alerts, baseline, runs, environment, scale_evals, fleet_latest_state,\n"
+    "  fleet_open_alerts, fleet_daily_trend, fleet_passages_daily, fleet_window_trend,\n"
+    "  fleet_latest_scale TO amfi_reader;\n"
+    "ALTER TABLE fleet_site_roles ENABLE ROW LEVEL SECURITY;\n"
+    "CREATE POLICY fleet_own_role ON fleet_site_roles FOR SELECT TO amfi_site\n"
+    "  USING (role_name = current_user);\n"
+    "CREATE POLICY fleet_reader ON fleet_site_roles FOR SELECT TO amfi_reader USING (true);\n"
+    "DO $$ DECLARE t text; BEGIN\n"
+    "  FOREACH t IN ARRAY ARRAY['passages', 'axles', 'indicators', 'alerts', 'baseline', 'runs',\n"
+    "                           'environment', 'scale_evals', 'fleet_sync_state'] LOOP\n"
+    "    EXECUTE format('ALTER TABLE %I ENABLE ROW LEVEL SECURITY', t);\n"
+    "    EXECUTE format('CREATE POLICY fleet_site ON %I TO amfi_site '\n"
+    "      'USING (site_id = (SELECT r.site_id FROM fleet_site_roles AS r '\n"
+    "      'WHERE r.role_name = current_user)) '\n"
+    "      'WITH CHECK (site_id = (SELECT r.site_id FROM fleet_site_roles AS r '\n"
+    "      'WHERE r.role_name = current_user))', t);\n"
+    "    EXECUTE format('CREATE POLICY fleet_reader ON %I FOR SELECT TO amfi_reader USING (true)', t);\n"
+    "  END LOOP;\n"
+    "END $$;\n";
+
+/* A later version that adds a site table enables row-level security on it
+ * with the two policies of version 6 (fleet_site, fleet_reader), grants
+ * amfi_site SELECT, INSERT and amfi_reader SELECT on it, and revokes a new
+ * view from PUBLIC and grants it to amfi_reader only (tests/fleet_security.sh
+ * fails on a table with a site_id and no policy). */
 const struct fleet_migration fleet_migrations[] = {
     {1, "site tables with site_id, fleet_sync_state, fleet views", fleet_v1},
     {2, "fleet_window_trend: indicators with their alerts, per site", fleet_v2},
@@ -145,6 +220,8 @@ const struct fleet_migration fleet_migrations[] = {
     {4, "passages: n_vehicles and quality", fleet_v4},
     {5, "passages: reference_gvw_kg, deck_c, f1_hz, f1_comp_hz, f1_zeta, f1_r2, gvw_comp_kg; "
         "environment, scale_evals, fleet_latest_scale", fleet_v5},
+    {6, "one role per site: fleet_site_roles, row-level security on every site table, "
+        "fleet_migrations written by the owner only", fleet_v6},
 };
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
 

@@ -35,6 +35,7 @@ pkgs=(
   libclang-rt-14-dev             # clang 14's libFuzzer and sanitizer runtimes (-fsanitize=fuzzer)
   libpq-dev                      # libpq: amfi-sync ships site stores to the central PostgreSQL (fleet/)
   postgresql                     # initdb, pg_ctl: the fleet_* tests start a throwaway server
+  openssl                        # openssl req: fleet_security's self-signed server certificate (TLS)
   python3-numpy                  # tools/research/multi-r5: the offline analysis behind
                                  #   docs/results/multi-vehicle.md round five (nothing built needs it)
 )

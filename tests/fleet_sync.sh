@@ -24,48 +24,8 @@ pg_tmp fleet_sync
 failures=0
 fail() { echo "FAIL $case: $*"; failures=$((failures + 1)); }
 
-awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
-     on && !/^```/' "$doc" > "$tmp/ddl.sql"
-[ -s "$tmp/ddl.sql" ] || { echo "fleet_sync.sh: no DDL block in $doc" >&2; exit 1; }
-store_version=$(sed -n 's/.*PRAGMA user_version` (this document: version \([0-9]*\)).*/\1/p' "$doc")
-[ -n "$store_version" ] || { echo "fleet_sync.sh: no schema version in $doc" >&2; exit 1; }
+fleet_store_setup "$doc"
 
-# add_rows DB N: N passages (2 axles each), an indicator per 10, an alert per 50.
-add_rows() {
-    sqlite3 "$1" <<SQL > /dev/null
-PRAGMA busy_timeout = 5000;
-BEGIN;
-WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $2)
-INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason,
-                      lambda, residual_rms, formulation, solve_ms)
-SELECT i, 1763769600000000 + ((SELECT count(*) FROM passages) + i) * 40000000, 1, 25.0, 2,
-       CASE WHEN i % 10 = 0 THEN NULL ELSE 15000.0 + 1000 * (i % 7) + 0.1 END,
-       CASE WHEN i % 10 = 0 THEN 'gap' ELSE 'ok' END,
-       CASE WHEN i % 10 = 0 THEN 'tab	and "quote" \\ back' ELSE '' END,
-       7.94e-9, 0.001, 'paper', 15.0 FROM k;
-INSERT INTO axles SELECT id, 1, NULL, 0.4 * gvw_kg FROM passages WHERE id NOT IN (SELECT passage_id FROM axles);
-INSERT INTO axles SELECT id, 2, 4.5, 0.6 * gvw_kg FROM passages p WHERE NOT EXISTS
-  (SELECT 1 FROM axles a WHERE a.passage_id = p.id AND a.idx = 2);
-WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $2 / 10)
-INSERT INTO indicators (utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state)
-SELECT 1763769600000000 + i, 20, 17800, 1900, 17800, 1900, 1.0, 0.5, 'normal' FROM k;
-WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $2 / 50)
-INSERT INTO alerts (utime, level, kind, message, indicator_id, raised)
-SELECT 1763769600000000 + i, 'warning', 'std_increase', 'STD up
-two lines', NULL, i % 2 FROM k;
-COMMIT;
-SQL
-}
-# mkstore DB SITE N
-mkstore() {
-    { cat "$tmp/ddl.sql"; echo "PRAGMA journal_mode = WAL;
-PRAGMA user_version = $store_version;
-INSERT INTO meta (key, value) VALUES ('site.id', '$2');
-INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note) VALUES (0, 30, 17800, 1900, 'auto', '');
-INSERT INTO runs (version, config_path) VALUES ('0.test', '/etc/amfi/amfid.yaml');"; } |
-        sqlite3 "$1" > /dev/null
-    add_rows "$1" "$3"
-}
 # same DB SITE: central rows of the site equal the store's, no gap
 # (fleet_same, pg_server.sh), and text copied exactly.
 same() {
@@ -77,36 +37,47 @@ same() {
 
 case=init
 "$sync" --pg "$PG_CONNINFO" --init-schema 2> "$tmp/init.log" || fail "--init-schema: $(cat "$tmp/init.log")"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 5 ] || fail "schema version"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 6 ] || fail "schema version"
 # a central database of version 1 migrates on the next contact
-v5_down="DROP VIEW fleet_latest_scale; DROP TABLE environment, scale_evals;
+v6_down="DO \$\$ DECLARE t text; BEGIN
+        FOREACH t IN ARRAY ARRAY['passages', 'axles', 'indicators', 'alerts', 'baseline', 'runs',
+                                 'environment', 'scale_evals', 'fleet_sync_state'] LOOP
+          EXECUTE format('DROP POLICY fleet_site ON %I', t);
+          EXECUTE format('DROP POLICY fleet_reader ON %I', t);
+          EXECUTE format('ALTER TABLE %I DISABLE ROW LEVEL SECURITY', t);
+        END LOOP;
+      END \$\$;
+      DROP TABLE fleet_site_roles;"
+v5_down="$v6_down DROP VIEW fleet_latest_scale; DROP TABLE environment, scale_evals;
       ALTER TABLE passages DROP COLUMN reference_gvw_kg, DROP COLUMN deck_c, DROP COLUMN f1_hz,
       DROP COLUMN f1_comp_hz, DROP COLUMN f1_zeta, DROP COLUMN f1_r2, DROP COLUMN gvw_comp_kg;"
 pg_q "$v5_down DROP VIEW fleet_window_trend; ALTER TABLE passages DROP COLUMN speed_given_mps,
       DROP COLUMN speed_estimated, DROP COLUMN n_vehicles, DROP COLUMN quality;
       DELETE FROM fleet_migrations WHERE version > 1"
-"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 5"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 5 ] || fail "not migrated to 5"
+"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 6"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 6 ] || fail "not migrated to 6"
 pg_q "SELECT count(*) FROM fleet_window_trend" > /dev/null || fail "no fleet_window_trend after migration"
 grep -q password "$tmp/init.log" && fail "log mentions a password"
-# docs/fleet.md's DDL of version 5 is what amfi-sync applies: a database
-# migrated by it and one taken back to version 4 and given the document's
-# block have the same schema
-awk '/^<!-- fleet-v5:begin -->/ { on = 1; next } /^<!-- fleet-v5:end -->/ { on = 0 }
-     on && !/^```/' "$fleetdoc" > "$tmp/v5.sql"
-[ -s "$tmp/v5.sql" ] || fail "no version 5 block in $fleetdoc"
+# docs/fleet.md's DDL of versions 5 and 6 is what amfi-sync applies: a
+# database migrated by it and one taken back to version 4 and given the
+# document's blocks have the same schema (tables, policies, rights)
+for v in 5 6; do
+    awk "/^<!-- fleet-v$v:begin -->/ { on = 1; next } /^<!-- fleet-v$v:end -->/ { on = 0 }
+         on && !/^\`\`\`/" "$fleetdoc" > "$tmp/v$v.sql"
+    [ -s "$tmp/v$v.sql" ] || fail "no version $v block in $fleetdoc"
+done
 for d in docv5a docv5b; do
     pg_q "CREATE DATABASE $d"
     "$sync" --pg "host=$PG_DIR dbname=$d user=postgres" --init-schema --quiet || fail "$d: --init-schema"
 done
 psql -X -q -v ON_ERROR_STOP=1 "host=$PG_DIR dbname=docv5b user=postgres" -c "$v5_down" -f "$tmp/v5.sql" \
-    > "$tmp/v5.log" 2>&1 || fail "docs/fleet.md's version 5 block: $(cat "$tmp/v5.log")"
+    -f "$tmp/v6.sql" > "$tmp/v5.log" 2>&1 || fail "docs/fleet.md's version 5 and 6 blocks: $(cat "$tmp/v5.log")"
 for d in docv5a docv5b; do
     pg_dump -s -T fleet_migrations "host=$PG_DIR dbname=$d user=postgres" > "$tmp/$d.dump" || fail "pg_dump $d"
     grep -v "^\\\\\(un\)\?restrict " "$tmp/$d.dump" > "$tmp/$d.sql"  # a random key per dump
 done
 cmp -s "$tmp/docv5a.sql" "$tmp/docv5b.sql" ||
-    fail "docs/fleet.md's version 5 differs from amfi-sync's: $(diff "$tmp/docv5a.sql" "$tmp/docv5b.sql" | head -6)"
+    fail "docs/fleet.md's versions 5 and 6 differ from amfi-sync's: $(diff "$tmp/docv5a.sql" "$tmp/docv5b.sql" | head -6)"
 
 case=three-sites
 for s in a b c; do mkstore "$tmp/$s.db" "site-$s" 3000; done
@@ -319,65 +290,80 @@ rc=$?
 grep -q "bad.yaml:3: site.idd: unknown key" "$tmp/bad.log" || fail "message: $(cat "$tmp/bad.log")"
 
 case=roles
+# docs/fleet.md's roles block run as written: an analyst and a site's role
 awk '/^<!-- roles:begin -->/ { on = 1; next } /^<!-- roles:end -->/ { on = 0 }
      on && !/^```/' "$fleetdoc" > "$tmp/roles.sql"
 [ -s "$tmp/roles.sql" ] || fail "no roles block in $fleetdoc"
 psql -X -q -v ON_ERROR_STOP=1 "$PG_CONNINFO" -f "$tmp/roles.sql" > "$tmp/roles.log" 2>&1 ||
     fail "the roles SQL of docs/fleet.md: $(cat "$tmp/roles.log")"
-pg_q "CREATE ROLE analyst LOGIN IN ROLE amfi_reader"
-writer="host=$PG_DIR dbname=postgres user=amfi_sync"
-reader="host=$PG_DIR dbname=postgres user=analyst"
-mkstore "$tmp/w.db" site-w 3000
-"$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the writer role cannot sync"
-"$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the writer role: second pass"
-same "$tmp/w.db" site-w
-[ "$(psql -X -At "$reader" -c "SELECT count(*) FROM fleet_window_trend WHERE site_id = 'site-w'")" = \
+writer="host=$PG_DIR dbname=postgres user=amfi_sync_a1-km12"
+reader="host=$PG_DIR dbname=postgres user=alice"
+mkstore "$tmp/w.db" a1-km12 3000
+"$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the site's role cannot sync"
+"$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the site's role: second pass"
+same "$tmp/w.db" a1-km12
+[ "$(psql -X -At "$reader" -c "SELECT count(*) FROM fleet_window_trend WHERE site_id = 'a1-km12'")" = \
   "$(sqlite3 "$tmp/w.db" "SELECT count(*) FROM window_trend")" ] || fail "fleet_window_trend differs from the store's window_trend"
-[ "$(psql -X -At "$reader" -c "SELECT count(*) FROM fleet_latest_state WHERE site_id = 'site-w'")" = 1 ] ||
+[ "$(psql -X -At "$reader" -c "SELECT count(*) FROM fleet_latest_state WHERE site_id = 'a1-km12'")" = 1 ] ||
     fail "the reader cannot read fleet_latest_state"
+[ "$(psql -X -At "$reader" -c "SELECT count(DISTINCT site_id) FROM passages")" -gt 3 ] ||
+    fail "the reader does not read every site"
 psql -X -At "$reader" -c "SELECT count(*) FROM fleet_daily_trend" > /dev/null 2>&1 ||
     fail "the reader cannot read fleet_daily_trend"
-psql -X -At "$reader" -c "DELETE FROM passages WHERE site_id = 'site-w'" > /dev/null 2>&1 &&
+psql -X -At "$reader" -c "DELETE FROM passages WHERE site_id = 'a1-km12'" > /dev/null 2>&1 &&
     fail "the reader deleted passages"
-psql -X -At "$writer" -c "DELETE FROM passages WHERE site_id = 'site-w'" > /dev/null 2>&1 &&
-    fail "the writer deleted passages"
+psql -X -At "$writer" -c "DELETE FROM passages WHERE site_id = 'a1-km12'" > /dev/null 2>&1 &&
+    fail "the site's role deleted passages"
 add_rows "$tmp/w.db" 100
 "$sync" --db "$tmp/w.db" --pg "$reader" --once 2> "$tmp/reader.log" && fail "the reader role synced"
-grep -q "permission denied" "$tmp/reader.log" || fail "reader sync: $(cat "$tmp/reader.log")"
-"$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the writer role: after the reader"
-same "$tmp/w.db" site-w
+grep -q "no site's role" "$tmp/reader.log" || fail "reader sync: $(cat "$tmp/reader.log")"
+"$sync" --db "$tmp/w.db" --pg "$writer" --once --quiet || fail "the site's role: after the reader"
+same "$tmp/w.db" a1-km12
 
 case=upgrade
-# A central database of version 4 (as amfi-sync of version 4 left it, its
-# roles set up without default privileges) with a site shipped. The writer
-# role cannot migrate: it asks for --init-schema, ships nothing; the owner
-# migrates; the writer's next pass ships the new passages with their new
-# columns and every environment and scale_evals row. The passages shipped
-# before keep NULL in the new columns.
+# A central database of version 4 (as amfi-sync of version 4 left it, with
+# the shared writer role amfi_sync of then) with a site shipped. The writer
+# cannot migrate: it asks for --init-schema, ships nothing; the owner
+# migrates to 6, which retires the shared writer (refused, exit 2); the
+# owner gives the site its role, which ships the new passages with their
+# new columns and every environment and scale_evals row. The passages
+# shipped before keep NULL in the new columns.
 pg_q "CREATE DATABASE up4"
 up="host=$PG_DIR dbname=up4 user=postgres"
 main_db=$PG_CONNINFO
 PG_CONNINFO=$up
 "$sync" --pg "$up" --init-schema --quiet || fail "--init-schema"
-grep -v '^CREATE ROLE\|^ALTER DEFAULT' "$tmp/roles.sql" | psql -X -q -v ON_ERROR_STOP=1 "$up" > "$tmp/up.log" 2>&1 ||
-    fail "roles: $(cat "$tmp/up.log")"
 mkstore "$tmp/u.db" site-u 1000
 fleet_issue14_rows "$tmp/u.db"
 "$sync" --db "$tmp/u.db" --pg "$up" --once --quiet || fail "first sync: exit $?"
 pg_q "$v5_down DELETE FROM fleet_sync_state WHERE tbl IN ('environment', 'scale_evals');
-      DELETE FROM fleet_migrations WHERE version > 4"
+      DELETE FROM fleet_migrations WHERE version > 4;
+      DO \$\$ BEGIN
+        IF NOT EXISTS (SELECT 1 FROM pg_roles WHERE rolname = 'amfi_sync') THEN
+          CREATE ROLE amfi_sync LOGIN;
+        END IF;
+      END \$\$;
+      GRANT USAGE ON SCHEMA public TO amfi_sync;
+      GRANT SELECT, INSERT ON ALL TABLES IN SCHEMA public TO amfi_sync;
+      GRANT UPDATE ON fleet_sync_state TO amfi_sync;"
 add_rows "$tmp/u.db" 500
 fleet_issue14_rows "$tmp/u.db" 1000
 upw="host=$PG_DIR dbname=up4 user=amfi_sync"
 "$sync" --db "$tmp/u.db" --pg "$upw" --once 2> "$tmp/up.log"
 rc=$?
 [ $rc = 1 ] || fail "the writer role at version 4: exit $rc, expected 1"
-grep -q "central schema is at version 4, this program needs 5: run 'amfi-sync --init-schema'" "$tmp/up.log" ||
+grep -q "central schema is at version 4, this program needs 6: run 'amfi-sync --init-schema'" "$tmp/up.log" ||
     fail "the writer role at version 4: $(cat "$tmp/up.log")"
 [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-u'")" = 1000 ] || fail "the writer shipped at version 4"
-"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 4 -> 5"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 5 ] || fail "not migrated to 5"
-"$sync" --db "$tmp/u.db" --pg "$upw" --once --quiet || fail "the writer after the migration: exit $?"
+"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 4 -> 6"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 6 ] || fail "not migrated to 6"
+"$sync" --db "$tmp/u.db" --pg "$upw" --once 2> "$tmp/up.log"
+rc=$?
+[ $rc = 2 ] || fail "the shared writer after the migration: exit $rc, expected 2"
+grep -q "not a site's role" "$tmp/up.log" || fail "the shared writer after the migration: $(cat "$tmp/up.log")"
+"$sync" --pg "$up" --init-site-role site-u --quiet || fail "--init-site-role site-u"
+"$sync" --db "$tmp/u.db" --pg "host=$PG_DIR dbname=up4 user=amfi_sync_site-u" --once --quiet ||
+    fail "the site's role after the migration: exit $?"
 same "$tmp/u.db" site-u
 fleet_columns_same "$tmp/u.db" site-u passages "id > 1000"
 fleet_columns_same "$tmp/u.db" site-u environment
@@ -386,7 +372,7 @@ fleet_columns_same "$tmp/u.db" site-u scale_evals
            (deck_c IS NOT NULL OR f1_hz IS NOT NULL OR reference_gvw_kg IS NOT NULL OR
             gvw_comp_kg IS NOT NULL)")" = 0 ] ||
     fail "passages shipped before the migration have values in its columns"
-[ "$(psql -X -At "host=$PG_DIR dbname=up4 user=analyst" -c "SELECT count(*) FROM fleet_latest_scale")" = 2 ] ||
+[ "$(psql -X -At "host=$PG_DIR dbname=up4 user=alice" -c "SELECT count(*) FROM fleet_latest_scale")" = 2 ] ||
     fail "the reader role cannot read fleet_latest_scale"
 PG_CONNINFO=$main_db
 

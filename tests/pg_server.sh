@@ -101,3 +101,49 @@ SELECT 1763769600000000 + i * 86400000000 + 1, 'known_truck', i, 0.9921875 + 0.0
 COMMIT;
 SQL
 }
+# fleet_store_setup SCHEMA_MD: site stores made from docs/schema.md's DDL
+# block at its version, with the functions below (fleet_sync.sh,
+# fleet_security.sh).
+fleet_store_setup() {
+    awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
+         on && !/^```/' "$1" > "$tmp/ddl.sql"
+    [ -s "$tmp/ddl.sql" ] || { echo "pg_server.sh: no DDL block in $1" >&2; exit 1; }
+    store_version=$(sed -n 's/.*PRAGMA user_version` (this document: version \([0-9]*\)).*/\1/p' "$1")
+    [ -n "$store_version" ] || { echo "pg_server.sh: no schema version in $1" >&2; exit 1; }
+}
+# add_rows DB N: N passages (2 axles each), an indicator per 10, an alert per 50.
+add_rows() {
+    sqlite3 "$1" <<SQL > /dev/null
+PRAGMA busy_timeout = 5000;
+BEGIN;
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $2)
+INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason,
+                      lambda, residual_rms, formulation, solve_ms)
+SELECT i, 1763769600000000 + ((SELECT count(*) FROM passages) + i) * 40000000, 1, 25.0, 2,
+       CASE WHEN i % 10 = 0 THEN NULL ELSE 15000.0 + 1000 * (i % 7) + 0.1 END,
+       CASE WHEN i % 10 = 0 THEN 'gap' ELSE 'ok' END,
+       CASE WHEN i % 10 = 0 THEN 'tab	and "quote" \\ back' ELSE '' END,
+       7.94e-9, 0.001, 'paper', 15.0 FROM k;
+INSERT INTO axles SELECT id, 1, NULL, 0.4 * gvw_kg FROM passages WHERE id NOT IN (SELECT passage_id FROM axles);
+INSERT INTO axles SELECT id, 2, 4.5, 0.6 * gvw_kg FROM passages p WHERE NOT EXISTS
+  (SELECT 1 FROM axles a WHERE a.passage_id = p.id AND a.idx = 2);
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $2 / 10)
+INSERT INTO indicators (utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state)
+SELECT 1763769600000000 + i, 20, 17800, 1900, 17800, 1900, 1.0, 0.5, 'normal' FROM k;
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $2 / 50)
+INSERT INTO alerts (utime, level, kind, message, indicator_id, raised)
+SELECT 1763769600000000 + i, 'warning', 'std_increase', 'STD up
+two lines', NULL, i % 2 FROM k;
+COMMIT;
+SQL
+}
+# mkstore DB SITE N
+mkstore() {
+    { cat "$tmp/ddl.sql"; echo "PRAGMA journal_mode = WAL;
+PRAGMA user_version = $store_version;
+INSERT INTO meta (key, value) VALUES ('site.id', '$2');
+INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note) VALUES (0, 30, 17800, 1900, 'auto', '');
+INSERT INTO runs (version, config_path) VALUES ('0.test', '/etc/amfi/amfid.yaml');"; } |
+        sqlite3 "$1" > /dev/null
+    add_rows "$1" "$3"
+}

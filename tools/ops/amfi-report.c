@@ -67,6 +67,7 @@ typedef struct options {
     const char *db;
     const char *pg;         /* --pg CONNINFO: the central database, NULL: none */
     const char *site;       /* --site ID (with --pg) */
+    int allow_plaintext;    /* --allow-plaintext: no TLS to a remote --pg server */
     int summary, trend, alerts, errors, check;
     int baseline_last;   /* N of --set-baseline-last, 0: not given */
     int baseline_given;  /* --set-baseline MEAN,STD,N given */
@@ -114,6 +115,7 @@ static void usage(FILE *f)
             "                               summary, or with --site the report of one "
             "site\n"
             "      --site ID                the site, with --pg\n"
+            "      --allow-plaintext        with --pg: no TLS to a server not on this machine\n"
             "  -s, --summary                passages by status, GVW of the ok "
             "ones, time span, baseline\n"
             "  -t, --trend                  the last %d indicators\n"
@@ -249,6 +251,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"format", required_argument, NULL, 'F'},
         {"pg", required_argument, NULL, 'G'},
         {"site", required_argument, NULL, 'I'},
+        {"allow-plaintext", no_argument, NULL, 'X'},
         AMFI_CLI_END};
     memset(o, 0, sizeof *o);
     o->ex.from = 0;
@@ -283,6 +286,7 @@ static int parse_args(int argc, char **argv, options *o)
                 return usage_error(opt, "'%s' is not a site id (1 to 63 of A-Z a-z 0-9 _ . -)",
                                    amfi_cli_shown(val));
             break;
+        case 'X': o->allow_plaintext = 1; break;
         case 'P': o->passages = 1; break;
         case 'H': o->histogram = 1; break;
         case 'O': o->overloads = 1; break;
@@ -358,6 +362,8 @@ static int parse_args(int argc, char **argv, options *o)
         return usage_error("--db", "missing (see --help)");
     if (o->site && !o->pg)
         return usage_error("--site", "only with --pg");
+    if (o->allow_plaintext && !o->pg)
+        return usage_error("--allow-plaintext", "only with --pg");
     if (o->pg && (o->baseline_last || o->baseline_given || o->check))
         return usage_error("--pg", "the central database is read only here: --set-baseline* and "
                            "--check work on a site's store (--db)");
@@ -927,10 +933,10 @@ int main(int argc, char **argv)
     if (parse_args(argc, argv, &o) != 0)
         return EXIT_USAGE;
     if (o.pg && !o.site) {
-        rc = report_pg_fleet(o.pg, stdout, err, sizeof err);
+        rc = report_pg_fleet(o.pg, o.allow_plaintext, stdout, err, sizeof err);
         if (rc)
             fprintf(stderr, PROG ": --pg: %s\n", err);
-        return rc ? EXIT_DATA : 0;
+        return rc == 2 ? EXIT_USAGE : rc ? EXIT_DATA : 0;
     }
     /* --pg --site: the site's central rows in a private temporary store,
      * reported like any store (report_pg.c) */
@@ -944,7 +950,7 @@ int main(int argc, char **argv)
         }
         snprintf(tmpdb, sizeof tmpdb, "%s/%s.db", tmpdir, o.site);
         long rows = 0;
-        rc = report_pg_fetch_site(o.pg, o.site, tmpdb, &rows, err, sizeof err);
+        rc = report_pg_fetch_site(o.pg, o.allow_plaintext, o.site, tmpdb, &rows, err, sizeof err);
         if (rc) {
             fprintf(stderr, PROG ": --pg: %s\n", err);
             remove_tmp(tmpdir, tmpdb);

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "amfi_config.h"
+#include "fleet_pg.h"
 #include "fleet_schema.h"
 #include "store.h"
 
@@ -44,14 +45,13 @@ static int fail(char *err, size_t errlen, int rc, const char *fmt, ...)
     return rc;
 }
 
-static PGconn *connect_pg(const char *conninfo, char *err, size_t errlen)
+/* TLS required for a server not on this machine unless allow_plaintext
+ * (fleet_pg_connect); *rc: 1 server away, 2 refused (TLS, password file). */
+static PGconn *connect_pg(const char *conninfo, int allow_plaintext, int *rc, char *err, size_t errlen)
 {
-    PGconn *pg = PQconnectdb(conninfo);
-    if (PQstatus(pg) != CONNECTION_OK) {
-        fail(err, errlen, 1, "cannot connect to PostgreSQL: %s", PQerrorMessage(pg));
-        PQfinish(pg);
-        return NULL;
-    }
+    char why[1024];
+    PGconn *pg = fleet_pg_connect(conninfo, NULL, allow_plaintext, NULL, rc, why, sizeof why);
+    if (!pg) fail(err, errlen, *rc, "%s", why);
     return pg;
 }
 
@@ -111,10 +111,11 @@ static const char *fleet_row_problem(PGresult *r, int i)
     return NULL;
 }
 
-int report_pg_fleet(const char *conninfo, FILE *out, char *err, size_t errlen)
+int report_pg_fleet(const char *conninfo, int allow_plaintext, FILE *out, char *err, size_t errlen)
 {
-    PGconn *pg = connect_pg(conninfo, err, errlen);
-    if (!pg) return 1;
+    int crc;
+    PGconn *pg = connect_pg(conninfo, allow_plaintext, &crc, err, errlen);
+    if (!pg) return crc;
     /* Per site: the newest passage id and time shipped (ids are never
      * reused in a store, so the id counts the passages), the latest
      * indicator, the open alerts and when the site last shipped. Index
@@ -265,11 +266,12 @@ static int fetch_table(PGconn *pg, sqlite3 *db, const char *site_lit, const char
     return rc;
 }
 
-int report_pg_fetch_site(const char *conninfo, const char *site, const char *path, long *rows,
-                         char *err, size_t errlen)
+int report_pg_fetch_site(const char *conninfo, int allow_plaintext, const char *site, const char *path,
+                         long *rows, char *err, size_t errlen)
 {
-    PGconn *pg = connect_pg(conninfo, err, errlen);
-    if (!pg) return 1;
+    int crc;
+    PGconn *pg = connect_pg(conninfo, allow_plaintext, &crc, err, errlen);
+    if (!pg) return crc;
     const char *pv[1] = {site};
     PGresult *r = PQexecParams(pg, "SELECT 1 FROM fleet_sync_state WHERE site_id = $1 LIMIT 1", 1,
                                NULL, pv, NULL, NULL, 0);
