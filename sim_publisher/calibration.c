@@ -219,7 +219,6 @@ int amfi_cal_runs_write(const char *dir, const amfi_bridge *b, const amfi_profil
     fprintf(truth, "file,truck,model,speed_mps,entry_time_s,axle_spacings_m,axle_kg,"
                    "mean_force_N,sensor_x_m,track,lost_contact_steps,detector_speed_mps,"
                    "detector_entry_time_s\n");
-    const double L = amfi_bridge_params_of(b)->span_m;
     int run = 0;
     for (int ti = 0; ti < p->n_trucks; ti++) {
         const amfi_cal_truck *t = &p->trucks[ti];
@@ -305,7 +304,6 @@ int amfi_cal_runs_write(const char *dir, const amfi_bridge *b, const amfi_profil
             fputc(',', truth);
             put_list(truth, sp->sensor_x_m, ns, "%.4f");
             fprintf(truth, ",%d,%ld,%.6f,%.6f\n", track, lost, det_speed, det_entry);
-            (void)L;
         }
     }
     if (fclose(runs) != 0) {

@@ -64,6 +64,24 @@
  *                 [--damage-step-at K|none] [--noise-ms2 STD] [--block N]
  *                 [--start-utime US] [--detector-lead SEC] ... (as above)
  *
+ * As built (--as-built FILE, config/amfi_as_built.h): the bridge the
+ * vehicles really cross, the sensors' true positions and the detector's
+ * clock offset and speed and spacing scale errors, in a file apart from the
+ * configuration (which stays the design). The accelerations come from the
+ * as-built bridge; vehicle_t and meta.csv's first columns carry what the
+ * detector says, truth_t and meta.csv's appended columns the truth.
+ *
+ * Commissioning records (offline, no bus, no population; calibration.h):
+ * --calibration-runs DIR writes each calibration truck's runs alone on the
+ * bridge at speeds spread over --calibration-speeds, with --tail seconds of
+ * free vibration, as DIR/runNNN.csv, DIR/RUNS.csv (what the detector said
+ * and the weighed axle loads) and DIR/RUNS.truth.csv; --ambient-out FILE an
+ * ambient record under white-noise forces.
+ *
+ *   sim_publisher [--as-built FILE] --calibration-runs DIR [--truck S1,../L1,L2,..]...
+ *                 [--runs-per-truck N] [--calibration-speeds LO,HI] [--tail SEC]
+ *                 [--ambient-out FILE [--ambient-duration SEC] [--ambient-force N]]
+ *
  * Exit status: 0; 1 bad input file, bus or simulation failure; 2 bad command
  * line.
  */
