@@ -83,6 +83,36 @@ for set in ab de; do
   done < "$dir/$set.tails"
 done
 
+# A key the as-built file leaves out keeps the design's value (a design of
+# another modulus); segments and elastic bearings of the as-built bridge
+# ring at its libamfi f1 too.
+printf 'bridge: {E_pa: 3.0e10}\n' > "$dir/soft.yaml"
+printf 'detector: {clock_offset_s: 0.001}\n' > "$dir/keep.yaml"
+[ "$("$chk" f1 "$dir/soft.yaml" "$dir/keep.yaml")" = "$("$chk" f1 "$dir/soft.yaml")" ] ||
+  fail "an as-built file without bridge keys did not keep the design's bridge"
+near "$("$chk" f1 "$dir/soft.yaml")" "$f1_design" 0.01 && fail "the soft design has the paper's f1"
+cat > "$dir/seg.yaml" <<'EOF'
+bridge:
+  supports:
+    - {at_m: 0, type: elastic, k_w_npm: 2.0e9}
+    - {at_m: 20, type: elastic, k_w_npm: 2.0e9}
+  segments:
+    - {from_m: 0, to_m: 4, EI_nm2: 2.0e10, mass_kgpm: 3000}
+    - {from_m: 16, to_m: 20, EI_nm2: 2.0e10, mass_kgpm: 3000}
+EOF
+f1_seg=$("$chk" f1 "$design" "$dir/seg.yaml") || fail "f1 of the segmented bridge"
+near "$f1_seg" "$f1_design" 0.02 && fail "the segmented bridge has the design's f1"
+"$sim" --config "$design" --as-built "$dir/seg.yaml" --calibration-runs "$dir/seg" \
+  --runs-per-truck 1 2>/dev/null || fail "calibration runs on the segmented bridge exited $?"
+for r in 2 3; do
+  set -- $(sed -n ${r}p "$dir/seg/RUNS.truth.csv" | awk -F, '{
+      n = split($6, s, ";"); L = 0; for (i = 1; i <= n; i++) L += s[i];
+      printf "%s %.6f\n", $1, $5 + (20 + L) / $4 + 0.1 }')
+  m=$("$chk" freq "$dir/seg/$1" 1 "$2" 2 15) || fail "seg/$1: no frequency"
+  echo "seg/$1: free vibration at $m Hz (bridge f1 $f1_seg Hz)"
+  near "$m" "$f1_seg" 0.005 || fail "seg/$1: $m Hz is not within 0.5 % of $f1_seg Hz"
+done
+
 # RUNS.csv holds what the detector said, RUNS.truth.csv what happened.
 paste -d, "$dir/ab/RUNS.csv" "$dir/ab/RUNS.truth.csv" | tail -n +2 | awk -F, '
   function first(s) { split(s, a, ";"); return a[1] }
