@@ -19,10 +19,14 @@
  *               design's sensors ids) really is at at_m, or offset_m from
  *               where the design puts it; sensors not listed are where the
  *               design says
- *   detector:   clock_offset_s (the detector's entry times are late by this,
- *               s, [-10, 10]; negative: early), speed_scale_error (the
- *               reported speed is the true one times 1 + e, (-0.5, 0.5)),
- *               spacing_scale_error (the reported axle spacings likewise)
+ *   detector:   clock_offset_s (the detector's clock minus the
+ *               accelerometers': its entry times are late by this, s,
+ *               [-1, 1]; negative: early), speed_scale (reported over true
+ *               speed, [0.5, 2]), spacing_scale (reported over true axle
+ *               spacings, [0.5, 2]; default: speed_scale, the spacings being
+ *               measured from the speed): the names and meanings of the site
+ *               file's detector: section, which holds what a commissioning
+ *               found; here they are the truth it should find
  *
  * Keys are validated like the site file's ("FILE:LINE: key.path: problem",
  * the same walker and the same bridge: table); the as-built bridge is built
@@ -43,9 +47,9 @@ extern "C" {
 #endif
 
 typedef struct amfi_detector_error {
-    double clock_offset_s;      /* reported entry time − true entry time, s */
-    double speed_scale_error;   /* reported speed = true · (1 + this) */
-    double spacing_scale_error; /* reported spacing = true · (1 + this) */
+    double clock_offset_s; /* reported entry time − true entry time, s */
+    double speed_scale;    /* reported speed / true speed */
+    double spacing_scale;  /* reported spacing / true spacing */
 } amfi_detector_error;
 
 typedef struct amfi_as_built {
@@ -59,7 +63,7 @@ typedef struct amfi_as_built {
     amfi_detector_error detector;
 } amfi_as_built;
 
-/* The identity: the design's bridge and sensors, an exact detector. */
+/* The identity: the design's bridge and sensors, an exact detector (0, 1, 1). */
 void amfi_as_built_from_design(const amfi_site_config *design, amfi_as_built *out);
 
 /* Load `path` over amfi_as_built_from_design(design). 0 and *out filled, or

@@ -93,19 +93,21 @@ static const list_schema ab_sensor_list = {ab_sensor_fields, &ab_sensor_default}
 static const kind K_AB_SENSORS = {"list", p_ab_sensors, d_ab_sensors, v_ab_sensors,
                                   NEST_LIST};
 
-static const field detector_fields[] = {
+/* The names, meanings and ranges of the site file's detector: section
+ * (what a commissioning finds), here the truth it should find. */
+static const field ab_detector_fields[] = {
     {.key = "clock_offset_s", .kind = &K_DOUBLE, .off = AB(detector.clock_offset_s),
-     .lo = -10, .hi = 10},
-    {.key = "speed_scale_error", .kind = &K_DOUBLE, .off = AB(detector.speed_scale_error),
-     .lo = -0.5, .hi = 0.5, .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "spacing_scale_error", .kind = &K_DOUBLE, .off = AB(detector.spacing_scale_error),
-     .lo = -0.5, .hi = 0.5, .flags = F_LO_OPEN | F_HI_OPEN},
+     .lo = -1, .hi = 1},
+    {.key = "speed_scale", .kind = &K_DOUBLE, .off = AB(detector.speed_scale), .lo = 0.5,
+     .hi = 2},
+    {.key = "spacing_scale", .kind = &K_DOUBLE, .off = AB(detector.spacing_scale), .lo = 0.5,
+     .hi = 2},
     {.key = NULL}};
 
 static const field ab_top[] = {
     {.key = "bridge", .kind = &K_MAP, .aux = bridge_fields},
     {.key = "sensors", .kind = &K_AB_SENSORS, .aux = &ab_sensor_list},
-    {.key = "detector", .kind = &K_MAP, .aux = detector_fields},
+    {.key = "detector", .kind = &K_MAP, .aux = ab_detector_fields},
     {.key = NULL}};
 
 /* The bridge's own checks and the model built (section_bridge.c,
@@ -118,6 +120,9 @@ static int ab_check(ctx *x, void *base)
 
     if (bridge_check(x, &a->site) || model_check(x, &a->site))
         return -1;
+    /* spacings measured from the speed: scaled alike unless the file says */
+    if (!noted(x, "detector.spacing_scale"))
+        a->detector.spacing_scale = a->detector.speed_scale;
     for (int k = 0; k < a->site.solver.n_sensors; k++)
         if (!(a->sensor_x_m[k] >= 0 && a->sensor_x_m[k] <= a->site.bridge.span_m)) {
             /* the sensor's item when it was moved, else the span that shrank */
@@ -135,6 +140,7 @@ void amfi_as_built_from_design(const amfi_site_config *design, amfi_as_built *ou
     memset(out, 0, sizeof *out);
     memcpy(&out->site, design, sizeof *design);
     memcpy(out->sensor_x_m, design->solver.sensor_x_m, sizeof out->sensor_x_m);
+    out->detector = (amfi_detector_error){0.0, 1.0, 1.0};
 }
 
 int amfi_as_built_load(const char *path, const amfi_site_config *design, amfi_as_built *out,

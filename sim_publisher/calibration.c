@@ -285,11 +285,11 @@ int amfi_cal_runs_write(const char *dir, const amfi_bridge *b, const amfi_profil
             if (write_accel(path, n, ns, p->sensor_id, sp->scan_rate_hz, acc, err, errlen))
                 goto out;
             /* what the detector reports: its clock, its speed and spacing scales */
-            const double det_speed = speed_meas * (1.0 + p->det.speed_scale_error);
+            const double det_speed = speed_meas * p->det.speed_scale;
             const double det_entry = entry_true + p->det.clock_offset_s;
             double det_sp[AMFI_MAX_AXLES - 1];
             for (int a = 0; a + 1 < t->n_axles; a++)
-                det_sp[a] = t->spacing_m[a] * (1.0 + p->det.spacing_scale_error);
+                det_sp[a] = t->spacing_m[a] * p->det.spacing_scale;
             fprintf(runs, "%s,%.6f,", name, det_speed);
             put_list(runs, det_sp, t->n_axles - 1, "%.4f");
             fprintf(runs, ",%.6f,", det_entry);

@@ -551,6 +551,7 @@ static int world_build(const opts *o, const amfi_site_config *cfg, const amfi_as
     char err[512];
     const int step = !o->out && !o->calib_dir && !o->ambient_out && o->damage_step_at >= 0;
     memset(w, 0, sizeof *w);
+    w->det = (amfi_detector_error){0.0, 1.0, 1.0}; /* exact */
     amfi_bridge_params bp = ab ? ab->site.bridge : cfg->bridge;
     /* an as-built bridge's own damage and the run's compound: (1 − δ)(1 − δ') */
     const double d0 = ab ? ab->site.bridge.damage : 0.0;
@@ -856,8 +857,8 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
                 speed *= 1.0 + o->speed_err_mean +
                          (o->speed_err_std > 0 ? gsl_ran_gaussian(noise, o->speed_err_std) : 0.0);
             /* the detector's systematic errors (--as-built; none: zero) */
-            speed *= 1.0 + w->det.speed_scale_error;
-            double spacing = p->spacing * (1.0 + w->det.spacing_scale_error);
+            speed *= w->det.speed_scale;
+            double spacing = p->spacing * w->det.spacing_scale;
             const double entry = p->entry_s + w->det.clock_offset_s;
             amfi_vehicle_t m = {o->start_utime + (int64_t)llround(entry * 1e6), p->v.id, p->lane,
                                 speed, 2, 1, &spacing, PROG, p->reference_kg};
@@ -1134,8 +1135,8 @@ int main(int argc, char **argv)
         }
         const double spacing = spec.car.D1_m + spec.car.D2_m;
         fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,%g",
-                name, pr.speed_measured_mps * (1.0 + w.det.speed_scale_error), spec.speed_mps,
-                spacing * (1.0 + w.det.spacing_scale_error),
+                name, pr.speed_measured_mps * w.det.speed_scale, spec.speed_mps,
+                spacing * w.det.spacing_scale,
                 -pr.t_first_s + w.det.clock_offset_s, rec->axle_kg[0] + rec->axle_kg[1],
                 rec->axle_kg[0], rec->axle_kg[1], pr.truth.mean_force_N[0],
                 pr.truth.mean_force_N[1], o.damage, o.noise,

@@ -63,8 +63,8 @@ sensors:
   - {id: 0, offset_m: -0.5}
 detector:
   clock_offset_s: 0.010
-  speed_scale_error: 0.02
-  spacing_scale_error: -0.01
+  speed_scale: 1.02
+  spacing_scale: 0.99
 EOF
 f1_design=$("$chk" f1 "$design") || fail "f1 of the design"
 f1_ab=$("$chk" f1 "$design" "$dir/ab.yaml") || fail "f1 of the as-built bridge"
@@ -162,6 +162,14 @@ for set in de ab; do
   done || exit 1
 done
 
+# Without spacing_scale, the spacings (measured from the speed) scale alike.
+printf 'detector: {speed_scale: 0.97}\n' > "$dir/slow.yaml"
+"$sim" --config "$design" --as-built "$dir/slow.yaml" --calibration-runs "$dir/slow" \
+  --runs-per-truck 1 --truck 4.0/6000,9000 --calibration-speeds 20,20 2>/dev/null ||
+  fail "speed_scale alone exited $?"
+sed -n 2p "$dir/slow/RUNS.csv" | grep -q '^run001.csv,19.400000,3.8800,0.500000,6000.0;9000.0$' ||
+  fail "speed_scale 0.97 alone: $(sed -n 2p "$dir/slow/RUNS.csv")"
+
 # Several sensors: the header names them by id, each sensor at its place.
 cat > "$dir/two.yaml" <<'EOF'
 sensors:
@@ -228,11 +236,11 @@ bad both "2: sensors[0]: give exactly one of at_m" 'sensors:
   - {id: 0, at_m: 9, offset_m: 1}'
 bad off_span "2: sensors[id 0]: at 25 m, off the as-built span" 'sensors:
   - {id: 0, offset_m: 15}'
-bad clock "2: detector.clock_offset_s" 'detector:
-  clock_offset_s: 11'
-bad scale "3: detector.speed_scale_error" 'detector:
+bad clock "2: detector.clock_offset_s: must be in [-1, 1]" 'detector:
+  clock_offset_s: 1.5'
+bad scale "3: detector.speed_scale: must be in [0.5, 2]" 'detector:
   clock_offset_s: 0.01
-  speed_scale_error: 0.5'
+  speed_scale: 0.4'
 bad elastic "3: bridge.supports[0]: an elastic support needs k_w_npm" 'bridge:
   supports:
     - {at_m: 0, type: elastic}
