@@ -64,6 +64,24 @@
  *                 [--damage-step-at K|none] [--noise-ms2 STD] [--block N]
  *                 [--start-utime US] [--detector-lead SEC] ... (as above)
  *
+ * As built (--as-built FILE, config/amfi_as_built.h): the bridge the
+ * vehicles really cross, the sensors' true positions and the detector's
+ * clock offset and speed and spacing scale errors, in a file apart from the
+ * configuration (which stays the design). The accelerations come from the
+ * as-built bridge; vehicle_t and meta.csv's first columns carry what the
+ * detector says, truth_t and meta.csv's appended columns the truth.
+ *
+ * Commissioning records (offline, no bus, no population; calibration.h):
+ * --calibration-runs DIR writes each calibration truck's runs alone on the
+ * bridge at speeds spread over --calibration-speeds, with --tail seconds of
+ * free vibration, as DIR/runNNN.csv, DIR/RUNS.csv (what the detector said
+ * and the weighed axle loads) and DIR/RUNS.truth.csv; --ambient-out FILE an
+ * ambient record under white-noise forces.
+ *
+ *   sim_publisher [--as-built FILE] --calibration-runs DIR [--truck S1,../L1,L2,..]...
+ *                 [--runs-per-truck N] [--calibration-speeds LO,HI] [--tail SEC]
+ *                 [--ambient-out FILE [--ambient-duration SEC] [--ambient-force N]]
+ *
  * Exit status: 0; 1 bad input file, bus or simulation failure; 2 bad command
  * line.
  */
@@ -82,8 +100,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "amfi_as_built.h"
 #include "amfi_cli.h"
 #include "amfi_config.h"
+#include "calibration.h"
 #include "amfi_datafile.h"
 #include "amfi_messages.h"
 #include "passage.h"
@@ -130,6 +150,13 @@ typedef struct opts {
     double environment_period; /* s of data time between environment_t */
     double time_compression;
     long calibration_every; /* > 0: every this many vehicles the calibration truck */
+    /* the as-built bridge and detector (NULL: the design is the truth) */
+    const char *as_built;
+    /* offline commissioning records (calibration.h) */
+    const char *calib_dir, *ambient_out; /* NULL: not written */
+    amfi_cal_params cal;                 /* trucks, runs, speeds, tail */
+    int trucks_given;                    /* --truck seen: the defaults replaced */
+    double ambient_s, ambient_force_n;
 } opts;
 
 static void usage(FILE *f)
@@ -143,7 +170,10 @@ static void usage(FILE *f)
             "       [--first K] [--damage FRACTION] [--seed S] [--profile A..H|smooth]\n"
             "       [--track-std TRACKS] [--scan-rate HZ] [--noise FRACTION]\n"
             "       [--speed-error MEAN,STD] [--preceding-gap LO[,HI]|none] [--pre SEC]\n"
-            "       [--post SEC] [--dt SEC]\n"
+            "       [--post SEC] [--dt SEC] [--as-built FILE.yaml]\n"
+            "       [--calibration-runs DIR] [--truck S1,../L1,L2,..] [--runs-per-truck N]\n"
+            "       [--calibration-speeds LO,HI] [--tail SEC] [--ambient-out FILE.csv]\n"
+            "       [--ambient-duration SEC] [--ambient-force N]\n"
             "\n"
             "Simulated vehicles crossing the bridge: passage files (--out) or a live\n"
             "LCM stream (docs/simulator.md).\n"
@@ -179,6 +209,18 @@ static void usage(FILE *f)
             "      --environment-period SEC   environment_t every SEC of data time\n"
             "      --calibration-every N      every Nth vehicle the pre-weighed calibration\n"
             "                                 truck, its reference GVW on vehicle_t (0: none)\n"
+            "      --as-built FILE            the bridge, sensors and detector as really\n"
+            "                                 built (the site file stays the design)\n"
+            "      --calibration-runs DIR     offline: calibration trucks one at a time,\n"
+            "                                 DIR/runNNN.csv, RUNS.csv, RUNS.truth.csv\n"
+            "      --truck S1,../L1,L2,..     a calibration truck: axle spacings m / static\n"
+            "                                 axle loads kg (repeat; default 18 t 2-axle, 40 t 5-axle)\n"
+            "      --runs-per-truck N         calibration runs of each truck (10)\n"
+            "      --calibration-speeds LO,HI true speeds spread over LO..HI m/s (15,25)\n"
+            "      --tail SEC                 free vibration recorded after the last axle (3)\n"
+            "      --ambient-out FILE         offline: an ambient record (white-noise forces)\n"
+            "      --ambient-duration SEC     its length (300)\n"
+            "      --ambient-force N          force std at each node per sample (20)\n"
             "  -h, --help                     this help\n"
             "  -V, --version                  print the version\n"
             "Settings: built-in defaults < the configuration file's simulation: section\n"
@@ -191,7 +233,9 @@ enum {
     O_FIRST = 256, O_PROFILE, O_TRACK_STD, O_SCAN_RATE, O_NOISE, O_SPEED_ERROR,
     O_PRECEDING_GAP, O_PRE, O_POST, O_DT, O_SPEEDUP, O_HEADWAY, O_DAMAGE_STEP_AT,
     O_NOISE_MS2, O_BLOCK, O_START_UTIME, O_DETECTOR_LEAD, O_ENVIRONMENT,
-    O_TIME_COMPRESSION, O_ENVIRONMENT_PERIOD, O_CALIBRATION_EVERY, O_FLOW, O_MIN_HEADWAY, O_LANES
+    O_TIME_COMPRESSION, O_ENVIRONMENT_PERIOD, O_CALIBRATION_EVERY, O_FLOW, O_MIN_HEADWAY, O_LANES,
+    O_AS_BUILT, O_CALIB_RUNS, O_TRUCK, O_RUNS_PER_TRUCK, O_CALIB_SPEEDS, O_TAIL, O_AMBIENT_OUT,
+    O_AMBIENT_DURATION, O_AMBIENT_FORCE
 };
 
 static const struct option longopts[] = {
@@ -227,6 +271,15 @@ static const struct option longopts[] = {
     {"time-compression", required_argument, NULL, O_TIME_COMPRESSION},
     {"environment-period", required_argument, NULL, O_ENVIRONMENT_PERIOD},
     {"calibration-every", required_argument, NULL, O_CALIBRATION_EVERY},
+    {"as-built", required_argument, NULL, O_AS_BUILT},
+    {"calibration-runs", required_argument, NULL, O_CALIB_RUNS},
+    {"truck", required_argument, NULL, O_TRUCK},
+    {"runs-per-truck", required_argument, NULL, O_RUNS_PER_TRUCK},
+    {"calibration-speeds", required_argument, NULL, O_CALIB_SPEEDS},
+    {"tail", required_argument, NULL, O_TAIL},
+    {"ambient-out", required_argument, NULL, O_AMBIENT_OUT},
+    {"ambient-duration", required_argument, NULL, O_AMBIENT_DURATION},
+    {"ambient-force", required_argument, NULL, O_AMBIENT_FORCE},
     AMFI_CLI_END};
 
 /* "A" or "A,B" */
@@ -316,6 +369,13 @@ static void opts_from_config(opts *o, const amfi_sim_config *c, const char *file
     o->time_compression = c->time_compression;
     o->environment_period = c->environment_period_s;
     o->calibration_every = c->calibration_every;
+    o->cal.n_trucks = amfi_cal_default_trucks(o->cal.trucks);
+    o->cal.runs_per_truck = 10;
+    o->cal.speed_lo = 15.0;
+    o->cal.speed_hi = 25.0;
+    o->cal.tail_s = 3.0;
+    o->ambient_s = 300.0;
+    o->ambient_force_n = 20.0;
 }
 
 /* The flags over the values already in *o; exits 0 after --help, 2 after a
@@ -392,13 +452,43 @@ static void apply_flags(int argc, char **argv, opts *o)
             break;
         case O_CALIBRATION_EVERY: o->calibration_every = amfi_cli_integer(&c, v, 0, 1e7); break;
         case O_TIME_COMPRESSION: o->time_compression = amfi_cli_num(&c, v, 1, 1e6); break;
+        case O_AS_BUILT: o->as_built = v; break;
+        case O_CALIB_RUNS: o->calib_dir = v; break;
+        case O_TRUCK: {
+            char why[256];
+            if (!o->trucks_given)
+                o->cal.n_trucks = 0;
+            o->trucks_given = 1;
+            if (o->cal.n_trucks == AMFI_CAL_MAX_TRUCKS)
+                amfi_cli_fail(&c, "at most %d trucks", AMFI_CAL_MAX_TRUCKS);
+            if (amfi_cal_truck_parse(v, &o->cal.trucks[o->cal.n_trucks], why, sizeof why))
+                amfi_cli_fail(&c, "'%s': %s", amfi_cli_shown(v), why);
+            o->cal.n_trucks++;
+            break;
         }
+        case O_RUNS_PER_TRUCK: o->cal.runs_per_truck = (int)amfi_cli_integer(&c, v, 1, 1000); break;
+        case O_CALIB_SPEEDS:
+            pair(&c, v, 1, 60, &o->cal.speed_lo, &o->cal.speed_hi, 0);
+            if (o->cal.speed_hi < o->cal.speed_lo)
+                amfi_cli_fail(&c, "LO must not exceed HI");
+            break;
+        case O_TAIL: o->cal.tail_s = amfi_cli_num(&c, v, 0, 60); break;
+        case O_AMBIENT_OUT: o->ambient_out = v; break;
+        case O_AMBIENT_DURATION: o->ambient_s = amfi_cli_num(&c, v, 1, 3600); break;
+        case O_AMBIENT_FORCE: o->ambient_force_n = amfi_cli_num(&c, v, 0, 1e7); break;
+        }
+    }
+    if (o->out && (o->calib_dir || o->ambient_out)) {
+        fprintf(stderr, "%s: --out and --calibration-runs/--ambient-out are separate modes\n",
+                PROG);
+        exit(2);
     }
     if (o->speed_err_std < 0) {
         fprintf(stderr, "%s: --speed-error: STD must be >= 0\n", PROG);
         exit(2);
     }
-    if (!o->out && o->lcm_url && !strcmp(o->lcm_url, "none") && !o->log) {
+    if (!o->out && !o->calib_dir && !o->ambient_out && o->lcm_url &&
+        !strcmp(o->lcm_url, "none") && !o->log) {
         if (o->lcm_url_flag)
             fprintf(stderr, "%s: --lcm-url none without --log would produce nothing\n", PROG);
         else
@@ -423,14 +513,27 @@ static void seed_vehicle(gsl_rng *r, unsigned long seed, long i)
 /* What both modes simulate on: the bridge (healthy; with a damage step
  * while streaming, also the damaged one), the road carpet, the simulation
  * settings and the vehicle property law. Built once per run, by
- * world_build(); owned by main. */
+ * world_build(); owned by main. With --as-built, the bridge and the sensor
+ * positions are the as-built ones and det the detector's errors (else the
+ * design's and none). */
 typedef struct world {
     amfi_bridge *bridge;  /* the bridge the run starts with */
     amfi_bridge *damaged; /* --damage-step-at: the bridge from then on, else NULL */
     amfi_profile *prof;
     amfi_sim_params sp;
     amfi_halfcar_dist dist;
+    amfi_bridge_params bp;   /* the simulated bridge, healthy (before any damage) */
+    amfi_detector_error det; /* what the detector gets wrong */
+    int as_built;            /* 1: --as-built given */
+    double damage0;          /* the as-built bridge's own damage, compounded with
+                                --damage: 1 − (1 − damage0)(1 − δ) */
 } world;
+
+/* The damage simulated for a run's damage d. */
+static double world_damage(const world *w, double d)
+{
+    return 1.0 - (1.0 - w->damage0) * (1.0 - d);
+}
 
 static void world_free(world *w)
 {
@@ -440,36 +543,49 @@ static void world_free(world *w)
     memset(w, 0, sizeof *w);
 }
 
-/* 0, or 1 after a message. */
-static int world_build(const opts *o, const amfi_site_config *cfg, world *w)
+/* 0, or 1 after a message. ab: the as-built bridge, sensors and detector,
+ * or NULL (the design's). */
+static int world_build(const opts *o, const amfi_site_config *cfg, const amfi_as_built *ab,
+                       world *w)
 {
     char err[512];
-    const int step = !o->out && o->damage_step_at >= 0;
+    const int step = !o->out && !o->calib_dir && !o->ambient_out && o->damage_step_at >= 0;
     memset(w, 0, sizeof *w);
-    amfi_bridge_params bp = cfg->bridge;
-    bp.damage = step ? 0.0 : o->damage;
+    w->det = (amfi_detector_error){0.0, 1.0, 1.0}; /* exact */
+    amfi_bridge_params bp = ab ? ab->site.bridge : cfg->bridge;
+    /* an as-built bridge's own damage and the run's compound: (1 − δ)(1 − δ') */
+    const double d0 = ab ? ab->site.bridge.damage : 0.0;
+    bp.damage = 0.0;
+    if (ab) {
+        w->as_built = 1;
+        w->det = ab->detector;
+    }
+    w->bp = bp;
+    w->damage0 = d0;
+    bp.damage = 1.0 - (1.0 - d0) * (1.0 - (step ? 0.0 : o->damage));
     if (amfi_bridge_create(&bp, &w->bridge, err, sizeof err)) {
         fprintf(stderr, "%s: bridge: %s\n", PROG, err);
         return 1;
     }
     if (step) {
-        bp.damage = o->damage;
+        bp.damage = 1.0 - (1.0 - d0) * (1.0 - o->damage);
         if (amfi_bridge_create(&bp, &w->damaged, err, sizeof err)) {
             fprintf(stderr, "%s: bridge: %s\n", PROG, err);
             world_free(w);
             return 1;
         }
     }
-    amfi_sim_params_default(&w->sp, cfg->bridge.span_m);
+    amfi_sim_params_default(&w->sp, bp.span_m);
     w->sp.dt_s = o->dt;
     w->sp.scan_rate_hz = o->scan_rate;
     w->sp.n_sensors = cfg->solver.n_sensors;
-    memcpy(w->sp.sensor_x_m, cfg->solver.sensor_x_m, sizeof w->sp.sensor_x_m);
+    memcpy(w->sp.sensor_x_m, ab ? ab->sensor_x_m : cfg->solver.sensor_x_m,
+           sizeof w->sp.sensor_x_m);
     amfi_profile_params pp;
     amfi_profile_params_default(&pp);
     pp.iso_class = o->profile_class;
     pp.seed = o->seed;
-    pp.length_m = w->sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + cfg->bridge.span_m + 100.0;
+    pp.length_m = w->sp.approach_m + AMFI_SIM_PROFILE_LEAD_M + bp.span_m + 100.0;
     if (amfi_profile_create(&pp, &w->prof, err, sizeof err)) {
         fprintf(stderr, "%s: profile: %s\n", PROG, err);
         world_free(w);
@@ -582,7 +698,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
     if (!plan || !rng || !frng)
         goto out;
     if (o->environment &&
-        amfi_site_init(&site, &cfg->bridge, recs, n_recs, o->start_utime, o->time_compression,
+        amfi_site_init(&site, &w->bp, recs, n_recs, o->start_utime, o->time_compression,
                        o->seed, err, sizeof err)) {
         fprintf(stderr, "%s: %s: %s\n", PROG, ppath, err);
         goto out;
@@ -646,7 +762,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         plan[i].lane = 1;
         if (o->flow > 0) {
             if (!i && amfi_flow_init(&fl, o->lanes, 3600.0 / o->flow, o->min_headway,
-                                     cfg->bridge.span_m, sp.approach_m, sp.approach_m + 1.0, frng, err,
+                                     w->bp.span_m, sp.approach_m, sp.approach_m + 1.0, frng, err,
                                      sizeof err)) {
                 fprintf(stderr, "%s: %s\n", PROG, err);
                 goto out;
@@ -702,7 +818,8 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             if (damaged && !stepped && next_add == o->damage_step_at)
                 break; /* switch the bridge first (next loop turn) */
             if (o->environment &&
-                site_update(&site, sim, now, damaged && !stepped ? 0.0 : o->damage, &cur,
+                site_update(&site, sim, now,
+                            world_damage(w, damaged && !stepped ? 0.0 : o->damage), &cur,
                             deck_range))
                 goto out;
             if (amfi_sim_add(sim, &plan[next_add].v, err, sizeof err)) {
@@ -722,7 +839,8 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             fprintf(stderr, "%s: damage %.3g from vehicle %ld on (t = %.1f s)\n", PROG, o->damage,
                     plan[next_add].v.id, now);
             cur = damaged;
-            if (o->environment && site_update(&site, sim, now, o->damage, &cur, deck_range))
+            if (o->environment &&
+                site_update(&site, sim, now, world_damage(w, o->damage), &cur, deck_range))
                 goto out;
             if (amfi_sim_add(sim, &plan[next_add].v, err, sizeof err)) {
                 fprintf(stderr, "%s: vehicle %ld: %s\n", PROG, plan[next_add].v.id, err);
@@ -738,8 +856,11 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             if (o->speed_err_mean != 0 || o->speed_err_std > 0)
                 speed *= 1.0 + o->speed_err_mean +
                          (o->speed_err_std > 0 ? gsl_ran_gaussian(noise, o->speed_err_std) : 0.0);
-            double spacing = p->spacing;
-            amfi_vehicle_t m = {o->start_utime + (int64_t)llround(p->entry_s * 1e6), p->v.id, p->lane,
+            /* the detector's systematic errors (--as-built; none: zero) */
+            speed *= w->det.speed_scale;
+            double spacing = p->spacing * w->det.spacing_scale;
+            const double entry = p->entry_s + w->det.clock_offset_s;
+            amfi_vehicle_t m = {o->start_utime + (int64_t)llround(entry * 1e6), p->v.id, p->lane,
                                 speed, 2, 1, &spacing, PROG, p->reference_kg};
             if (EMIT(&b, amfi_vehicle_t, cfg->daemon.ch_vehicle, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
@@ -827,6 +948,55 @@ out:
     return rc;
 }
 
+/* ---- commissioning records (--calibration-runs, --ambient-out) ------------ */
+
+/* Offline, no bus, no population: the calibration runs and/or the ambient
+ * record on the as-built bridge (ab, or the design's when NULL). 0, or 1
+ * after a message. */
+static int commissioning(const opts *o, const amfi_site_config *cfg, const amfi_as_built *ab)
+{
+    char err[512];
+    world w;
+    int rc = 1;
+    if (world_build(o, cfg, ab, &w))
+        return 1;
+    if (o->calib_dir) {
+        if (mkdir(o->calib_dir, 0777) != 0 && errno != EEXIST) {
+            fprintf(stderr, "%s: %s: cannot create: %s\n", PROG, o->calib_dir, strerror(errno));
+            goto out;
+        }
+        amfi_cal_params p = o->cal;
+        p.pre_s = o->pre;
+        p.noise_frac = o->noise;
+        p.noise_ms2 = o->noise_ms2;
+        p.speed_err_mean = o->speed_err_mean;
+        p.speed_err_std = o->speed_err_std;
+        p.track_std = o->track_std;
+        p.seed = o->seed;
+        p.det = w.det;
+        p.sensor_id = cfg->sensor_id;
+        if (amfi_cal_runs_write(o->calib_dir, w.bridge, w.prof, &w.sp, &w.dist, &p, err,
+                                sizeof err)) {
+            fprintf(stderr, "%s: calibration runs: %s\n", PROG, err);
+            goto out;
+        }
+        fprintf(stderr, "%s: %d calibration runs of %d trucks in %s\n", PROG,
+                p.n_trucks * p.runs_per_truck, p.n_trucks, o->calib_dir);
+    }
+    if (o->ambient_out) {
+        amfi_ambient_params a = {o->ambient_s, o->ambient_force_n, o->noise, o->noise_ms2,
+                                 o->seed, cfg->sensor_id};
+        if (amfi_ambient_write(o->ambient_out, w.bridge, &w.sp, &a, err, sizeof err)) {
+            fprintf(stderr, "%s: %s\n", PROG, err);
+            goto out;
+        }
+    }
+    rc = 0;
+out:
+    world_free(&w);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     opts o;
@@ -841,6 +1011,13 @@ int main(int argc, char **argv)
     amfi_set_blas_threads(1);
     char err[512];
     cfg.bridge.damage = o.damage;
+    static amfi_as_built ab; /* --as-built: large */
+    if (o.as_built && amfi_as_built_load(o.as_built, &cfg, &ab, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    if (o.calib_dir || o.ambient_out)
+        return commissioning(&o, &cfg, o.as_built ? &ab : NULL);
     char found[4096];
     const char *ppath = o.population;
     if (!ppath) {
@@ -865,7 +1042,7 @@ int main(int argc, char **argv)
         return 2;
     }
     world w;
-    if (world_build(&o, &cfg, &w)) {
+    if (world_build(&o, &cfg, o.as_built ? &ab : NULL, &w)) {
         amfi_traffic_free(recs);
         return 1;
     }
@@ -901,9 +1078,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: %s: %s\n", PROG, path, acc ? strerror(errno) : "out of memory");
         goto out;
     }
+    /* with --as-built: what the detector reported in the first columns, the
+     * design's sensor position, and the truth appended */
     fprintf(meta, "name,speed_mps,speed_true_mps,axle_spacing_m,entry_time_s,gvw_kg,axle1_kg,"
                   "axle2_kg,mean_force1_N,mean_force2_N,damage,noise,profile,track,"
-                  "preceding_gap_s,lost_contact_steps,scan_rate_hz,sensor_x_m\n");
+                  "preceding_gap_s,lost_contact_steps,scan_rate_hz,sensor_x_m%s\n",
+            w.as_built ? ",entry_time_true_s,axle_spacing_true_m,sensor_x_true_m" : "");
     for (long i = 0; i < o.vehicles; i++) {
         const amfi_vehicle_rec *rec = &recs[o.first + i];
         amfi_passage_spec spec;
@@ -953,13 +1133,19 @@ int main(int argc, char **argv)
             fprintf(stderr, "%s: %s: write failed\n", PROG, path);
             goto out;
         }
-        fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,%g\n",
-                name, pr.speed_measured_mps, spec.speed_mps, spec.car.D1_m + spec.car.D2_m,
-                -pr.t_first_s, rec->axle_kg[0] + rec->axle_kg[1], rec->axle_kg[0],
-                rec->axle_kg[1], pr.truth.mean_force_N[0], pr.truth.mean_force_N[1], o.damage,
-                o.noise, o.profile_class ? (char[]){o.profile_class, 0} : "smooth", spec.track,
-                gap, pr.truth.lost_contact_steps[0] + pr.truth.lost_contact_steps[1],
-                o.scan_rate, sp.sensor_x_m[0]);
+        const double spacing = spec.car.D1_m + spec.car.D2_m;
+        fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,%g",
+                name, pr.speed_measured_mps * w.det.speed_scale, spec.speed_mps,
+                spacing * w.det.spacing_scale,
+                -pr.t_first_s + w.det.clock_offset_s, rec->axle_kg[0] + rec->axle_kg[1],
+                rec->axle_kg[0], rec->axle_kg[1], pr.truth.mean_force_N[0],
+                pr.truth.mean_force_N[1], o.damage, o.noise,
+                o.profile_class ? (char[]){o.profile_class, 0} : "smooth", spec.track, gap,
+                pr.truth.lost_contact_steps[0] + pr.truth.lost_contact_steps[1], o.scan_rate,
+                cfg.solver.sensor_x_m[0]);
+        if (w.as_built)
+            fprintf(meta, ",%.6f,%.9g,%g", -pr.t_first_s, spacing, sp.sensor_x_m[0]);
+        fputc('\n', meta);
     }
     if (fclose(meta) != 0) {
         meta = NULL;

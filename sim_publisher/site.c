@@ -95,6 +95,9 @@ const amfi_bridge *amfi_site_bridge_at(amfi_site *s, double t_s, double damage, 
     }
     amfi_bridge_params bp = s->bp;
     bp.E_pa = s->bp.E_pa * (double)key * AMFI_SITE_MODULUS_STEP;
+    /* the segments' own E·I follow the same modulus */
+    for (int i = 0; i < bp.n_segments; i++)
+        bp.segments[i].EI_nm2 = s->bp.segments[i].EI_nm2 * (double)key * AMFI_SITE_MODULUS_STEP;
     bp.damage = damage;
     amfi_site_bridge *e = &s->bridges[s->n_bridges];
     if (amfi_bridge_create(&bp, &e->b, err, errlen))

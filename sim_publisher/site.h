@@ -3,7 +3,8 @@
  * site.h: simulation.environment: site for a streaming run: the site
  * climate (environment.h) on the stream's data clock, the drifting mix
  * (mix.h) choosing each vehicle's population record, and the bridges of
- * the temperature-scaled moduli, built on demand and kept until the run
+ * the temperature-scaled moduli (the segments' own E·I scaled alike), built
+ * on demand and kept until the run
  * ends (amfi_sim_set_bridge needs the bridge to outlive the simulation).
  *
  * Owned and used by sim_publisher's main thread only.
