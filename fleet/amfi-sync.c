@@ -399,6 +399,40 @@ static int check_backwards(PGconn *pg, sqlite3 *db, const char *site)
     return 0;
 }
 
+/* The store is read as a file from elsewhere: SQLite's defensive mode, an
+ * untrusted schema (views and triggers may call only innocuous functions),
+ * no extension loading, triggers and views off (amfi-sync reads tables
+ * only), query_only; every setting read back. A store holding a trigger or
+ * a view in place of a table shipped fails on the first read of it. */
+static int store_harden(sqlite3 *db, const char *store)
+{
+    static const struct {
+        int op, want;
+        const char *name;
+    } set[] = {
+        {SQLITE_DBCONFIG_DEFENSIVE, 1, "SQLITE_DBCONFIG_DEFENSIVE"},
+        {SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, "SQLITE_DBCONFIG_TRUSTED_SCHEMA"},
+        {SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0, "SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION"},
+        {SQLITE_DBCONFIG_ENABLE_TRIGGER, 0, "SQLITE_DBCONFIG_ENABLE_TRIGGER"},
+        {SQLITE_DBCONFIG_ENABLE_VIEW, 0, "SQLITE_DBCONFIG_ENABLE_VIEW"},
+    };
+    for (size_t k = 0; k < sizeof set / sizeof set[0]; k++) {
+        int got = -1;
+        if (sqlite3_db_config(db, set[k].op, set[k].want, &got) != SQLITE_OK || got != set[k].want) {
+            fprintf(stderr, "amfi-sync: %s: cannot set %s to %d (SQLite %s)\n", store, set[k].name,
+                    set[k].want, sqlite3_libversion());
+            return -1;
+        }
+    }
+    char *emsg = NULL;
+    if (sqlite3_exec(db, "PRAGMA query_only = ON", NULL, NULL, &emsg) != SQLITE_OK) {
+        fprintf(stderr, "amfi-sync: %s: PRAGMA query_only: %s\n", store, emsg ? emsg : "failed");
+        sqlite3_free(emsg);
+        return -1;
+    }
+    return 0;
+}
+
 static int store_site_id(sqlite3 *db, char out[SITE_ID_MAX + 1])
 {
     sqlite3_stmt *st = NULL;
@@ -442,6 +476,11 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         return EX_RETRY;
     }
     sqlite3_busy_timeout(db, 5000);
+    if (store_harden(db, store) != 0) {
+        sqlite3_close(db);
+        PQfinish(pg);
+        return EX_REFUSED;
+    }
     /* The columns shipped are those of the current store schema; amfid
      * migrates an older store when it starts (read-only here, amfi-sync
      * cannot). Retried: follow mode goes on once amfid has run. */

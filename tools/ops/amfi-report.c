@@ -640,7 +640,7 @@ static int set_baseline(const options *o)
     char err[512];
     int rc = 0, n = 0;
     memset(&b, 0, sizeof b);
-    if (amfi_store_open(o->db, 1, &s, err, sizeof err) != 0) {
+    if (amfi_store_open_foreign(o->db, 1, &s, err, sizeof err) != 0) {
         fprintf(stderr, PROG ": %s\n", err); /* starts with the path */
         return -1;
     }
