@@ -433,6 +433,42 @@ static int store_harden(sqlite3 *db, const char *store)
     return 0;
 }
 
+/* Every table shipped (and meta) must be a table of the file, not a view
+ * or a virtual table put in its place: refused (exit 3) naming it. */
+static int store_tables_real(sqlite3 *db, const char *store)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(db, "SELECT type, coalesce(sql, '') FROM sqlite_schema WHERE name = ?1",
+                           -1, &st, NULL) != SQLITE_OK) {
+        fprintf(stderr, "amfi-sync: %s: reading the schema: %s\n", store, sqlite3_errmsg(db));
+        return -1;
+    }
+    int bad = 0;
+    for (int i = -1; !bad && i < 2 * fleet_n_tables; i++) {
+        const char *name = i < 0 ? "meta" : i % 2 ? fleet_tables[i / 2].child : fleet_tables[i / 2].name;
+        if (!name)
+            continue;
+        sqlite3_reset(st);
+        sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
+        int src = sqlite3_step(st);
+        const char *type = src == SQLITE_ROW ? (const char *)sqlite3_column_text(st, 0) : NULL;
+        const char *sql = src == SQLITE_ROW ? (const char *)sqlite3_column_text(st, 1) : "";
+        if (src == SQLITE_ROW && type && strcmp(type, "table") == 0
+            && strncmp(sql, "CREATE VIRTUAL", 14) != 0)
+            continue;
+        if (src != SQLITE_ROW && src != SQLITE_DONE)
+            fprintf(stderr, "amfi-sync: %s: reading the schema: %s\n", store, sqlite3_errmsg(db));
+        else
+            fprintf(stderr, "amfi-sync: refused: store %s: '%s' is %s, not a table: not an amfi "
+                            "store (nothing shipped)\n", store, name,
+                    src == SQLITE_DONE ? "missing" : type && strcmp(type, "table") ? type
+                                                                                 : "a virtual table");
+        bad = 1;
+    }
+    sqlite3_finalize(st);
+    return bad ? -1 : 0;
+}
+
 static int store_site_id(sqlite3 *db, char out[SITE_ID_MAX + 1])
 {
     sqlite3_stmt *st = NULL;
@@ -497,6 +533,10 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         sqlite3_close(db);
         PQfinish(pg);
         return EX_RETRY;
+    }
+    if (store_tables_real(db, store) != 0) {
+        rc = EX_REFUSED;
+        goto out;
     }
     char site[SITE_ID_MAX + 1] = "";
     if (!store_site_id(db, site)) {
