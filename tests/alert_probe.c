@@ -7,9 +7,10 @@
  *   sigign HEX         SigIgn of /proc/self/status
  *   sigblk HEX         SigBlk
  *   pid PID pgrp PGRP
- * With AMFI_ALERT_KIND=hang it then starts a grandchild, writes
- * "grandchild PID" and both sleep 600 s (the grandchild ignores SIGTERM:
- * only a SIGKILL of the group ends it); with any other kind it exits 0.
+ * With AMFI_ALERT_KIND=hang, or when the file $AMFI_DB.hang exists, it then
+ * starts a grandchild, writes "grandchild PID" and both sleep 600 s (the
+ * grandchild ignores SIGTERM: only a SIGKILL of the group ends it);
+ * otherwise it exits 0.
  */
 #define _GNU_SOURCE
 #include <dirent.h>
@@ -62,7 +63,9 @@ int main(void)
     status_line(out, "SigIgn:", "sigign");
     status_line(out, "SigBlk:", "sigblk");
     fprintf(out, "pid %ld pgrp %ld\n", (long)getpid(), (long)getpgrp());
-    if (strcmp(kind, "hang") != 0)
+    char hang[4200];
+    snprintf(hang, sizeof hang, "%s.hang", db);
+    if (strcmp(kind, "hang") != 0 && access(hang, F_OK) != 0)
         return fclose(out) == 0 ? 0 : 5;
     fflush(out);
     pid_t g = fork();
