@@ -187,8 +187,12 @@ static void ended(daemon_s *d, int i, int status)
     const char *cmd = d->cfg.daemon.alert_command;
     if (ns->term_sent[i]) {
         ns->timeouts++;
-        LOG_ERR("alert notice: %s killed after %.0f s (alerts.command_timeout_s)", cmd,
-                d->cfg.daemon.alert_timeout_s);
+        if (ns->stopping)
+            LOG_ERR("alert notice: %s killed at stop after %.0f s "
+                    "(alerts.command_stop_wait_s)", cmd, d->cfg.daemon.alert_stop_wait_s);
+        else
+            LOG_ERR("alert notice: %s killed after %.0f s (alerts.command_timeout_s)", cmd,
+                    d->cfg.daemon.alert_timeout_s);
     } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
         ns->ok++;
     } else {
@@ -270,6 +274,7 @@ void notify_finish(daemon_s *d)
         return;
     LOG_ERR("alert notice: stopping: %d notice(s) still running after %.0f s "
             "(alerts.command_stop_wait_s), killed", ns->running, wait);
+    ns->stopping = 1;
     for (int i = 0; i < NOTIFY_MAX_RUNNING; i++)
         if (ns->pid[i] > 0 && !ns->term_sent[i]) {
             kill_group(ns->pid[i], SIGTERM);

@@ -186,9 +186,10 @@ static int gp_dir(const char *dir, char *out, size_t len, char *err, size_t errl
     size_t k = 0;
     for (const char *p = dir; *p; p++) {
         if ((unsigned char)*p < 0x20 || *p == 0x7f)
-            return fail(err, errlen, "%s: the directory name holds a control character", dir);
+            return fail(err, errlen, "the directory name holds a control character (0x%02x at "
+                        "byte %zu)", (unsigned)(unsigned char)*p, (size_t)(p - dir));
         if (k + 3 >= len)
-            return fail(err, errlen, "%.80s...: directory name too long", dir);
+            return fail(err, errlen, "the directory name is too long (%zu bytes)", strlen(dir));
         if (*p == '\'')
             out[k++] = '\'';
         out[k++] = *p;
