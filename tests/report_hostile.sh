@@ -117,7 +117,7 @@ canary_empty() {
 # ---- --plot: hostile site names ----------------------------------------------
 # sql_str TEXT: TEXT as an SQL string literal
 sql_str() { printf "'%s'" "$(printf '%s' "$1" | sed "s/'/''/g")"; }
-long=$(printf '%0200d' 0 | tr 0 A)
+long=$(printf '%04000d' 0 | tr 0 A)
 if command -v gnuplot > /dev/null; then
     k=0
     # the site names, one SQL expression a line

@@ -890,7 +890,7 @@ static int run_section(int (*fn)(amfi_store *), amfi_store *s, int *printed)
  * the indicator defaults. */
 static int plot(const options *o, const amfi_site_config *c, amfi_store *s)
 {
-    char site[256], err[1024];
+    char site[4097], err[1024]; /* meta values hold at most 4096 bytes */
     int found = 0;
     amfi_indicator_params ip;
     amfi_indicator_params_default(&ip);
