@@ -114,6 +114,7 @@ void amfi_config_defaults(amfi_site_config *c)
     d->status_period_s = 1.0;
     d->alert_timeout_s = 30.0;
     d->alert_max_running = 4;
+    d->alert_stop_wait_s = 10.0;
     d->metrics_interval_s = 15.0;
     /* EU Directive 96/53/EC, Annex I: 40 t for a vehicle combination
      * (2.2.2), 11.5 t for a driving axle (3.2); the site may set its own. */

@@ -76,6 +76,8 @@ typedef struct amfi_daemon_config {
                                  "" none */
     double alert_timeout_s;   /* alerts.command_timeout_s: killed after, (0, 3600] */
     int alert_max_running;    /* alerts.command_max_running: at once, 1 .. 64 */
+    double alert_stop_wait_s; /* alerts.command_stop_wait_s: at stop, notices running or
+                                 waiting get this long, then are killed, [0, 30] */
     char metrics_path[512];   /* metrics.textfile: Prometheus text file; "" off */
     double metrics_interval_s; /* metrics.interval_s: rewritten every, [1, 3600] */
     /* alerts.speed_drift.*: the speed-drift alert's parameters (speed_drift.h,

@@ -81,6 +81,8 @@ const field alerts_fields[] = {
      .hi = 3600, .flags = F_LO_OPEN},
     {.key = "command_max_running", .kind = &K_INT, .off = OPS(alert_max_running), .lo = 1,
      .hi = 64},
+    {.key = "command_stop_wait_s", .kind = &K_DOUBLE, .off = OPS(alert_stop_wait_s), .lo = 0,
+     .hi = 30},
     {.key = "speed_drift", .kind = &K_MAP, .aux = speed_drift_fields},
     {.key = "scale", .kind = &K_MAP, .aux = scale_fields},
     {.key = "known_truck", .kind = &K_MAP, .aux = known_truck_fields},

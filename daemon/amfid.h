@@ -116,7 +116,8 @@ struct notice;
 typedef struct notify_state {
     int pid[NOTIFY_MAX_RUNNING];        /* running children, 0: free slot */
     double started[NOTIFY_MAX_RUNNING]; /* amfi_mono_s() at spawn */
-    int term_sent[NOTIFY_MAX_RUNNING];  /* SIGTERM sent (timed out) */
+    int term_sent[NOTIFY_MAX_RUNNING];  /* SIGTERM sent (timed out, or amfid stopping) */
+    int stopping;                       /* notify_finish gave up waiting: killed at stop */
     int running;
     struct notice *queue[NOTIFY_QUEUE];
     int qhead, queued;

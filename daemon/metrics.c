@@ -7,14 +7,16 @@
  * received, queue depth, held and lost passages, solve times (a histogram
  * and the quantiles of the newest 1024), the newest indicator values, open
  * alerts by kind, notices, uptime and the build. The file is written whole
- * to a temporary file in the same folder, synced and renamed over the old
- * one, so a reader never sees half of it; a failed write is logged once
+ * to a new temporary file in the same folder (mkostemp: never a file or
+ * symlink already there), synced and renamed over the old one, so a reader
+ * never sees half of it; a failed write is logged once
  * (until a write succeeds again) and counted.
  *
  * Thread: the main thread only; the counters it reads are the main thread's.
  */
 #define _GNU_SOURCE
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -232,16 +234,28 @@ void metrics_tick(daemon_s *d, int force)
     if (!force && m->last_write > 0 && now - m->last_write < d->cfg.daemon.metrics_interval_s)
         return;
     m->last_write = now;
+    /* A new file of a name nobody can guess, in the same folder (the
+     * rename stays atomic): mkostemp opens it O_CREAT|O_EXCL, mode 0600, so a
+     * file or symlink planted there is never followed nor truncated. */
     char tmp[sizeof d->cfg.daemon.metrics_path + 32];
-    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
-    FILE *f = fopen(tmp, "w");
-    int e = f ? 0 : (errno ? errno : EIO); /* the first failure's errno */
+    snprintf(tmp, sizeof tmp, "%s.tmp.XXXXXX", path);
+    int fd = mkostemp(tmp, O_CLOEXEC);
+    FILE *f = NULL;
+    int e = 0; /* the first failure's errno */
+    if (fd < 0) {
+        e = errno ? errno : EIO;
+    } else if (!(f = fdopen(fd, "w"))) {
+        e = errno ? errno : EIO;
+        close(fd);
+        unlink(tmp);
+    }
     if (f) {
         /* node-exporter runs as another user (prometheus); the unit's
          * UMask=0027 would hide the file from it */
-        fchmod(fileno(f), 0644);
+        if (fchmod(fd, 0644) != 0)
+            e = errno ? errno : EIO;
         write_all(d, f);
-        if (fflush(f) != 0 || fsync(fileno(f)) != 0)
+        if ((fflush(f) != 0 || fsync(fileno(f)) != 0) && !e)
             e = errno ? errno : EIO;
         if (fclose(f) != 0 && !e)
             e = errno ? errno : EIO;

@@ -5,8 +5,13 @@
  * alert in its environment, never blocking the pipeline: posix_spawn without
  * a shell, at most alerts.command_max_running at once, the rest queued (256,
  * beyond: dropped and counted), children reaped from the loop with waitpid
- * (WNOHANG), SIGTERM at alerts.command_timeout_s and SIGKILL 5 s later; every
- * failure (exit status, signal, timeout, spawn error) logged and counted.
+ * (WNOHANG), SIGTERM to the child's process group at
+ * alerts.command_timeout_s and SIGKILL to the group 5 s later; every failure
+ * (exit status, signal, timeout, spawn error) logged and counted. The child
+ * inherits nothing of amfid's but stdout and stderr: descriptors 3 and up
+ * closed (the bus's sockets and pipes), every signal at its default (amfid
+ * ignores SIGPIPE), an empty mask, a process group of its own. At stop,
+ * notify_finish gives the notices alerts.command_stop_wait_s, then kills.
  *
  * Thread: the main thread only (the pipeline raises alerts there; the loop
  * calls notify_tick). Owns the queued environments and the child table.
@@ -21,10 +26,12 @@
 #include <string.h>
 #include <sys/wait.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "amfid.h"
 
 #define KILL_AFTER_S 5.0 /* SIGKILL this long after SIGTERM */
+#define STOP_KILL_AFTER_S 2.0 /* at stop: SIGKILL this long after SIGTERM */
 
 struct notice {
     char *envp[16];
@@ -48,18 +55,62 @@ static void put_env(struct notice *n, int *k, size_t *used, const char *name, co
     *used += (size_t)w + 1;
 }
 
+#if !(defined(__GLIBC__) && __GLIBC_PREREQ(2, 34))
+/* Without posix_spawn_file_actions_addclosefrom_np: every descriptor from 3
+ * up marked close-on-exec in amfid itself (amfid execs nothing else). */
+static void cloexec_from_3(void)
+{
+    long max = sysconf(_SC_OPEN_MAX);
+    for (int fd = 3; fd < (max > 0 && max < 65536 ? max : 65536); fd++) {
+        int fl = fcntl(fd, F_GETFD);
+        if (fl >= 0 && !(fl & FD_CLOEXEC))
+            fcntl(fd, F_SETFD, fl | FD_CLOEXEC);
+    }
+}
+#endif
+
+/* Signal a notice's whole process group (it is the group's leader, not
+ * reaped yet or its group still holds the id: never another process). */
+static void kill_group(pid_t pid, int sig)
+{
+    if (kill(-pid, sig) != 0 && errno != ESRCH)
+        kill(pid, sig);
+}
+
 static int start_child(daemon_s *d, struct notice *n)
 {
     notify_state *ns = &d->notify;
     char *argv[] = {d->cfg.daemon.alert_command, NULL};
     posix_spawn_file_actions_t fa;
+    posix_spawnattr_t at;
+    sigset_t all, none;
     pid_t pid;
     int rc;
 
+    sigfillset(&all);
+    sigemptyset(&none);
     posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    rc = posix_spawn(&pid, argv[0], &fa, NULL, argv, n->envp);
+    posix_spawnattr_init(&at);
+    rc = posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+#if defined(__GLIBC__) && __GLIBC_PREREQ(2, 34)
+    if (rc == 0)
+        rc = posix_spawn_file_actions_addclosefrom_np(&fa, 3);
+#else
+    cloexec_from_3();
+#endif
+    if (rc == 0)
+        rc = posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK
+                                               | POSIX_SPAWN_SETPGROUP);
+    if (rc == 0)
+        rc = posix_spawnattr_setsigdefault(&at, &all);
+    if (rc == 0)
+        rc = posix_spawnattr_setsigmask(&at, &none);
+    if (rc == 0)
+        rc = posix_spawnattr_setpgroup(&at, 0);
+    if (rc == 0)
+        rc = posix_spawn(&pid, argv[0], &fa, &at, argv, n->envp);
     posix_spawn_file_actions_destroy(&fa);
+    posix_spawnattr_destroy(&at);
     if (rc != 0) {
         ns->failed++;
         LOG_ERR("alert notice: cannot run %s: %s", argv[0], strerror(rc));
@@ -136,8 +187,12 @@ static void ended(daemon_s *d, int i, int status)
     const char *cmd = d->cfg.daemon.alert_command;
     if (ns->term_sent[i]) {
         ns->timeouts++;
-        LOG_ERR("alert notice: %s killed after %.0f s (alerts.command_timeout_s)", cmd,
-                d->cfg.daemon.alert_timeout_s);
+        if (ns->stopping)
+            LOG_ERR("alert notice: %s killed at stop after %.0f s "
+                    "(alerts.command_stop_wait_s)", cmd, d->cfg.daemon.alert_stop_wait_s);
+        else
+            LOG_ERR("alert notice: %s killed after %.0f s (alerts.command_timeout_s)", cmd,
+                    d->cfg.daemon.alert_timeout_s);
     } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
         ns->ok++;
     } else {
@@ -164,15 +219,19 @@ void notify_tick(daemon_s *d)
         int status = 0;
         pid_t r = waitpid(ns->pid[i], &status, WNOHANG);
         if (r == ns->pid[i] || (r < 0 && errno == ECHILD)) {
+            /* a notice killed at its timeout: what it started goes too,
+             * had it caught or ignored the SIGTERM */
+            if (ns->term_sent[i])
+                kill_group(ns->pid[i], SIGKILL);
             ended(d, i, status);
             continue;
         }
         double age = now - ns->started[i];
         if (!ns->term_sent[i] && age > d->cfg.daemon.alert_timeout_s) {
-            kill(ns->pid[i], SIGTERM);
+            kill_group(ns->pid[i], SIGTERM);
             ns->term_sent[i] = 1;
         } else if (ns->term_sent[i] && age > d->cfg.daemon.alert_timeout_s + KILL_AFTER_S) {
-            kill(ns->pid[i], SIGKILL);
+            kill_group(ns->pid[i], SIGKILL);
         }
     }
     while (ns->queued > 0 && ns->running < d->cfg.daemon.alert_max_running) {
@@ -185,16 +244,52 @@ void notify_tick(daemon_s *d)
     }
 }
 
+/* At stop: the notices running, and the queued ones as slots free up, get
+ * alerts.command_stop_wait_s; then SIGTERM to every group still running,
+ * SIGKILL STOP_KILL_AFTER_S later, and the notices never started are
+ * dropped and counted. Bounded: stop_wait + STOP_KILL_AFTER_S + 1 s. */
 void notify_finish(daemon_s *d)
 {
     notify_state *ns = &d->notify;
     if (ns->running == 0 && ns->queued == 0)
         return;
-    LOG_INFO("waiting for %d alert notice(s) (%d queued), at most %.0f s", ns->running,
-             ns->queued, d->cfg.daemon.alert_timeout_s + KILL_AFTER_S);
-    while (ns->running > 0 || ns->queued > 0) {
+    double wait = d->cfg.daemon.alert_stop_wait_s, t0 = amfi_mono_s();
+    LOG_INFO("waiting for %d alert notice(s) (%d queued), at most %.0f s "
+             "(alerts.command_stop_wait_s)", ns->running, ns->queued, wait);
+    struct timespec ts = {0, 20000000};
+    while ((ns->running > 0 || ns->queued > 0) && amfi_mono_s() - t0 < wait) {
         notify_tick(d);
-        struct timespec ts = {0, 20000000};
+        nanosleep(&ts, NULL);
+    }
+    if (ns->queued > 0) {
+        LOG_ERR("alert notice: stopping: %d notice(s) not started, dropped", ns->queued);
+        ns->dropped += ns->queued;
+        for (; ns->queued > 0; ns->queued--) {
+            free(ns->queue[ns->qhead]);
+            ns->queue[ns->qhead] = NULL;
+            ns->qhead = (ns->qhead + 1) % NOTIFY_QUEUE;
+        }
+    }
+    if (ns->running == 0)
+        return;
+    LOG_ERR("alert notice: stopping: %d notice(s) still running after %.0f s "
+            "(alerts.command_stop_wait_s), killed", ns->running, wait);
+    ns->stopping = 1;
+    for (int i = 0; i < NOTIFY_MAX_RUNNING; i++)
+        if (ns->pid[i] > 0 && !ns->term_sent[i]) {
+            kill_group(ns->pid[i], SIGTERM);
+            ns->term_sent[i] = 1;
+        }
+    double t1 = amfi_mono_s();
+    int killed = 0;
+    while (ns->running > 0 && amfi_mono_s() - t1 < STOP_KILL_AFTER_S + 1.0) {
+        if (!killed && amfi_mono_s() - t1 >= STOP_KILL_AFTER_S) {
+            for (int i = 0; i < NOTIFY_MAX_RUNNING; i++)
+                if (ns->pid[i] > 0)
+                    kill_group(ns->pid[i], SIGKILL);
+            killed = 1;
+        }
+        notify_tick(d);
         nanosleep(&ts, NULL);
     }
 }
@@ -209,8 +304,8 @@ void notify_free(daemon_s *d)
     }
     for (int i = 0; i < NOTIFY_MAX_RUNNING; i++)
         if (ns->pid[i] > 0) {
-            kill(ns->pid[i], SIGKILL);
-            waitpid(ns->pid[i], NULL, 0);
+            kill_group(ns->pid[i], SIGKILL);
+            waitpid(ns->pid[i], NULL, WNOHANG); /* never blocks: init reaps it */
             ns->pid[i] = 0;
         }
     ns->running = 0;

@@ -453,6 +453,76 @@ static int check_backwards(PGconn *pg, sqlite3 *db, const char *site)
     return 0;
 }
 
+/* The store is read as a file from elsewhere: SQLite's defensive mode, an
+ * untrusted schema (views and triggers may call only innocuous functions),
+ * no extension loading, triggers and views off (amfi-sync reads tables
+ * only), query_only; every setting read back. A store holding a trigger or
+ * a view in place of a table shipped fails on the first read of it. */
+static int store_harden(sqlite3 *db, const char *store)
+{
+    static const struct {
+        int op, want;
+        const char *name;
+    } set[] = {
+        {SQLITE_DBCONFIG_DEFENSIVE, 1, "SQLITE_DBCONFIG_DEFENSIVE"},
+        {SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, "SQLITE_DBCONFIG_TRUSTED_SCHEMA"},
+        {SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0, "SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION"},
+        {SQLITE_DBCONFIG_ENABLE_TRIGGER, 0, "SQLITE_DBCONFIG_ENABLE_TRIGGER"},
+        {SQLITE_DBCONFIG_ENABLE_VIEW, 0, "SQLITE_DBCONFIG_ENABLE_VIEW"},
+    };
+    for (size_t k = 0; k < sizeof set / sizeof set[0]; k++) {
+        int got = -1;
+        if (sqlite3_db_config(db, set[k].op, set[k].want, &got) != SQLITE_OK || got != set[k].want) {
+            fprintf(stderr, "amfi-sync: %s: cannot set %s to %d (SQLite %s)\n", store, set[k].name,
+                    set[k].want, sqlite3_libversion());
+            return -1;
+        }
+    }
+    char *emsg = NULL;
+    if (sqlite3_exec(db, "PRAGMA query_only = ON", NULL, NULL, &emsg) != SQLITE_OK) {
+        fprintf(stderr, "amfi-sync: %s: PRAGMA query_only: %s\n", store, emsg ? emsg : "failed");
+        sqlite3_free(emsg);
+        return -1;
+    }
+    return 0;
+}
+
+/* Every table shipped (and meta) must be a table of the file, not a view
+ * or a virtual table put in its place: refused (exit 3) naming it. */
+static int store_tables_real(sqlite3 *db, const char *store)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(db, "SELECT type, coalesce(sql, '') FROM sqlite_schema WHERE name = ?1",
+                           -1, &st, NULL) != SQLITE_OK) {
+        fprintf(stderr, "amfi-sync: %s: reading the schema: %s\n", store, sqlite3_errmsg(db));
+        return -1;
+    }
+    int bad = 0;
+    for (int i = -1; !bad && i < 2 * fleet_n_tables; i++) {
+        const char *name = i < 0 ? "meta" : i % 2 ? fleet_tables[i / 2].child : fleet_tables[i / 2].name;
+        if (!name)
+            continue;
+        sqlite3_reset(st);
+        sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
+        int src = sqlite3_step(st);
+        const char *type = src == SQLITE_ROW ? (const char *)sqlite3_column_text(st, 0) : NULL;
+        const char *sql = src == SQLITE_ROW ? (const char *)sqlite3_column_text(st, 1) : "";
+        if (src == SQLITE_ROW && type && strcmp(type, "table") == 0
+            && strncmp(sql, "CREATE VIRTUAL", 14) != 0)
+            continue;
+        if (src != SQLITE_ROW && src != SQLITE_DONE)
+            fprintf(stderr, "amfi-sync: %s: reading the schema: %s\n", store, sqlite3_errmsg(db));
+        else
+            fprintf(stderr, "amfi-sync: refused: store %s: '%s' is %s, not a table: not an amfi "
+                            "store (nothing shipped)\n", store, name,
+                    src == SQLITE_DONE ? "missing" : type && strcmp(type, "table") ? type
+                                                                                 : "a virtual table");
+        bad = 1;
+    }
+    sqlite3_finalize(st);
+    return bad ? -1 : 0;
+}
+
 static int store_site_id(sqlite3 *db, char out[SITE_ID_MAX + 1])
 {
     sqlite3_stmt *st = NULL;
@@ -560,6 +630,11 @@ static int open_store(const char *store, sqlite3 **db, int *store_version)
             return EX_RETRY;
         }
         sqlite3_busy_timeout(*db, 5000);
+        if (store_harden(*db, store) != 0) {
+            sqlite3_close(*db);
+            *db = NULL;
+            return EX_REFUSED;
+        }
         sqlite3_stmt *uv = NULL;
         int ok = sqlite3_prepare_v2(*db, "PRAGMA user_version", -1, &uv, NULL) == SQLITE_OK
                  && sqlite3_step(uv) == SQLITE_ROW;
@@ -619,6 +694,10 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         sqlite3_close(db);
         PQfinish(pg);
         return EX_RETRY;
+    }
+    if (store_tables_real(db, store) != 0) {
+        rc = EX_REFUSED;
+        goto out;
     }
     char site[SITE_ID_MAX + 1] = "";
     if (!store_site_id(db, site)) {

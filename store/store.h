@@ -94,13 +94,23 @@ typedef struct amfi_store amfi_store; /* opaque */
  * knows, or one that is not an amfi store (other application_id, or
  * user_version 0 with tables in it). A file that is not SQLite gives
  * AMFI_STORE_ECORRUPT. On success *out is the handle (close it with
- * amfi_store_close); on failure *out is NULL. */
+ * amfi_store_close); on failure *out is NULL. Every connection is in
+ * SQLite's defensive mode (SQLITE_DBCONFIG_DEFENSIVE) with an untrusted
+ * schema (SQLITE_DBCONFIG_TRUSTED_SCHEMA off: the file's views may call
+ * only innocuous functions) and no extension loading. */
 int amfi_store_open(const char *path, int sync_full, amfi_store **out,
                     char *err, size_t errlen);
 
+/* The same for a store this process did not write (amfi-report
+ * --set-baseline): triggers are off too (SQLITE_DBCONFIG_ENABLE_TRIGGER),
+ * and a file holding a trigger is refused with AMFI_STORE_ESCHEMA. */
+int amfi_store_open_foreign(const char *path, int sync_full, amfi_store **out, char *err,
+                            size_t errlen);
+
 /* The same, read-only (SQLITE_OPEN_READONLY, query_only), for reports: the
  * file must exist and already be at AMFI_STORE_SCHEMA_VERSION (nothing is
- * created or migrated). The add/set functions then fail with
+ * created or migrated); triggers off and a file holding one refused, as
+ * amfi_store_open_foreign. The add/set functions then fail with
  * AMFI_STORE_EDB. */
 int amfi_store_open_readonly(const char *path, amfi_store **out, char *err,
                              size_t errlen);

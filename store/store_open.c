@@ -295,7 +295,52 @@ static int migrate(amfi_store *s, char *err, size_t errlen)
     return rc;
 }
 
-static int open_store(const char *path, int readonly, int sync_full,
+/* The connection's defences, before anything is read from the file:
+ * defensive mode (no writable_schema, no journal_mode OFF, no writes that
+ * could corrupt the file), an untrusted schema (a view or trigger in the
+ * file may only call functions SQLite marks innocuous, so no
+ * load_extension, fts3_tokenizer or the like), no extension loading.
+ * `foreign` (a store this process did not write: amfi-report's readers and
+ * its --set-baseline): triggers off too, an amfi store has none. Each
+ * setting is read back: an SQLite that ignores one is refused. */
+static int harden(amfi_store *s, int foreign, char *err, size_t errlen)
+{
+    static const struct {
+        int op, want;
+        const char *name;
+    } set[] = {
+        {SQLITE_DBCONFIG_DEFENSIVE, 1, "SQLITE_DBCONFIG_DEFENSIVE"},
+        {SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, "SQLITE_DBCONFIG_TRUSTED_SCHEMA"},
+        {SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0, "SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION"},
+        {SQLITE_DBCONFIG_ENABLE_TRIGGER, 0, "SQLITE_DBCONFIG_ENABLE_TRIGGER"},
+    };
+    for (size_t k = 0; k < sizeof set / sizeof set[0]; k++) {
+        if (set[k].op == SQLITE_DBCONFIG_ENABLE_TRIGGER && !foreign)
+            continue;
+        int got = -1;
+        int src = sqlite3_db_config(s->db, set[k].op, set[k].want, &got);
+        if (src != SQLITE_OK || got != set[k].want)
+            return st_fail(err, errlen, AMFI_STORE_EDB, "%s: cannot set %s to %d (SQLite %s)",
+                           s->path, set[k].name, set[k].want, sqlite3_libversion());
+    }
+    return 0;
+}
+
+/* A store from elsewhere holding a trigger is refused: amfi's schema has
+ * none, and one would run on the rows this program writes. */
+static int no_trigger(amfi_store *s, char *err, size_t errlen)
+{
+    char name[128] = "", ex[48];
+    int rc = st_one_off(s, "SELECT name FROM sqlite_schema WHERE type = 'trigger' LIMIT 1",
+                        s->path, NULL, name, sizeof name, err, errlen);
+    if (rc == 0 && name[0])
+        rc = st_fail(err, errlen, AMFI_STORE_ESCHEMA,
+                     "%s: not an amfi store: it holds trigger '%s' (amfi's schema has none; "
+                     "the file was not changed)", s->path, st_excerpt(name, ex));
+    return rc;
+}
+
+static int open_store(const char *path, int readonly, int foreign, int sync_full,
                       amfi_store **out, char *err, size_t errlen)
 {
     amfi_store *s = NULL;
@@ -330,8 +375,12 @@ static int open_store(const char *path, int readonly, int sync_full,
     if (rc == 0) {
         sqlite3_extended_result_codes(s->db, 1);
         sqlite3_busy_timeout(s->db, AMFI_STORE_BUSY_TIMEOUT_MS);
-        rc = check_identity(s, &version, err, errlen);
+        rc = harden(s, foreign, err, errlen);
     }
+    if (rc == 0)
+        rc = check_identity(s, &version, err, errlen);
+    if (rc == 0 && foreign)
+        rc = no_trigger(s, err, errlen);
     if (rc == 0 && readonly && version != AMFI_STORE_SCHEMA_VERSION)
         rc = st_fail(err, errlen, AMFI_STORE_ESCHEMA,
                   version == 0
@@ -385,11 +434,17 @@ static int open_store(const char *path, int readonly, int sync_full,
 int amfi_store_open(const char *path, int sync_full, amfi_store **out,
                     char *err, size_t errlen)
 {
-    return open_store(path, 0, sync_full, out, err, errlen);
+    return open_store(path, 0, 0, sync_full, out, err, errlen);
+}
+
+int amfi_store_open_foreign(const char *path, int sync_full, amfi_store **out, char *err,
+                            size_t errlen)
+{
+    return open_store(path, 0, 1, sync_full, out, err, errlen);
 }
 
 int amfi_store_open_readonly(const char *path, amfi_store **out, char *err,
                              size_t errlen)
 {
-    return open_store(path, 1, 0, out, err, errlen);
+    return open_store(path, 1, 1, 0, out, err, errlen);
 }

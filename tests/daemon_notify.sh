@@ -17,7 +17,13 @@
 #  6. A metrics file that cannot be written (a read-only mount, in a private
 #     mount namespace): logged once with the reason, every passage still
 #     stored, amfid exits 0.
-# Usage: daemon_notify.sh AMFID SIM_PUBLISHER CONFIG PROM_CHECK_AWK
+#  7. With ALERT_PROBE (tests/alert_probe.c) as the command: it sees only
+#     descriptors 0 to 2 of amfid's (not the bus's, the store's, the log's),
+#     no signal ignored or blocked, its own process group; then, made to
+#     hang with a grandchild (command_timeout_s 600), amfid's stop takes
+#     alerts.command_stop_wait_s (2 s) + 3 s at most, kills both, counts
+#     the notices never started as dropped, exits 0.
+# Usage: daemon_notify.sh AMFID SIM_PUBLISHER CONFIG PROM_CHECK_AWK [ALERT_PROBE]
 set -u
 amfid=$1 sim=$2 config=$3 check=$4
 dir=$(mktemp -d)
@@ -131,3 +137,46 @@ n=$(grep -c "metrics: cannot write $dir/ro/amfid.prom: Read-only file system" "$
 [ "$(q ro "SELECT count(*) FROM passages")" -eq 60 ] || fail "$(q ro "SELECT count(*) FROM passages") of 60 passages"
 [ ! -e "$dir/ro/amfid.prom" ] || fail "a metrics file outside the namespace's mount"
 echo "metrics on a read-only mount: the write error logged once, all 60 passages stored, exit 0"
+
+# 7. what the command inherits of amfid's, and a stop with notices hanging
+[ -n "${5:-}" ] || { echo "no ALERT_PROBE: case 7 skipped"; exit 0; }
+probe=$5
+conf "$probe" 600 | sed "s/^  command_stop_wait_s: 10 /  command_stop_wait_s: 2 /" > "$dir/probe.yaml"
+grep -q "^  command_stop_wait_s: 2 " "$dir/probe.yaml" || fail "the test's command_stop_wait_s did not apply"
+run probe || fail "amfid exit $? (probe)"
+n=0
+for f in "$dir"/probe.db.probe.*; do
+  [ -f "$f" ] || fail "the probe never ran"
+  n=$((n + 1))
+  grep -qx "fds 0 1 2" "$f" || fail "the alert command inherited amfid's descriptors: $(head -1 "$f")"
+  ign=$(sed -n 's/^sigign //p' "$f") blk=$(sed -n 's/^sigblk //p' "$f")
+  # signals 32 and 33 are glibc's own: posix_spawn leaves them ignored
+  [ $((0x$ign & ~(3 << 31))) -eq 0 ] || fail "the alert command starts with signals ignored (SigIgn $ign; SIGPIPE is 0x1000)"
+  [ $((0x$blk)) -eq 0 ] || fail "the alert command starts with signals blocked (SigBlk $blk)"
+  set -- $(sed -n 's/^pid \([0-9]*\) pgrp \([0-9]*\)$/\1 \2/p' "$f")
+  [ "${1:-x}" = "${2:-y}" ] || fail "the alert command does not lead its process group: $(grep '^pid' "$f")"
+done
+rm -f "$dir"/probe.db.probe.*
+touch "$dir/probe.db.hang" # the probe now hangs, with a grandchild ignoring SIGTERM
+t0=$(date +%s)
+rm -f "$dir/probe.db"
+timeout 120 "$amfid" --config "$dir/probe.yaml" --db "$dir/probe.db" \
+  --lcm-url "file://$dir/t.lcmlog?speed=0" 2> "$dir/amfid.log" || fail "amfid exit $? (hanging notices)"
+t1=$(date +%s)
+grep -q "still running after 2 s (alerts.command_stop_wait_s), killed" "$dir/amfid.log" ||
+  fail "no kill at stop logged"
+[ "$(q probe "SELECT count(*) FROM passages")" -eq 60 ] || fail "$(q probe "SELECT count(*) FROM passages") of 60 passages"
+[ $((t1 - t0)) -lt 30 ] || fail "amfid took $((t1 - t0)) s to run and stop with notices hanging"
+g=0
+for f in "$dir"/probe.db.probe.*; do
+  p=$(sed -n 's/^grandchild //p' "$f")
+  [ -n "$p" ] || continue
+  g=$((g + 1))
+  i=0
+  while kill -0 "$p" 2> /dev/null && [ "$(awk '{ print $3 }' "/proc/$p/stat" 2> /dev/null)" != Z ]; do
+    i=$((i + 1)); [ $i -lt 100 ] || { kill -9 "$p"; fail "grandchild $p outlived amfid's stop"; }; sleep 0.05
+  done
+done
+[ "$g" -ge 1 ] || fail "no hanging probe started a grandchild"
+echo "probe: $n notices saw descriptors 0-2 only, no ignored or blocked signal, their own group; with notices hanging amfid ran and stopped in $((t1 - t0)) s, $g grandchildren killed"
+

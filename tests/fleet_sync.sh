@@ -256,6 +256,31 @@ rc=$?
 [ $rc = 1 ] || fail "a version-3 store: exit $rc, expected 1"
 grep -q "store schema version 3, this amfi-sync needs" "$tmp/old.log" || fail "message: $(cat "$tmp/old.log")"
 [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-old'")" = 0 ] || fail "a version-3 store shipped"
+case=crafted-store
+# a store from elsewhere whose alerts table is a view computing its rows (a
+# function of an untrusted schema) and whose indicators is an fts5 virtual
+# table: refused (exit 3) naming the object, nothing shipped
+cp "$tmp/a.db" "$tmp/view.db"
+rm -f "$tmp/view.db-wal" "$tmp/view.db-shm"
+sqlite3 "$tmp/view.db" "UPDATE meta SET value = 'site-view' WHERE key = 'site.id';
+ALTER TABLE alerts RENAME TO alerts_real;
+CREATE VIEW alerts AS SELECT id, utime, level, json_extract('{\"k\":\"std_increase\"}', '\$.k') AS kind,
+  message, indicator_id, raised FROM alerts_real;" || fail "cannot make the crafted store"
+"$sync" --db "$tmp/view.db" --pg "$PG_CONNINFO" --once 2> "$tmp/view.log"
+rc=$?
+[ $rc = 3 ] || fail "a view in place of alerts: exit $rc, expected 3 ($(cat "$tmp/view.log"))"
+grep -Fq "refused: store $tmp/view.db: 'alerts' is view, not a table" "$tmp/view.log" ||
+    fail "message: $(cat "$tmp/view.log")"
+cp "$tmp/a.db" "$tmp/vt.db"
+rm -f "$tmp/vt.db-wal" "$tmp/vt.db-shm"
+sqlite3 "$tmp/vt.db" "UPDATE meta SET value = 'site-view' WHERE key = 'site.id';
+DROP TABLE indicators; CREATE VIRTUAL TABLE indicators USING fts5(x);" || fail "cannot make the fts5 store"
+"$sync" --db "$tmp/vt.db" --pg "$PG_CONNINFO" --once 2> "$tmp/vt.log"
+rc=$?
+[ $rc = 3 ] || fail "fts5 in place of indicators: exit $rc, expected 3 ($(cat "$tmp/vt.log"))"
+grep -Fq "refused: store $tmp/vt.db: 'indicators' is a virtual table, not a table" "$tmp/vt.log" ||
+    fail "message: $(cat "$tmp/vt.log")"
+[ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-view'")" = 0 ] || fail "a crafted store shipped"
 # the new columns ship as they are in the store
 add_rows "$tmp/a.db" 20
 sqlite3 "$tmp/a.db" "UPDATE passages SET speed_given_mps = 26.25, speed_estimated = 1, n_vehicles = 2, quality = 1.25 WHERE id = (SELECT max(id) FROM passages)"

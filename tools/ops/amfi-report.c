@@ -646,7 +646,7 @@ static int set_baseline(const options *o)
     char err[512];
     int rc = 0, n = 0;
     memset(&b, 0, sizeof b);
-    if (amfi_store_open(o->db, 1, &s, err, sizeof err) != 0) {
+    if (amfi_store_open_foreign(o->db, 1, &s, err, sizeof err) != 0) {
         fprintf(stderr, PROG ": %s\n", err); /* starts with the path */
         return -1;
     }
@@ -896,7 +896,7 @@ static int run_section(int (*fn)(amfi_store *), amfi_store *s, int *printed)
  * the indicator defaults. */
 static int plot(const options *o, const amfi_site_config *c, amfi_store *s)
 {
-    char site[256], err[1024];
+    char site[4097], err[1024]; /* meta values hold at most 4096 bytes */
     int found = 0;
     amfi_indicator_params ip;
     amfi_indicator_params_default(&ip);

@@ -37,14 +37,37 @@ static const char *iso(int64_t utime, char buf[32])
     return export_utc(utime, "%Y-%m-%dT%H:%M:%SZ", buf);
 }
 
-/* An RFC 4180 field: quoted when it holds a comma, a quote or a line break. */
+/* Would a spreadsheet read this text cell as a formula? It starts, after
+ * any blanks, with = + - @ (or their full-width forms U+FF1D U+FF0B
+ * U+FF0D U+FF20), or with a tab, carriage return or line feed (the OWASP
+ * CSV-injection set). */
+static int csv_formula_like(const char *s)
+{
+    while (*s == ' ')
+        s++;
+    if (*s && strchr("=+-@\t\r\n", *s))
+        return 1;
+    const unsigned char *u = (const unsigned char *)s;
+    return u[0] == 0xef && ((u[1] == 0xbc && (u[2] == 0x9d || u[2] == 0x8b || u[2] == 0x8d))
+                            || (u[1] == 0xbc && u[2] == 0xa0));
+}
+
+/* A text field from the store, RFC 4180: quoted when it holds a comma, a
+ * quote or a line break, and a cell that would start a formula neutralised
+ * with a leading single quote (the text is still all there). Numbers are
+ * written by csv_num and fprintf, never through here. */
 static void csv_str(FILE *f, const char *s)
 {
+    int neutral = csv_formula_like(s);
     if (!strpbrk(s, ",\"\r\n")) {
+        if (neutral)
+            fputc('\'', f);
         fputs(s, f);
         return;
     }
     fputc('"', f);
+    if (neutral)
+        fputc('\'', f);
     for (; *s; s++) {
         if (*s == '"')
             fputc('"', f);
@@ -269,11 +292,14 @@ int export_summary(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, siz
         fprintf(f, "baseline_std_kg,"), csv_num(f, found ? b.std_kg : NAN, "%.1f"),
             fputc('\n', f);
         fprintf(f, "baseline_n,%d\n", found ? b.n : 0);
-        if (in.found)
-            fprintf(f, "intake_run,%lld\nintake_as_of,%s\nintake_messages_received,%lld\n"
+        if (in.found) {
+            fprintf(f, "intake_run,%lld\nintake_as_of,", in.run);
+            csv_str(f, in.as_of);
+            fprintf(f, "\nintake_messages_received,%lld\n"
                        "intake_messages_refused,%lld\nintake_datagrams_dropped,%lld\n"
                        "intake_samples_missing,%lld\nintake_passages_lost,%lld\n",
-                    in.run, in.as_of, in.received, in.refused, in.dropped, in.missing, in.lost);
+                    in.received, in.refused, in.dropped, in.missing, in.lost);
+        }
         fprintf(f, "f1_n,%zu\n", nf.n);
         fprintf(f, "f1_mean_hz,"), csv_num(f, nf.mean_hz, "%.6f"), fputc('\n', f);
         fprintf(f, "f1_sd_hz,"), csv_num(f, nf.sd_hz, "%.6f"), fputc('\n', f);
@@ -363,7 +389,8 @@ int export_trend(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size_
             csv_num(f, r->baseline_std_kg, "%.1f"), fputc(',', f);
             csv_num(f, r->std_ratio, "%.6f"), fputc(',', f);
             csv_num(f, r->p_value, "%.6g"), fputc(',', f);
-            fprintf(f, "%s\n", r->state);
+            csv_str(f, r->state);
+            fputc('\n', f);
         } else {
             json_t *o = json_object();
             json_object_set_new(o, "indicator_id", json_integer(rec[k].id));
@@ -408,8 +435,10 @@ int export_alerts(amfi_store *s, int fmt, FILE *f, json_t *root, char *err, size
     for (int k = n - 1; k >= 0; k--) {
         const amfi_alert_rec *a = &rec[k];
         if (fmt == FMT_CSV) {
-            fprintf(f, "%lld,%s,%lld,%s,", (long long)a->id, iso(a->utime, t),
-                    (long long)a->utime, a->level);
+            fprintf(f, "%lld,%s,%lld,", (long long)a->id, iso(a->utime, t),
+                    (long long)a->utime);
+            csv_str(f, a->level);
+            fputc(',', f);
             csv_str(f, a->kind);
             fprintf(f, ",%s,", a->raised ? "raised" : "cleared");
             if (a->indicator_id > 0)
@@ -536,7 +565,9 @@ static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
             if (a + 1 < r->n_axles)
                 csv_num(f, r->spacing_m[a], "%.3f");
         }
-        fprintf(f, ",%s,", r->status);
+        fputc(',', f);
+        csv_str(f, r->status);
+        fputc(',', f);
         csv_str(f, r->reason);
         fputc(',', f);
         csv_num(f, r->speed_given_mps, "%.3f");

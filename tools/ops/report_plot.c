@@ -122,14 +122,80 @@ static void utc_min(double t, char buf[32])
         snprintf(buf, 32, "%.0f s", t);
 }
 
-/* gnuplot string literal contents: no quotes or backslashes or controls */
-static void gp_safe(const char *s, char *out, size_t len)
+/* Text from the store (the site name, or the store's file name) for a
+ * gnuplot string: an allow-list, never an escape. gnuplot runs `...` even
+ * inside double quotes and expands @macros, so only letters, digits, the
+ * space, - _ . , : ; ( ) / + # & = ! ? [ ] and whole UTF-8 sequences of two
+ * to four bytes pass; every other byte (quotes, backslash, backquote, $, @,
+ * control characters, a broken UTF-8 sequence) becomes '_'. At most len - 1
+ * bytes, never a UTF-8 sequence cut. */
+static void gp_text(const char *s, char *out, size_t len)
+{
+    static const char punct[] = " -_.,:;()/+#&=!?[]";
+    size_t k = 0;
+    const unsigned char *p = (const unsigned char *)s;
+    if (len == 0)
+        return;
+    while (*p && k + 1 < len) {
+        unsigned char c = *p;
+        if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9')
+            || (c < 0x80 && strchr(punct, c))) {
+            out[k++] = (char)c;
+            p++;
+            continue;
+        }
+        /* a UTF-8 sequence: lead byte, then 1..3 continuation bytes */
+        int n = c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3
+              : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+        int whole = n > 0;
+        for (int j = 1; whole && j < n; j++)
+            whole = (p[j] & 0xc0) == 0x80;
+        if (whole) {
+            if (k + (size_t)n >= len)
+                break;
+            memcpy(out + k, p, (size_t)n);
+            k += (size_t)n;
+            p += n;
+        } else {
+            out[k++] = '_';
+            p++;
+        }
+    }
+    out[k] = '\0';
+}
+
+/* A word from the store written to a data file (an alert's level and kind,
+ * an indicator's state): one whitespace-free token of printable ASCII, so
+ * that a line break or blank in the store cannot add rows or columns. */
+static const char *dat_word(const char *s, char out[64])
 {
     size_t k = 0;
-    for (; *s && k + 1 < len; s++)
-        out[k++] = (*s == '"' || *s == '\\' || *s == '\'' || *s == '@'
-                    || (unsigned char)*s < 0x20) ? '_' : *s;
+    for (; s && s[k] && k < 63; k++)
+        out[k] = (unsigned char)s[k] > 0x20 && (unsigned char)s[k] < 0x7f ? s[k] : '_';
+    if (k == 0)
+        out[k++] = '-';
     out[k] = '\0';
+    return out;
+}
+
+/* The --plot directory in a gnuplot single-quoted string (no backquote or
+ * macro expansion there; a quote is written twice): refused when it holds a
+ * control character, which would end the script line. */
+static int gp_dir(const char *dir, char *out, size_t len, char *err, size_t errlen)
+{
+    size_t k = 0;
+    for (const char *p = dir; *p; p++) {
+        if ((unsigned char)*p < 0x20 || *p == 0x7f)
+            return fail(err, errlen, "the directory name holds a control character (0x%02x at "
+                        "byte %zu)", (unsigned)(unsigned char)*p, (size_t)(p - dir));
+        if (k + 3 >= len)
+            return fail(err, errlen, "the directory name is too long (%zu bytes)", strlen(dir));
+        if (*p == '\'')
+            out[k++] = '\'';
+        out[k++] = *p;
+    }
+    out[k] = '\0';
+    return 0;
 }
 
 static int mkdir_p(const char *d)
@@ -197,10 +263,13 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     size_t n_sdays = 0;
     int rc = -1, n_ind = 0, n_al = 0, found = 0;
     int64_t total_ind = 0, total_al = 0;
-    char serr[512], site[128], t0s[32], t1s[32], sub[256], path[4096];
+    char serr[512], site[128], t0s[32], t1s[32], sub[256], path[4096], gdir[8200];
+    char w1[64], w2[64];
     amfi_baseline b;
 
-    gp_safe(site_raw, site, sizeof site);
+    gp_text(site_raw, site, sizeof site);
+    if (gp_dir(dir, gdir, sizeof gdir, err, errlen) != 0)
+        goto out;
     snprintf(path, sizeof path, "%s/data", dir);
     if (mkdir_p(dir) != 0 || mkdir_p(path) != 0) {
         fail(err, errlen, "%s: cannot create: %s", path, strerror(errno));
@@ -294,7 +363,7 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         const amfi_indicator_row *r = &ind[k].row;
         double mr = r->mean_kg / r->baseline_mean_kg;
         fprintf(f, "%.3f %.5g %.5g %.5g %d %s\n", (double)r->utime / 1e6,
-                r->std_ratio, r->p_value, isfinite(mr) ? mr : NAN, r->n, r->state);
+                r->std_ratio, r->p_value, isfinite(mr) ? mr : NAN, r->n, dat_word(r->state, w1));
     }
     if (report_data_close(f, dir, "indicators.dat", err, errlen) != 0)
         goto out;
@@ -305,7 +374,8 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
     fprintf(f, "# alert_id time_s raised(1)/cleared(0) level kind\n");
     for (int k = n_al - 1; k >= 0; k--)
         fprintf(f, "%lld %.3f %d %s %s\n", (long long)al[k].id,
-                (double)al[k].utime / 1e6, al[k].raised, al[k].level, al[k].kind);
+                (double)al[k].utime / 1e6, al[k].raised, dat_word(al[k].level, w1),
+                dat_word(al[k].kind, w2));
     if (report_data_close(f, dir, "alerts.dat", err, errlen) != 0)
         goto out;
 
@@ -439,7 +509,7 @@ int report_plot(amfi_store *s, const char *dir, const char *site_raw,
         "set xdata time\nset timefmt '%%s'\nset format x \"%%H:%%M\\n%%d %%b\"\n"
         "set xlabel 'time (UTC, data time)'\n"
         "set xrange [%.3f:%.3f]\n",
-        dir, dir, dir, t0 - 0.01 * (t1 - t0), t1 + 0.01 * (t1 - t0));
+        dir, gdir, gdir, t0 - 0.01 * (t1 - t0), t1 + 0.01 * (t1 - t0));
     /* 1: GVW over time */
     fprintf(f,
         "set output o.'gvw.png'\n"
