@@ -39,6 +39,10 @@ sed '8s/.*/0.007,nan/' "$c/accel_csv/valid.csv" >"$c/accel_csv/nan.csv"
 sed '8s/.*/0.001,1/' "$c/accel_csv/valid.csv" >"$c/accel_csv/time-back.csv"
 sed '1s/.*/time,acc/' "$c/accel_csv/valid.csv" >"$c/accel_csv/bad-header.csv"
 head -c 30 "$c/accel_csv/valid.csv.gz" >"$c/accel_csv/gzip-cut.gz"
+# several sensors: a column per sensor id, and a repeated id
+sed -e '1s/.*/t,accel_3,accel_7,accel_12/' -e '2,$s/$/,1e-3,-2e-3/' "$c/accel_csv/valid.csv" \
+  >"$c/accel_csv/three-sensors.csv"
+sed '1s/accel_7/accel_3/' "$c/accel_csv/three-sensors.csv" >"$c/accel_csv/repeated-sensor.csv"
 
 # --- traffic: the shipped population's first vehicles, 12 axles, broken ones ---
 head -6 "$top/sim_publisher/data/population.csv" >"$c/traffic/valid.csv"
