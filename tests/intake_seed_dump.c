@@ -105,7 +105,8 @@ int main(int argc, char **argv)
             break;
         }
         default:
-            fprintf(stderr, "%s: record %ld: channel %d (0..3: accel, vehicle, truth, environment)\n",
+            fprintf(stderr,
+                    "%s: record %ld: channel %d (0..3: accel, vehicle, truth, environment)\n",
                     path, k, h[0]);
             rc = 1;
             break;

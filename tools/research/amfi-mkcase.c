@@ -203,7 +203,8 @@ int main(int argc, char **argv)
     int bad = 0;
     char line[64 + 24 * AMFI_MAX_SENSORS];
     for (int i = -1; i < n && !bad; i++) {
-        int k = i < 0 ? snprintf(line, sizeof line, "t") : snprintf(line, sizeof line, "%.6f", i / scan);
+        int k = i < 0 ? snprintf(line, sizeof line, "t")
+                      : snprintf(line, sizeof line, "%.6f", i / scan);
         for (int si = 0; si < ns; si++) {
             if (i >= 0)
                 k += snprintf(line + k, sizeof line - k, ",%.9g", acc[(size_t)i * ns + si]);
