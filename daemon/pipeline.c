@@ -340,13 +340,25 @@ static job *vehicle_job(const job *e, int i)
  * data do not fix its own weight, status "multiple" with the reason, the
  * joint estimate kept in the row (gvw, axles, quality: the sum is not lost)
  * but not fed to the indicators. In order: another vehicle on the span in
- * its window but outside its solve (the event cut down at a limit); an
+ * its window but outside its solve (the event cut down at a limit); axles
+ * the solver merged with another vehicle's (coincident all along: its
+ * group, amfi_vehicle_result.group, whose sum is given); an
  * axle within daemon.inseparable_gap_m of another vehicle's for at least
  * daemon.inseparable_share of its crossing (one point of the beam: only
  * the two vehicles' sum is fixed, and it is given); a quality figure above
  * daemon.inseparable_quality, or daemon.inseparable_quality_lanes in an
  * event with vehicles of several lanes (its weight moves when λ is
  * loosened). */
+/* Another vehicle of event e in vehicle i's group of coincident axles
+ * (amfi_solve_multi merged their axles), or −1. */
+static int coincident_with(const job *e, int i)
+{
+    for (int v = 0; v < e->w.n_vehicles; v++)
+        if (v != i && e->veh[v].group == e->veh[i].group)
+            return v;
+    return -1;
+}
+
 static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
 {
     if (!j->solved || strcmp(j->status, "ok") != 0)
@@ -357,6 +369,16 @@ static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
                  "inseparable: vehicle %lld was on the span inside its window but not weighed "
                  "with it (event cut down at a limit); the weight misses that load",
                  (long long)e->w.outside_id[i]);
+    } else if (e->w.n_vehicles > 1 && coincident_with(e, i) >= 0) {
+        const int k = coincident_with(e, i);
+        int n = 0;
+        for (int v = 0; v < e->w.n_vehicles; v++)
+            n += e->veh[v].group == e->veh[i].group;
+        snprintf(j->reason, sizeof j->reason,
+                 "inseparable: axles at one point with vehicle %lld's all along its crossing "
+                 "(one unknown in the solve); %.0f kg the %d together; the weight is an even "
+                 "split of that",
+                 (long long)e->w.ev[k].vehicle_id, e->veh[i].group_gvw_kg, n);
     } else if (e->w.n_vehicles > 1) {
         amfi_nearness nr;
         amfi_window_nearness(&e->w, d->cfg.bridge.span_m, c->inseparable_gap_m, i, &nr);
@@ -374,11 +396,6 @@ static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
                      "crossing (closest %.2f m)%s; the weight is the joint estimate",
                      c->inseparable_gap_m, (long long)e->w.ev[nr.other].vehicle_id,
                      100.0 * nr.share, nr.min_gap_m, sum);
-        } else if (j->quality >= AMFI_MULTI_QUALITY_UNFIXED) {
-            snprintf(j->reason, sizeof j->reason,
-                     "inseparable: the event's solve was singular (axles of its vehicles at one "
-                     "point); the %d vehicles weigh %.0f kg together",
-                     e->w.n_vehicles, e->gvw_kg);
         } else if (j->quality > (lanes > 1 ? c->inseparable_quality_lanes
                                            : c->inseparable_quality)) {
             snprintf(j->reason, sizeof j->reason,

@@ -154,6 +154,8 @@ static void solve_event(amfi_solver *s, job *j)
         const amfi_vehicle_result *vr = &r->vehicle[v];
         job_vehicle *o = &j->veh[v];
         o->quality = vr->quality;
+        o->group = vr->group;
+        o->group_gvw_kg = vr->group_gvw_kg;
         if (!(vr->gvw_kg > 0.0) || !isfinite(vr->gvw_kg)) {
             snprintf(o->reason, sizeof o->reason,
                      "inferred GVW %.0f kg is not positive in the joint solve of %d vehicles",

@@ -24,6 +24,9 @@ typedef struct job_vehicle {
     int solved;              /* 1: gvw_kg and axle_kg hold its weight */
     double gvw_kg, axle_kg[AMFI_MAX_AXLES];
     double quality;          /* amfi_vehicle_result.quality */
+    int group;               /* amfi_vehicle_result.group: the first vehicle (index
+                                in the event) of its group of coincident axles */
+    double group_gvw_kg;     /* amfi_vehicle_result.group_gvw_kg: the group's sum */
     char reason[200];        /* why not solved (status "error") */
 } job_vehicle;
 

@@ -23,7 +23,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     char err[512] = "";
     if (accel_csv_read_max(path, 100000, &c, err, sizeof err) != 0) {
         fuzz_file_expect_named(path, err);
-        if (c.n != 0 || c.accel != NULL)
+        if (c.n != 0 || c.accel != NULL || c.n_channels != 0)
             abort();
         return 0;
     }
@@ -32,9 +32,22 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fprintf(stderr, "fuzz_accel_csv: accepted n=%d rate=%g\n", c.n, c.rate_hz);
         abort();
     }
+    if (c.n_channels < 1 || c.n_channels > ACCEL_CSV_MAX_CHANNELS || c.accel != c.channel[0]) {
+        fprintf(stderr, "fuzz_accel_csv: accepted %d channels\n", c.n_channels);
+        abort();
+    }
     volatile double sum = 0; /* every value readable (ASan sees a short array) */
-    for (int i = 0; i < c.n; i++)
-        sum += c.accel[i];
+    for (int k = 0; k < c.n_channels; k++) {
+        /* ids: −1 only for the one 't,accel' column, else 0 .. 255, each once */
+        int id = c.channel_id[k];
+        if (!c.channel[k] || (id < 0 && !(id == -1 && c.n_channels == 1)) || id > 255)
+            abort();
+        for (int j = 0; j < k; j++)
+            if (c.channel_id[j] == id)
+                abort();
+        for (int i = 0; i < c.n; i++)
+            sum += c.channel[k][i];
+    }
     (void)sum;
     accel_csv_free(&c);
     return 0;

@@ -5,9 +5,12 @@
 #   sh fuzz/make_corpus.sh BUILD [OUT]
 #       BUILD: a configured and built tree (any flavour) holding
 #       tests/test_msg_check; OUT: where to write (default fuzz/corpus)
-# Deterministic: the same sources give the same files, so the fuzz_corpus
-# test can tell a committed corpus that a changed .lcm or config/*.yaml left
-# stale (a message seed with the old fingerprint seeds nothing).
+# Deterministic: the same sources give the same files (the intake seeds,
+# simulator output, the same to the last bits on one CPU and BLAS kernel,
+# to about 1e-9 relative on another), so the fuzz_corpus test
+# (tests/fuzz_corpus.sh) can tell a committed corpus that a changed .lcm or
+# config/*.yaml left stale (a message seed with the old fingerprint seeds
+# nothing).
 set -eu
 top=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:?usage: make_corpus.sh BUILD [OUT]}
@@ -36,6 +39,10 @@ sed '8s/.*/0.007,nan/' "$c/accel_csv/valid.csv" >"$c/accel_csv/nan.csv"
 sed '8s/.*/0.001,1/' "$c/accel_csv/valid.csv" >"$c/accel_csv/time-back.csv"
 sed '1s/.*/time,acc/' "$c/accel_csv/valid.csv" >"$c/accel_csv/bad-header.csv"
 head -c 30 "$c/accel_csv/valid.csv.gz" >"$c/accel_csv/gzip-cut.gz"
+# several sensors: a column per sensor id, and a repeated id
+sed -e '1s/.*/t,accel_3,accel_7,accel_12/' -e '2,$s/$/,1e-3,-2e-3/' "$c/accel_csv/valid.csv" \
+  >"$c/accel_csv/three-sensors.csv"
+sed '1s/accel_7/accel_3/' "$c/accel_csv/three-sensors.csv" >"$c/accel_csv/repeated-sensor.csv"
 
 # --- traffic: the shipped population's first vehicles, 12 axles, broken ones ---
 head -6 "$top/sim_publisher/data/population.csv" >"$c/traffic/valid.csv"

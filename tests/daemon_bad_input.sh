@@ -50,3 +50,30 @@ n=$(sqlite3 "$dir/c.db" "SELECT count(*) FROM passages WHERE status = 'error' AN
 [ "$n" -eq 3 ] || fail "absurd samples: $(sqlite3 "$dir/c.db" "SELECT status, reason FROM passages")"
 grep -q "store_degraded" "$dir/amfid.log" && fail "absurd samples made the store degraded"
 echo "absurd samples: 3 passages stored as error (result not storable), store never degraded"
+
+# Two vehicles side by side (every vehicle with a twin on the other lane:
+# same entry, speed and spacings; the samples hold one vehicle): axles at
+# one point all along, merged by the solver. Each is stored multiple, not
+# error (with OpenBLAS's SkylakeX kernel the event once failed as a whole,
+# "sweep failed: numerical failure"), with the reason naming the other and
+# the pair's weight, which is the one vehicle's (truth within 5 %) and the
+# sum of the two rows' weights.
+"$inject" --twin-lanes "$dir/clean.log" "$dir/twins.log" || fail "lcm_inject --twin-lanes"
+"$amfid" --config "$config" --db "$dir/d.db" --lcm-url "file://$dir/twins.log?speed=0" \
+  2> "$dir/amfid.log"; rc=$?
+[ $rc -eq 0 ] || fail "amfid on twins: exit status $rc"
+q() { sqlite3 "$dir/d.db" "$1"; }
+pairs="passages a JOIN passages b ON b.vehicle_id = a.vehicle_id + 1000000
+       JOIN truth t ON t.vehicle_id = a.vehicle_id"
+n=$(q "SELECT count(*) FROM passages WHERE status = 'multiple' AND n_vehicles = 2
+       AND reason GLOB 'inseparable: axles at one point with vehicle [0-9]*''s all along*; [0-9]* kg the 2 together*'")
+[ "$n" -eq 6 ] || fail "twins: $n of 6 rows multiple with the reason: $(q "SELECT vehicle_id, status, reason FROM passages")"
+npairs=$(q "SELECT count(*) FROM $pairs")
+bad=$(q "SELECT count(*) FROM $pairs
+         WHERE NOT (abs((a.gvw_kg + b.gvw_kg) / t.gvw_kg - 1) < 0.05
+                    AND abs(CAST(substr(a.reason, instr(a.reason, '; ') + 2) AS REAL)
+                            - (a.gvw_kg + b.gvw_kg)) <= 1
+                    AND instr(a.reason, 'vehicle ' || b.vehicle_id || '''s') > 0)")
+[ "$npairs" -eq 3 ] && [ "$bad" -eq 0 ] ||
+  fail "twins: $npairs pairs with truth, $bad whose sum or reason is wrong: $(q "SELECT a.vehicle_id, a.gvw_kg + b.gvw_kg, t.gvw_kg, a.reason FROM $pairs")"
+echo "twins side by side: 6 rows multiple; each pair against the vehicle's truth: $(q "SELECT group_concat(printf('%+.2f %%', 100 * ((a.gvw_kg + b.gvw_kg) / t.gvw_kg - 1)), ', ') FROM $pairs")"

@@ -34,6 +34,14 @@
  * calibration truck's): 500 kg (ids 434343) and +infinity (434344).
  *
  *   lcm_inject --bad-reference IN.log OUT.log
+ *
+ * With --twin-lanes, every vehicle_t of IN.log is followed by its twin on
+ * the other lane (lane 1 <-> 2, vehicle id + 1000000), same entry time,
+ * speed and spacings: two vehicles side by side whose axles coincide all
+ * along, carrying together the one vehicle the samples hold
+ * (tests/daemon_bad_input.sh).
+ *
+ *   lcm_inject --twin-lanes IN.log OUT.log
  */
 #include <lcm/eventlog.h>
 #include <math.h>
@@ -77,6 +85,38 @@ static int vehicles_only(const char *inp, const char *outp)
     while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
         if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0) {
             rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
+            n++;
+        }
+        lcm_eventlog_free_event(e);
+    }
+    lcm_eventlog_destroy(in);
+    lcm_eventlog_destroy(out);
+    if (rc || n == 0) {
+        fprintf(stderr, "lcm_inject: %s\n", rc ? "write failed" : "no vehicle in the log");
+        return 1;
+    }
+    return 0;
+}
+
+static int twin_lanes(const char *inp, const char *outp)
+{
+    lcm_eventlog_t *in, *out;
+    if (open_logs(inp, outp, &in, &out))
+        return 1;
+    lcm_eventlog_event_t *e;
+    int64_t num = 0;
+    int rc = 0, n = 0;
+    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
+        rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
+        amfi_vehicle_t m;
+        if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0 &&
+            amfi_vehicle_t_decode(e->data, 0, e->datalen, &m) >= 0) {
+            m.vehicle_id += 1000000;
+            m.lane = m.lane == 1 ? 2 : 1;
+            unsigned char b[4096];
+            int len = amfi_vehicle_t_encode(b, 0, sizeof b, &m);
+            rc |= len < 0 || put(out, &num, e->timestamp, e->channel, b, len);
+            amfi_vehicle_t_decode_cleanup(&m);
             n++;
         }
         lcm_eventlog_free_event(e);
@@ -240,6 +280,8 @@ int main(int argc, char **argv)
         return scale_accel(atof(argv[2]), argv[3], argv[4]);
     if (argc == 4 && strcmp(argv[1], "--vehicles-only") == 0)
         return vehicles_only(argv[2], argv[3]);
+    if (argc == 4 && strcmp(argv[1], "--twin-lanes") == 0)
+        return twin_lanes(argv[2], argv[3]);
     if (argc != 3) {
         fprintf(stderr, "usage: lcm_inject [--vehicles-only | --bad-environment | --bad-reference | "
                         "--scale-accel F] IN.log OUT.log\n");

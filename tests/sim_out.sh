@@ -1,8 +1,9 @@
 #!/bin/sh
 # SPDX-License-Identifier: GPL-3.0-or-later
 # sim_publisher's offline output: the files amfi-solve reads, meta.csv with
-# the truth, the same seed giving the same bytes, and the weights amfi-solve
-# infers from them close to the truth on the ideal defaults.
+# the truth, the same seed giving the same numbers (tests/num_cmp.sh, 1e-9
+# relative: floating point is not compared byte for byte), and the weights
+# amfi-solve infers from them close to the truth on the ideal defaults.
 # Usage: sim_out.sh SIM_PUBLISHER AMFI_SOLVE
 set -u
 sim=$1
@@ -10,14 +11,15 @@ solve=$2
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
+same() { sh "$(dirname "$0")/num_cmp.sh" "$1" "$2" >/dev/null; }
 
 "$sim" --out "$dir/a" --vehicles 4 --seed 5 || fail "sim_publisher exited $?"
 "$sim" --out "$dir/b" --vehicles 4 --seed 5 || fail "second run exited $?"
 "$sim" --out "$dir/c" --vehicles 4 --seed 6 || fail "third run exited $?"
 for f in meta.csv v00001.csv v00004.csv; do
-  cmp -s "$dir/a/$f" "$dir/b/$f" || fail "same seed, different $f"
+  same "$dir/a/$f" "$dir/b/$f" || fail "same seed, different $f"
 done
-cmp -s "$dir/a/v00001.csv" "$dir/c/v00001.csv" && fail "another seed gave the same v00001.csv"
+same "$dir/a/v00001.csv" "$dir/c/v00001.csv" && fail "another seed gave the same v00001.csv"
 head -1 "$dir/a/meta.csv" | grep -q '^name,speed_mps,speed_true_mps,axle_spacing_m,entry_time_s,gvw_kg,axle1_kg,axle2_kg,mean_force1_N,mean_force2_N,damage,noise' ||
   fail "meta.csv header: $(head -1 "$dir/a/meta.csv")"
 [ "$(wc -l < "$dir/a/meta.csv")" -eq 5 ] || fail "meta.csv rows"
@@ -38,10 +40,10 @@ mkdir "$dir/cfg"
 printf 'simulation: {vehicles: 2, seed: 5}\n' > "$dir/cfg/two.yaml"
 "$sim" --config "$dir/cfg/two.yaml" --out "$dir/e" || fail "--config exited $?"
 [ "$(wc -l < "$dir/e/meta.csv")" -eq 3 ] || fail "simulation.vehicles: 2 not applied"
-cmp -s "$dir/a/v00001.csv" "$dir/e/v00001.csv" || fail "simulation.seed: 5 not applied"
+same "$dir/a/v00001.csv" "$dir/e/v00001.csv" || fail "simulation.seed: 5 not applied"
 "$sim" --config "$dir/cfg/two.yaml" --out "$dir/f" --vehicles 3 || fail "--vehicles over --config exited $?"
 [ "$(wc -l < "$dir/f/meta.csv")" -eq 4 ] || fail "--vehicles 3 did not override simulation.vehicles"
-cmp -s "$dir/a/v00001.csv" "$dir/f/v00001.csv" || fail "simulation.seed lost under --vehicles"
+same "$dir/a/v00001.csv" "$dir/f/v00001.csv" || fail "simulation.seed lost under --vehicles"
 # A relative population is read from the file's folder, wherever we run.
 printf 'timestamp_s,lane,speed_mps,gvw_kg,axle1_kg,axle2_kg,spacing1_m\n%s\n%s\n' \
   '5.856,1,21.82,8003,3820,4183,4.19' '16.827,1,25.52,10034,4828,5206,3.93' > "$dir/cfg/wim.csv"

@@ -83,4 +83,36 @@ check() { # FILE TRUTH1 TRUTH2
 }
 check "$tmp/joint.json" 18000 15000
 check "$tmp/reversed.json" 15000 18000
+
+# Side by side: a two-axle truck's passage declared as two vehicles at one
+# entry time, speed and spacing (two lanes, the beam has no width): every
+# axle coincides with the other vehicle's, so the axles are merged, both
+# vehicles are one group (quality 1e6) whose weight is the one-vehicle
+# solve's, at the same λ (once a numerical failure, or a solve at 10 λ,
+# depending on the BLAS kernel).
+"$mkcase" $config --out "$tmp/truck.csv" --speed 25 --axle-loads-kg 10400,7600 \
+    --axle-spacing 5 --pre 0.5 --post 0.5 --scan-rate 1000 > /dev/null || fail "amfi-mkcase: exit $?"
+# shellcheck disable=SC2086
+"$solve" $config --accel "$tmp/truck.csv" --speed 25 --axle-spacing 5 --entry-time 0.5 \
+    > "$tmp/truck.json" || fail "truck alone: exit $?"
+# shellcheck disable=SC2086
+"$solve" $config --accel "$tmp/truck.csv" --vehicle 0.5:25:5 --vehicle 0.5:25:5 \
+    > "$tmp/pair.json" || fail "side by side: exit $?"
+echo "side by side: $(sed 's/.*"vehicles"/"vehicles"/' "$tmp/pair.json")"
+lam1=$(sed 's/.*"lambda_ref":\([^,]*\),.*/\1/' "$tmp/truck.json")
+lam2=$(sed 's/.*"lambda_ref":\([^,]*\),.*/\1/' "$tmp/pair.json")
+[ "$lam1" = "$lam2" ] || fail "side by side solved at λ $lam2, alone at $lam1"
+g1=$(sed 's/^{"gvw_kg":\([^,]*\),.*/\1/' "$tmp/truck.json")
+sed 's/.*"vehicles":\[//' "$tmp/pair.json" | tr '}' '\n' | awk -v g1="$g1" '
+    /"gvw_kg"/ {
+        n++
+        if ($0 !~ /"quality":1000000\.0,/ || $0 !~ /"group":0,/ || $0 !~ /"n_merged":2,/) {
+            print "vehicle " n " not marked as a group of merged axles: " $0; bad = 1
+        }
+        s = $0; sub(/.*"group_gvw_kg":/, "", s); g = s + 0
+        d = g / g1 - 1; if (d < 0) d = -d
+        if (d > 1e-6) { printf "vehicle %d: the group weighs %s, the truck alone %s\n", n, g, g1; bad = 1 }
+    }
+    END { if (n != 2) { print "expected 2 vehicles, got " n; bad = 1 }; exit bad }' ||
+    fail "side by side"
 echo "solve_multi: ok"

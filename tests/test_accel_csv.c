@@ -233,6 +233,70 @@ static void test_header(void **state)
                  "missing header");
 }
 
+/* Several sensors: 't,accel_ID,...', a column per sensor id, in the
+ * file's order; each id once, 0 .. 255 written plainly, at most
+ * ACCEL_CSV_MAX_CHANNELS columns, every row with all of them. */
+static void test_channels(void **state)
+{
+    (void)state;
+    char text[8192];
+    size_t n = (size_t)snprintf(text, sizeof text, "\xEF\xBB\xBFt, accel_7 ,accel_0,accel_255\r\n");
+    for (int k = 0; k < 20; k++)
+        n += (size_t)snprintf(text + n, sizeof text - n, "%.3f,%d,%d.5,-%d\r\n", k * 1e-3, k,
+                              2 * k, 3 * k);
+    const char *p = write_text("three.csv", text);
+    accel_csv c;
+    assert_int_equal(accel_csv_read(p, &c, err, sizeof err), 0);
+    assert_int_equal(c.n, 20);
+    assert_int_equal(c.n_channels, 3);
+    assert_int_equal(c.channel_id[0], 7);
+    assert_int_equal(c.channel_id[1], 0);
+    assert_int_equal(c.channel_id[2], 255);
+    assert_true(c.accel == c.channel[0]);
+    for (int k = 0; k < 20; k++) {
+        assert_true(c.channel[0][k] == k);
+        assert_true(c.channel[1][k] == 2 * k + 0.5);
+        assert_true(c.channel[2][k] == -3 * k);
+    }
+    accel_csv_free(&c);
+    assert_int_equal(c.n_channels, 0);
+    /* the one-sensor format: one channel without an id */
+    char *one = make_csv(20);
+    assert_int_equal(accel_csv_read(write_text("one.csv", one), &c, err, sizeof err), 0);
+    free(one);
+    assert_int_equal(c.n_channels, 1);
+    assert_int_equal(c.channel_id[0], -1);
+    accel_csv_free(&c);
+
+    expect_error(write_text("dup.csv", "t,accel_3,accel_4,accel_3\n0,1,2,3\n"), 1,
+                 "column 4 repeats sensor 3 (column 2)");
+    static const char *const bad[] = {"accel_01", "accel_256", "accel_x", "accel_", "accel_-1",
+                                      "accel_+1", "Accel_1", "accel_1000"};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        snprintf(text, sizeof text, "t,accel_1,%s\n0,1,2\n", bad[k]);
+        char name[64], what[64];
+        snprintf(name, sizeof name, "badid%zu.csv", k);
+        snprintf(what, sizeof what, "column 3 '%s' is not accel_ID", bad[k]);
+        expect_error(write_text(name, text), 1, what);
+    }
+    /* 'accel' beside named columns */
+    expect_error(write_text("mixed.csv", "t,accel_1,accel\n0,1,2\n"), 1, "column 3 'accel'");
+    expect_error(write_text("nine.csv", "t,accel_1,accel_2,accel_3,accel_4,accel_5,accel_6,"
+                                        "accel_7,accel_8,accel_9\n"),
+                 1, "9 accel columns: at most 8");
+    /* a row without one of the columns, or a bad value in one, names it */
+    n = (size_t)snprintf(text, sizeof text, "t,accel_1,accel_2\n");
+    for (int k = 0; k < 20; k++)
+        n += (size_t)snprintf(text + n, sizeof text - n, k == 4 ? "%.3f,1\n" : "%.3f,1,2\n",
+                              k * 1e-3);
+    expect_error(write_text("short-row.csv", text), 6, "expected 3 fields");
+    n = (size_t)snprintf(text, sizeof text, "t,accel_1,accel_2\n");
+    for (int k = 0; k < 20; k++)
+        n += (size_t)snprintf(text + n, sizeof text - n, k == 4 ? "%.3f,1,x\n" : "%.3f,1,2\n",
+                              k * 1e-3);
+    expect_error(write_text("bad-value.csv", text), 6, "accel_2");
+}
+
 static void test_columns(void **state)
 {
     (void)state;
@@ -476,6 +540,7 @@ int main(void)
         cmocka_unit_test(test_longest_line),
         cmocka_unit_test(test_cannot_open),
         cmocka_unit_test(test_header),
+        cmocka_unit_test(test_channels),
         cmocka_unit_test(test_columns),
         cmocka_unit_test(test_numbers),
         cmocka_unit_test(test_nul_byte),

@@ -36,7 +36,25 @@ static int parse_number(amfi_csv *r, const char *name, const char *s, size_t n,
     }
 }
 
-static int read_header(amfi_csv *r)
+#define EXPECTED "expected 't,accel' or 't,accel_ID,...'"
+
+/* "accel_ID", ID 0 .. 255 without sign or leading zeros: the id, else −1. */
+static int channel_name_id(const char *s, size_t n)
+{
+    if (n < 7 || n > 9 || memcmp(s, "accel_", 6) != 0)
+        return -1;
+    if (n > 7 && s[6] == '0')
+        return -1;
+    int id = 0;
+    for (size_t k = 6; k < n; k++) {
+        if (s[k] < '0' || s[k] > '9')
+            return -1;
+        id = 10 * id + (s[k] - '0');
+    }
+    return id <= 255 ? id : -1;
+}
+
+static int read_header(amfi_csv *r, accel_csv *out)
 {
     size_t n = 0;
     const char *s = NULL;
@@ -44,34 +62,61 @@ static int read_header(amfi_csv *r)
     if (rc < 0)
         return -1;
     if (rc == 0)
-        return amfi_csv_fail(r, 1, NULL, "empty file (expected header 't,accel')");
+        return amfi_csv_fail(r, 1, NULL, "empty file (" EXPECTED ")");
     amfi_csv_strip_bom(&s, &n);
-    const char *f[2];
-    size_t fl[2];
-    int count = amfi_csv_split(s, n, f, fl, 2);
-    if (count == 2 && fl[0] == 1 && f[0][0] == 't' && fl[1] == 5
-        && memcmp(f[1], "accel", 5) == 0)
-        return 0;
+    const char *f[ACCEL_CSV_MAX_CHANNELS + 1];
+    size_t fl[ACCEL_CSV_MAX_CHANNELS + 1];
+    int count = amfi_csv_split(s, n, f, fl, ACCEL_CSV_MAX_CHANNELS + 1);
     char q[32];
+    if (count >= 2 && fl[0] == 1 && f[0][0] == 't') {
+        if (count == 2 && fl[1] == 5 && memcmp(f[1], "accel", 5) == 0) {
+            out->n_channels = 1;
+            out->channel_id[0] = -1;
+            return 0;
+        }
+        if (count - 1 > ACCEL_CSV_MAX_CHANNELS)
+            return amfi_csv_fail(r, 1, NULL, "%d accel columns: at most %d", count - 1,
+                                 ACCEL_CSV_MAX_CHANNELS);
+        for (int k = 1; k < count; k++) {
+            int id = channel_name_id(f[k], fl[k]);
+            if (id < 0) {
+                /* 't,accel' with more columns, or a name not accel_ID */
+                return amfi_csv_fail(r, 1, NULL,
+                                     "bad header: column %d '%s' is not accel_ID (ID a "
+                                     "sensor id, 0 .. 255) (" EXPECTED ")",
+                                     k + 1, amfi_csv_quote(f[k], fl[k], q));
+            }
+            for (int j = 0; j < k - 1; j++)
+                if (out->channel_id[j] == id)
+                    return amfi_csv_fail(r, 1, NULL,
+                                         "bad header: column %d repeats sensor %d (column %d)",
+                                         k + 1, id, j + 2);
+            out->channel_id[k - 1] = id;
+        }
+        out->n_channels = count - 1;
+        return 0;
+    }
     double x;
     if (count >= 1 && amfi_csv_field_double(f[0], fl[0], &x) != AMFI_CSV_NOT_NUMBER
         && fl[0] > 0)
-        return amfi_csv_fail(r, 1, NULL, "missing header (expected 't,accel', found data)");
-    return amfi_csv_fail(r, 1, NULL, "bad header '%s' (expected 't,accel')",
-                         amfi_csv_quote(s, n, q));
+        return amfi_csv_fail(r, 1, NULL, "missing header (" EXPECTED ", found data)");
+    return amfi_csv_fail(r, 1, NULL, "bad header '%s' (" EXPECTED ")", amfi_csv_quote(s, n, q));
 }
 
-static int grow(double **a, double **b, size_t *cap)
+/* The times and the nc channels to cap rows (t: one array, a: nc arrays). */
+static int grow(double **t, double **a, int nc, size_t *cap)
 {
     size_t ncap = *cap ? 2 * *cap : 4096;
-    double *na = realloc(*a, ncap * sizeof **a);
-    if (!na)
+    double *nt = realloc(*t, ncap * sizeof **t);
+    if (!nt)
         return -1;
-    *a = na;
-    double *nb = realloc(*b, ncap * sizeof **b);
-    if (!nb)
-        return -1;
-    *b = nb;
+    *t = nt;
+    for (int c = 0; c < nc; c++) {
+        double *na = realloc(a[c], ncap * sizeof **a);
+        if (!na)
+            return -1;
+        a[c] = na;
+    }
     *cap = ncap;
     return 0;
 }
@@ -100,7 +145,15 @@ static int check_uniform(amfi_csv *r, const double *t, size_t n, double *rate)
 
 static int read_rows(amfi_csv *r, long max_rows, accel_csv *out)
 {
-    double *t = NULL, *a = NULL;
+    const int nc = out->n_channels;
+    double *t = NULL, *a[ACCEL_CSV_MAX_CHANNELS] = {NULL};
+    char names[ACCEL_CSV_MAX_CHANNELS][24];
+    for (int c = 0; c < nc; c++) {
+        if (out->channel_id[c] < 0)
+            snprintf(names[c], sizeof names[c], "accel");
+        else
+            snprintf(names[c], sizeof names[c], "accel_%d", out->channel_id[c]);
+    }
     size_t n = 0, cap = 0;
     int rc = -1;
     for (;;) {
@@ -116,30 +169,33 @@ static int read_rows(amfi_csv *r, long max_rows, accel_csv *out)
             amfi_csv_fail(r, lineno, NULL, "more than %ld rows", max_rows);
             goto done;
         }
-        const char *f[2];
-        size_t fl[2];
-        int count = amfi_csv_split(line, len, f, fl, 2);
-        if (count != 2) {
-            amfi_csv_fail(r, lineno, NULL,
-                          "%s column: expected 2 fields (t,accel), found %d",
-                          count < 2 ? "missing" : "extra", count);
+        const char *f[ACCEL_CSV_MAX_CHANNELS + 1];
+        size_t fl[ACCEL_CSV_MAX_CHANNELS + 1];
+        int count = amfi_csv_split(line, len, f, fl, ACCEL_CSV_MAX_CHANNELS + 1);
+        if (count != nc + 1) {
+            amfi_csv_fail(r, lineno, NULL, "%s column: expected %d fields (t,%s%s), found %d",
+                          count < nc + 1 ? "missing" : "extra", nc + 1, names[0],
+                          nc > 1 ? ",..." : "", count);
             goto done;
         }
-        double tv, av;
-        if (parse_number(r, "t", f[0], fl[0], &tv) != 0
-            || parse_number(r, "accel", f[1], fl[1], &av) != 0)
+        double tv, av[ACCEL_CSV_MAX_CHANNELS];
+        if (parse_number(r, "t", f[0], fl[0], &tv) != 0)
             goto done;
+        for (int c = 0; c < nc; c++)
+            if (parse_number(r, names[c], f[c + 1], fl[c + 1], &av[c]) != 0)
+                goto done;
         if (n > 0 && !(tv > t[n - 1])) {
             amfi_csv_fail(r, lineno, NULL, "t not increasing: %.10g after %.10g", tv,
                           t[n - 1]);
             goto done;
         }
-        if (n == cap && grow(&t, &a, &cap) != 0) {
+        if (n == cap && grow(&t, a, nc, &cap) != 0) {
             amfi_csv_fail(r, lineno, NULL, "out of memory");
             goto done;
         }
         t[n] = tv;
-        a[n] = av;
+        for (int c = 0; c < nc; c++)
+            a[c][n] = av[c];
         n++;
     }
     if (n < ACCEL_CSV_MIN_ROWS) {
@@ -150,18 +206,22 @@ static int read_rows(amfi_csv *r, long max_rows, accel_csv *out)
     double rate = 0;
     if (check_uniform(r, t, n, &rate) != 0)
         goto done;
-    double *shrunk = realloc(a, n * sizeof *a);
-    if (shrunk)
-        a = shrunk;
+    for (int c = 0; c < nc; c++) {
+        double *shrunk = realloc(a[c], n * sizeof *a[c]);
+        if (shrunk)
+            a[c] = shrunk;
+        out->channel[c] = a[c];
+        a[c] = NULL;
+    }
     out->n = (int)n;
     out->t0_s = t[0];
     out->rate_hz = rate;
-    out->accel = a;
-    a = NULL;
+    out->accel = out->channel[0];
     rc = 0;
 done:
     free(t);
-    free(a);
+    for (int c = 0; c < nc; c++)
+        free(a[c]);
     return rc;
 }
 
@@ -174,11 +234,11 @@ int accel_csv_read_max(const char *path, long max_rows, accel_csv *out,
     amfi_csv *r = amfi_csv_open(path, ACCEL_CSV_MAX_LINE, err, errlen);
     if (!r)
         return -1;
-    int rc = read_header(r) == 0 ? read_rows(r, max_rows, out) : -1;
-    if (amfi_csv_close(r, rc == 0) != 0) {
-        accel_csv_free(out);
+    int rc = read_header(r, out) == 0 ? read_rows(r, max_rows, out) : -1;
+    if (amfi_csv_close(r, rc == 0) != 0)
         rc = -1;
-    }
+    if (rc != 0)
+        accel_csv_free(out); /* nothing left behind, n_channels 0 */
     return rc;
 }
 
@@ -191,6 +251,7 @@ void accel_csv_free(accel_csv *c)
 {
     if (!c)
         return;
-    free(c->accel);
+    for (int k = 0; k < c->n_channels && k < ACCEL_CSV_MAX_CHANNELS; k++)
+        free(c->channel[k]);
     memset(c, 0, sizeof *c);
 }

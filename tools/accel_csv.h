@@ -9,6 +9,13 @@
  *     0.0002,-0.0456         t in s, strictly increasing and uniformly sampled;
  *     ...                    accel in m/s², positive downward
  *
+ * or several sensors, one column each, named by the sensor's id (the `id`
+ * of the site file's sensors, 0 .. 255, decimal without sign or leading
+ * zeros), in any order, each id once, 1 .. ACCEL_CSV_MAX_CHANNELS of them:
+ *
+ *     t,accel_0,accel_1,accel_2
+ *     0.0000,0.0123,0.0101,0.0098
+ *
  * Uniform means |Δt_k − Δt_mean| <= 1e-6·Δt_mean + 1e-9 s for every step, with
  * Δt_mean = (t_last − t_first)/(n − 1). Blank lines are allowed only at the end.
  *
@@ -31,12 +38,19 @@
 #define ACCEL_CSV_MIN_ROWS 16       /* fewer samples is an error */
 #define ACCEL_CSV_MAX_ROWS 50000000 /* more rows is an error */
 
+#define ACCEL_CSV_MAX_CHANNELS 8     /* accel columns (amfi.h's AMFI_MAX_SENSORS) */
+
 typedef struct accel_csv {
     int n;          /* samples, ACCEL_CSV_MIN_ROWS .. ACCEL_CSV_MAX_ROWS */
     double t0_s;    /* time of the first sample, s (the file's own clock) */
     double rate_hz; /* (n − 1) / (t_last − t_first), Hz */
-    double *accel;  /* n values, m/s², positive downward; owned, free with
-                       accel_csv_free() */
+    double *accel;  /* n values, m/s², positive downward: the first column
+                       (channel[0]); owned, free with accel_csv_free() */
+    int n_channels; /* accel columns, 1 .. ACCEL_CSV_MAX_CHANNELS */
+    int channel_id[ACCEL_CSV_MAX_CHANNELS]; /* sensor id of column k + 2
+                                               (accel_ID), −1 for 't,accel' */
+    double *channel[ACCEL_CSV_MAX_CHANNELS]; /* n values each, in the file's
+                                                column order; owned */
 } accel_csv;
 
 /* Read `path` (plain text or gzip, detected from the content; a name ending

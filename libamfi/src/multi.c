@@ -2,7 +2,9 @@
 /*
  * multi.c: several vehicles on the span solved together (issue 13). Every
  * vehicle's axles move at its own speed from its own entry time; all axles go
- * into one sweep (solver.c's amfi_solve_window/_lambda/_end), then each vehicle's GVW comes
+ * into one sweep (solver.c's amfi_solve_window/_lambda/_end), coincident
+ * axles (amfi.h, AMFI_MULTI_COINCIDENT_M: found from the geometry before
+ * any sweep) as one unknown, then each vehicle's GVW comes
  * from its own axles' mean forces, with a quality figure from a second sweep
  * at a tenth of λ (how far the weight moves when the regularisation that
  * decides the load split between close axles is loosened) and a
@@ -104,21 +106,110 @@ static int normal_matrix(const struct amfi_solver *s, double *A)
     return AMFI_OK;
 }
 
-/* Each vehicle's GVW, kg, from the sweep's forces in s->force: the sum of
- * its axles' mean forces while on the span (as amfi_solve_end). */
-static void vehicle_gvw(const struct amfi_solver *s, const amfi_multi_passage *p, double *gvw)
+/* Coincident axles. Axle a moves as x = vf[a]·t − off[a] and is on the span
+ * over [off/vf, (off + L)/vf]; the largest distance between two axles while
+ * either is on the span (their difference is linear in t: at the ends of
+ * the hull of the two intervals). */
+static double axle_gap_max(double L, double vfa, double offa, double vfb, double offb)
+{
+    const double t0 = fmin(offa / vfa, offb / vfb);
+    const double t1 = fmax((offa + L) / vfa, (offb + L) / vfb);
+    const double d0 = fabs((vfa - vfb) * t0 - (offa - offb));
+    const double d1 = fabs((vfa - vfb) * t1 - (offa - offb));
+    return fmax(d0, d1);
+}
+
+static int uf_root(int *parent, int a)
+{
+    while (parent[a] != a)
+        a = parent[a] = parent[parent[a]];
+    return a;
+}
+
+/* Join the sets of a and b, the smaller index the root (so a set's root is
+ * its first member). */
+static void uf_join(int *parent, int a, int b)
+{
+    a = uf_root(parent, a);
+    b = uf_root(parent, b);
+    if (a < b)
+        parent[b] = a;
+    else if (b < a)
+        parent[a] = b;
+}
+
+/* The event's unknowns: axles (vf, off: na of them, vehicle by vehicle;
+ * veh[a] the vehicle of axle a) within AMFI_MULTI_COINCIDENT_M of each
+ * other, or of one calculation step's travel when that is longer, all
+ * along their crossing are one unknown (transitively). unk[a]: the unknown
+ * of axle a, numbered in order of first axle; cnt[u]: its axles; vf_u,
+ * off_u: its trajectory, the mean of its axles'. vgroup[v]: the first
+ * vehicle whose axles share an unknown with v's (transitively; v itself
+ * when none do). Returns the number of unknowns. */
+static int coincident_axles(double L, double h, int na, const double *vf, const double *off,
+                            const int *veh, int nv, int *unk, int *cnt, double *vf_u,
+                            double *off_u, int *vgroup)
+{
+    int parent[AMFI_MAX_AXLES];
+    for (int a = 0; a < na; a++)
+        parent[a] = a;
+    for (int a = 0; a < na; a++)
+        for (int b = a + 1; b < na; b++) {
+            const double tol = fmax(AMFI_MULTI_COINCIDENT_M, fmax(vf[a], vf[b]) * h);
+            if (axle_gap_max(L, vf[a], off[a], vf[b], off[b]) <= tol)
+                uf_join(parent, a, b);
+        }
+    int nu = 0, first[AMFI_MAX_AXLES];
+    for (int a = 0; a < na; a++) {
+        const int r = uf_root(parent, a);
+        if (r == a) { /* the first axle of its set */
+            first[nu] = a;
+            unk[a] = nu++;
+        } else {
+            unk[a] = unk[r];
+        }
+    }
+    for (int u = 0; u < nu; u++) {
+        cnt[u] = 0;
+        vf_u[u] = 0.0;
+        off_u[u] = 0.0;
+    }
+    for (int a = 0; a < na; a++) {
+        cnt[unk[a]]++;
+        vf_u[unk[a]] += vf[a];
+        off_u[unk[a]] += off[a];
+    }
+    for (int u = 0; u < nu; u++) {
+        vf_u[u] /= cnt[u];
+        off_u[u] /= cnt[u];
+    }
+    int vp[AMFI_MAX_VEHICLES];
+    for (int v = 0; v < nv; v++)
+        vp[v] = v;
+    for (int a = 0; a < na; a++)
+        uf_join(vp, veh[a], veh[first[unk[a]]]);
+    for (int v = 0; v < nv; v++)
+        vgroup[v] = uf_root(vp, v);
+    return nu;
+}
+
+/* Each vehicle's GVW, kg, from the sweep's forces in s->force (one column
+ * per unknown): the sum of its axles' mean forces while on the span (as
+ * amfi_solve_end), an unknown of several axles shared evenly among them. */
+static void vehicle_gvw(const struct amfi_solver *s, const amfi_multi_passage *p,
+                        const int *unk, const int *cnt, double *gvw)
 {
     int i = 0;
     for (int v = 0; v < p->n_vehicles; v++) {
         gvw[v] = 0.0;
         for (int a = 0; a < p->vehicle[v].n_axles; a++, i++)
-            gvw[v] += amfi_axle_mean_force(s, i) / AMFI_GRAVITY;
+            gvw[v] += amfi_axle_mean_force(s, unk[i]) / cnt[unk[i]] / AMFI_GRAVITY;
     }
 }
 
-/* uᵀ M⁻¹ u for the SPD block M (k × k) of A at rows/cols first..first+k−1 (or
- * all of A when k == na), u = ones. */
-static int quad_inverse(const double *A, int na, int first, int k, double *out)
+/* uᵀ M⁻¹ u for the SPD block M of A (na × na) on the k rows/cols idx[0..k),
+ * u = ones. */
+static int quad_inverse(const double *A, int na, const int *idx, int k, double *out)
 {
     double *M = malloc(sizeof(double) * k * k);
     double *u = malloc(sizeof(double) * k);
@@ -129,7 +220,7 @@ static int quad_inverse(const double *A, int na, int first, int k, double *out)
     for (int i = 0; i < k; i++) {
         u[i] = 1.0;
         for (int j = 0; j < k; j++)
-            M[i * k + j] = A[(first + i) * na + first + j];
+            M[i * k + j] = A[idx[i] * na + idx[j]];
     }
     int rc = amfi_spd_solve(k, M, u);
     double v = 0.0;
@@ -138,6 +229,19 @@ static int quad_inverse(const double *A, int na, int first, int k, double *out)
     *out = v;
     free(M), free(u);
     return rc ? AMFI_ENUM : AMFI_OK;
+}
+
+/* Spread the forces of the nu unknowns in s->force ((N + 1) × nu) over the
+ * na axles ((N + 1) × na, in place: the workspace holds na_max >= na
+ * columns), an unknown's force shared evenly among its axles. */
+static void spread_forces(struct amfi_solver *s, int nu, int na, const int *unk, const int *cnt)
+{
+    double row[AMFI_MAX_AXLES];
+    for (int j = s->N; j >= 0; j--) { /* row j moves right: later rows first */
+        memcpy(row, s->force + (size_t)j * nu, sizeof(double) * nu);
+        for (int a = 0; a < na; a++)
+            s->force[(size_t)j * na + a] = row[unk[a]] / cnt[unk[a]];
+    }
 }
 
 int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lambda *lam,
@@ -189,22 +293,38 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
         return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory for %d axles", na);
     /* axle i of vehicle v at x = v·(t − entry) − offset_i = v·t − (v·entry + offset_i):
      * speed 1, the vehicle's speed as the axle's factor (solver_internal.h) */
-    s->speed = 1.0;
+    double vf[AMFI_MAX_AXLES], off[AMFI_MAX_AXLES];
+    int veh[AMFI_MAX_AXLES];
     int i = 0;
     for (int v = 0; v < p->n_vehicles; v++) {
         const amfi_vehicle *ve = &p->vehicle[v];
-        double off = 0.0;
+        double o = 0.0;
         for (int a = 0; a < ve->n_axles; a++, i++) {
             if (a > 0)
-                off += ve->axle_spacing_m[a - 1];
-            s->vf[i] = ve->speed_mps;
-            s->off[i] = ve->speed_mps * ve->entry_s + off;
+                o += ve->axle_spacing_m[a - 1];
+            vf[i] = ve->speed_mps;
+            off[i] = ve->speed_mps * ve->entry_s + o;
+            veh[i] = v;
         }
+    }
+    /* Coincident axles are one unknown, decided from the geometry before
+     * any sweep: the data fix only their sum (a constant difference of
+     * their forces changes neither the fit nor the smoothing term), so
+     * kept apart they leave the sweep's start singular, and whether its
+     * factorisation noticed depended on the BLAS's summation order. */
+    int unk[AMFI_MAX_AXLES], cnt[AMFI_MAX_AXLES], vgroup[AMFI_MAX_VEHICLES];
+    double vf_u[AMFI_MAX_AXLES], off_u[AMFI_MAX_AXLES];
+    const int nu = coincident_axles(L, s->h, na, vf, off, veh, p->n_vehicles, unk, cnt, vf_u,
+                                    off_u, vgroup);
+    s->speed = 1.0;
+    for (int u = 0; u < nu; u++) {
+        s->vf[u] = vf_u[u];
+        s->off[u] = off_u[u];
     }
     memset(res, 0, sizeof *res);
     double lam_h;
     int n_solves = 0;
-    if ((rc = amfi_solve_window(s, &samples, na, win.start_s, win.end_s, err, errlen)) != 0 ||
+    if ((rc = amfi_solve_window(s, &samples, nu, win.start_s, win.end_s, err, errlen)) != 0 ||
         (rc = amfi_solve_lambda(s, lam, &lam_h, &n_solves, err, errlen)) != 0)
         return rc;
     if (p->n_vehicles > 1 && p->lambda_factor > 0.0)
@@ -213,35 +333,20 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
      * sweep then leaves the answer in the workspace); one vehicle alone has
      * nothing to trade load with and needs no second sweep */
     double loose[AMFI_MAX_VEHICLES];
-    int unfixed = 0; /* a sweep failed numerically: quality AMFI_MULTI_QUALITY_UNFIXED */
     if (p->n_vehicles > 1) {
         double rn, sn;
         rc = amfi_sweep(s, lam_h * AMFI_MULTI_QUALITY_LAMBDA, &rn, &sn);
-        if (rc == AMFI_ENUM) /* axles of two vehicles at one point all along (side by
-                                side, entering together): the looser problem is
-                                singular; the answer at λ still stands */
-            unfixed = 1;
-        else if (rc != 0)
+        if (rc != 0)
             return amfi_fail(err, errlen, rc, "quality sweep failed: %s", amfi_strerror(rc));
         n_solves++;
-        if (!unfixed)
-            vehicle_gvw(s, p, loose);
+        vehicle_gvw(s, p, unk, cnt, loose);
     }
-    rc = amfi_solve_end(s, lam, lam_h, n_solves, &res->all, err, errlen);
-    /* the same at λ itself: the sweep can be singular to round-off (which
-     * one fails depends on the BLAS's summation order); the event is then
-     * solved at 10 λ (at most 100 λ, res->all.lambda_ref says which) and its
-     * vehicles marked unfixed */
-    for (int k = 0; rc == AMFI_ENUM && p->n_vehicles > 1 && k < 2; k++) {
-        unfixed = 1;
-        lam_h *= 10.0;
-        rc = amfi_solve_end(s, lam, lam_h, n_solves + k + 1, &res->all, err, errlen);
-    }
-    if (rc != 0)
+    if ((rc = amfi_solve_end(s, lam, lam_h, n_solves, &res->all, err, errlen)) != 0)
         return rc;
     REQ(isfinite(res->all.gvw_kg), AMFI_ENUM, "the joint solution is not finite");
 
-    double *A = malloc(sizeof(double) * na * na);
+    /* separability on the unknowns (s->na = nu still) */
+    double *A = malloc(sizeof(double) * nu * nu);
     if (!A)
         return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory");
     rc = normal_matrix(s, A);
@@ -249,15 +354,37 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
         free(A);
         return amfi_fail(err, errlen, rc, "quality: %s", amfi_strerror(rc));
     }
-    /* a relative ridge of 1e-12 keeps A invertible when two axles coincide */
+    /* a relative ridge of 1e-12 keeps A invertible for axles close to each
+     * other but outside the coincidence tolerance */
     double tr = 0.0;
-    for (int a = 0; a < na; a++)
-        tr += A[a * na + a];
-    for (int a = 0; a < na; a++)
-        A[a * na + a] += 1e-12 * tr / na;
+    for (int u = 0; u < nu; u++)
+        tr += A[u * nu + u];
+    for (int u = 0; u < nu; u++)
+        A[u * nu + u] += 1e-12 * tr / nu;
+
+    /* the joint result on the axles: an unknown's force and mean shared
+     * evenly among its axles (their sum is what the data fix) */
+    double mf[AMFI_MAX_AXLES];
+    memcpy(mf, res->all.mean_force_N, sizeof(double) * nu);
+    spread_forces(s, nu, na, unk, cnt);
+    s->na = na;
+    for (int a = 0; a < na; a++) {
+        s->vf[a] = vf[a];
+        s->off[a] = off[a];
+    }
+    res->all.n_axles = na;
+    res->all.force_N = s->force;
+    res->all.gvw_kg = 0.0;
+    for (int a = 0; a < na; a++) {
+        res->all.mean_force_N[a] = mf[unk[a]] / cnt[unk[a]];
+        res->all.axle_kg[a] = res->all.mean_force_N[a] / AMFI_GRAVITY;
+        res->all.gvw_kg += res->all.axle_kg[a];
+        res->axle_unknown[a] = unk[a];
+    }
+    res->n_unknowns = nu;
     res->n_vehicles = p->n_vehicles;
     res->total_gvw_kg = 0.0;
-    double *U = malloc(sizeof(double) * (na * na + na));
+    double *U = malloc(sizeof(double) * (nu * nu + nu));
     if (!U) {
         free(A);
         return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory");
@@ -267,24 +394,51 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
         amfi_vehicle_result *vr = &res->vehicle[v];
         vr->first_axle = i;
         vr->n_axles = p->vehicle[v].n_axles;
+        vr->group = vgroup[v];
+        vr->n_merged = 0;
         vr->gvw_kg = 0.0;
         for (int a = 0; a < vr->n_axles; a++) {
             vr->axle_kg[a] = res->all.axle_kg[i + a];
             vr->gvw_kg += vr->axle_kg[a];
+            for (int b = 0; b < na; b++)
+                if (unk[b] == unk[i + a] && veh[b] != v) {
+                    vr->n_merged++;
+                    break;
+                }
         }
         res->total_gvw_kg += vr->gvw_kg;
-        /* joint: uᵀA⁻¹u with u the vehicle's indicator over all axles */
-        memcpy(U, A, sizeof(double) * na * na);
-        double *u = U + na * na;
-        for (int a = 0; a < na; a++)
-            u[a] = (a >= i && a < i + vr->n_axles) ? 1.0 : 0.0;
+        i += vr->n_axles;
+    }
+    for (int v = 0; v < p->n_vehicles; v++) {
+        amfi_vehicle_result *vr = &res->vehicle[v];
+        int grouped = 0; /* other vehicles in its group */
+        vr->group_gvw_kg = 0.0;
+        for (int w = 0; w < p->n_vehicles; w++)
+            if (vgroup[w] == vgroup[v]) {
+                vr->group_gvw_kg += res->vehicle[w].gvw_kg;
+                grouped += w != v;
+            }
+        /* joint: uᵀA⁻¹u with u the indicator of the unknowns of its group's
+         * axles (the vehicle's own when it has no group) */
+        int idx[AMFI_MAX_AXLES], k = 0;
+        memcpy(U, A, sizeof(double) * nu * nu);
+        double *u = U + nu * nu;
+        for (int q = 0; q < nu; q++) {
+            int in = 0;
+            for (int a = 0; a < na; a++)
+                if (unk[a] == q && vgroup[veh[a]] == vgroup[v])
+                    in = 1;
+            u[q] = in;
+            if (in)
+                idx[k++] = q;
+        }
         double joint = NAN, alone = NAN;
-        rc = amfi_spd_solve(na, U, u) ? AMFI_ENUM : AMFI_OK;
+        rc = amfi_spd_solve(nu, U, u) ? AMFI_ENUM : AMFI_OK;
         if (!rc) {
             joint = 0.0;
-            for (int a = i; a < i + vr->n_axles; a++)
-                joint += u[a];
-            rc = quad_inverse(A, na, i, vr->n_axles, &alone);
+            for (int q = 0; q < k; q++)
+                joint += u[idx[q]];
+            rc = quad_inverse(A, nu, idx, k, &alone);
         }
         if (rc) {
             free(U), free(A);
@@ -294,7 +448,7 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
         vr->separability = sqrt(joint / alone);
         vr->gvw_sd_kg = res->all.residual_rms * sqrt(joint) / AMFI_GRAVITY;
         vr->quality = 1.0;
-        if (p->n_vehicles > 1 && unfixed) {
+        if (grouped) {
             vr->quality = AMFI_MULTI_QUALITY_UNFIXED;
         } else if (p->n_vehicles > 1) {
             vr->quality = 1.0 + 100.0 * fabs(loose[v] - vr->gvw_kg) / fabs(vr->gvw_kg);
@@ -304,7 +458,6 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
                                  v + 1);
             }
         }
-        i += vr->n_axles;
     }
     free(U), free(A);
 #undef REQ

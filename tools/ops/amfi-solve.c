@@ -10,8 +10,11 @@
  *              [--forces OUT.csv] [--lcurve OUT.csv]
  *              [--estimate-speed [--speed-sd FRACTION]]
  *
- * Reads a single-sensor passage CSV (tools/accel_csv.h), builds the site's
- * bridge and solver from the configuration (default: the shipped
+ * Reads a passage CSV (tools/accel_csv.h): 't,accel' for a site of one
+ * sensor, or 't,accel_ID,...' with a column for every sensor of the site
+ * (by its id; a site sensor without a column, a column of no site sensor,
+ * or 't,accel' for a site of several sensors is refused, naming them),
+ * builds the site's bridge and solver from the configuration (default: the shipped
  * paper-20m.yaml, or the built-in paper-20m defaults when that file is not
  * installed), solves, and prints one JSON object on one line to stdout.
  * With --estimate-speed (or solver.speed: estimate) --speed is the
@@ -85,8 +88,8 @@ static void usage(FILE *f)
             "   or: " PROG " ... --vehicle ENTRY_S:SPEED_MPS:S1[,S2,...] "
             "[--vehicle ...] (instead of --speed/--axle-spacing/--entry-time)\n"
             "\n"
-            "Solves one recorded passage (CSV 't,accel', plain or gzip) "
-            "and prints a JSON line.\n"
+            "Solves one recorded passage (CSV 't,accel', or 't,accel_ID,...' with a column\n"
+            "per sensor of the site by its id; plain or gzip) and prints a JSON line.\n"
             "  -c, --config FILE        site configuration (default: paper-20m.yaml\n"
             "                           from %s,\n"
             "                           else the built-in paper-20m values)\n"
@@ -296,13 +299,15 @@ static int parse_args(int argc, char **argv, options *o)
     return 0;
 }
 
-/* 0 loaded (or defaults because no file exists), −1 error reported. */
-static int load_config(const options *o, amfi_site_config *c)
+/* 0 loaded (or defaults because no file exists), −1 error reported. The
+ * site's name for messages into name: the file, or "built-in paper-20m". */
+static int load_config(const options *o, amfi_site_config *c, char *name, size_t namelen)
 {
     char err[512], found[4096];
     const char *file = o->config;
     if (!file && amfi_datafile_find(DEFAULT_CONFIG_NAME, found, sizeof found) == 0)
         file = found;
+    snprintf(name, namelen, "%s", file ? file : "built-in paper-20m");
     if (!file) {
         amfi_config_defaults(c);
         return 0;
@@ -312,6 +317,61 @@ static int load_config(const options *o, amfi_site_config *c)
         return -1;
     }
     return 0;
+}
+
+/* Append ", " and an id to a list. */
+static void add_id(char *list, size_t len, const char *prefix, int id)
+{
+    size_t used = strlen(list);
+    if (used < len)
+        snprintf(list + used, len - used, "%s%s%d", used ? ", " : "", prefix, id);
+}
+
+/* The CSV column of each site sensor: col[i] for sensor i of the site
+ * (c->sensor_id[i]). 't,accel' is the sensor of a one-sensor site; with
+ * several sensors every one needs its column 'accel_ID' and every column
+ * its sensor. 0, or −1 with one line on stderr naming the sensors and
+ * columns. */
+static int map_sensors(const char *path, const char *site, const amfi_site_config *c,
+                       const accel_csv *csv, int *col)
+{
+    const int ns = c->solver.n_sensors;
+    char ids[128] = "", missing[128] = "", unknown[160] = "";
+    for (int i = 0; i < ns; i++)
+        add_id(ids, sizeof ids, "", c->sensor_id[i]);
+    if (csv->channel_id[0] < 0) { /* 't,accel' */
+        if (ns == 1) {
+            col[0] = 0;
+            return 0;
+        }
+        fprintf(stderr,
+                "%s:1: one column 't,accel', but the site (%s) has %d sensors (ids %s): "
+                "give each its column, 't,accel_ID,...'\n",
+                path, site, ns, ids);
+        return -1;
+    }
+    for (int k = 0; k < csv->n_channels; k++) {
+        int i = 0;
+        while (i < ns && c->sensor_id[i] != csv->channel_id[k])
+            i++;
+        if (i == ns)
+            add_id(unknown, sizeof unknown, "accel_", csv->channel_id[k]);
+    }
+    for (int i = 0; i < ns; i++) {
+        int k = 0;
+        while (k < csv->n_channels && csv->channel_id[k] != c->sensor_id[i])
+            k++;
+        if (k == csv->n_channels)
+            add_id(missing, sizeof missing, "", c->sensor_id[i]);
+        col[i] = k;
+    }
+    if (!missing[0] && !unknown[0])
+        return 0;
+    fprintf(stderr, "%s:1: the site (%s) has sensors %s:%s%s%s%s%s\n", path, site, ids,
+            missing[0] ? " no column for sensor(s) " : "", missing,
+            missing[0] && unknown[0] ? ";" : "",
+            unknown[0] ? " column(s) of no sensor of the site: " : "", unknown);
+    return -1;
 }
 
 static double elapsed_ms(const struct timespec *a, const struct timespec *b)
@@ -450,6 +510,13 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
         json_decref(o);
         o = NULL;
     }
+    json_t *ids = o ? json_array() : NULL; /* the site's sensors, all in the solve */
+    for (int i = 0; ids && i < c->solver.n_sensors; i++)
+        json_array_append_new(ids, json_integer(c->sensor_id[i]));
+    if (o && json_object_set_new(o, "sensor_ids", ids)) {
+        json_decref(o);
+        o = NULL;
+    }
     if (o && m) { /* --vehicle: one object per vehicle, in the order given */
         json_t *vs = json_array();
         for (int v = 0; v < m->n_vehicles; v++) {
@@ -457,11 +524,20 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
             json_t *ak = json_array();
             for (int a = 0; a < vr->n_axles; a++)
                 json_array_append_new(ak, amfi_json_num(vr->axle_kg[a]));
-            json_array_append_new(
-                vs, json_pack("{s:o, s:o, s:o, s:o, s:o}", "gvw_kg", amfi_json_num(vr->gvw_kg),
-                              "axle_kg", ak, "quality", amfi_json_num(vr->quality),
-                              "gvw_sd_kg", amfi_json_num(vr->gvw_sd_kg), "separability",
-                              amfi_json_num(vr->separability)));
+            json_t *vo = json_pack("{s:o, s:o, s:o, s:o, s:o}", "gvw_kg",
+                                   amfi_json_num(vr->gvw_kg), "axle_kg", ak, "quality",
+                                   amfi_json_num(vr->quality), "gvw_sd_kg",
+                                   amfi_json_num(vr->gvw_sd_kg), "separability",
+                                   amfi_json_num(vr->separability));
+            int grouped = 0; /* axles shared with another vehicle's (coincident) */
+            for (int w = 0; w < m->n_vehicles; w++)
+                grouped |= w != v && m->vehicle[w].group == vr->group;
+            if (vo && grouped) {
+                json_object_set_new(vo, "group", json_integer(vr->group));
+                json_object_set_new(vo, "n_merged", json_integer(vr->n_merged));
+                json_object_set_new(vo, "group_gvw_kg", amfi_json_num(vr->group_gvw_kg));
+            }
+            json_array_append_new(vs, vo);
         }
         json_object_set_new(o, "vehicles", vs);
     }
@@ -476,7 +552,8 @@ int main(int argc, char **argv)
     amfi_set_blas_threads(1); /* small matrices: threads only spin */
 
     static amfi_site_config cfg; /* large; zeroed */
-    if (load_config(&o, &cfg) != 0)
+    char site[4096];
+    if (load_config(&o, &cfg, site, sizeof site) != 0)
         return EXIT_DATA;
     if (o.lambda) {
         if (strcmp(o.lambda, "auto") == 0) {
@@ -567,8 +644,6 @@ int main(int argc, char **argv)
     const double win_lo = win.start_s; /* never "-0" */
     const double win_hi = win.end_s;
 
-    /* single-sensor CSV: sensor 0 of the configuration */
-    cfg.solver.n_sensors = 1;
     if (cfg.solver.max_axles < n_axles)
         cfg.solver.max_axles = n_axles;
     /* the speed search reaches down to v·(1 − range·sd): a longer window */
@@ -588,6 +663,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s\n", err);
         goto done;
     }
+    int col[AMFI_MAX_SENSORS]; /* the CSV column of each site sensor */
+    if (map_sensors(o.accel, site, &cfg, &csv, col) != 0)
+        goto done;
     if (amfi_bridge_create(&cfg.bridge, &bridge, err, sizeof err) != 0) {
         fprintf(stderr, PROG ": bridge model: %s\n", err);
         goto done;
@@ -603,7 +681,8 @@ int main(int argc, char **argv)
     p.n_samples = csv.n;
     p.scan_rate_hz = csv.rate_hz;
     p.t_first_s = csv.t0_s - o.entry_time_s;
-    p.accel[0] = csv.accel;
+    for (int i = 0; i < cfg.solver.n_sensors; i++)
+        p.accel[i] = csv.channel[col[i]];
     p.speed_mps = o.speed_mps;
     p.n_axles = n_axles;
     for (int k = 0; k < o.n_spacings; k++)
@@ -612,7 +691,8 @@ int main(int argc, char **argv)
     mp.n_samples = csv.n;
     mp.scan_rate_hz = csv.rate_hz;
     mp.t_first_s = csv.t0_s;
-    mp.accel[0] = csv.accel;
+    for (int i = 0; i < cfg.solver.n_sensors; i++)
+        mp.accel[i] = csv.channel[col[i]];
 
     amfi_result res;
     memset(&res, 0, sizeof res);

@@ -9,11 +9,14 @@
  *
  * The bridge (from the configuration, with --damage applied) carries point
  * forces W_a·g·(1 + vary·sin(2π·vary_hz·t + 1.3a)) moving at --speed; its
- * response at sensor 0 comes from the Newmark integrator of libamfi (the
+ * response at the site's sensors comes from the Newmark integrator of libamfi (the
  * tests' independent reference, dt = 20 µs), sampled at --scan-rate, with
  * --pre seconds of rest before the first axle enters (t = --pre in the file)
  * and --post seconds after the last one leaves, plus Gaussian noise of
- * --noise × the signal's RMS (GSL, Mersenne Twister, --seed).
+ * --noise × each sensor's signal RMS (GSL, Mersenne Twister, --seed).
+ * A site of one sensor gives 't,accel'; of several, a column per sensor
+ * named by its id, 't,accel_ID,...' (tools/accel_csv.h), in the site
+ * file's order.
  * This is not vehicle-bridge interaction: the forces are prescribed. The
  * simulator (sim_publisher) models vehicles.
  *
@@ -159,28 +162,30 @@ int main(int argc, char **argv)
                  T = amfi_passage_window(L, speed, n_loads, spacing, pre, post).end_s;
     const int n_rest = (int)lround(pre * scan), n_move = (int)floor(T * scan) + 1;
     const int n = n_rest + n_move;
-    double *acc = calloc(n, sizeof(double));
+    const int ns = cfg.solver.n_sensors;
+    double *acc = calloc((size_t)n * ns, sizeof(double)); /* n × ns, row-major */
     if (!acc) {
         fprintf(stderr, "%s: out of memory\n", PROG);
         return 1;
     }
-    const double xs = cfg.solver.sensor_x_m[0];
     /* dt = 20 µs, or the nearest step that divides the sample interval */
     double dt = 1.0 / (scan * ceil(1.0 / (scan * 2e-5)));
-    if (amfi_forward_newmark(b, speed, n_loads, off, force, &f, 1, &xs, dt, scan, n_move,
-                             acc + n_rest, err, sizeof err)) {
+    if (amfi_forward_newmark(b, speed, n_loads, off, force, &f, ns, cfg.solver.sensor_x_m, dt,
+                             scan, n_move, acc + (size_t)n_rest * ns, err, sizeof err)) {
         fprintf(stderr, "%s: %s\n", PROG, err);
         return 1;
     }
     if (noise > 0) {
-        double rms = 0.0;
-        for (int i = 0; i < n; i++)
-            rms += acc[i] * acc[i];
-        rms = sqrt(rms / n);
         gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
         gsl_rng_set(rng, seed);
-        for (int i = 0; i < n; i++)
-            acc[i] += gsl_ran_gaussian(rng, noise * rms);
+        for (int si = 0; si < ns; si++) {
+            double rms = 0.0;
+            for (int i = 0; i < n; i++)
+                rms += acc[(size_t)i * ns + si] * acc[(size_t)i * ns + si];
+            rms = sqrt(rms / n);
+            for (int i = 0; i < n; i++)
+                acc[(size_t)i * ns + si] += gsl_ran_gaussian(rng, noise * rms);
+        }
         gsl_rng_free(rng);
     }
     size_t len = strlen(out);
@@ -196,10 +201,19 @@ int main(int argc, char **argv)
         return 1;
     }
     int bad = 0;
-    char line[96];
+    char line[64 + 24 * AMFI_MAX_SENSORS];
     for (int i = -1; i < n && !bad; i++) {
-        int k = i < 0 ? snprintf(line, sizeof line, "t,accel\n")
-                      : snprintf(line, sizeof line, "%.6f,%.9g\n", i / scan, acc[i]);
+        int k = i < 0 ? snprintf(line, sizeof line, "t")
+                      : snprintf(line, sizeof line, "%.6f", i / scan);
+        for (int si = 0; si < ns; si++) {
+            if (i >= 0)
+                k += snprintf(line + k, sizeof line - k, ",%.9g", acc[(size_t)i * ns + si]);
+            else if (ns == 1)
+                k += snprintf(line + k, sizeof line - k, ",accel");
+            else
+                k += snprintf(line + k, sizeof line - k, ",accel_%d", cfg.sensor_id[si]);
+        }
+        k += snprintf(line + k, sizeof line - k, "\n");
         bad = gz ? gzwrite(gzf, line, (unsigned)k) != k : fwrite(line, 1, k, fp) != (size_t)k;
     }
     bad |= gz ? gzclose(gzf) != Z_OK : fclose(fp) != 0;

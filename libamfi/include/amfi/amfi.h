@@ -430,8 +430,20 @@ double amfi_speed_dip_at(const amfi_speed_prior *p, const double *j, int n, int 
 
 #define AMFI_MAX_VEHICLES 8
 
-/* amfi_vehicle_result.quality when the second sweep failed numerically. */
+/* amfi_vehicle_result.quality of a vehicle whose axles share an unknown
+ * with another vehicle's (coincident axles, below): the data fix only the
+ * group's sum. */
 #define AMFI_MULTI_QUALITY_UNFIXED 1e6
+/* Coincident axles, m: two axles of an event (of two vehicles, or of one)
+ * whose distance stays within this, or within the distance the faster
+ * travels in one calculation step when that is longer, for as long as
+ * either is on the span (side by side on two lanes entering together, or
+ * one axle behind another's, at one speed) are one unknown of the solve
+ * (transitively). Decided from the geometry (entry times, speeds,
+ * spacings) before any sweep: only their sum is in the data (a constant
+ * difference of their forces changes neither the fit nor the smoothing
+ * term), and solved apart they leave the sweep singular. */
+#define AMFI_MULTI_COINCIDENT_M 0.01
 /* The factor on λ of amfi_solve_multi's second sweep (quality figure). */
 #define AMFI_MULTI_QUALITY_LAMBDA 0.1
 
@@ -470,6 +482,18 @@ typedef struct amfi_vehicle_result {
     int n_axles;
     double axle_kg[AMFI_MAX_AXLES]; /* mean force of its own axles on the span / g */
     double gvw_kg;
+    /* Coincident axles (AMFI_MULTI_COINCIDENT_M): the index, in the order
+     * given, of the first vehicle of this one's inseparable group (vehicles
+     * whose axles share an unknown, transitively), itself when it shares
+     * none; n_merged: its axles that share an unknown with another
+     * vehicle's. A shared unknown's force is split evenly among its axles
+     * in axle_kg and gvw_kg, which the data do not fix: only the group's
+     * sum, group_gvw_kg (= gvw_kg for a vehicle of no group), is. The
+     * vehicles of a group have quality AMFI_MULTI_QUALITY_UNFIXED, and
+     * gvw_sd_kg and separability are the group sum's. */
+    int group;
+    int n_merged;
+    double group_gvw_kg;
     /* How well this vehicle's weight is determined in the event: 1 + the
      * change of gvw_kg, in % of it, when the event is solved again at λ ×
      * AMFI_MULTI_QUALITY_LAMBDA. Load that close axles of different vehicles
@@ -478,10 +502,8 @@ typedef struct amfi_vehicle_result {
      * tenth by this figure holds 21-35 of the 60 largest errors of 300
      * pairs, separability 12-19). 1 exactly for a vehicle alone in its
      * event (no second sweep then). AMFI_MULTI_QUALITY_UNFIXED for every
-     * vehicle of an event whose second sweep, or whose sweep at λ, failed
-     * numerically (axles of two vehicles at one point all along; the
-     * event is then solved at 10 λ, at most 100 λ): the weights are still
-     * returned, but the data do not fix how they split. */
+     * vehicle of an inseparable group (coincident axles, above): the
+     * weights are still returned, but the data do not fix how they split. */
     double quality;
     /* σ·sqrt(uᵀA⁻¹u)/g with σ the joint fit's residual RMS: the posterior
      * standard deviation of the weight under the constant-axle-load model
@@ -501,7 +523,13 @@ typedef struct amfi_vehicle_result {
 
 typedef struct amfi_multi_result {
     amfi_result all; /* the joint solve: all axles, vehicle by vehicle in the
-                        order given; t0_s on the samples' clock */
+                        order given; t0_s on the samples' clock; the force
+                        and mean of an unknown of coincident axles split
+                        evenly among them */
+    int n_unknowns;  /* the axles' unknowns: all.n_axles less coincident ones */
+    int axle_unknown[AMFI_MAX_AXLES]; /* the unknown of each axle (numbered in
+                                         order of first axle); axles sharing
+                                         one were coincident */
     int n_vehicles;
     amfi_vehicle_result vehicle[AMFI_MAX_VEHICLES];
     double total_gvw_kg; /* Σ of the vehicles' GVW */
@@ -512,7 +540,8 @@ typedef struct amfi_multi_result {
 amfi_passage_times amfi_multi_window(double span_m, const amfi_multi_passage *p,
                                      double pre_roll_s, double post_roll_s);
 
-/* Solve all vehicles' axles in one sweep. The workspace grows (outside the
+/* Solve all vehicles' axles in one sweep, coincident axles as one unknown
+ * (AMFI_MULTI_COINCIDENT_M). The workspace grows (outside the
  * time loop) to the event's total axles and duration. Refused: no vehicles,
  * more than AMFI_MAX_VEHICLES, more than AMFI_MAX_AXLES axles in all
  * (AMFI_EINVAL); data not covering the window (AMFI_ERANGE). */
