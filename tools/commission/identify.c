@@ -1,0 +1,667 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/* identify.c: the three stages of commissioning (commission.h). */
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_multifit_nlinear.h>
+#include <gsl/gsl_sort.h>
+#include <gsl/gsl_statistics_double.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "commission.h"
+
+const char *const cm_param_names[CM_N_PARAMS] = {
+    "stiffness-to-mass ratio", "mass (common) scale", "bearing rotational stiffness",
+    "sensor offset", "detector clock offset", "detector speed scale"};
+
+/* finite-difference steps of the Jacobian, in the parameters' own units:
+ * larger than the jumps of the solve's window and grid */
+static const double fd_step[CM_N_PARAMS] = {0.004, 0.004, 0.05, 0.03, 0.0015, 0.002};
+
+/* κ below this is a pin (log κ is held there) */
+#define KAPPA_PIN 1e-3
+
+void cm_options_default(cm_options *o)
+{
+    memset(o, 0, sizeof *o);
+    for (int i = 0; i < CM_N_PARAMS; i++)
+        o->fit[i] = 1;
+    o->tail_s = 1.0;
+    o->search_rate_hz = 2000;
+    o->max_search_runs = 12;
+}
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+/* supports whose rotation is free (the bearings whose stiffness is fitted) */
+static int rotatable(const amfi_support *s) { return !s->restrain_theta; }
+
+static double design_EI(const amfi_site_config *d) { return d->bridge.E_pa * d->bridge.I_m4; }
+
+int cm_site_apply(const amfi_site_config *design, const double *p, amfi_site_config *out,
+                  char *err, size_t errlen)
+{
+    *out = *design;
+    amfi_bridge_params *b = &out->bridge;
+    const double sE = exp(p[CM_P_EI] + p[CM_P_MASS]), sM = exp(p[CM_P_MASS]);
+    b->E_pa *= sE;
+    b->density_kgm3 *= sM;
+    for (int i = 0; i < b->n_segments; i++) {
+        b->segments[i].EI_nm2 *= sE;
+        b->segments[i].mass_kgpm *= sM;
+    }
+    /* κ relative to the beam's own (updated) E·I: then every frequency
+     * goes as √r at a fixed κ, and the scan below can meet f1 exactly */
+    const double kappa = exp(p[CM_P_KAPPA]) > KAPPA_PIN ? exp(p[CM_P_KAPPA]) : 0.0;
+    for (int i = 0; i < b->n_supports; i++)
+        if (rotatable(&b->supports[i]))
+            b->supports[i].k_theta_nmprad = kappa * sE * design_EI(design) / b->span_m;
+    for (int s = 0; s < out->solver.n_sensors; s++) {
+        double x = design->solver.sensor_x_m[s] + p[CM_P_SENSOR];
+        if (!(x >= 0 && x <= b->span_m)) {
+            snprintf(err, errlen, "sensor %d moved to %.3f m, off the span", out->sensor_id[s], x);
+            return -1;
+        }
+        out->solver.sensor_x_m[s] = x;
+    }
+    return 0;
+}
+
+/* one model on the runs marked in use (NULL: all) */
+int cm_evaluate(const amfi_site_config *site, const double *p, const cm_runs *runs,
+                const cm_options *o, double calc_rate_hz, const int *use, cm_eval *ev,
+                char *err, size_t errlen)
+{
+    memset(ev, 0, sizeof *ev);
+    amfi_bridge *b = NULL;
+    amfi_solver *s = NULL;
+    if (amfi_bridge_create(&site->bridge, &b, err, errlen) != AMFI_OK)
+        return -1;
+    ev->f1_hz = amfi_bridge_omega(b)[0] / (2 * M_PI);
+    amfi_solver_params sp = site->solver;
+    sp.calc_rate_hz = calc_rate_hz;
+    sp.post_roll_s = o->tail_s;
+    sp.max_axles = AMFI_MAX_AXLES;
+    if (amfi_solver_create(b, &sp, &s, err, errlen) != AMFI_OK) {
+        amfi_bridge_destroy(b);
+        return -1;
+    }
+    const double scale = exp(p[CM_P_SPEED]), clock = p[CM_P_CLOCK];
+    int n = 0, rc = 0;
+    double sum_abs = 0, sum = 0, sum_res = 0;
+    for (int i = 0; i < runs->n; i++) {
+        if (use && !use[i])
+            continue;
+        const cm_run *r = &runs->run[i];
+        amfi_passage ps;
+        memset(&ps, 0, sizeof ps);
+        ps.n_samples = r->n_samples;
+        ps.scan_rate_hz = r->rate_hz;
+        ps.speed_mps = r->speed_mps / scale;
+        ps.n_axles = r->n_axles;
+        for (int a = 0; a + 1 < r->n_axles; a++)
+            ps.axle_spacing_m[a] = r->spacing_m[a] / scale;
+        ps.t_first_s = r->t0_s - (r->entry_s - clock);
+        for (int k = 0; k < site->solver.n_sensors; k++)
+            ps.accel[k] = r->accel[k];
+        amfi_result res;
+        char e2[256];
+        if (amfi_solve(s, &ps, &site->lambda, &res, e2, sizeof e2) != AMFI_OK) {
+            snprintf(err, errlen, "run %s (line %ld): %s", r->file, r->line, e2);
+            rc = -1;
+            break;
+        }
+        ev->gvw_err_pct[i] = 100.0 * (res.gvw_kg - r->gvw_kg) / r->gvw_kg;
+        for (int a = 0; a < r->n_axles; a++)
+            ev->axle_err_pct[i][a] = 100.0 * (res.axle_kg[a] - r->axle_kg[a]) / r->axle_kg[a];
+        ev->resid_rel[i] = res.signal_rms > 0 ? res.residual_rms / res.signal_rms : NAN;
+        sum_abs += fabs(ev->gvw_err_pct[i]);
+        sum += ev->gvw_err_pct[i];
+        sum_res += ev->resid_rel[i];
+        if (n == 0 || fabs(ev->gvw_err_pct[i]) > fabs(ev->worst_gvw_pct))
+            ev->worst_gvw_pct = ev->gvw_err_pct[i];
+        n++;
+    }
+    if (n > 0) {
+        ev->mean_abs_gvw_pct = sum_abs / n;
+        ev->mean_gvw_pct = sum / n;
+        ev->mean_resid_rel = sum_res / n;
+    }
+    amfi_solver_destroy(s);
+    amfi_bridge_destroy(b);
+    return rc;
+}
+
+/* ---- stage 1 ---------------------------------------------------------- */
+
+int cm_modal_identify(const cm_runs *runs, const amfi_site_config *design,
+                      const double *const *amb, const int *amb_n, const double *amb_rate,
+                      int n_amb, cm_result *res, char *err, size_t errlen)
+{
+    amfi_bridge *b = NULL;
+    if (amfi_bridge_create(&design->bridge, &b, err, errlen) != AMFI_OK)
+        return -1;
+    const double f_design = amfi_bridge_omega(b)[0] / (2 * M_PI);
+    const double f2 = amfi_bridge_omega(b)[1] / (2 * M_PI);
+    amfi_bridge_destroy(b);
+    /* a real bridge's f1 within a factor of two of its drawings' (springs,
+     * stiffness, mass), below the design's second mode */
+    const double lo = 0.5 * f_design, hi = fmin(2.0 * f_design, 0.5 * (f_design + f2) * 1.3);
+    double f[CM_MAX_RUNS + 64], z[CM_MAX_RUNS + 64];
+    int m = 0;
+    for (int i = 0; i < runs->n; i++) {
+        const cm_run *r = &runs->run[i];
+        amfi_passage_times w = amfi_passage_window(design->bridge.span_m, r->speed_mps,
+                                                   r->n_axles, r->spacing_m, 0, 0);
+        /* from 0.15 s after the last axle left (higher modes decayed) */
+        double t_from = r->entry_s + w.on_span_s + 0.15;
+        int k0 = (int)ceil((t_from - r->t0_s) * r->rate_hz);
+        if (k0 < 0 || k0 >= r->n_samples)
+            continue;
+        cm_modal md;
+        if (cm_modal_fit(r->accel[0] + k0, r->n_samples - k0, r->rate_hz, lo, hi, &md) == 0 &&
+            md.fit_rel < 0.5)
+            f[m] = md.f_hz, z[m++] = md.zeta;
+    }
+    for (int i = 0; i < n_amb && m < CM_MAX_RUNS + 64; i++) {
+        cm_modal md;
+        if (cm_modal_fit(amb[i], amb_n[i], amb_rate[i], lo, hi, &md) == 0 && md.fit_rel < 0.8)
+            f[m] = md.f_hz, z[m++] = md.zeta;
+    }
+    res->n_modal = m;
+    if (m < 3) {
+        snprintf(err, errlen,
+                 "the free vibration gave the first natural frequency in %d record%s; at least "
+                 "3 are needed (record at least %.1f s after each run, or give --ambient "
+                 "records)",
+                 m, m == 1 ? "" : "s", 4.0 / lo + 0.15);
+        return -1;
+    }
+    gsl_sort(f, 1, (size_t)m);
+    gsl_sort(z, 1, (size_t)m);
+    res->f1_meas_hz = gsl_stats_median_from_sorted_data(f, 1, (size_t)m);
+    res->zeta_meas = gsl_stats_median_from_sorted_data(z, 1, (size_t)m);
+    /* the standard error of the median, from the spread (1.2533 σ/√m) */
+    res->f1_meas_sd_hz = 1.2533 * gsl_stats_sd(f, 1, (size_t)m) / sqrt(m);
+    res->zeta_meas_sd = 1.2533 * gsl_stats_sd(z, 1, (size_t)m) / sqrt(m);
+    return 0;
+}
+
+/* ---- stage 2 ---------------------------------------------------------- */
+
+typedef struct nls {
+    const amfi_site_config *design;
+    const cm_runs *runs;
+    const cm_options *o;
+    const int *use;
+    int n_use;
+    int idx[CM_N_PARAMS]; /* fitted parameter k is p[idx[k]] */
+    int n_fit;
+    double p0[CM_N_PARAMS]; /* held values */
+    double f1, f1_sd;
+    int match_f1; /* CM_P_EI follows the others so that f1 is met exactly */
+    int evaluations;
+    char err[512];
+    int failed;
+} nls;
+
+/* residuals: the f1 term, then per run the GVW, the axles and the fit */
+static size_t n_resid(const nls *q, const cm_runs *runs)
+{
+    size_t m = 1;
+    for (int i = 0; i < runs->n; i++)
+        if (q->use[i])
+            m += 2 + (size_t)runs->run[i].n_axles;
+    return m;
+}
+
+static void unpack(const nls *q, const gsl_vector *x, double *p)
+{
+    memcpy(p, q->p0, sizeof q->p0);
+    for (int k = 0; k < q->n_fit; k++)
+        p[q->idx[k]] = gsl_vector_get(x, (size_t)k);
+}
+
+/* The stiffness-to-mass ratio that gives the measured f1 with the other
+ * parameters in p (every frequency goes as √r: exact). f1 is measured to a
+ * few hundredths of a percent, far tighter than anything else fixes r, so
+ * r follows the bearings along that constraint instead of being a free
+ * parameter strongly correlated with them. */
+static int match_f1(const amfi_site_config *design, double f1_meas, double *p, char *err,
+                    size_t errlen)
+{
+    amfi_site_config st;
+    amfi_bridge *b = NULL;
+    p[CM_P_EI] = 0;
+    if (cm_site_apply(design, p, &st, err, errlen) != 0 ||
+        amfi_bridge_create(&st.bridge, &b, err, errlen) != AMFI_OK)
+        return -1;
+    p[CM_P_EI] = 2 * log(f1_meas / (amfi_bridge_omega(b)[0] / (2 * M_PI)));
+    amfi_bridge_destroy(b);
+    return 0;
+}
+
+static int residuals(const gsl_vector *x, void *user, gsl_vector *f)
+{
+    nls *q = user;
+    double p[CM_N_PARAMS];
+    unpack(q, x, p);
+    amfi_site_config site;
+    cm_eval ev;
+    q->evaluations++;
+    if ((q->match_f1 && match_f1(q->design, q->f1, p, q->err, sizeof q->err) != 0) ||
+        cm_site_apply(q->design, p, &site, q->err, sizeof q->err) != 0 ||
+        cm_evaluate(&site, p, q->runs, q->o, q->o->search_rate_hz, q->use, &ev, q->err,
+                    sizeof q->err) != 0) {
+        /* a model that cannot be solved: a large residual steers the trust
+         * region back */
+        for (size_t i = 0; i < f->size; i++)
+            gsl_vector_set(f, i, 1e3);
+        q->failed = 1;
+        return GSL_SUCCESS;
+    }
+    size_t m = 0;
+    gsl_vector_set(f, m++, (ev.f1_hz - q->f1) / q->f1_sd);
+    for (int i = 0; i < q->runs->n; i++) {
+        if (!q->use[i])
+            continue;
+        const cm_run *r = &q->runs->run[i];
+        gsl_vector_set(f, m++, ev.gvw_err_pct[i] / 100.0);
+        for (int a = 0; a < r->n_axles; a++)
+            gsl_vector_set(f, m++, 0.5 * ev.axle_err_pct[i][a] / 100.0 * r->axle_kg[a] / r->gvw_kg);
+        gsl_vector_set(f, m++, ev.resid_rel[i]);
+    }
+    if (q->o->verbose)
+        fprintf(stderr, "amfi-commission: eval %d: EI x%.4f mass x%.4f kappa %.3f sensor %+.3f m "
+                        "clock %+.4f s speed x%.4f: f1 %.4f Hz, GVW mean |err| %.2f %%, fit %.4f\n",
+                q->evaluations, exp(p[CM_P_EI] + p[CM_P_MASS]), exp(p[CM_P_MASS]),
+                exp(p[CM_P_KAPPA]), p[CM_P_SENSOR], p[CM_P_CLOCK],
+                exp(p[CM_P_SPEED]), ev.f1_hz, ev.mean_abs_gvw_pct, ev.mean_resid_rel);
+    return GSL_SUCCESS;
+}
+
+/* forward differences with fixed steps per parameter */
+static int jacobian(const gsl_vector *x, void *user, gsl_matrix *J)
+{
+    nls *q = user;
+    const size_t m = J->size1;
+    gsl_vector *f0 = gsl_vector_alloc(m), *f1 = gsl_vector_alloc(m), *xh = gsl_vector_alloc(x->size);
+    if (!f0 || !f1 || !xh) {
+        gsl_vector_free(f0);
+        gsl_vector_free(f1);
+        gsl_vector_free(xh);
+        return GSL_ENOMEM;
+    }
+    residuals(x, user, f0);
+    for (int k = 0; k < q->n_fit; k++) {
+        gsl_vector_memcpy(xh, x);
+        double h = fd_step[q->idx[k]];
+        gsl_vector_set(xh, (size_t)k, gsl_vector_get(x, (size_t)k) + h);
+        residuals(xh, user, f1);
+        for (size_t i = 0; i < m; i++)
+            gsl_matrix_set(J, i, (size_t)k, (gsl_vector_get(f1, i) - gsl_vector_get(f0, i)) / h);
+    }
+    gsl_vector_free(f0);
+    gsl_vector_free(f1);
+    gsl_vector_free(xh);
+    return GSL_SUCCESS;
+}
+
+/* runs used while searching: up to max, spread over the speeds and the
+ * trucks (every k-th run in speed order) */
+static int pick_runs(const cm_runs *runs, int max, int *use)
+{
+    double sp[CM_MAX_RUNS];
+    size_t order[CM_MAX_RUNS];
+    for (int i = 0; i < runs->n; i++) {
+        sp[i] = runs->run[i].speed_mps;
+        use[i] = 0;
+    }
+    gsl_sort_index(order, sp, 1, (size_t)runs->n);
+    int n = runs->n < max ? runs->n : max;
+    for (int k = 0; k < n; k++)
+        use[order[(size_t)((k + 0.5) * runs->n / n)]] = 1;
+    return n;
+}
+
+static int run_nls(nls *q, double *p, double *sd, double cov_out[CM_N_PARAMS][CM_N_PARAMS],
+                   double *corr_max, int *ci, int *cj, int *iterations, int max_iter, char *err,
+                   size_t errlen)
+{
+    const size_t m = n_resid(q, q->runs), np = (size_t)q->n_fit;
+    gsl_multifit_nlinear_fdf fdf = {.f = residuals, .df = jacobian, .fvv = NULL, .n = m,
+                                    .p = np, .params = q};
+    gsl_multifit_nlinear_parameters fp = gsl_multifit_nlinear_default_parameters();
+    fp.scale = gsl_multifit_nlinear_scale_more;
+    gsl_multifit_nlinear_workspace *ws =
+        gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &fp, m, np);
+    gsl_vector *x = gsl_vector_alloc(np);
+    gsl_matrix *cov = gsl_matrix_alloc(np, np);
+    if (!ws || !x || !cov) {
+        gsl_multifit_nlinear_free(ws);
+        gsl_vector_free(x);
+        gsl_matrix_free(cov);
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    for (size_t k = 0; k < np; k++)
+        gsl_vector_set(x, k, p[q->idx[k]]);
+    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    int info = 0, rc = gsl_multifit_nlinear_init(x, &fdf, ws);
+    if (rc == GSL_SUCCESS)
+        rc = gsl_multifit_nlinear_driver((size_t)max_iter, 1e-4, 1e-8, 1e-8, NULL, NULL, &info,
+                                         ws);
+    gsl_set_error_handler(old);
+    int ret = 0;
+    if (rc != GSL_SUCCESS && rc != GSL_EMAXITER && rc != GSL_ENOPROG) {
+        snprintf(err, errlen, "the model update did not converge (%s)%s%s", gsl_strerror(rc),
+                 q->failed ? ": " : "", q->failed ? q->err : "");
+        ret = -1;
+    } else {
+        *iterations = (int)gsl_multifit_nlinear_niter(ws);
+        unpack(q, ws->x, p);
+        /* covariance (JᵀJ)⁻¹ scaled by the residual variance */
+        gsl_matrix *Jm = gsl_multifit_nlinear_jac(ws);
+        gsl_multifit_nlinear_covar(Jm, 1e-10, cov);
+        double chi;
+        gsl_blas_ddot(ws->f, ws->f, &chi);
+        double s2 = m > np ? chi / (double)(m - np) : chi;
+        *corr_max = 0;
+        *ci = *cj = -1;
+        for (int k = 0; k < CM_N_PARAMS; k++) {
+            sd[k] = NAN;
+            for (int l = 0; l < CM_N_PARAMS; l++)
+                cov_out[k][l] = 0;
+        }
+        for (size_t k = 0; k < np; k++)
+            for (size_t l = 0; l < np; l++)
+                cov_out[q->idx[k]][q->idx[l]] = s2 * gsl_matrix_get(cov, k, l);
+        for (size_t k = 0; k < np; k++) {
+            sd[q->idx[k]] = sqrt(s2 * gsl_matrix_get(cov, k, k));
+            for (size_t l = 0; l < k; l++) {
+                double c = gsl_matrix_get(cov, k, l) /
+                           sqrt(gsl_matrix_get(cov, k, k) * gsl_matrix_get(cov, l, l));
+                if (fabs(c) > *corr_max) {
+                    *corr_max = fabs(c);
+                    *ci = q->idx[k];
+                    *cj = q->idx[l];
+                }
+            }
+        }
+    }
+    gsl_multifit_nlinear_free(ws);
+    gsl_vector_free(x);
+    gsl_matrix_free(cov);
+    return ret;
+}
+
+/* ---- stage 3 and the whole ------------------------------------------- */
+
+/* GVW as amfid weighs (o_weigh: the site's post-roll), the fit with the
+ * free vibration in the window (o: the tail), at the site's rate */
+static int evaluate_both(const amfi_site_config *site, const double *p, const cm_runs *runs,
+                         const cm_options *o, const cm_options *o_weigh, cm_eval *ev, char *err,
+                         size_t errlen)
+{
+    cm_eval fit;
+    if (cm_evaluate(site, p, runs, o_weigh, site->solver.calc_rate_hz, NULL, ev, err, errlen) !=
+            0 ||
+        cm_evaluate(site, p, runs, o, site->solver.calc_rate_hz, NULL, &fit, err, errlen) != 0)
+        return -1;
+    memcpy(ev->resid_rel, fit.resid_rel, sizeof fit.resid_rel);
+    ev->mean_resid_rel = fit.mean_resid_rel;
+    return 0;
+}
+
+int cm_identify(const amfi_site_config *design0, const cm_runs *runs,
+                const double *const *amb, const int *amb_n, const double *amb_rate, int n_amb,
+                const cm_options *o0, cm_result *res, char *err, size_t errlen)
+{
+    const double t_start = now_s();
+    memset(res, 0, sizeof *res);
+    cm_options o = *o0;
+    /* the tail the runs allow: the shortest free vibration after a run */
+    for (int i = 0; i < runs->n; i++) {
+        const cm_run *r = &runs->run[i];
+        amfi_passage_times w = amfi_passage_window(design0->bridge.span_m, r->speed_mps,
+                                                   r->n_axles, r->spacing_m, 0, 0);
+        double avail = r->t0_s + (r->n_samples - 1) / r->rate_hz - (r->entry_s + w.on_span_s);
+        if (avail - 0.1 < o.tail_s)
+            o.tail_s = avail - 0.1;
+    }
+    if (o.tail_s < 0.3) {
+        snprintf(err, errlen, "the runs keep only %.2f s of free vibration after the last "
+                 "axle: record at least 1 s more", o.tail_s + 0.1);
+        return -1;
+    }
+    /* speeds: the clock offset and the speed scale separate only over a
+     * spread of speeds */
+    double vmin = INFINITY, vmax = 0;
+    for (int i = 0; i < runs->n; i++) {
+        vmin = fmin(vmin, runs->run[i].speed_mps);
+        vmax = fmax(vmax, runs->run[i].speed_mps);
+    }
+    if ((o.fit[CM_P_CLOCK] || o.fit[CM_P_SPEED]) && vmax / vmin < 1.15) {
+        snprintf(err, errlen,
+                 "the runs' speeds (%.1f .. %.1f m/s) are too alike to tell the detector's "
+                 "clock offset from its speed scale: spread them over at least 15 %% "
+                 "(COST 323: the site's range of speeds) or hold one of the two",
+                 vmin, vmax);
+        return -1;
+    }
+    /* stage 1 */
+    if (cm_modal_identify(runs, design0, amb, amb_n, amb_rate, n_amb, res, err, errlen) != 0)
+        return -1;
+    amfi_site_config design = *design0;
+    design.bridge.damping_ratio = res->zeta_meas;
+    int max_axles = 1;
+    for (int i = 0; i < runs->n; i++)
+        if (runs->run[i].n_axles > max_axles)
+            max_axles = runs->run[i].n_axles;
+    if (design.solver.max_axles < max_axles)
+        design.solver.max_axles = max_axles;
+
+    int any_rot = 0;
+    for (int i = 0; i < design.bridge.n_supports; i++)
+        any_rot |= rotatable(&design.bridge.supports[i]);
+    o.fit[CM_P_KAPPA] &= any_rot;
+
+    /* the design as it is: weighed as amfid weighs, and its fit with the
+     * free vibration in the window */
+    cm_options o_weigh = o;
+    o_weigh.tail_s = design0->solver.post_roll_s;
+    double p[CM_N_PARAMS] = {0};
+    if (evaluate_both(design0, p, runs, &o, &o_weigh, &res->before, err, errlen) != 0)
+        return -1;
+
+    int use[CM_MAX_RUNS];
+    nls q;
+    memset(&q, 0, sizeof q);
+    q.design = &design;
+    q.runs = runs;
+    q.o = &o;
+    q.use = use;
+    q.n_use = pick_runs(runs, o.max_search_runs, use);
+    q.f1 = res->f1_meas_hz;
+    /* f1 is weighted by its spread, but never tighter than 0.02 % (the
+     * model's own discretisation) */
+    q.f1_sd = fmax(res->f1_meas_sd_hz, 2e-4 * res->f1_meas_hz);
+
+    /* Stage 2a: the bearings scanned. For each κ the stiffness-to-mass
+     * ratio that gives the measured f1 (ω ∝ √r at a fixed κ: exact) and
+     * the common scale that the loads ask (forces ∝ c), then the cost of
+     * the whole residual vector. The design's κ is where the scan starts. */
+    double kd = 0;
+    for (int i = 0; i < design.bridge.n_supports; i++)
+        if (rotatable(&design.bridge.supports[i]) && design.bridge.supports[i].k_theta_nmprad > 0)
+            kd = design.bridge.supports[i].k_theta_nmprad * design.bridge.span_m /
+                 design_EI(&design);
+    double kgrid[16] = {kd};
+    int nk = 1;
+    if (o.fit[CM_P_KAPPA]) {
+        static const double g[] = {0, 0.1, 0.25, 0.5, 1, 2, 4, 8, 20, 60};
+        for (size_t i = 0; i < sizeof g / sizeof g[0]; i++)
+            if (fabs(g[i] - kd) > 1e-9)
+                kgrid[nk++] = g[i];
+    }
+    const size_t m = n_resid(&q, runs);
+    gsl_vector *fv = gsl_vector_alloc(m);
+    gsl_vector *xv = gsl_vector_alloc(CM_N_PARAMS);
+    if (!fv || !xv) {
+        gsl_vector_free(fv);
+        gsl_vector_free(xv);
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    double best_cost = INFINITY, best_p[CM_N_PARAMS] = {0};
+    q.n_fit = CM_N_PARAMS; /* residuals() reads every parameter from x here */
+    for (int k = 0; k < CM_N_PARAMS; k++)
+        q.idx[k] = k;
+    for (int g = 0; g < nk; g++) {
+        double pk[CM_N_PARAMS] = {0};
+        pk[CM_P_KAPPA] = log(kgrid[g] > KAPPA_PIN ? kgrid[g] : 0.1 * KAPPA_PIN);
+        amfi_site_config st;
+        amfi_bridge *b = NULL;
+        cm_eval ev;
+        if (cm_site_apply(&design, pk, &st, err, errlen) != 0 ||
+            amfi_bridge_create(&st.bridge, &b, err, errlen) != AMFI_OK)
+            goto scan_fail;
+        pk[CM_P_EI] = 2 * log(res->f1_meas_hz / (amfi_bridge_omega(b)[0] / (2 * M_PI)));
+        amfi_bridge_destroy(b);
+        if (cm_site_apply(&design, pk, &st, err, errlen) != 0 ||
+            cm_evaluate(&st, pk, runs, &o, o.search_rate_hz, use, &ev, err, errlen) != 0)
+            goto scan_fail;
+        pk[CM_P_MASS] = -log1p(ev.mean_gvw_pct / 100.0);
+        for (int k = 0; k < CM_N_PARAMS; k++)
+            gsl_vector_set(xv, (size_t)k, pk[k]);
+        residuals(xv, &q, fv);
+        double c;
+        gsl_blas_ddot(fv, fv, &c);
+        if (q.failed)
+            c = INFINITY, q.failed = 0;
+        res->kappa_grid[g] = kgrid[g];
+        res->kappa_cost[g] = c;
+        if (o.verbose)
+            fprintf(stderr, "amfi-commission: bearings kL/EI = %g: cost %.5g\n", kgrid[g], c);
+        if (c < best_cost) {
+            best_cost = c;
+            memcpy(best_p, pk, sizeof pk);
+        }
+        continue;
+    scan_fail:
+        gsl_vector_free(fv);
+        gsl_vector_free(xv);
+        return -1;
+    }
+    gsl_vector_free(fv);
+    gsl_vector_free(xv);
+    res->n_kappa = nk;
+    memcpy(p, best_p, sizeof p);
+    /* a pin stays a pin: log κ has no slope there */
+    if (exp(p[CM_P_KAPPA]) <= KAPPA_PIN)
+        o.fit[CM_P_KAPPA] = 0;
+
+    /* Stage 2b: every fitted parameter from the scan's best, the ratio
+     * following f1 */
+    q.n_fit = 0;
+    q.match_f1 = o.fit[CM_P_EI];
+    for (int k = 0; k < CM_N_PARAMS; k++)
+        if (o.fit[k] && k != CM_P_EI)
+            q.idx[q.n_fit++] = k;
+    memcpy(q.p0, p, sizeof p);
+    if (q.n_fit > 0) {
+        if (run_nls(&q, p, res->sd, res->cov, &res->corr_max, &res->corr_i, &res->corr_j,
+                    &res->iterations, 40, err, errlen) != 0)
+            return -1;
+        res->evaluations = q.evaluations;
+        if (q.match_f1) {
+            /* log r = 2 log(f1_meas / f1(others)): its variance from f1's
+             * and, through the bearings, from κ's (d log r / d log κ by a
+             * difference) */
+            double pk[CM_N_PARAMS];
+            memcpy(pk, p, sizeof pk);
+            if (match_f1(&design, q.f1, p, err, errlen) != 0)
+                return -1;
+            double d = 0;
+            if (o.fit[CM_P_KAPPA]) {
+                pk[CM_P_KAPPA] += fd_step[CM_P_KAPPA];
+                if (match_f1(&design, q.f1, pk, err, errlen) != 0)
+                    return -1;
+                d = (pk[CM_P_EI] - p[CM_P_EI]) / fd_step[CM_P_KAPPA];
+            }
+            double sf = 2 * res->f1_meas_sd_hz / res->f1_meas_hz;
+            for (int k = 0; k < CM_N_PARAMS; k++)
+                res->cov[CM_P_EI][k] = res->cov[k][CM_P_EI] = d * res->cov[CM_P_KAPPA][k];
+            res->cov[CM_P_EI][CM_P_EI] = sf * sf + d * d * res->cov[CM_P_KAPPA][CM_P_KAPPA];
+            res->sd[CM_P_EI] = sqrt(res->cov[CM_P_EI][CM_P_EI]);
+        }
+        if (res->corr_max > 0.98) {
+            snprintf(err, errlen,
+                     "the runs cannot tell the %s from the %s (correlation %.3f): they trade "
+                     "against each other; add runs at other speeds or with another truck, "
+                     "or hold one of them",
+                     cm_param_names[res->corr_i], cm_param_names[res->corr_j], res->corr_max);
+            return -1;
+        }
+    } else {
+        for (int k = 0; k < CM_N_PARAMS; k++)
+            res->sd[k] = NAN;
+    }
+    memcpy(res->p, p, sizeof p);
+    if (cm_site_apply(&design, p, &res->site, err, errlen) != 0)
+        return -1;
+
+    /* stage 3: λ over a grid, judged on the runs left out */
+    static const double grid[] = {1e-10, 3e-10, 1e-9, 3e-9, 7.94e-9, 2e-8, 6e-8, 2e-7, 6e-7};
+    enum { NG = sizeof grid / sizeof grid[0] };
+    static double err_g[NG][CM_MAX_RUNS];
+    amfi_site_config s = res->site;
+    s.lambda.automatic = 0;
+    s.lambda.ref_rate_hz = design.lambda.ref_rate_hz;
+    for (int g = 0; g < NG; g++) {
+        cm_eval ev;
+        s.lambda.lambda_ref = grid[g];
+        if (cm_evaluate(&s, p, runs, &o_weigh, design.solver.calc_rate_hz, NULL, &ev, err,
+                        errlen) != 0)
+            return -1;
+        memcpy(err_g[g], ev.gvw_err_pct, sizeof ev.gvw_err_pct);
+    }
+    int best = 0;
+    double best_lcost = INFINITY;
+    for (int g = 0; g < NG; g++) {
+        double c = 0;
+        for (int i = 0; i < runs->n; i++)
+            c += err_g[g][i] * err_g[g][i];
+        if (c < best_lcost)
+            best_lcost = c, best = g;
+    }
+    for (int i = 0; i < runs->n; i++) { /* λ picked without run i */
+        int bg = 0;
+        double bc = INFINITY;
+        for (int g = 0; g < NG; g++) {
+            double c = 0;
+            for (int j = 0; j < runs->n; j++)
+                if (j != i)
+                    c += err_g[g][j] * err_g[g][j];
+            if (c < bc)
+                bc = c, bg = g;
+        }
+        res->loo_gvw_err_pct[i] = err_g[bg][i];
+    }
+    res->lambda_ref = grid[best];
+    res->site.lambda.automatic = 0;
+    res->site.lambda.lambda_ref = grid[best];
+    if (evaluate_both(&res->site, p, runs, &o, &o_weigh, &res->after, err, errlen) != 0)
+        return -1;
+    res->seconds = now_s() - t_start;
+    return 0;
+}
