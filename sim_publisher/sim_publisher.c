@@ -533,7 +533,8 @@ typedef struct planned {
                             --environment site) */
     double entry_s;      /* sim time */
     int added, announced;
-    double spacing;
+    int n_axles;
+    double spacing[AMFI_MAX_AXLES]; /* n_axles − 1 */
     int lane;            /* 1-based */
     double start_s;      /* its approach starts (sim time) */
     double reference_kg; /* the calibration truck: its static GVW; else 0 */
@@ -639,7 +640,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         seed_vehicle(rng, o->seed, o->first + i);
         if (amfi_passage_spec_from_rec(rec, &w->dist, w->prof, o->track_std, rng, &spec, err,
                                        sizeof err)) {
-            fprintf(stderr, "%s: %s: vehicle %d: %s\n", PROG, ppath, ri + 1, err);
+            fprintf(stderr, "%s: %s:%ld: vehicle %d: %s\n", PROG, ppath, rec->line, ri + 1, err);
             goto out;
         }
         t = i ? t + gap : sp.approach_m / spec.speed_mps + 1.0;
@@ -662,11 +663,17 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         plan[i].v.id = o->first + i + 1;
         plan[i].rec = ri;
         plan[i].v.car = spec.car;
+        plan[i].v.truck = spec.truck;
         plan[i].v.speed_mps = spec.speed_mps;
         plan[i].v.t_entry_s = t;
         plan[i].start_s = t - sp.approach_m / spec.speed_mps;
         plan[i].v.track = spec.track;
-        plan[i].spacing = spec.car.D1_m + spec.car.D2_m;
+        {
+            double W[AMFI_MAX_AXLES], x[AMFI_MAX_AXLES];
+            plan[i].n_axles = amfi_passage_axles(&spec, W, x);
+            for (int a = 1; a < plan[i].n_axles; a++)
+                plan[i].spacing[a - 1] = x[a] - x[a - 1];
+        }
         plan[i].reference_kg = calib ? rec->axle_kg[0] + rec->axle_kg[1] : 0.0;
     }
     if (o->flow > 0) {
@@ -738,9 +745,11 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             if (o->speed_err_mean != 0 || o->speed_err_std > 0)
                 speed *= 1.0 + o->speed_err_mean +
                          (o->speed_err_std > 0 ? gsl_ran_gaussian(noise, o->speed_err_std) : 0.0);
-            double spacing = p->spacing;
+            double spacing[AMFI_MAX_AXLES];
+            memcpy(spacing, p->spacing, sizeof spacing);
             amfi_vehicle_t m = {o->start_utime + (int64_t)llround(p->entry_s * 1e6), p->v.id, p->lane,
-                                speed, 2, 1, &spacing, PROG, p->reference_kg};
+                                speed, (int16_t)p->n_axles, (int16_t)(p->n_axles - 1), spacing,
+                                PROG, p->reference_kg};
             if (EMIT(&b, amfi_vehicle_t, cfg->daemon.ch_vehicle, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
                 goto out;
@@ -782,9 +791,16 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         amfi_sim_vehicle d;
         while (amfi_sim_pop_done(sim, &d)) {
             const amfi_vehicle_rec *rec = &recs[plan[d.id - 1 - o->first].rec];
-            double axle[2] = {rec->axle_kg[0], rec->axle_kg[1]};
+            /* the static loads simulated: the record's (a load-sharing
+             * group's equalised) */
+            const int na = d.truck.n_axles;
+            double axle[AMFI_MAX_AXLES], gvw = 0.0;
+            for (int a = 0; a < na; a++) {
+                axle[a] = na == 2 ? rec->axle_kg[a] : d.truck.W_N[a] / AMFI_GRAVITY;
+                gvw += axle[a];
+            }
             amfi_truth_t m = {o->start_utime + (int64_t)llround(d.t_entry_s * 1e6), d.id,
-                              axle[0] + axle[1], 2, axle, d.mean_force_N, d.speed_mps};
+                              gvw, (int16_t)na, axle, d.mean_force_N, d.speed_mps};
             if (EMIT(&b, amfi_truth_t, cfg->daemon.ch_truth, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
                 goto out;
@@ -903,14 +919,16 @@ int main(int argc, char **argv)
     }
     fprintf(meta, "name,speed_mps,speed_true_mps,axle_spacing_m,entry_time_s,gvw_kg,axle1_kg,"
                   "axle2_kg,mean_force1_N,mean_force2_N,damage,noise,profile,track,"
-                  "preceding_gap_s,lost_contact_steps,scan_rate_hz,sensor_x_m\n");
+                  "preceding_gap_s,lost_contact_steps,scan_rate_hz,sensor_x_m,n_axles,"
+                  "axle_spacings_m,axle_kgs,mean_forces_N\n");
     for (long i = 0; i < o.vehicles; i++) {
         const amfi_vehicle_rec *rec = &recs[o.first + i];
         amfi_passage_spec spec;
         seed_vehicle(rng, o.seed, o.first + i);
         if (amfi_passage_spec_from_rec(rec, &dist, prof, o.track_std, rng, &spec, err,
                                        sizeof err)) {
-            fprintf(stderr, "%s: %s: vehicle %ld: %s\n", PROG, ppath, o.first + i + 1, err);
+            fprintf(stderr, "%s: %s:%ld: vehicle %ld: %s\n", PROG, ppath, rec->line,
+                    o.first + i + 1, err);
             goto out;
         }
         spec.pre_s = o.pre;
@@ -921,12 +939,13 @@ int main(int argc, char **argv)
             amfi_passage_spec ps;
             if (amfi_passage_spec_from_rec(p, &dist, prof, o.track_std, rng, &ps, err,
                                            sizeof err)) {
-                fprintf(stderr, "%s: %s: preceding vehicle: %s\n", PROG, ppath, err);
+                fprintf(stderr, "%s: %s:%ld: preceding vehicle: %s\n", PROG, ppath, p->line, err);
                 goto out;
             }
             gap = o.gap_lo + (o.gap_hi - o.gap_lo) * gsl_rng_uniform(rng);
             spec.preceding = 1;
             spec.prec_car = ps.car;
+            spec.prec_truck = ps.truck;
             spec.prec_speed_mps = ps.speed_mps;
             spec.prec_track = ps.track;
             spec.gap_s = gap;
@@ -953,13 +972,28 @@ int main(int argc, char **argv)
             fprintf(stderr, "%s: %s: write failed\n", PROG, path);
             goto out;
         }
-        fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,%g\n",
-                name, pr.speed_measured_mps, spec.speed_mps, spec.car.D1_m + spec.car.D2_m,
-                -pr.t_first_s, rec->axle_kg[0] + rec->axle_kg[1], rec->axle_kg[0],
-                rec->axle_kg[1], pr.truth.mean_force_N[0], pr.truth.mean_force_N[1], o.damage,
-                o.noise, o.profile_class ? (char[]){o.profile_class, 0} : "smooth", spec.track,
-                gap, pr.truth.lost_contact_steps[0] + pr.truth.lost_contact_steps[1],
-                o.scan_rate, sp.sensor_x_m[0]);
+        /* the first two axles in the two-axle columns, every axle in the lists */
+        double Wn[AMFI_MAX_AXLES], xa[AMFI_MAX_AXLES], akg[AMFI_MAX_AXLES], gvw = 0.0;
+        const int na = amfi_passage_axles(&spec, Wn, xa);
+        long lost = 0;
+        for (int a = 0; a < na; a++) {
+            akg[a] = na == 2 ? rec->axle_kg[a] : Wn[a] / AMFI_GRAVITY;
+            gvw += akg[a];
+            lost += pr.truth.lost_contact_steps[a];
+        }
+        fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,%g,%d,",
+                name, pr.speed_measured_mps, spec.speed_mps, xa[1], -pr.t_first_s,
+                na == 2 ? rec->axle_kg[0] + rec->axle_kg[1] : gvw, akg[0], akg[1],
+                pr.truth.mean_force_N[0], pr.truth.mean_force_N[1], o.damage, o.noise,
+                o.profile_class ? (char[]){o.profile_class, 0} : "smooth", spec.track, gap, lost,
+                o.scan_rate, sp.sensor_x_m[0], na);
+        for (int a = 1; a < na; a++)
+            fprintf(meta, "%s%.9g", a > 1 ? ";" : "", xa[a] - xa[a - 1]);
+        for (int a = 0; a < na; a++)
+            fprintf(meta, "%s%.6f", a ? ";" : ",", akg[a]);
+        for (int a = 0; a < na; a++)
+            fprintf(meta, "%s%.6f", a ? ";" : ",", pr.truth.mean_force_N[a]);
+        fputc('\n', meta);
     }
     if (fclose(meta) != 0) {
         meta = NULL;
