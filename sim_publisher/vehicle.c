@@ -171,7 +171,7 @@ int amfi_truck_finish(amfi_truck *t, char *err, size_t errlen)
             if (seen) {
                 double a = t->W_N[i] - t->mu_kg[i] * AMFI_GRAVITY,
                        b = t->W_N[j] - t->mu_kg[j] * AMFI_GRAVITY;
-                if (fabs(a - b) > 1e-6 * fmax(a, b))
+                if (!(fabs(a - b) <= 1e-6 * fmax(a, b)))
                     return TFAIL("axles %d and %d share their suspension but carry %g and %g N "
                                  "on their springs",
                                  j + 1, i + 1, b, a);
@@ -230,7 +230,7 @@ int amfi_truck_finish(amfi_truck *t, char *err, size_t errlen)
             Mo -= t->Fk_N * t->xk_m;
         }
         const double W = t->ms_kg[b] * g + (b == 0 ? t->Fk_N : 0.0);
-        if (fabs(F) > 1e-6 * W || fabs(Mo) > 1e-6 * W * fmax(len, 1.0))
+        if (!(fabs(F) <= 1e-6 * W) || !(fabs(Mo) <= 1e-6 * W * fmax(len, 1.0)))
             return TFAIL("body %d is not in static equilibrium (force %g N, moment %g N·m "
                          "left)",
                          b + 1, F, Mo);

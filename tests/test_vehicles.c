@@ -468,6 +468,10 @@ static void refusals(void **state)
     t.ms_kg[1] = NAN;
     assert_int_equal(amfi_truck_finish(&t, err, sizeof err), -1);
     t = good;
+    t.xcg_m[1] = NAN; /* a NaN centre of gravity: no equilibrium */
+    assert_int_equal(amfi_truck_finish(&t, err, sizeof err), -1);
+    assert_non_null(strstr(err, "equilibrium"));
+    t = good;
     t.n_axles = 13;
     assert_int_equal(amfi_truck_finish(&t, err, sizeof err), -1);
     /* the simulation refuses it too, with the message */
