@@ -71,6 +71,15 @@ awk '$1 == "V" && $3 >= 5 { n++ } END { exit !(n >= 3) }' "$work/s.txt" ||
 awk '$1 == "V" { v[$2] = $3 } $1 == "T" { if (v[$2] != $3) bad++ } END { exit bad > 0 }' \
   "$work/s.txt" || fail "truth_t and vehicle_t axle counts differ"
 
+# The drifting mix (--environment site) draws from the classes too.
+"$sim" --population "$work/eu.csv" --lcm-url none --log "$work/env.log" --speedup max \
+  --vehicles 12 --headway 3 --environment site --time-compression 36500 --dt 2.5e-4 \
+  2>"$work/env.err" || { cat "$work/env.err" >&2; fail "stream with --environment site"; }
+"$trucks" "$work/env.log" >"$work/env.txt" || fail "lcm_trucks (environment)"
+[ "$(grep -c '^T ' "$work/env.txt")" -eq 12 ] || fail "environment: truth_t count"
+awk '$1 == "V" && $3 > 2 { n++ } END { exit !(n >= 4) }' "$work/env.txt" ||
+  { cat "$work/env.txt"; fail "environment: fewer than 4 multi-axle vehicles of 12"; }
+
 # Impossible vehicles: refused with FILE:LINE, exit 1, no crash.
 hdr='timestamp_s,lane,speed_mps,class,gvw_kg,n_axles,axle_kg,spacings_m'
 good='1.0,1,25,A23,33000,5,7000;11000;5000;5000;5000,3.70;6.00;1.31;1.31'

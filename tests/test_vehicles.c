@@ -22,6 +22,7 @@
 
 #include "amfi/amfi.h"
 #include "profile.h"
+#include "traffic.h"
 #include "vbi.h"
 #include "vclass.h"
 #include "vehicle.h"
@@ -429,6 +430,49 @@ static void crossing(void **state)
     amfi_bridge_destroy(b);
 }
 
+/* ---- the shipped heavy traffic ------------------------------------------ */
+
+/* Every vehicle of population-eu.csv gets its model with properties drawn
+ * (two generators), in equilibrium (amfi_truck_finish inside), a
+ * load-sharing group's loads summing to the record's. */
+static void population_models(void **state)
+{
+    (void)state;
+    amfi_vehicle_rec *r = NULL;
+    int n = 0;
+    char err[256];
+    assert_int_equal(amfi_traffic_read(AMFI_SIM_DATA_DIR "/population-eu.csv", &r, &n, err,
+                                       sizeof err),
+                     0);
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    int built = 0;
+    double kmax = 0;
+    for (int seed = 1; seed <= 2; seed++) {
+        gsl_rng_set(rng, (unsigned long)seed);
+        for (int i = 0; i < n; i++) {
+            const amfi_vclass *c = amfi_vclass_get(r[i].vclass);
+            if (c->n_axles == 2)
+                continue;
+            amfi_truck t;
+            int rc = amfi_vclass_truck(c, r[i].axle_kg, r[i].spacing_m, rng, &t, err, sizeof err);
+            if (rc)
+                print_message("line %ld (%s): %s\n", r[i].line, c->name, err);
+            assert_int_equal(rc, 0);
+            double sum = 0;
+            for (int a = 0; a < t.n_axles; a++)
+                sum += t.W_N[a] / AMFI_GRAVITY;
+            assert_true(fabs(sum - r[i].gvw_kg) < 1e-6 * r[i].gvw_kg);
+            for (int b = 0; b < t.n_bodies; b++)
+                kmax = fmax(kmax, t.ms_kg[b]);
+            built++;
+        }
+    }
+    print_message("%d multi-axle models built (2 draws each), heaviest body %.0f kg\n", built,
+                  kmax);
+    gsl_rng_free(rng);
+    amfi_traffic_free(r);
+}
+
 /* ---- the half-car as before ------------------------------------------ */
 
 /* Two half-cars (the baseline and one from WIM weights, Table 2 means) on
@@ -587,7 +631,7 @@ int main(void)
         cmocka_unit_test(equilibrium),     cmocka_unit_test(load_sharing),
         cmocka_unit_test(eigenfrequencies), cmocka_unit_test(dynamic_load),
         cmocka_unit_test(crossing),        cmocka_unit_test(refusals),
-        cmocka_unit_test(halfcar_as_before),
+        cmocka_unit_test(halfcar_as_before), cmocka_unit_test(population_models),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
