@@ -566,6 +566,15 @@ static int site_update(amfi_site *site, amfi_sim *sim, double now, double damage
     return 0;
 }
 
+/* A record's static weight: the sum of its axle loads (all of them). */
+static double rec_static_kg(const amfi_vehicle_rec *r)
+{
+    double s = 0.0;
+    for (int a = 0; a < r->n_axles; a++)
+        s += r->axle_kg[a];
+    return s;
+}
+
 static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
                   const amfi_vehicle_rec *recs, int n_recs, const char *ppath)
 {
@@ -614,11 +623,10 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
     double t = 0.0;
     amfi_flow fl;
     /* the calibration truck (--calibration-every): the population's heaviest
-     * record, a loaded two-axle truck, the same vehicle at every run */
+     * record (the sum of all its axles), the same vehicle at every run */
     int truck = 0;
     for (int k = 1; k < n_recs; k++)
-        if (recs[k].axle_kg[0] + recs[k].axle_kg[1] >
-            recs[truck].axle_kg[0] + recs[truck].axle_kg[1])
+        if (rec_static_kg(&recs[k]) > rec_static_kg(&recs[truck]))
             truck = k;
     if (frng)
         gsl_rng_set(frng, o->seed ^ 0xf10bu);
@@ -674,7 +682,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             for (int a = 1; a < plan[i].n_axles; a++)
                 plan[i].spacing[a - 1] = x[a] - x[a - 1];
         }
-        plan[i].reference_kg = calib ? rec->axle_kg[0] + rec->axle_kg[1] : 0.0;
+        plan[i].reference_kg = calib ? rec_static_kg(rec) : 0.0;
     }
     if (o->flow > 0) {
         /* the simulator takes vehicles in the order their approach starts */
