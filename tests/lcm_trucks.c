@@ -2,7 +2,8 @@
 /*
  * lcm_trucks: the vehicles and truths of an LCM log (sim_publisher --log),
  * for tests/sim_trucks.sh. One line per vehicle_t, "V ID N_AXLES
- * SPACING1;SPACING2;...", and per truth_t, "T ID N_AXLES GVW_KG
+ * SPACING1;SPACING2;... REFERENCE_GVW_KG" (0 for an ordinary vehicle), and
+ * per truth_t, "T ID N_AXLES GVW_KG
  * AXLE1_KG;AXLE2_KG;...". Exit 1 when a message does not decode, or when
  * one is inconsistent: n_spacings other than n_axles − 1, a spacing or a
  * load <= 0, a truth's GVW other than the sum of its axles (1e-9).
@@ -43,7 +44,7 @@ int main(int argc, char **argv)
                     printf("%s%.2f", i ? ";" : "", m.axle_spacing_m[i]);
                     bad |= !(m.axle_spacing_m[i] > 0);
                 }
-                printf("\n");
+                printf(" %.1f\n", isfinite(m.reference_gvw_kg) ? m.reference_gvw_kg : 0.0);
                 amfi_vehicle_t_decode_cleanup(&m);
             }
         } else if (!strcmp(e->channel, AMFI_CHANNEL_TRUTH)) {

@@ -71,6 +71,19 @@ awk '$1 == "V" && $3 >= 5 { n++ } END { exit !(n >= 3) }' "$work/s.txt" ||
 awk '$1 == "V" { v[$2] = $3 } $1 == "T" { if (v[$2] != $3) bad++ } END { exit bad > 0 }' \
   "$work/s.txt" || fail "truth_t and vehicle_t axle counts differ"
 
+# The calibration truck (--calibration-every): the heaviest record by all
+# its axles, announced with that GVW, which its truth_t confirms.
+"$sim" --population "$work/eu.csv" --lcm-url none --log "$work/cal.log" --speedup max \
+  --vehicles 4 --headway 3 --calibration-every 2 --dt 2.5e-4 2>"$work/cal.err" ||
+  { cat "$work/cal.err" >&2; fail "stream with --calibration-every"; }
+"$trucks" "$work/cal.log" >"$work/cal.txt" || fail "lcm_trucks (calibration)"
+awk '$1 == "V" && $5 > 0 { ref[$2] = $5; n++ }
+     $1 == "T" && ($2 in ref) { d = $4 - ref[$2]; if (d > 1 || d < -1) bad++; ok++ }
+     END { exit !(n == 2 && ok == 2 && !bad) }' "$work/cal.txt" ||
+  { cat "$work/cal.txt"; fail "calibration truck: reference GVW and truth differ"; }
+awk '$1 == "V" && $5 > 0 { print "calibration truck: " $3 " axles, reference " $5 " kg" }' \
+  "$work/cal.txt" | head -1
+
 # The drifting mix (--environment site) draws from the classes too.
 "$sim" --population "$work/eu.csv" --lcm-url none --log "$work/env.log" --speedup max \
   --vehicles 12 --headway 3 --environment site --time-compression 36500 --dt 2.5e-4 \
