@@ -56,6 +56,10 @@ sed '3s/,[0-9.]*$/,-1/' "$c/traffic/valid.csv" >"$c/traffic/negative-spacing.csv
 sed '2s/8003/9000/' "$c/traffic/valid.csv" >"$c/traffic/gvw-mismatch.csv"
 head -1 "$c/traffic/valid.csv" >"$c/traffic/header-only.csv"
 sed '1s/axle2_kg/axle3_kg/' "$c/traffic/valid.csv" >"$c/traffic/axle-hole.csv"
+# the class format: heavy traffic by class, an unknown class, a short list
+head -6 "$top/sim_publisher/data/population-eu.csv" >"$c/traffic/classes.csv"
+sed '2s/,A33,/,A99,/' "$c/traffic/classes.csv" >"$c/traffic/class-unknown.csv"
+sed '3s/;[0-9]*,/,/' "$c/traffic/classes.csv" >"$c/traffic/class-short-list.csv"
 
 # --- intake: sim_publisher traffic as fuzz_intake records (tests/lcm_intake_seed) ---
 mkdir -p "$c/intake"

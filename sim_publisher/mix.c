@@ -92,6 +92,61 @@ int amfi_mix_pick(const amfi_mix_classes *c, double share, double u_class, doubl
     return loaded ? c->loaded[k] : c->empty[k];
 }
 
+static int cmp_double(const void *a, const void *b);
+
+int amfi_mix_classify_by_class(const amfi_vehicle_rec *recs, int n, amfi_mix_classes *c,
+                               char *err, size_t errlen)
+{
+    memset(c, 0, sizeof *c);
+    int nk = 1; /* class k at k + 1, no class at 0 */
+    for (int i = 0; i < n; i++)
+        if (recs[i].vclass + 2 > nk)
+            nk = recs[i].vclass + 2;
+    double *split = calloc((size_t)nk, sizeof *split), *g = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1));
+    if (!split || !g) {
+        free(split);
+        free(g);
+        if (errlen)
+            snprintf(err, errlen, "traffic mix: out of memory");
+        return AMFI_ENOMEM;
+    }
+    for (int k = 0; k < nk; k++) {
+        int m = 0;
+        for (int i = 0; i < n; i++)
+            if (recs[i].vclass + 1 == k)
+                g[m++] = recs[i].gvw_kg;
+        if (!m)
+            continue;
+        qsort(g, (size_t)m, sizeof *g, cmp_double);
+        split[k] = m % 2 ? g[m / 2] : 0.5 * (g[m / 2 - 1] + g[m / 2]);
+    }
+    free(g);
+    c->empty = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+    c->loaded = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+    if (!c->empty || !c->loaded) {
+        free(split);
+        amfi_mix_classes_free(c);
+        if (errlen)
+            snprintf(err, errlen, "traffic mix: out of memory");
+        return AMFI_ENOMEM;
+    }
+    for (int i = 0; i < n; i++) {
+        if (recs[i].gvw_kg >= split[recs[i].vclass + 1])
+            c->loaded[c->n_loaded++] = i;
+        else
+            c->empty[c->n_empty++] = i;
+    }
+    free(split);
+    if (!c->n_empty || !c->n_loaded) {
+        if (errlen)
+            snprintf(err, errlen, "traffic mix: splitting %d vehicles at their classes' median "
+                     "GVW leaves no %s vehicle", n, c->n_empty ? "loaded" : "empty");
+        amfi_mix_classes_free(c);
+        return AMFI_EINVAL;
+    }
+    return 0;
+}
+
 static int cmp_double(const void *a, const void *b)
 {
     const double x = *(const double *)a, y = *(const double *)b;

@@ -4,7 +4,8 @@
  * (simulation.environment: site; docs/simulator.md, "Traffic mix").
  *
  * The population's vehicles are split at a GVW into "empty" (below) and
- * "loaded" (at or above) classes; each simulated vehicle is drawn from the
+ * "loaded" (at or above) classes (with vehicle classes: at each class's
+ * own median); each simulated vehicle is drawn from the
  * loaded class with the probability amfi_mix_loaded_share(day) and from the
  * empty class otherwise, uniformly within its class. With a share equal to
  * the population's own loaded fraction the draw reproduces the population;
@@ -58,6 +59,14 @@ typedef struct amfi_mix_classes {
 int amfi_mix_classify(const amfi_vehicle_rec *recs, int n, double split_kg,
                       amfi_mix_classes *c, char *err, size_t errlen);
 void amfi_mix_classes_free(amfi_mix_classes *c); /* NULL-safe, idempotent */
+
+/* The same with a split per vehicle class (amfi_vehicle_rec.vclass): a
+ * record is loaded at or above its own class's median GVW (records without
+ * a class together), so that the loaded and empty draws keep the mix of
+ * classes. With one class in recs it equals amfi_mix_classify at the
+ * population's median. */
+int amfi_mix_classify_by_class(const amfi_vehicle_rec *recs, int n, amfi_mix_classes *c,
+                               char *err, size_t errlen);
 
 /* The record index for one vehicle: u_class and u_pick uniform in [0, 1). */
 int amfi_mix_pick(const amfi_mix_classes *c, double share, double u_class, double u_pick);

@@ -9,10 +9,35 @@
 #include <string.h>
 
 #include "passage.h"
+#include "vclass.h"
 
-static double on_span_s(double L, const amfi_halfcar *c, double v)
+/* the length from the first to the last axle */
+static double length_m(const amfi_halfcar *c, const amfi_truck *t)
 {
-    return (L + c->D1_m + c->D2_m) / v;
+    return t->n_axles ? t->x_m[t->n_axles - 1] : c->D1_m + c->D2_m;
+}
+
+static double on_span_s(double L, const amfi_halfcar *c, const amfi_truck *t, double v)
+{
+    return (L + length_m(c, t)) / v;
+}
+
+int amfi_passage_axles(const amfi_passage_spec *spec, double *W_N, double *x_m)
+{
+    if (spec->truck.n_axles) {
+        for (int i = 0; i < spec->truck.n_axles; i++) {
+            W_N[i] = spec->truck.W_N[i];
+            x_m[i] = spec->truck.x_m[i];
+        }
+        return spec->truck.n_axles;
+    }
+    amfi_halfcar c = spec->car;
+    amfi_halfcar_finish(&c, NULL, 0);
+    W_N[0] = c.W_N[0];
+    W_N[1] = c.W_N[1];
+    x_m[0] = 0.0;
+    x_m[1] = c.D1_m + c.D2_m;
+    return 2;
 }
 
 int amfi_passage_spec_from_rec(const amfi_vehicle_rec *rec, const amfi_halfcar_dist *d,
@@ -20,14 +45,24 @@ int amfi_passage_spec_from_rec(const amfi_vehicle_rec *rec, const amfi_halfcar_d
                                amfi_passage_spec *spec, char *err, size_t errlen)
 {
     memset(spec, 0, sizeof *spec);
-    if (rec->n_axles != 2) {
-        snprintf(err, errlen, "passage: the half-car has 2 axles, the record has %d",
-                 rec->n_axles);
-        return -1;
+    if (rec->n_axles == 2) {
+        if (amfi_halfcar_from_weights(rec->gvw_kg, rec->axle_kg[0], rec->axle_kg[1],
+                                      rec->spacing_m[0], d, rng, &spec->car, err, errlen))
+            return -1;
+    } else {
+        const amfi_vclass *c = amfi_vclass_get(rec->vclass);
+        if (!c) {
+            snprintf(err, errlen, "no vehicle class (%s) fits its %d axles and spacings",
+                     amfi_vclass_names(), rec->n_axles);
+            return -1;
+        }
+        char e2[200];
+        if (amfi_vclass_truck(c, rec->axle_kg, rec->spacing_m, rng, &spec->truck, e2,
+                              sizeof e2)) {
+            snprintf(err, errlen, "class %s: %s", c->name, e2);
+            return -1;
+        }
     }
-    if (amfi_halfcar_from_weights(rec->gvw_kg, rec->axle_kg[0], rec->axle_kg[1],
-                                  rec->spacing_m[0], d, rng, &spec->car, err, errlen))
-        return -1;
     spec->speed_mps = rec->speed_mps;
     spec->track = prof ? (rng ? amfi_profile_draw_track(prof, std_tracks, rng)
                               : amfi_profile_tracks(prof) / 2)
@@ -39,7 +74,8 @@ int amfi_passage_samples(const amfi_bridge *b, const amfi_sim_params *sp,
                          const amfi_passage_spec *spec)
 {
     const double L = amfi_bridge_params_of(b)->span_m;
-    double T = spec->pre_s + on_span_s(L, &spec->car, spec->speed_mps) + spec->post_s;
+    double T = spec->pre_s + on_span_s(L, &spec->car, &spec->truck, spec->speed_mps) +
+               spec->post_s;
     return (int)ceil(T * sp->scan_rate_hz - 1e-9) + 1;
 }
 
@@ -61,15 +97,15 @@ int amfi_passage_simulate(const amfi_bridge *b, const amfi_profile *prof,
         return -1;
     }
     amfi_halfcar car = spec->car, pcar = spec->prec_car;
-    if (amfi_halfcar_finish(&car, err, errlen) ||
-        (spec->preceding && amfi_halfcar_finish(&pcar, err, errlen)))
+    if ((!spec->truck.n_axles && amfi_halfcar_finish(&car, err, errlen)) ||
+        (spec->preceding && !spec->prec_truck.n_axles && amfi_halfcar_finish(&pcar, err, errlen)))
         return -1;
     /* Times, with the target's entry at T_e; the simulation starts (t = 0) when
      * the first vehicle starts its approach, snapped to a sample. */
     double t0_target = -sp->approach_m / spec->speed_mps; /* relative to T_e */
     double t0 = t0_target, prec_entry = 0.0;
     if (spec->preceding) {
-        prec_entry = -spec->gap_s - on_span_s(L, &pcar, spec->prec_speed_mps);
+        prec_entry = -spec->gap_s - on_span_s(L, &pcar, &spec->prec_truck, spec->prec_speed_mps);
         t0 = fmin(t0, prec_entry - sp->approach_m / spec->prec_speed_mps);
     }
     t0 = fmin(t0, -spec->pre_s);
@@ -88,6 +124,7 @@ int amfi_passage_simulate(const amfi_bridge *b, const amfi_profile *prof,
     if (spec->preceding) {
         v.id = 1;
         v.car = pcar;
+        v.truck = spec->prec_truck;
         v.speed_mps = spec->prec_speed_mps;
         v.t_entry_s = Te + prec_entry;
         v.track = spec->prec_track;
@@ -96,6 +133,7 @@ int amfi_passage_simulate(const amfi_bridge *b, const amfi_profile *prof,
     }
     v.id = 0;
     v.car = car;
+    v.truck = spec->truck;
     v.speed_mps = spec->speed_mps;
     v.t_entry_s = Te;
     v.track = spec->track;

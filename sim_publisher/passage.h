@@ -27,11 +27,13 @@ typedef struct amfi_measure {
 } amfi_measure;
 
 typedef struct amfi_passage_spec {
-    amfi_halfcar car;      /* the target vehicle */
+    amfi_halfcar car;      /* the target vehicle (a half-car) ... */
+    amfi_truck truck;      /* ... or this one when truck.n_axles > 0 (vehicle.h) */
     double speed_mps;      /* its true speed */
     int track;             /* its profile track */
     int preceding;         /* 1: a vehicle crosses before it */
     amfi_halfcar prec_car;
+    amfi_truck prec_truck; /* as truck */
     double prec_speed_mps;
     int prec_track;
     double gap_s;          /* preceding vehicle's rear axle leaves the bridge
@@ -48,16 +50,21 @@ typedef struct amfi_passage_rec {
     amfi_sim_vehicle truth;   /* the target after it left (mean forces, contact) */
 } amfi_passage_rec;
 
-/* The target of a passage from a two-axle WIM record: a half-car with the
- * record's weights and spacing and Table 2 properties drawn from `d` with
- * rng (NULL: the means), the record's speed, a carpet track drawn with
- * std_tracks (prof NULL: track 0). pre_s, post_s and the preceding vehicle
- * are left to the caller (zero, none). */
+/* The target of a passage from a WIM record: for two axles a half-car with
+ * the record's weights and spacing and Table 2 properties drawn from `d`
+ * with rng (NULL: the means); for more, the model of the record's class
+ * (vclass.h, its properties drawn with rng); the record's speed, a carpet
+ * track drawn with std_tracks (prof NULL: track 0). pre_s, post_s and the
+ * preceding vehicle are left to the caller (zero, none). */
 int amfi_passage_spec_from_rec(const amfi_vehicle_rec *rec, const amfi_halfcar_dist *d,
                                const amfi_profile *prof, double std_tracks, gsl_rng *rng,
                                amfi_passage_spec *spec, char *err, size_t errlen);
 
 /* Samples a passage of this spec records (for sizing the buffer). */
+/* The static axle loads (N) and the axle positions behind axle 1 (m) of
+ * a spec's target; returns its axle count. */
+int amfi_passage_axles(const amfi_passage_spec *spec, double *W_N, double *x_m);
+
 int amfi_passage_samples(const amfi_bridge *b, const amfi_sim_params *sp,
                          const amfi_passage_spec *spec);
 

@@ -649,7 +649,8 @@ typedef struct planned {
                             --environment site) */
     double entry_s;      /* sim time */
     int added, announced;
-    double spacing;
+    int n_axles;
+    double spacing[AMFI_MAX_AXLES]; /* n_axles − 1 */
     int lane;            /* 1-based */
     double start_s;      /* its approach starts (sim time) */
     double reference_kg; /* the calibration truck: its static GVW; else 0 */
@@ -679,6 +680,15 @@ static int site_update(amfi_site *site, amfi_sim *sim, double now, double damage
     if (site->env.deck_c > deck_range[1])
         deck_range[1] = site->env.deck_c;
     return 0;
+}
+
+/* A record's static weight: the sum of its axle loads (all of them). */
+static double rec_static_kg(const amfi_vehicle_rec *r)
+{
+    double s = 0.0;
+    for (int a = 0; a < r->n_axles; a++)
+        s += r->axle_kg[a];
+    return s;
 }
 
 static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
@@ -729,11 +739,10 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
     double t = 0.0;
     amfi_flow fl;
     /* the calibration truck (--calibration-every): the population's heaviest
-     * record, a loaded two-axle truck, the same vehicle at every run */
+     * record (the sum of all its axles), the same vehicle at every run */
     int truck = 0;
     for (int k = 1; k < n_recs; k++)
-        if (recs[k].axle_kg[0] + recs[k].axle_kg[1] >
-            recs[truck].axle_kg[0] + recs[truck].axle_kg[1])
+        if (rec_static_kg(&recs[k]) > rec_static_kg(&recs[truck]))
             truck = k;
     if (frng)
         gsl_rng_set(frng, o->seed ^ 0xf10bu);
@@ -755,7 +764,7 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         seed_vehicle(rng, o->seed, o->first + i);
         if (amfi_passage_spec_from_rec(rec, &w->dist, w->prof, o->track_std, rng, &spec, err,
                                        sizeof err)) {
-            fprintf(stderr, "%s: %s: vehicle %d: %s\n", PROG, ppath, ri + 1, err);
+            fprintf(stderr, "%s: %s:%ld: vehicle %d: %s\n", PROG, ppath, rec->line, ri + 1, err);
             goto out;
         }
         t = i ? t + gap : sp.approach_m / spec.speed_mps + 1.0;
@@ -778,12 +787,18 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         plan[i].v.id = o->first + i + 1;
         plan[i].rec = ri;
         plan[i].v.car = spec.car;
+        plan[i].v.truck = spec.truck;
         plan[i].v.speed_mps = spec.speed_mps;
         plan[i].v.t_entry_s = t;
         plan[i].start_s = t - sp.approach_m / spec.speed_mps;
         plan[i].v.track = spec.track;
-        plan[i].spacing = spec.car.D1_m + spec.car.D2_m;
-        plan[i].reference_kg = calib ? rec->axle_kg[0] + rec->axle_kg[1] : 0.0;
+        {
+            double W[AMFI_MAX_AXLES], x[AMFI_MAX_AXLES];
+            plan[i].n_axles = amfi_passage_axles(&spec, W, x);
+            for (int a = 1; a < plan[i].n_axles; a++)
+                plan[i].spacing[a - 1] = x[a] - x[a - 1];
+        }
+        plan[i].reference_kg = calib ? rec_static_kg(rec) : 0.0;
     }
     if (o->flow > 0) {
         /* the simulator takes vehicles in the order their approach starts */
@@ -858,10 +873,13 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
                          (o->speed_err_std > 0 ? gsl_ran_gaussian(noise, o->speed_err_std) : 0.0);
             /* the detector's systematic errors (--as-built; none: zero) */
             speed *= w->det.speed_scale;
-            double spacing = p->spacing * w->det.spacing_scale;
+            double spacing[AMFI_MAX_AXLES];
+            for (int a = 0; a < p->n_axles - 1; a++)
+                spacing[a] = p->spacing[a] * w->det.spacing_scale;
             const double entry = p->entry_s + w->det.clock_offset_s;
             amfi_vehicle_t m = {o->start_utime + (int64_t)llround(entry * 1e6), p->v.id, p->lane,
-                                speed, 2, 1, &spacing, PROG, p->reference_kg};
+                                speed, (int16_t)p->n_axles, (int16_t)(p->n_axles - 1), spacing,
+                                PROG, p->reference_kg};
             if (EMIT(&b, amfi_vehicle_t, cfg->daemon.ch_vehicle, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
                 goto out;
@@ -903,9 +921,16 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
         amfi_sim_vehicle d;
         while (amfi_sim_pop_done(sim, &d)) {
             const amfi_vehicle_rec *rec = &recs[plan[d.id - 1 - o->first].rec];
-            double axle[2] = {rec->axle_kg[0], rec->axle_kg[1]};
+            /* the static loads simulated: the record's (a load-sharing
+             * group's equalised) */
+            const int na = d.truck.n_axles;
+            double axle[AMFI_MAX_AXLES], gvw = 0.0;
+            for (int a = 0; a < na; a++) {
+                axle[a] = na == 2 ? rec->axle_kg[a] : d.truck.W_N[a] / AMFI_GRAVITY;
+                gvw += axle[a];
+            }
             amfi_truth_t m = {o->start_utime + (int64_t)llround(d.t_entry_s * 1e6), d.id,
-                              axle[0] + axle[1], 2, axle, d.mean_force_N, d.speed_mps};
+                              gvw, (int16_t)na, axle, d.mean_force_N, d.speed_mps};
             if (EMIT(&b, amfi_truth_t, cfg->daemon.ch_truth, &m)) {
                 fprintf(stderr, "%s: publishing failed\n", PROG);
                 goto out;
@@ -1082,7 +1107,8 @@ int main(int argc, char **argv)
      * design's sensor position, and the truth appended */
     fprintf(meta, "name,speed_mps,speed_true_mps,axle_spacing_m,entry_time_s,gvw_kg,axle1_kg,"
                   "axle2_kg,mean_force1_N,mean_force2_N,damage,noise,profile,track,"
-                  "preceding_gap_s,lost_contact_steps,scan_rate_hz,sensor_x_m%s\n",
+                  "preceding_gap_s,lost_contact_steps,scan_rate_hz,sensor_x_m,n_axles,"
+                  "axle_spacings_m,axle_kgs,mean_forces_N%s\n",
             w.as_built ? ",entry_time_true_s,axle_spacing_true_m,sensor_x_true_m" : "");
     for (long i = 0; i < o.vehicles; i++) {
         const amfi_vehicle_rec *rec = &recs[o.first + i];
@@ -1090,7 +1116,8 @@ int main(int argc, char **argv)
         seed_vehicle(rng, o.seed, o.first + i);
         if (amfi_passage_spec_from_rec(rec, &dist, prof, o.track_std, rng, &spec, err,
                                        sizeof err)) {
-            fprintf(stderr, "%s: %s: vehicle %ld: %s\n", PROG, ppath, o.first + i + 1, err);
+            fprintf(stderr, "%s: %s:%ld: vehicle %ld: %s\n", PROG, ppath, rec->line,
+                    o.first + i + 1, err);
             goto out;
         }
         spec.pre_s = o.pre;
@@ -1101,12 +1128,13 @@ int main(int argc, char **argv)
             amfi_passage_spec ps;
             if (amfi_passage_spec_from_rec(p, &dist, prof, o.track_std, rng, &ps, err,
                                            sizeof err)) {
-                fprintf(stderr, "%s: %s: preceding vehicle: %s\n", PROG, ppath, err);
+                fprintf(stderr, "%s: %s:%ld: preceding vehicle: %s\n", PROG, ppath, p->line, err);
                 goto out;
             }
             gap = o.gap_lo + (o.gap_hi - o.gap_lo) * gsl_rng_uniform(rng);
             spec.preceding = 1;
             spec.prec_car = ps.car;
+            spec.prec_truck = ps.truck;
             spec.prec_speed_mps = ps.speed_mps;
             spec.prec_track = ps.track;
             spec.gap_s = gap;
@@ -1133,16 +1161,30 @@ int main(int argc, char **argv)
             fprintf(stderr, "%s: %s: write failed\n", PROG, path);
             goto out;
         }
-        const double spacing = spec.car.D1_m + spec.car.D2_m;
-        fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,%g",
+        /* the first two axles in the two-axle columns, every axle in the lists
+         * (true spacings; the detector's first one in axle_spacing_m) */
+        double Wn[AMFI_MAX_AXLES], xa[AMFI_MAX_AXLES], akg[AMFI_MAX_AXLES], gvw = 0.0;
+        const int na = amfi_passage_axles(&spec, Wn, xa);
+        const double spacing = xa[1];
+        long lost = 0;
+        for (int a = 0; a < na; a++) {
+            akg[a] = na == 2 ? rec->axle_kg[a] : Wn[a] / AMFI_GRAVITY;
+            gvw += akg[a];
+            lost += pr.truth.lost_contact_steps[a];
+        }
+        fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,%g,%d,",
                 name, pr.speed_measured_mps * w.det.speed_scale, spec.speed_mps,
-                spacing * w.det.spacing_scale,
-                -pr.t_first_s + w.det.clock_offset_s, rec->axle_kg[0] + rec->axle_kg[1],
-                rec->axle_kg[0], rec->axle_kg[1], pr.truth.mean_force_N[0],
-                pr.truth.mean_force_N[1], o.damage, o.noise,
-                o.profile_class ? (char[]){o.profile_class, 0} : "smooth", spec.track, gap,
-                pr.truth.lost_contact_steps[0] + pr.truth.lost_contact_steps[1], o.scan_rate,
-                cfg.solver.sensor_x_m[0]);
+                spacing * w.det.spacing_scale, -pr.t_first_s + w.det.clock_offset_s,
+                na == 2 ? rec->axle_kg[0] + rec->axle_kg[1] : gvw, akg[0], akg[1],
+                pr.truth.mean_force_N[0], pr.truth.mean_force_N[1], o.damage, o.noise,
+                o.profile_class ? (char[]){o.profile_class, 0} : "smooth", spec.track, gap, lost,
+                o.scan_rate, cfg.solver.sensor_x_m[0], na);
+        for (int a = 1; a < na; a++)
+            fprintf(meta, "%s%.9g", a > 1 ? ";" : "", xa[a] - xa[a - 1]);
+        for (int a = 0; a < na; a++)
+            fprintf(meta, "%s%.6f", a ? ";" : ",", akg[a]);
+        for (int a = 0; a < na; a++)
+            fprintf(meta, "%s%.6f", a ? ";" : ",", pr.truth.mean_force_N[a]);
         if (w.as_built)
             fprintf(meta, ",%.6f,%.9g,%g", -pr.t_first_s, spacing, sp.sensor_x_m[0]);
         fputc('\n', meta);

@@ -45,7 +45,7 @@ int amfi_site_init(amfi_site *s, const amfi_bridge_params *bp, const amfi_vehicl
     /* weekday of 1 January of the start's year, Monday = 0 */
     s->mix.day0_weekday = (((tm.tm_wday + 6) % 7 - tm.tm_yday) % 7 + 7) % 7;
     s->mix.split_kg = amfi_mix_median_gvw(recs, n_recs);
-    return amfi_mix_classify(recs, n_recs, s->mix.split_kg, &s->classes, err, errlen);
+    return amfi_mix_classify_by_class(recs, n_recs, &s->classes, err, errlen);
 }
 
 void amfi_site_free(amfi_site *s)

@@ -48,7 +48,8 @@ typedef struct amfi_site {
 
 /* Set up for a stream starting at start_utime (µs since 1970) with the
  * site defaults, the given compression (>= 1) and seed, the mix split at
- * the population's median GVW. 0, or an AMFI_E* code with a message. */
+ * each vehicle class's median GVW (mix.h; split_kg is the population's
+ * median). 0, or an AMFI_E* code with a message. */
 int amfi_site_init(amfi_site *s, const amfi_bridge_params *bp, const amfi_vehicle_rec *recs,
                    int n_recs, int64_t start_utime, double compression, uint64_t seed,
                    char *err, size_t errlen);

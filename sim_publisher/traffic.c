@@ -12,6 +12,7 @@
 #include "traffic.h"
 
 #include "amfi_csv.h"
+#include "vclass.h"
 
 #include <errno.h>
 #include <math.h>
@@ -22,9 +23,14 @@
 
 #define MAX_COLS (4 + 2 * AMFI_MAX_AXLES - 1) /* fixed + axles + spacings */
 
-enum role { R_TIME, R_LANE, R_SPEED, R_GVW, R_AXLE, R_SPACING };
+enum role { R_TIME, R_LANE, R_SPEED, R_GVW, R_CLASS, R_NAX, R_AXLES, R_SPACINGS, R_AXLE,
+            R_SPACING };
 
-static const char *const role_name[] = {"timestamp_s", "lane", "speed_mps", "gvw_kg"};
+/* the four columns of both formats, then the class format's four */
+#define N_NAMED 8
+static const char *const role_name[N_NAMED] = {"timestamp_s", "lane",    "speed_mps", "gvw_kg",
+                                               "class",       "n_axles", "axle_kg",
+                                               "spacings_m"};
 
 typedef struct column {
     enum role role;
@@ -34,7 +40,8 @@ typedef struct column {
 
 typedef struct reader {
     amfi_csv *csv;
-    int n_cols, n_axles;
+    int n_cols, n_axles; /* n_axles: the wide format's, 0 in the class format */
+    int class_format;
     column col[MAX_COLS];
 } reader;
 
@@ -77,7 +84,7 @@ static int read_header(reader *r)
     const char *f[MAX_COLS];
     size_t fl[MAX_COLS];
     int count = split(s, n, f, fl, MAX_COLS);
-    int seen_fixed[4] = {0};
+    int seen_fixed[N_NAMED] = {0};
     int axle_seen[AMFI_MAX_AXLES + 1] = {0}, spacing_seen[AMFI_MAX_AXLES + 1] = {0};
     int max_axle = 0, max_spacing = 0;
     char q[32];
@@ -100,7 +107,7 @@ static int read_header(reader *r)
         memcpy(c->name, f[i], fl[i]);
         c->name[fl[i]] = '\0';
         int k, found = 0;
-        for (k = 0; k < 4; k++)
+        for (k = 0; k < N_NAMED; k++)
             if (!strcmp(c->name, role_name[k])) {
                 found = 1;
                 break;
@@ -138,7 +145,8 @@ static int read_header(reader *r)
             continue;
         }
         fail(r, 1, q, "unknown column (expected timestamp_s, lane, speed_mps, gvw_kg, "
-                      "axle1_kg .. axleN_kg, spacing1_m .. spacingN-1_m)");
+                      "axle1_kg .. axleN_kg, spacing1_m .. spacingN-1_m, or class, n_axles, "
+                      "axle_kg, spacings_m)");
         return -1;
     }
     for (int k = 0; k < 4; k++)
@@ -146,6 +154,26 @@ static int read_header(reader *r)
             fail(r, 1, role_name[k], "missing column");
             return -1;
         }
+    int class_cols = 0;
+    for (int k = 4; k < N_NAMED; k++)
+        class_cols += seen_fixed[k];
+    if (class_cols) {
+        if (max_axle || max_spacing) {
+            fail(r, 1, NULL, "numbered axle or spacing columns and the class format's columns "
+                             "(class, n_axles, axle_kg, spacings_m) do not mix");
+            return -1;
+        }
+        for (int k = 4; k < N_NAMED; k++)
+            if (!seen_fixed[k]) {
+                fail(r, 1, role_name[k], "missing column (the class format has class, "
+                                         "n_axles, axle_kg and spacings_m)");
+                return -1;
+            }
+        r->n_cols = count;
+        r->n_axles = 0;
+        r->class_format = 1;
+        return 0;
+    }
     for (int a = 1; a <= max_axle; a++)
         if (!axle_seen[a]) {
             fail(r, 1, NULL, "axle%d_kg missing: axle columns must be axle1_kg .. axle%d_kg",
@@ -204,6 +232,76 @@ static int in_range(reader *r, const column *c, double v, double lo, double hi, 
     return -1;
 }
 
+/* The class format's axle_kg and spacings_m (';'-separated) against
+ * n_axles and the class. */
+static int parse_lists(reader *r, const char *const *f, const size_t *fl, const int list_col[2],
+                       amfi_vehicle_rec *v)
+{
+    const long line = amfi_csv_lineno(r->csv);
+    const amfi_vclass *vc = amfi_vclass_get(v->vclass);
+    if (v->n_axles != vc->n_axles) {
+        fail(r, line, "n_axles", "%d, but class %s has %d axles", v->n_axles, vc->name,
+             vc->n_axles);
+        return -1;
+    }
+    for (int L = 0; L < 2; L++) {
+        const column *c = &r->col[list_col[L]];
+        const char *s = f[list_col[L]];
+        const size_t n = fl[list_col[L]];
+        const int want = L ? v->n_axles - 1 : v->n_axles;
+        double *out = L ? v->spacing_m : v->axle_kg;
+        int k = 0;
+        size_t a = 0;
+        for (;;) {
+            size_t b = a;
+            while (b < n && s[b] != ';')
+                b++;
+            size_t x = a, y = b;
+            while (x < y && (s[x] == ' ' || s[x] == '\t'))
+                x++;
+            while (y > x && (s[y - 1] == ' ' || s[y - 1] == '\t'))
+                y--;
+            if (k == want) {
+                fail(r, line, c->name, "more than %d values for %d axles", want, v->n_axles);
+                return -1;
+            }
+            double val;
+            char q[32];
+            switch (amfi_csv_field_double(s + x, y - x, &val)) {
+            case 0:
+                break;
+            case AMFI_CSV_EMPTY:
+                fail(r, line, c->name, "value %d is empty", k + 1);
+                return -1;
+            default:
+                fail(r, line, c->name, "value %d, '%s', is not a finite number", k + 1,
+                     quote(s + x, y - x, q));
+                return -1;
+            }
+            if (L ? !(val >= 0.5 && val <= 30.0) : !(val > 0.0 && val <= 30000.0)) {
+                fail(r, line, c->name, L ? "value %d, %g, is out of range [0.5, 30] m"
+                                         : "value %d, %g, is out of range (0, 30000] kg",
+                     k + 1, val);
+                return -1;
+            }
+            out[k++] = val;
+            if (b == n)
+                break;
+            a = b + 1;
+        }
+        if (k != want) {
+            fail(r, line, c->name, "%d values for %d axles (%d expected)", k, v->n_axles, want);
+            return -1;
+        }
+    }
+    char err[200];
+    if (amfi_vclass_check(vc, v->n_axles, v->spacing_m, err, sizeof err)) {
+        fail(r, line, "spacings_m", "%s", err);
+        return -1;
+    }
+    return 0;
+}
+
 static int parse_row(reader *r, const char *line, size_t len, amfi_vehicle_rec *v)
 {
     const char *f[MAX_COLS];
@@ -215,10 +313,28 @@ static int parse_row(reader *r, const char *line, size_t len, amfi_vehicle_rec *
     }
     memset(v, 0, sizeof *v);
     v->n_axles = r->n_axles;
+    v->line = amfi_csv_lineno(r->csv);
+    v->vclass = -1;
+    int list_col[2] = {-1, -1}; /* axle_kg, spacings_m: read once n_axles is known */
     for (int i = 0; i < count; i++) {
         const column *c = &r->col[i];
         double x;
-        if (c->role == R_LANE) {
+        if (c->role == R_AXLES || c->role == R_SPACINGS) {
+            list_col[c->role == R_SPACINGS] = i;
+            continue;
+        }
+        if (c->role == R_CLASS) {
+            char q[32];
+            v->vclass = amfi_vclass_find(f[i], fl[i]);
+            if (v->vclass < 0) {
+                fail(r, amfi_csv_lineno(r->csv), c->name,
+                     fl[i] ? "'%s' is not a known class (%s)" : "empty value%.0s%.0s",
+                     quote(f[i], fl[i], q), amfi_vclass_names());
+                return -1;
+            }
+            continue;
+        }
+        if (c->role == R_LANE || c->role == R_NAX) {
             char q[32], tmp[32];
             long lane = 0;
             int ok = fl[i] > 0 && fl[i] < sizeof tmp;
@@ -235,12 +351,17 @@ static int parse_row(reader *r, const char *line, size_t len, amfi_vehicle_rec *
                      quote(f[i], fl[i], q));
                 return -1;
             }
-            if (lane < 1 || lane > AMFI_TRAFFIC_MAX_LANE) {
-                fail(r, amfi_csv_lineno(r->csv), c->name, "%ld is out of range 1 .. %d", lane,
-                     AMFI_TRAFFIC_MAX_LANE);
+            const int hi = c->role == R_LANE ? AMFI_TRAFFIC_MAX_LANE : AMFI_MAX_AXLES;
+            const int lo = c->role == R_LANE ? 1 : 2;
+            if (lane < lo || lane > hi) {
+                fail(r, amfi_csv_lineno(r->csv), c->name, "%ld is out of range %d .. %d", lane,
+                     lo, hi);
                 return -1;
             }
-            v->lane = (int)lane;
+            if (c->role == R_LANE)
+                v->lane = (int)lane;
+            else
+                v->n_axles = (int)lane;
             continue;
         }
         if (parse_number(r, c, f[i], fl[i], &x) != 0)
@@ -271,9 +392,15 @@ static int parse_row(reader *r, const char *line, size_t len, amfi_vehicle_rec *
                 return -1;
             v->spacing_m[c->index] = x;
             break;
-        case R_LANE:
+        default:
             break;
         }
+    }
+    if (r->class_format) {
+        if (parse_lists(r, f, fl, list_col, v) != 0)
+            return -1;
+    } else {
+        v->vclass = amfi_vclass_guess(v->n_axles, v->spacing_m);
     }
     double sum = 0.0;
     for (int a = 0; a < v->n_axles; a++)

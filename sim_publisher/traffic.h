@@ -17,7 +17,23 @@
  *   spacingI_m    I = 1 .. n − 1, distance from axle I to axle I+1, 0.5 .. 30 m
  *
  * Any other column is an error, as are a duplicate, a gap in the axle or
- * spacing numbering and a spacing count other than n − 1. Spaces and tabs
+ * spacing numbering and a spacing count other than n − 1. The vehicle
+ * class of such a record is guessed from its axle count and spacings
+ * (amfi_vclass_guess: R2 for two axles; −1 when no class fits).
+ *
+ * The class format (amfi-population's; every vehicle its own axle count):
+ *
+ *     timestamp_s,lane,speed_mps,class,gvw_kg,n_axles,axle_kg,spacings_m
+ *     12.480,1,24.31,A23,37400,5,6800;10600;6667;6667;6666,3.71;6.02;1.31;1.31
+ *
+ *   class         a class of vclass.h (R2, R3, R4, A22, A23, A32, A33)
+ *   n_axles       2 .. AMFI_MAX_AXLES, the class's axle count
+ *   axle_kg       n_axles loads separated by ';', each (0, 30000] kg
+ *   spacings_m    n_axles − 1 spacings separated by ';', 0.5 .. 30 m,
+ *                 fitting the class's groups (amfi_vclass_check: inside a
+ *                 group 0.9 .. 2.5 m, between groups >= 2 m)
+ *
+ * The two formats do not mix in one header. Spaces and tabs
  * around a field, CRLF line ends and a UTF-8 BOM are allowed; blank lines
  * only at the end. No quoting, no comments.
  *
@@ -30,7 +46,7 @@
  * a file that cannot be opened.
  *
  * Workload: read once at start-up; the whole list is held in memory
- * (sizeof(amfi_vehicle_rec) = 232 bytes per vehicle on x86-64), at most
+ * (sizeof(amfi_vehicle_rec) = 248 bytes per vehicle on x86-64), at most
  * AMFI_TRAFFIC_MAX_ROWS vehicles, lines of at most AMFI_TRAFFIC_MAX_LINE
  * characters. O(rows).
  */
@@ -61,6 +77,9 @@ typedef struct amfi_vehicle_rec {
     double spacing_m[AMFI_MAX_AXLES];   /* spacing_m[i]: axle i to axle i+1,
                                            0.5 .. 30 m; n_axles − 1 used, 0
                                            past them */
+    int vclass;                         /* vclass.h class index; −1: none fits
+                                           (a wide-format record) */
+    long line;                          /* its line in the file */
 } amfi_vehicle_rec;
 
 /* Read `path`. Returns 0 with *recs (an array of *n >= 1 records in file

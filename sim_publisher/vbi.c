@@ -7,7 +7,7 @@
  * the new acceleration solves S a' = f' − (C v̂ + K û), S = M + dt/2·C +
  * dt²/4·K, and u' = û + β a', v' = v̂ + dt/2·a' (β = dt²/4).
  *   bridge, per mode k: S_k = 1 + dt·ζω + β ω², f_k = Σ_J ψ_k(x_J)(W_J + P_J)
- *   vehicle: S_v (4 × 4, inverted once with LAPACK), f_v = −[0, 0, P_1, P_2]
+ *   vehicle: S_v (n × n, inverted once with LAPACK), f_v = −P_i on axle i's hop DOF
  * Both new axle hops and new bridge deflections under the axles are affine
  * in the dynamic tyre forces P, so P_I = kt_I (y_u,I' − w(x_I)' + r_I) is
  *   (I + β·diag(kt)(A + B)) P = c,
@@ -21,12 +21,16 @@
 
 #include "vbi.h"
 
+#define MD AMFI_TRUCK_MAX_DOF
+#define MAX_AX (AMFI_SIM_MAX_ACTIVE * AMFI_MAX_AXLES) /* axles in the simulation */
+
 typedef struct active {
     amfi_sim_vehicle v;
-    double u[4], vel[4], acc[4]; /* y_s, θ, y_u1, y_u2 */
-    double K[16], C[16];         /* suspension matrices, row-major */
-    double Sinv[16];             /* (M + dt/2 C + β K)⁻¹ */
-    double sumF[2];
+    int nd, h0;                     /* DOFs; the first hop DOF (vehicle.h) */
+    double u[MD], vel[MD], acc[MD]; /* vehicle.h's DOF order */
+    double K[MD * MD], C[MD * MD];  /* suspension matrices, row-major nd × nd */
+    double Sinv[MD * MD];           /* (M + dt/2 C + β K)⁻¹ */
+    double sumF[AMFI_MAX_AXLES];
 } active;
 
 struct amfi_sim {
@@ -42,7 +46,8 @@ struct amfi_sim {
     double *Sk;             /* n: effective modal mass */
     double *qh, *pred;      /* n: predictors */
     double *cs;             /* n_sensors × n: ψ_k(x_s) */
-    double *phi;            /* AMFI_SIM_MAX_ACTIVE·2 × n: ψ_k at the axles */
+    double *phi;            /* MAX_AX × n: ψ_k at the axles */
+    double *Amat, *Ms;      /* MAX_AX²: the coupling matrix and its working copy */
     active act[AMFI_SIM_MAX_ACTIVE];
     int n_act;
     amfi_sim_vehicle pend[AMFI_SIM_MAX_PENDING];
@@ -83,6 +88,8 @@ void amfi_sim_destroy(amfi_sim *s)
     free(s->pred);
     free(s->cs);
     free(s->phi);
+    free(s->Amat);
+    free(s->Ms);
     free(s);
 }
 
@@ -127,8 +134,11 @@ int amfi_sim_create(const amfi_bridge *b, const amfi_profile *prof, const amfi_s
     s->qh = malloc(sizeof(double) * n);
     s->pred = malloc(sizeof(double) * n);
     s->cs = malloc(sizeof(double) * n * p->n_sensors);
-    s->phi = malloc(sizeof(double) * n * 2 * AMFI_SIM_MAX_ACTIVE);
-    if (!s->q || !s->qd || !s->qdd || !s->Sk || !s->qh || !s->pred || !s->cs || !s->phi) {
+    s->phi = malloc(sizeof(double) * n * MAX_AX);
+    s->Amat = malloc(sizeof(double) * MAX_AX * MAX_AX);
+    s->Ms = malloc(sizeof(double) * MAX_AX * MAX_AX);
+    if (!s->q || !s->qd || !s->qdd || !s->Sk || !s->qh || !s->pred || !s->cs || !s->phi ||
+        !s->Amat || !s->Ms) {
         amfi_sim_destroy(s);
         return fail(err, errlen, "sim: out of memory%.0g%.0g", 0, 0);
     }
@@ -163,18 +173,21 @@ int amfi_sim_add(amfi_sim *s, const amfi_sim_vehicle *v, char *err, size_t errle
     if (s->prof && (v->track < 0 || v->track >= amfi_profile_tracks(s->prof)))
         return fail(err, errlen, "sim: track %g out of range (%g tracks)", v->track,
                     amfi_profile_tracks(s->prof));
-    amfi_halfcar c = v->car;
-    if (amfi_halfcar_finish(&c, err, errlen))
+    amfi_sim_vehicle w = *v;
+    if (w.truck.n_axles == 0) { /* the half-car */
+        if (amfi_halfcar_finish(&w.car, err, errlen) ||
+            amfi_truck_from_halfcar(&w.car, &w.truck, err, errlen))
+            return -1;
+    } else if (amfi_truck_finish(&w.truck, err, errlen)) {
         return -1;
+    }
     if (t_start(s, v) < amfi_sim_time(s) - 0.5 * s->p.dt_s)
         return fail(err, errlen, "sim: vehicle starts its approach at %g s, before now (%g s)",
                     t_start(s, v), amfi_sim_time(s));
     if (s->n_pend == AMFI_SIM_MAX_PENDING)
         return fail(err, errlen, "sim: more than %g vehicles pending%.0g", AMFI_SIM_MAX_PENDING,
                     0);
-    s->pend[s->n_pend] = *v;
-    s->pend[s->n_pend].car = c;
-    s->n_pend++;
+    s->pend[s->n_pend++] = w;
     return 0;
 }
 
@@ -186,34 +199,28 @@ static int start(amfi_sim *s, const amfi_sim_vehicle *v)
     active *a = &s->act[s->n_act];
     memset(a, 0, sizeof *a);
     a->v = *v;
-    const amfi_halfcar *c = &v->car;
-    const double arm[2] = {-c->D1_m, c->D2_m};
-    for (int i = 0; i < 2; i++) {
-        /* e_i = g·u, g = [1, arm_i, −δ_i0, −δ_i1] */
-        const double g[4] = {1.0, arm[i], i == 0 ? -1.0 : 0.0, i == 1 ? -1.0 : 0.0};
-        for (int r = 0; r < 4; r++)
-            for (int q = 0; q < 4; q++) {
-                a->K[r * 4 + q] += c->ks_Nm[i] * g[r] * g[q];
-                a->C[r * 4 + q] += c->cs_Nsm[i] * g[r] * g[q];
-            }
+    const amfi_truck *t = &v->truck;
+    double M[MD * MD];
+    const int nd = amfi_truck_matrices(t, M, a->C, a->K);
+    a->nd = nd;
+    a->h0 = amfi_truck_hop0(t);
+    for (int i = 0; i < t->n_axles; i++) {
         a->v.min_force_N[i] = INFINITY;
         a->v.max_force_N[i] = -INFINITY;
     }
-    const double M[4] = {c->ms_kg, c->Is_kgm2, c->mu_kg[0], c->mu_kg[1]};
     const double dt = s->p.dt_s, beta = dt * dt / 4.0;
-    for (int r = 0; r < 4; r++)
-        for (int q = 0; q < 4; q++) {
-            a->Sinv[r * 4 + q] = (r == q ? M[r] : 0.0) + 0.5 * dt * a->C[r * 4 + q] +
-                                 beta * a->K[r * 4 + q];
-        }
+    for (int r = 0; r < nd; r++)
+        for (int q = 0; q < nd; q++)
+            a->Sinv[r * nd + q] = M[r * nd + q] + 0.5 * dt * a->C[r * nd + q] +
+                                  beta * a->K[r * nd + q];
     /* SPD: Cholesky inverse (column-major 'L' is row-major 'U' here). */
-    if (LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', 4, a->Sinv, 4) != 0 ||
-        LAPACKE_dpotri_work(LAPACK_COL_MAJOR, 'L', 4, a->Sinv, 4) != 0)
+    if (LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', nd, a->Sinv, nd) != 0 ||
+        LAPACKE_dpotri_work(LAPACK_COL_MAJOR, 'L', nd, a->Sinv, nd) != 0)
         return -1;
     /* dpotri filled column-major 'L', i.e. the row-major upper triangle. */
-    for (int r = 0; r < 4; r++)
+    for (int r = 0; r < nd; r++)
         for (int q = 0; q < r; q++)
-            a->Sinv[r * 4 + q] = a->Sinv[q * 4 + r];
+            a->Sinv[r * nd + q] = a->Sinv[q * nd + r];
     s->n_act++;
     return 0;
 }
@@ -232,13 +239,13 @@ static void retire(amfi_sim *s)
     const double t = amfi_sim_time(s);
     for (int i = 0; i < s->n_act;) {
         active *a = &s->act[i];
-        const double S = a->v.car.D1_m + a->v.car.D2_m;
+        const double S = a->v.truck.x_m[a->v.truck.n_axles - 1];
         double x2 = a->v.speed_mps * (t - a->v.t_entry_s) - S;
         if (x2 <= s->L + s->p.exit_m) {
             i++;
             continue;
         }
-        for (int k = 0; k < 2; k++)
+        for (int k = 0; k < a->v.truck.n_axles; k++)
             a->v.mean_force_N[k] =
                 a->v.on_span_steps[k] ? a->sumF[k] / a->v.on_span_steps[k] : NAN;
         if (s->n_done < AMFI_SIM_MAX_PENDING)
@@ -266,16 +273,15 @@ static int admit(amfi_sim *s)
 /* One Newmark step of the coupled system, to time (step + 1)·dt. */
 static int step(amfi_sim *s, char *err, size_t errlen)
 {
-    const int n = s->n, na = 2 * s->n_act;
+    const int n = s->n;
     const double dt = s->p.dt_s, beta = dt * dt / 4.0, hdt = 0.5 * dt;
     const double t1 = (s->step + 1) * dt;
-    double x[2 * AMFI_SIM_MAX_ACTIVE], W[2 * AMFI_SIM_MAX_ACTIVE], kt[2 * AMFI_SIM_MAX_ACTIVE];
-    double c[2 * AMFI_SIM_MAX_ACTIVE], P[2 * AMFI_SIM_MAX_ACTIVE];
-    double Amat[4 * AMFI_SIM_MAX_ACTIVE * AMFI_SIM_MAX_ACTIVE]; /* na × na, column-major */
-    double wfree[2 * AMFI_SIM_MAX_ACTIVE];
-    int on[2 * AMFI_SIM_MAX_ACTIVE], fixed[2 * AMFI_SIM_MAX_ACTIVE];
-    lapack_int ipiv[2 * AMFI_SIM_MAX_ACTIVE];
-    double av0[AMFI_SIM_MAX_ACTIVE][4], vh[AMFI_SIM_MAX_ACTIVE][4], uh[AMFI_SIM_MAX_ACTIVE][4];
+    double x[MAX_AX], W[MAX_AX], kt[MAX_AX], c[MAX_AX], P[MAX_AX], wfree[MAX_AX];
+    int on[MAX_AX], fixed[MAX_AX], veh[MAX_AX], ax[MAX_AX], first[AMFI_SIM_MAX_ACTIVE];
+    lapack_int ipiv[MAX_AX];
+    double av0[AMFI_SIM_MAX_ACTIVE][MD], vh[AMFI_SIM_MAX_ACTIVE][MD], uh[AMFI_SIM_MAX_ACTIVE][MD];
+    double *const Amat = s->Amat, *const Ms = s->Ms; /* na × na, column-major */
+    int na = 0;
 
     /* Bridge predictors and the acceleration without contact forces. */
     for (int k = 0; k < n; k++) {
@@ -286,30 +292,33 @@ static int step(amfi_sim *s, char *err, size_t errlen)
     /* Vehicles: predictors, force-free acceleration, axle data. */
     for (int v = 0; v < s->n_act; v++) {
         active *a = &s->act[v];
-        double f[4];
-        for (int r = 0; r < 4; r++) {
+        const int nd = a->nd;
+        double f[MD];
+        for (int r = 0; r < nd; r++) {
             uh[v][r] = a->u[r] + dt * a->vel[r] + beta * a->acc[r];
             vh[v][r] = a->vel[r] + hdt * a->acc[r];
         }
-        for (int r = 0; r < 4; r++) {
+        for (int r = 0; r < nd; r++) {
             double pr = 0.0;
-            for (int q = 0; q < 4; q++)
-                pr += a->C[r * 4 + q] * vh[v][q] + a->K[r * 4 + q] * uh[v][q];
+            for (int q = 0; q < nd; q++)
+                pr += a->C[r * nd + q] * vh[v][q] + a->K[r * nd + q] * uh[v][q];
             f[r] = -pr;
         }
-        for (int r = 0; r < 4; r++) {
+        for (int r = 0; r < nd; r++) {
             double acc = 0.0;
-            for (int q = 0; q < 4; q++)
-                acc += a->Sinv[r * 4 + q] * f[q];
+            for (int q = 0; q < nd; q++)
+                acc += a->Sinv[r * nd + q] * f[q];
             av0[v][r] = acc;
         }
-        const double S = a->v.car.D1_m + a->v.car.D2_m;
-        for (int i = 0; i < 2; i++) {
-            int ia = 2 * v + i;
-            x[ia] = a->v.speed_mps * (t1 - a->v.t_entry_s) - (i ? S : 0.0);
-            W[ia] = a->v.car.W_N[i];
-            kt[ia] = a->v.car.kt_Nm[i];
-            on[ia] = amfi_bridge_mode_values(s->b, x[ia], s->phi + (size_t)ia * n) == 0;
+        const amfi_truck *tr = &a->v.truck;
+        first[v] = na;
+        for (int i = 0; i < tr->n_axles; i++, na++) {
+            x[na] = a->v.speed_mps * (t1 - a->v.t_entry_s) - tr->x_m[i];
+            W[na] = tr->W_N[i];
+            kt[na] = tr->kt_Nm[i];
+            veh[na] = v;
+            ax[na] = i;
+            on[na] = amfi_bridge_mode_values(s->b, x[na], s->phi + (size_t)na * n) == 0;
         }
     }
     /* c_I and the matrix (I + β diag(kt)(A + B)), column-major. */
@@ -320,6 +329,8 @@ static int step(amfi_sim *s, char *err, size_t errlen)
             for (int k = 0; k < n; k++)
                 w0 += pI[k] * (s->qh[k] - beta * s->pred[k] / s->Sk[k]);
         wfree[ia] = w0;
+        const int v = veh[ia];
+        const active *a = &s->act[v];
         for (int ja = 0; ja < na; ja++) {
             double bij = 0.0;
             if (on[ia] && on[ja]) {
@@ -328,19 +339,18 @@ static int step(amfi_sim *s, char *err, size_t errlen)
                     bij += pI[k] * pJ[k] / s->Sk[k];
             }
             double aij = 0.0;
-            if (ia / 2 == ja / 2) /* the same vehicle: hop DOFs 2 + i, 2 + j */
-                aij = s->act[ia / 2].Sinv[(2 + ia % 2) * 4 + 2 + ja % 2];
+            if (veh[ja] == v) /* the same vehicle: between its hop DOFs */
+                aij = a->Sinv[(a->h0 + ax[ia]) * a->nd + a->h0 + ax[ja]];
             Amat[ia + ja * na] = (ia == ja ? 1.0 : 0.0) + beta * kt[ia] * (aij + bij);
             wfree[ia] += beta * bij * W[ja];
         }
-        const int v = ia / 2, i = ia % 2;
-        double yu = uh[v][2 + i] + beta * av0[v][2 + i];
-        c[ia] = kt[ia] * (yu - wfree[ia] + road(s, s->act[v].v.track, x[ia]));
+        const int hop = a->h0 + ax[ia];
+        double yu = uh[v][hop] + beta * av0[v][hop];
+        c[ia] = kt[ia] * (yu - wfree[ia] + road(s, a->v.track, x[ia]));
         fixed[ia] = 0;
     }
     /* Solve; a tyre with W + P < 0 leaves the road (P = −W), then re-solve. */
     for (int pass = 0; pass <= na; pass++) {
-        double Ms[4 * AMFI_SIM_MAX_ACTIVE * AMFI_SIM_MAX_ACTIVE];
         for (int ia = 0; ia < na; ia++) {
             P[ia] = c[ia];
             for (int ja = 0; ja < na; ja++)
@@ -384,17 +394,20 @@ static int step(amfi_sim *s, char *err, size_t errlen)
     /* Vehicle update, truth, hook. */
     for (int v = 0; v < s->n_act; v++) {
         active *a = &s->act[v];
-        for (int r = 0; r < 4; r++) {
-            double acc = av0[v][r] - a->Sinv[r * 4 + 2] * P[2 * v] - a->Sinv[r * 4 + 3] * P[2 * v + 1];
+        const int nd = a->nd, h0 = a->h0, na_v = a->v.truck.n_axles;
+        const double *Pv = P + first[v];
+        for (int r = 0; r < nd; r++) {
+            double acc = av0[v][r];
+            for (int i = 0; i < na_v; i++)
+                acc -= a->Sinv[r * nd + h0 + i] * Pv[i];
             a->u[r] = uh[v][r] + beta * acc;
             a->vel[r] = vh[v][r] + hdt * acc;
             a->acc[r] = acc;
         }
-        double F[2], xx[2];
-        for (int i = 0; i < 2; i++) {
-            int ia = 2 * v + i;
+        double F[AMFI_MAX_AXLES];
+        for (int i = 0; i < na_v; i++) {
+            int ia = first[v] + i;
             F[i] = W[ia] + P[ia];
-            xx[i] = x[ia];
             if (fixed[ia])
                 a->v.lost_contact_steps[i]++;
             if (x[ia] >= 0.0 && x[ia] <= s->L) {
@@ -405,7 +418,7 @@ static int step(amfi_sim *s, char *err, size_t errlen)
             }
         }
         if (s->hook)
-            s->hook(s->hook_user, t1, &a->v, xx, F);
+            s->hook(s->hook_user, t1, &a->v, x + first[v], F);
     }
     s->step++;
     return 0;
@@ -443,11 +456,11 @@ int amfi_sim_pop_done(amfi_sim *s, amfi_sim_vehicle *out)
     return 1;
 }
 
-int amfi_sim_vehicle_state(const amfi_sim *s, long id, double u[4])
+int amfi_sim_vehicle_state(const amfi_sim *s, long id, double *u)
 {
     for (int v = 0; v < s->n_act; v++)
         if (s->act[v].v.id == id) {
-            memcpy(u, s->act[v].u, sizeof(double) * 4);
+            memcpy(u, s->act[v].u, sizeof(double) * (size_t)s->act[v].nd);
             return 0;
         }
     return -1;

@@ -18,9 +18,14 @@
  * it a rigid approach. The profile's own coordinate is x + approach_m +
  * AMFI_SIM_PROFILE_LEAD_M (so the rear axle's start is inside the profile).
  *
+ * Vehicles: the half-car, or any linear multi-body vehicle of vehicle.h
+ * (rigid trucks, tractor and semi-trailer, load-sharing axle groups): each
+ * has its own n DOFs (S_v n × n), one unknown per axle in the coupling.
+ *
  * Workload: one simulation per bridge state; vehicles are added in any
  * order before they start their approach, and leave after exit_m past the
- * bridge. Cost per step O(n_modes·axles²); nothing is allocated per step.
+ * bridge. Cost per step O(n_modes·axles² + axles³) over all the axles in
+ * the simulation; nothing is allocated per step.
  */
 #ifndef AMFI_VBI_H
 #define AMFI_VBI_H
@@ -50,15 +55,17 @@ void amfi_sim_params_default(amfi_sim_params *p, double span_m);
 typedef struct amfi_sim_vehicle {
     /* in */
     long id;
-    amfi_halfcar car;
+    amfi_halfcar car;  /* the two-axle half-car, used when truck.n_axles is 0 */
+    amfi_truck truck;  /* any vehicle (vehicle.h); n_axles 0: the half-car `car` */
     double speed_mps;  /* > 0 */
     double t_entry_s;  /* when the front axle reaches x = 0 */
     int track;         /* profile track, 0 .. n_tracks − 1 */
-    /* out, when the vehicle has left */
-    double mean_force_N[2]; /* mean contact force while the axle is on [0, L] */
-    double min_force_N[2], max_force_N[2]; /* over the same time */
-    long lost_contact_steps[2];            /* steps with the tyre off the road */
-    long on_span_steps[2];
+    /* out, when the vehicle has left (per axle, front first; the half-car
+     * is filled in as truck on amfi_sim_add) */
+    double mean_force_N[AMFI_MAX_AXLES]; /* mean contact force while the axle is on [0, L] */
+    double min_force_N[AMFI_MAX_AXLES], max_force_N[AMFI_MAX_AXLES]; /* over the same time */
+    long lost_contact_steps[AMFI_MAX_AXLES];            /* steps with the tyre off the road */
+    long on_span_steps[AMFI_MAX_AXLES];
 } amfi_sim_vehicle;
 
 typedef struct amfi_sim amfi_sim;
@@ -85,10 +92,10 @@ double amfi_sim_time(const amfi_sim *s);   /* time of the next sample, s */
 int amfi_sim_busy(const amfi_sim *s);      /* vehicles pending or active */
 
 /* Called after every integration step for every active vehicle: time, the
- * vehicle, its axles' positions (m) and contact forces (N). For force
- * histories in experiments; NULL to stop. */
+ * vehicle, its axles' positions (m) and contact forces (N), v->truck.n_axles
+ * of each. For force histories in experiments; NULL to stop. */
 typedef void (*amfi_sim_hook)(void *user, double t_s, const amfi_sim_vehicle *v,
-                              const double x_m[2], const double F_N[2]);
+                              const double *x_m, const double *F_N);
 void amfi_sim_set_hook(amfi_sim *s, amfi_sim_hook fn, void *user);
 
 /* Replace the simulated bridge (a damage step) while traffic runs: the
@@ -100,8 +107,9 @@ int amfi_sim_set_bridge(amfi_sim *s, const amfi_bridge *b, char *err, size_t err
 /* Bridge deflection at x (m, positive downward) at the current time. */
 double amfi_sim_deflection(amfi_sim *s, double x_m);
 
-/* Vehicle DOFs of an active vehicle (testing): u[4] = y_s, θ, y_u1, y_u2.
- * Returns 0, or −1 when no active vehicle has that id. */
-int amfi_sim_vehicle_state(const amfi_sim *s, long id, double u[4]);
+/* Vehicle DOFs of an active vehicle (testing): amfi_truck_ndof values in
+ * the order of vehicle.h (the half-car: y_s, θ, y_u1, y_u2). Returns 0, or
+ * −1 when no active vehicle has that id. */
+int amfi_sim_vehicle_state(const amfi_sim *s, long id, double *u);
 
 #endif

@@ -106,3 +106,199 @@ int amfi_halfcar_from_weights(double gvw_kg, double axle1_kg, double axle2_kg, d
     v->Is_kgm2 = v->ms_kg * v->D1_m * v->D2_m;
     return amfi_halfcar_finish(v, err, errlen);
 }
+
+/* ---- the general linear multi-body vehicle (vehicle.h) ------------------- */
+
+#include <string.h>
+
+#define TFAIL(...) (err && errlen ? snprintf(err, errlen, __VA_ARGS__) : 0, -1)
+
+int amfi_truck_ndof(const amfi_truck *t) { return amfi_truck_hop0(t) + t->n_axles; }
+int amfi_truck_hop0(const amfi_truck *t) { return t->n_bodies == 2 ? 3 : 2; }
+
+void amfi_truck_body_point(const amfi_truck *t, int body, double x_m, double *g)
+{
+    memset(g, 0, sizeof(double) * AMFI_TRUCK_MAX_DOF);
+    g[0] = 1.0;
+    if (body == 0) {
+        g[1] = x_m - t->xcg_m[0];
+    } else { /* through the kingpin: z0 + θ0·(x_k − x_cg0) + θ1·(x − x_k) */
+        g[1] = t->xk_m - t->xcg_m[0];
+        g[2] = x_m - t->xk_m;
+    }
+}
+
+int amfi_truck_finish(amfi_truck *t, char *err, size_t errlen)
+{
+    const int n = t->n_axles, nb = t->n_bodies;
+    if (n < 2 || n > AMFI_MAX_AXLES)
+        return TFAIL("%d axles (2 .. %d)", n, AMFI_MAX_AXLES);
+    if (nb < 1 || nb > AMFI_TRUCK_MAX_BODIES)
+        return TFAIL("%d bodies (1 or 2)", nb);
+    if (t->x_m[0] != 0.0)
+        return TFAIL("axle 1 at %g m, not 0", t->x_m[0]);
+    for (int i = 0; i < n; i++) {
+        if (i > 0 && !(t->x_m[i] - t->x_m[i - 1] >= 0.3 && t->x_m[i] - t->x_m[i - 1] <= 30.0))
+            return TFAIL("axle %d is %g m behind axle %d (0.3 .. 30 m)", i + 1,
+                         t->x_m[i] - t->x_m[i - 1], i);
+        if (t->body[i] < 0 || t->body[i] >= nb || (i > 0 && t->body[i] < t->body[i - 1]))
+            return TFAIL("axle %d on body %d: the bodies' axles must follow each other", i + 1,
+                         t->body[i]);
+        if (!(t->mu_kg[i] > 0) || !(t->mu_kg[i] < 1e4))
+            return TFAIL("axle %d: unsprung mass %g kg out of (0, 10000)", i + 1, t->mu_kg[i]);
+        if (!(t->ks_Nm[i] > 0) || !(t->ks_Nm[i] < 1e9))
+            return TFAIL("axle %d: suspension stiffness %g N/m out of (0, 1e9)", i + 1,
+                         t->ks_Nm[i]);
+        if (!(t->cs_Nsm[i] >= 0) || !(t->cs_Nsm[i] < 1e8) || !(t->kt_Nm[i] >= 0) ||
+            !(t->kt_Nm[i] < 1e10))
+            return TFAIL("axle %d: damping %g N·s/m or tyre stiffness %g N/m out of range", i + 1,
+                         t->cs_Nsm[i], t->kt_Nm[i]);
+        if (!(t->W_N[i] > t->mu_kg[i] * AMFI_GRAVITY) || !(t->W_N[i] < 1e6))
+            return TFAIL("axle %d: static load %g N not above its unsprung weight %g N (or "
+                         "above 1e6 N)",
+                         i + 1, t->W_N[i], t->mu_kg[i] * AMFI_GRAVITY);
+        if (t->share[i] < 0)
+            return TFAIL("axle %d: load-sharing set %d < 0", i + 1, t->share[i]);
+        if (t->share[i] > 0) {
+            int j = i - 1; /* the set's previous axle must be the one before */
+            int seen = 0;
+            for (int k = 0; k < i; k++)
+                if (t->share[k] == t->share[i])
+                    seen = 1;
+            if (seen && (t->share[j] != t->share[i] || t->body[j] != t->body[i]))
+                return TFAIL("axle %d: load-sharing set %d is not adjacent axles of one body",
+                             i + 1, t->share[i]);
+            if (seen) {
+                double a = t->W_N[i] - t->mu_kg[i] * AMFI_GRAVITY,
+                       b = t->W_N[j] - t->mu_kg[j] * AMFI_GRAVITY;
+                if (!(fabs(a - b) <= 1e-6 * fmax(a, b)))
+                    return TFAIL("axles %d and %d share their suspension but carry %g and %g N "
+                                 "on their springs",
+                                 j + 1, i + 1, b, a);
+            }
+        }
+    }
+    if (t->body[0] != 0 || t->body[n - 1] != nb - 1)
+        return TFAIL("every one of the %d bodies needs axles", nb);
+    for (int b = 0; b < nb; b++) {
+        if (!(t->ms_kg[b] > 0) || !(t->Is_kgm2[b] > 0))
+            return TFAIL("body %d: mass %g kg and pitch inertia %g kg·m² must be > 0", b + 1,
+                         t->ms_kg[b], t->Is_kgm2[b]);
+        /* supports: independent axles, load-sharing sets once, the kingpin */
+        int sup = b == 1;
+        for (int i = 0; i < n; i++)
+            if (t->body[i] == b && (t->share[i] == 0 || i == 0 || t->share[i - 1] != t->share[i]))
+                sup++;
+        if (sup < 2)
+            return TFAIL("body %d rests on %d support (a load-sharing group counts once): its "
+                         "pitch is free",
+                         b + 1, sup);
+    }
+    if (nb == 2) {
+        int last0 = 0;
+        while (t->body[last0 + 1] == 0)
+            last0++;
+        if (!(t->xk_m >= -1.0 && t->xk_m <= t->x_m[last0] + 1.5 && t->xk_m < t->x_m[last0 + 1]))
+            return TFAIL("kingpin at %g m: not over the tractor (axle 1 − 1 m .. last tractor "
+                         "axle + 1.5 m)",
+                         t->xk_m);
+    }
+    /* static equilibrium, trailer first: the kingpin load from its forces */
+    const double g = AMFI_GRAVITY;
+    double S[AMFI_MAX_AXLES];
+    for (int i = 0; i < n; i++)
+        S[i] = t->W_N[i] - t->mu_kg[i] * g;
+    t->Fk_N = 0.0;
+    for (int b = nb - 1; b >= 0; b--) {
+        double F = -t->ms_kg[b] * g, Mo = -t->ms_kg[b] * g * t->xcg_m[b], len = 0.0;
+        for (int i = 0; i < n; i++)
+            if (t->body[i] == b) {
+                F += S[i];
+                Mo += S[i] * t->x_m[i];
+                len = fmax(len, fabs(t->x_m[i] - t->xcg_m[b]));
+            }
+        if (b == 1) {
+            t->Fk_N = -F; /* the kingpin carries the rest */
+            Mo += t->Fk_N * t->xk_m;
+            F = 0.0;
+            if (!(t->Fk_N >= 0))
+                return TFAIL("the semi-trailer's axles carry %g N more than its weight: the "
+                             "kingpin would pull",
+                             -t->Fk_N);
+        } else if (nb == 2) {
+            F -= t->Fk_N;
+            Mo -= t->Fk_N * t->xk_m;
+        }
+        const double W = t->ms_kg[b] * g + (b == 0 ? t->Fk_N : 0.0);
+        if (!(fabs(F) <= 1e-6 * W) || !(fabs(Mo) <= 1e-6 * W * fmax(len, 1.0)))
+            return TFAIL("body %d is not in static equilibrium (force %g N, moment %g N·m "
+                         "left)",
+                         b + 1, F, Mo);
+    }
+    return 0;
+}
+
+int amfi_truck_from_halfcar(const amfi_halfcar *v, amfi_truck *t, char *err, size_t errlen)
+{
+    memset(t, 0, sizeof *t);
+    t->n_axles = 2;
+    t->n_bodies = 1;
+    t->x_m[1] = v->D1_m + v->D2_m;
+    t->xcg_m[0] = v->D1_m;
+    t->ms_kg[0] = v->ms_kg;
+    t->Is_kgm2[0] = v->Is_kgm2;
+    for (int i = 0; i < 2; i++) {
+        t->mu_kg[i] = v->mu_kg[i];
+        t->ks_Nm[i] = v->ks_Nm[i];
+        t->cs_Nsm[i] = v->cs_Nsm[i];
+        t->kt_Nm[i] = v->kt_Nm[i];
+        t->W_N[i] = v->W_N[i];
+    }
+    return amfi_truck_finish(t, err, errlen);
+}
+
+int amfi_truck_matrices(const amfi_truck *t, double *M, double *C, double *K)
+{
+    const int nd = amfi_truck_ndof(t), h0 = amfi_truck_hop0(t), n = t->n_axles;
+    memset(M, 0, sizeof(double) * nd * nd);
+    memset(C, 0, sizeof(double) * nd * nd);
+    memset(K, 0, sizeof(double) * nd * nd);
+    double g[AMFI_TRUCK_MAX_DOF];
+    /* bodies: the mass at its CG through g, the pitch inertia on its angle */
+    for (int b = 0; b < t->n_bodies; b++) {
+        amfi_truck_body_point(t, b, t->xcg_m[b], g);
+        for (int r = 0; r < h0; r++)
+            for (int q = 0; q < h0; q++)
+                M[r * nd + q] += t->ms_kg[b] * g[r] * g[q];
+        M[(1 + b) * nd + 1 + b] += t->Is_kgm2[b];
+    }
+    for (int i = 0; i < n; i++)
+        M[(h0 + i) * nd + h0 + i] = t->mu_kg[i];
+    /* suspensions: deflection e_i = d_i·u, d_i = g(x_i) − e_hop(i) */
+    double d[AMFI_MAX_AXLES][AMFI_TRUCK_MAX_DOF];
+    for (int i = 0; i < n; i++) {
+        amfi_truck_body_point(t, t->body[i], t->x_m[i], d[i]);
+        d[i][h0 + i] = -1.0;
+        for (int r = 0; r < nd; r++)
+            for (int q = 0; q < nd; q++)
+                C[r * nd + q] += t->cs_Nsm[i] * d[i][r] * d[i][q];
+    }
+    for (int i = 0; i < n;) {
+        int j = i + 1;
+        if (t->share[i] > 0)
+            while (j < n && t->share[j] == t->share[i])
+                j++;
+        /* one spring over axles i .. j−1: k̄/m·(Σ d)(Σ d)ᵀ, m = j − i */
+        double ds[AMFI_TRUCK_MAX_DOF] = {0}, kbar = 0.0;
+        for (int a = i; a < j; a++) {
+            kbar += t->ks_Nm[a] / (j - i);
+            for (int r = 0; r < nd; r++)
+                ds[r] += d[a][r];
+        }
+        for (int r = 0; r < nd; r++)
+            for (int q = 0; q < nd; q++)
+                K[r * nd + q] += kbar / (j - i) * ds[r] * ds[q];
+        i = j;
+    }
+    return nd;
+}

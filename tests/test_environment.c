@@ -212,6 +212,61 @@ static void mix_draw(void **state)
     amfi_traffic_free(recs);
 }
 
+/* The split per vehicle class: the shipped two-axle population (one class)
+ * splits exactly as at its median; in the heavy traffic by class every
+ * class is split at its own median, so that the loaded and the empty draws
+ * both keep the classes' shares. */
+static void mix_by_class(void **state)
+{
+    amfi_vehicle_rec *recs = NULL;
+    int n = 0;
+    char err[256];
+    amfi_mix_classes a, b;
+    (void)state;
+    assert_int_equal(amfi_traffic_read(AMFI_SIM_DATA_DIR "/population.csv", &recs, &n, err,
+                                       sizeof err), 0);
+    assert_int_equal(amfi_mix_classify(recs, n, amfi_mix_median_gvw(recs, n), &a, err,
+                                       sizeof err), 0);
+    assert_int_equal(amfi_mix_classify_by_class(recs, n, &b, err, sizeof err), 0);
+    assert_int_equal(a.n_loaded, b.n_loaded);
+    assert_int_equal(a.n_empty, b.n_empty);
+    assert_memory_equal(a.loaded, b.loaded, sizeof(int) * (size_t)a.n_loaded);
+    amfi_mix_classes_free(&a);
+    amfi_mix_classes_free(&b);
+    amfi_traffic_free(recs);
+    assert_int_equal(amfi_traffic_read(AMFI_SIM_DATA_DIR "/population-eu.csv", &recs, &n, err,
+                                       sizeof err), 0);
+    assert_int_equal(amfi_mix_classify_by_class(recs, n, &b, err, sizeof err), 0);
+    int pop[16] = {0}, ld[16] = {0}, em[16] = {0};
+    for (int i = 0; i < n; i++)
+        pop[recs[i].vclass]++;
+    for (int i = 0; i < b.n_loaded; i++)
+        ld[recs[b.loaded[i]].vclass]++;
+    for (int i = 0; i < b.n_empty; i++)
+        em[recs[b.empty[i]].vclass]++;
+    for (int k = 0; k < 16; k++) {
+        if (!pop[k])
+            continue;
+        /* each class about half loaded, so each draw keeps its share */
+        assert_true(abs(ld[k] - em[k]) <= 1);
+        assert_true(fabs((double)ld[k] / b.n_loaded - (double)pop[k] / n) < 0.005);
+    }
+    /* with one split for all, the loaded draw would be mostly articulated */
+    amfi_mix_classes c;
+    assert_int_equal(amfi_mix_classify(recs, n, amfi_mix_median_gvw(recs, n), &c, err,
+                                       sizeof err), 0);
+    int r2 = 0;
+    for (int i = 0; i < c.n_loaded; i++)
+        r2 += recs[c.loaded[i]].vclass == 0;
+    print_message("two-axle share of the loaded draw: %.1f %% split per class, %.1f %% at the "
+                  "population's median (population %.1f %%)\n",
+                  100.0 * ld[0] / b.n_loaded, 100.0 * r2 / c.n_loaded, 100.0 * pop[0] / n);
+    assert_true((double)r2 / c.n_loaded < 0.5 * pop[0] / n);
+    amfi_mix_classes_free(&b);
+    amfi_mix_classes_free(&c);
+    amfi_traffic_free(recs);
+}
+
 /* The streaming site: calendar from the start utime, the modulus-scaled
  * bridges (first circular frequency ∝ sqrt(E)) and their cache. */
 static void site_stream(void **state)
@@ -309,8 +364,8 @@ int main(void)
         cmocka_unit_test(modulus_law),     cmocka_unit_test(air_mean_cycles),
         cmocka_unit_test(a_year),          cmocka_unit_test(reproducible_and_compressed),
         cmocka_unit_test(deck_lags_air),   cmocka_unit_test(mix_calendar),
-        cmocka_unit_test(mix_draw),        cmocka_unit_test(site_stream),
-        cmocka_unit_test(site_segments),
+        cmocka_unit_test(mix_draw),        cmocka_unit_test(mix_by_class),
+        cmocka_unit_test(site_stream),     cmocka_unit_test(site_segments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "traffic.h"
+#include "vclass.h"
 
 static char dir[64];
 static char path[256];
@@ -412,6 +413,133 @@ static int teardown(void **state)
     return system(cmd) == 0 ? 0 : -1;
 }
 
+/* ---- the class format --------------------------------------------------- */
+
+#define CHDR "timestamp_s,lane,speed_mps,class,gvw_kg,n_axles,axle_kg,spacings_m\n"
+#define CGOOD "1.0,1,25,A23,33000,5,7000;11000;5000;5000;5000,3.70;6.00;1.31;1.31\n"
+
+static void test_class_format(void **state)
+{
+    (void)state;
+    /* any column order, spaces around list items, different axle counts */
+    const char *p = write_text("cls.csv", "class,n_axles, spacings_m ,axle_kg,timestamp_s,lane,"
+                                          "speed_mps,gvw_kg\n"
+                                          "R2,2,4.5,4000;5000,0,1,25,9000\n"
+                                          "A33,6,3.3; 1.35 ;5.3;1.31;1.31,6000;9000;9000;"
+                                          "6000;6000;6000,1,1,24,42000\n"
+                                          "R4,4,1.9;3.4;1.35,7000;7000;9000;9000,2,2,22,32000\n");
+    amfi_vehicle_rec *r = NULL;
+    int n = 0;
+    assert_int_equal(amfi_traffic_read(p, &r, &n, err, sizeof err), 0);
+    assert_int_equal(n, 3);
+    assert_int_equal(r[0].n_axles, 2);
+    assert_string_equal(amfi_vclass_get(r[0].vclass)->name, "R2");
+    assert_int_equal(r[1].n_axles, 6);
+    assert_string_equal(amfi_vclass_get(r[1].vclass)->name, "A33");
+    assert_true(r[1].spacing_m[1] == 1.35 && r[1].spacing_m[4] == 1.31 &&
+                r[1].spacing_m[5] == 0.0);
+    assert_true(r[1].axle_kg[5] == 6000 && r[1].axle_kg[6] == 0.0 && r[1].gvw_kg == 42000);
+    assert_int_equal(r[2].n_axles, 4);
+    assert_int_equal(r[2].line, 4);
+    assert_int_equal(r[2].lane, 2);
+    amfi_traffic_free(r);
+    /* the wide format: a class guessed from the spacings, or none */
+    p = write_text("wide.csv", "timestamp_s,lane,speed_mps,gvw_kg,axle1_kg,axle2_kg,axle3_kg,"
+                               "spacing1_m,spacing2_m\n"
+                               "0,1,25,20000,6000,7000,7000,4.6,1.35\n"
+                               "1,1,25,20000,6000,7000,7000,4.0,4.0\n");
+    assert_int_equal(amfi_traffic_read(p, &r, &n, err, sizeof err), 0);
+    assert_string_equal(amfi_vclass_get(r[0].vclass)->name, "R3");
+    assert_int_equal(r[1].vclass, -1);
+    amfi_traffic_free(r);
+    /* the shipped two-axle population: every record R2 */
+    assert_int_equal(amfi_traffic_read(AMFI_SIM_DATA_DIR "/population.csv", &r, &n, err,
+                                       sizeof err), 0);
+    for (int i = 0; i < n; i++)
+        assert_int_equal(r[i].vclass, 0);
+    amfi_traffic_free(r);
+    /* the shipped heavy traffic: every record of its class's layout */
+    assert_int_equal(amfi_traffic_read(AMFI_SIM_DATA_DIR "/population-eu.csv", &r, &n, err,
+                                       sizeof err), 0);
+    assert_int_equal(n, 5000);
+    int per[16] = {0};
+    for (int i = 0; i < n; i++) {
+        const amfi_vclass *c = amfi_vclass_get(r[i].vclass);
+        assert_non_null(c);
+        assert_int_equal(r[i].n_axles, c->n_axles);
+        assert_true(r[i].gvw_kg <= c->gvw_hi);
+        per[r[i].vclass]++;
+    }
+    for (int k = 0; k < amfi_vclass_count(); k++)
+        assert_true(per[k] > 100);
+    amfi_traffic_free(r);
+}
+
+/* Impossible vehicles: FILE:LINE: COLUMN: the reason. */
+static void test_class_refused(void **state)
+{
+    (void)state;
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,X5,33000,5,7000;11000;5000;5000;5000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "class", "'X5' is not a known class (R2, R3, R4, A22, A23, A32, A33)");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,,33000,5,7000;11000;5000;5000;5000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "class", "empty value");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,6,7000;11000;5000;5000;5000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "n_axles", "6, but class A23 has 5 axles");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,13,7000;11000;5000;5000;5000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "n_axles", "13 is out of range 2 .. 12");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;11000;5000;5000;5000,"
+                                     "3.70;6.00;1.31;1.31;1.31\n"),
+                 3, "spacings_m", "more than 4 values for 5 axles");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;11000;5000;5000;5000,"
+                                     "3.70;6.00;1.31\n"),
+                 3, "spacings_m", "3 values for 5 axles (4 expected)");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;11000;10000;5000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "axle_kg", "4 values for 5 axles (5 expected)");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;11000;;5000;10000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "axle_kg", "value 3 is empty");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;11000;x;5000;10000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "axle_kg", "value 3, 'x', is not a finite number");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;nan;5000;5000;15000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "axle_kg", "value 2, 'nan', is not a finite number");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;11000;-5000;10000;10000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "axle_kg", "value 3, -5000, is out of range (0, 30000] kg");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,73000,5,7000;11000;5000;5000;45000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "axle_kg", "value 5, 45000, is out of range");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;11000;5000;5000;5000,"
+                                     "3.70;0.2;1.31;1.31\n"),
+                 3, "spacings_m", "value 2, 0.2, is out of range [0.5, 30] m");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;11000;5000;5000;5000,"
+                                     "3.70;6.00;3.50;1.31\n"),
+                 3, "spacings_m", "spacing 3: 3.5 m between axles 3 and 4 of a group");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,33000,5,7000;11000;5000;5000;5000,"
+                                     "1.70;6.00;1.31;1.31\n"),
+                 3, "spacings_m", "spacing 1: 1.7 m between axles 1 and 2, which are in "
+                                  "different groups");
+    expect_error(write_text("c.csv", CHDR CGOOD "2,1,25,A23,39000,5,7000;11000;5000;5000;5000,"
+                                     "3.70;6.00;1.31;1.31\n"),
+                 3, "gvw_kg", "differs by");
+    /* headers: the formats do not mix; the class format needs its four */
+    expect_error(write_text("c.csv", "timestamp_s,lane,speed_mps,class,gvw_kg,n_axles,axle_kg,"
+                                     "spacings_m,axle1_kg\n" CGOOD),
+                 1, NULL, "do not mix");
+    expect_error(write_text("c.csv", "timestamp_s,lane,speed_mps,class,gvw_kg,axle_kg,"
+                                     "spacings_m\n1,1,25,A23,33000,7000,3.7\n"),
+                 1, "n_axles", "missing column");
+    expect_error(write_text("c.csv", "timestamp_s,lane,speed_mps,class,gvw_kg,n_axles,axle_kg,"
+                                     "spacings_m,class\n"),
+                 1, "class", "duplicate column");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -423,6 +551,8 @@ int main(void)
         cmocka_unit_test(test_rows),
         cmocka_unit_test(test_junk),
         cmocka_unit_test(test_population),
+        cmocka_unit_test(test_class_format),
+        cmocka_unit_test(test_class_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -1506,6 +1506,13 @@ int main(int argc, char **argv)
         die("%s%s", err, "");
     if (c.n_recs < c.o.vehicles)
         die("%s has fewer vehicles than a batch%s", ppath, "");
+    for (int i = 0; i < c.n_recs; i++) /* the paper's experiments: two-axle half-cars */
+        if (c.recs[i].n_axles != 2) {
+            char where[96];
+            snprintf(where, sizeof where, "%ld: %d axles: the paper's experiments simulate "
+                     "two-axle vehicles only", c.recs[i].line, c.recs[i].n_axles);
+            die("%s:%s", ppath, where);
+        }
     amfi_halfcar_dist_paper(&c.dist);
     amfi_sim_params_default(&c.sp, c.cfg.bridge.span_m);
     c.sp.n_sensors = 1;
