@@ -38,6 +38,12 @@ void release_windows(daemon_s *d, int flush)
 {
     amfi_window w;
     const int ns = d->cfg.solver.n_sensors;
+    /* Before the first sample nothing is decided: the vehicles queued so
+     * far are checked against the data time when it comes (on_accel), and
+     * one dated far ahead is refused then, never stored as a passage at
+     * its forged date. */
+    if (!flush && d->newest_utime == 0)
+        return;
     while (amfi_tracker_next(d->tracker, d->rings, flush, &w)) {
         d->released++;
         job *j = calloc(1, sizeof *j);
@@ -298,9 +304,9 @@ static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
 {
     /* A rejected vehicle is still a stored passage, with the reason; the raw
      * values that failed are in the reason, not in the typed columns. */
-    char reason[sizeof(((job *)0)->reason)];
+    char reason[400]; /* cut to the job's reason by store_refused */
     snprintf(reason, sizeof reason,
-             "%.90s (speed_mps %.6g, n_axles %d, utime %lld, reference_gvw_kg %.6g)", why,
+             "%.128s (speed_mps %.6g, n_axles %d, utime %lld, reference_gvw_kg %.6g)", why,
              m->speed_mps, m->n_axles, (long long)m->utime, m->reference_gvw_kg);
     store_refused(d, m->vehicle_id, m->utime, m->lane, "invalid", reason);
 }
