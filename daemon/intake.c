@@ -174,16 +174,6 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
     if (intake_decode(d, AMFI_MSG_ACCEL_BLOCK_T, REJECT_ACCEL, "accel_block_t", rb, ch, &m))
         return;
     d->blocks_received++;
-    if (!intake_take(d, REJECT_ACCEL, m.n > 0 ? (double)m.n : 1.0)) {
-        d->blocks_rejected++;
-        reject_note(d, REJECT_ACCEL, REJECT_RATE,
-                    "%s: accel_block_t sensor %d seq %lld refused: over the channel's rate limit "
-                    "(daemon.intake.accel_margin %g × the sensors' rate_hz: %.0f samples/s)",
-                    ch, m.sensor_id, (long long)m.seq, d->cfg.daemon.accel_margin,
-                    d->lim[REJECT_ACCEL].rate);
-        amfi_accel_block_t_decode_cleanup(&m);
-        return;
-    }
     const char *why = NULL;
     char wbuf[160];
     int idx = sensor_index(d, m.sensor_id);
@@ -205,6 +195,19 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
     for (int i = 0; !why && i < m.n; i++)
         if (!isfinite(m.accel[i]) || fabs(m.accel[i]) > 1000.0)
             why = "accel has a non-finite or absurd (> 1000 m/s²) value";
+    /* The channel's rate, in samples, charged for the blocks that pass the
+     * checks (a refused block costs its check only and takes nothing from
+     * the real stream's allowance). */
+    if (!why && !intake_take(d, REJECT_ACCEL, (double)m.n)) {
+        d->blocks_rejected++;
+        reject_note(d, REJECT_ACCEL, REJECT_RATE,
+                    "%s: accel_block_t sensor %d seq %lld refused: over the channel's rate limit "
+                    "(daemon.intake.accel_margin %g × the sensors' rate_hz: %.0f samples/s)",
+                    ch, m.sensor_id, (long long)m.seq, d->cfg.daemon.accel_margin,
+                    d->lim[REJECT_ACCEL].rate);
+        amfi_accel_block_t_decode_cleanup(&m);
+        return;
+    }
     if (!why && !d->rings[idx]) {
         d->rings[idx] = amfi_ring_create(d->cfg.sensor_rate_hz[idx], d->cfg.daemon.ring_s);
         if (!d->rings[idx])
