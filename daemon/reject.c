@@ -104,9 +104,11 @@ static void store_summary(daemon_s *d, double now)
     if (n > 0 && d->store) {
         char err[256];
         if (amfi_store_add_refusals(d->store, rows, n, err, sizeof err) != 0) {
-            LOG_WARN("store: the summary of refused messages (%d rows): %s", n, err);
             if (now - r->sum_start < 2.0 * d->cfg.daemon.summary_period_s)
-                return; /* kept, retried at the next tick */
+                return; /* kept, retried at the next tick (the counts grow) */
+            LOG_WARN("store: the summary of refused messages (%d rows) is lost: %s (the "
+                     "counts since start are in the log at stop and in the status message)",
+                     n, err);
             r->summaries_lost += n;
         } else {
             r->summaries_stored += n;
