@@ -254,8 +254,8 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
                 char reason[200];
                 d->vehicles_rejected++;
                 snprintf(reason, sizeof reason,
-                         "%s: vehicle_t %lld rejected: utime %.0f s after the newest data time "
-                         "(more than daemon.intake.vehicle_ahead_s %g s)",
+                         "%s: vehicle_t %lld rejected: utime %.0f s past the newest data time "
+                         "(daemon.intake.vehicle_ahead_s %g s)",
                          d->cfg.daemon.ch_vehicle, (long long)ev.vehicle_id,
                          1e-6 * (double)(ev.utime - newest), d->cfg.daemon.vehicle_ahead_s);
                 reject_note(d, REJECT_VEHICLE, REJECT_INVALID, "%s", reason);
@@ -386,7 +386,7 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
     } else if (!why && d->newest_utime > 0 &&
                (double)m.utime > (double)d->newest_utime + 1e6 * c->vehicle_ahead_s) {
         snprintf(wbuf, sizeof wbuf,
-                 "utime %.0f s after the newest data time (more than "
+                 "utime %.0f s past the newest data time ("
                  "daemon.intake.vehicle_ahead_s %g s)",
                  1e-6 * (double)(m.utime - d->newest_utime), c->vehicle_ahead_s);
         why = wbuf;

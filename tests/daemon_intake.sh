@@ -45,9 +45,13 @@ for case in $cases; do
   future)
     # the first burst waits (no data yet) and is refused when the data come;
     # the rest is over the vehicle channel's rate: counted, no row each
-    inv=$(q "SELECT count(*) FROM passages WHERE vehicle_id >= 800000 AND status = 'invalid' AND reason LIKE '%after the newest data time (more than daemon.intake.vehicle_ahead_s 120 s)%'")
+    inv=$(q "SELECT count(*) FROM passages WHERE vehicle_id >= 800000 AND status = 'invalid' AND reason LIKE '%s past the newest data time (daemon.intake.vehicle_ahead_s 120 s)%'")
     lim=$(refused vehicle rate_limited)
-    [ $((inv + lim)) -eq 256 ] || fail "$inv invalid rows + $lim rate-limited, want 256 forged vehicles"
+    [ $((inv + lim)) -eq 257 ] || fail "$inv invalid rows + $lim rate-limited, want 257 forged vehicles"
+    # the one sent once the data flowed: refused on arrival, stored at the data's time
+    q "SELECT status, reason FROM passages WHERE vehicle_id = 801000 AND utime < 4102444800000000" |
+      grep -q "^invalid|AMFI_VEHICLE: vehicle_t 801000 rejected: utime [0-9]* s past the newest data time (daemon.intake.vehicle_ahead_s 120 s)" ||
+      fail "vehicle 801000: $(q "SELECT status, utime, reason FROM passages WHERE vehicle_id = 801000")"
     [ "$inv" -le 200 ] || fail "$inv rows for the forged vehicles (the rate limit's burst is 100)"
     [ "$(q "SELECT count(*) FROM passages WHERE utime > 4102444800000000")" -eq 0 ] ||
       fail "a row dated after 2100: $(q "SELECT vehicle_id, utime FROM passages WHERE utime > 4102444800000000 LIMIT 1")" ;;

@@ -10,8 +10,8 @@
  *              999 Hz (12 samples, 1 s before the stream); it once fixed
  *              the sensor's rate and turned every passage into gap
  *   future     before the first message: 256 vehicle_t dated in 2286, 100 s apart
- *              (ids 800000 ..); they once filled the tracker and made every
- *              real vehicle invalid
+ *              (ids 800000 ..), and one more after the first vehicle (801000);
+ *              they once filled the tracker and made every real vehicle invalid
  *   slow       after the first vehicle: one vehicle_t at 1 m/s entering
  *              0.5 s after it (id 810000); it once made the real passages
  *              around it multiple
@@ -148,6 +148,9 @@ int main(int argc, char **argv)
         }
         if (is_vehicle) {
             if (vehicles++ == 0) {
+                if (strcmp(mode, "future") == 0) /* and one once the data flow */
+                    rc |= put_vehicle(out, ts, INT64_C(10000000000000000), 801000, 20.0,
+                                      "sim_publisher", 0.0);
                 if (strcmp(mode, "slow") == 0)
                     rc |= put_vehicle(out, ts, v.utime + 500000, 810000, 1.0, "sim_publisher",
                                       0.0);
