@@ -217,6 +217,7 @@ static int start_runtime(daemon_s *d)
         LOG_ERR("out of memory at start-up");
         return 1;
     }
+    intake_limits(d); /* the rate limits of the inputs: full buckets */
     char url[512];
     bus_url(&d->cfg.daemon, url, sizeof url);
     d->lcm = lcm_create(url);
@@ -224,7 +225,6 @@ static int start_runtime(daemon_s *d)
         LOG_ERR("cannot open the LCM bus '%s'", url);
         return 1;
     }
-    intake_limits(d);
     if (intake_subscribe(d))
         return 1;
     if (pool_start(&d->pool, d->bridge, &d->cfg.solver, d->cfg.daemon.workers,

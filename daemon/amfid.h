@@ -205,13 +205,13 @@ typedef struct daemon_s {
     int64_t blocks_received, blocks_rejected, vehicles_received, vehicles_rejected;
     int64_t messages_malformed, passages_stored, passages_ok, truth_received;
     int64_t messages_in;           /* every message the three inputs handed over */
-    int64_t newest_utime;
-    int64_t udp_drops, udp_drops_logged; /* kernel drops on our sockets */
-    reject_state rej;
     bucket lim[REJECT_NINPUTS];    /* rate limits per input channel (intake.c) */
     int64_t vehicles_evicted;      /* the tracker was full: the stalest went (stored) */
     int64_t references_refused;    /* calibration references not taken (source, range) */
     int64_t invalid_unstored;      /* refused vehicles over the rate: summarised only */
+    int64_t newest_utime;
+    int64_t udp_drops, udp_drops_logged; /* kernel drops on our sockets */
+    reject_state rej;
     env_state env;                 /* environment readings (environment.c) */
     scale_state sc;                /* scale indicator, known truck (scaleind.c) */
     freevib_state fv;              /* the natural frequency (freevib.c) */

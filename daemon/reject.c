@@ -28,18 +28,25 @@
 static const char *const input_name[REJECT_NINPUTS] = {"accel", "vehicle", "truth",
                                                          "environment"};
 
+/* the intake's bounds (intake.c, environment.c) */
+static const char *intake_reason_name(int reason)
+{
+    switch (reason) {
+    case REJECT_RATE: return "rate_limited";
+    case REJECT_SOURCE: return "source";
+    case REJECT_IMPLAUSIBLE: return "implausible";
+    default: return NULL;
+    }
+}
+
 const char *reject_reason_name(int reason)
 {
+    if (intake_reason_name(reason))
+        return intake_reason_name(reason);
     if (reason == REJECT_INVALID)
         return "invalid";
     if (reason == REJECT_QUARANTINE)
         return "quarantined";
-    if (reason == REJECT_RATE)
-        return "rate_limited";
-    if (reason == REJECT_SOURCE)
-        return "source";
-    if (reason == REJECT_IMPLAUSIBLE)
-        return "implausible";
     return amfi_msg_reason_name(reason);
 }
 

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Bounded intake: the few messages that once stopped amfid from weighing (a
 # misbehaving or misconfigured instrument sends the same), spliced by
-# lcm_forge into a clean stream and replayed through file:// (no network),
+# lcm_intake_forge into a clean stream and replayed through file:// (no network),
 # amfid with the shipped configuration. Each case: every real vehicle is
 # weighed ok, the forged messages are refused with a reason naming the
 # channel and the field, and the refusals are counted in the store's
@@ -28,7 +28,7 @@ case=clean
 "$sim" --lcm-url none --log "$dir/clean.lcmlog" --vehicles $N --headway 4 --speedup max --seed 2 \
   2> "$dir/sim.log" || fail "sim_publisher: $(tail -3 "$dir/sim.log")"
 for case in $cases; do
-  "$forge" "$case" "$dir/clean.lcmlog" "$dir/$case.lcmlog" || fail "lcm_forge"
+  "$forge" "$case" "$dir/clean.lcmlog" "$dir/$case.lcmlog" || fail "lcm_intake_forge"
   "$amfid" --config "$config" --db "$dir/$case.db" \
     --lcm-url "file://$dir/$case.lcmlog?speed=0" 2> "$dir/$case.log" || fail "amfid exit status $?"
   ok=$(q "SELECT count(*) FROM passages WHERE status = 'ok' AND vehicle_id < 800000")

@@ -1,10 +1,10 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * lcm_forge: copy an LCM log of sim_publisher's, splicing in the messages
+ * lcm_intake_forge: copy an LCM log of sim_publisher's, splicing in the messages
  * that once stopped amfid from weighing (a misbehaving or misconfigured
  * instrument would send the same), for tests/daemon_intake.sh:
  *
- *   lcm_forge MODE IN.log OUT.log
+ *   lcm_intake_forge MODE IN.log OUT.log
  *
  *   rate       before the first message: one accel block of sensor 0 at
  *              999 Hz (12 samples, 1 s before the stream); it once fixed
@@ -86,19 +86,19 @@ static int64_t first_accel(const char *inp)
 int main(int argc, char **argv)
 {
     if (argc != 4) {
-        fprintf(stderr, "usage: lcm_forge rate|future|slow|flood|environment|reference IN OUT\n");
+        fprintf(stderr, "usage: lcm_intake_forge rate|future|slow|flood|environment|reference IN OUT\n");
         return 2;
     }
     const char *mode = argv[1];
     const int64_t t0 = first_accel(argv[2]);
     if (t0 < 0) {
-        fprintf(stderr, "lcm_forge: no accel_block_t in %s\n", argv[2]);
+        fprintf(stderr, "lcm_intake_forge: no accel_block_t in %s\n", argv[2]);
         return 1;
     }
     lcm_eventlog_t *in = lcm_eventlog_create(argv[2], "r");
     lcm_eventlog_t *out = lcm_eventlog_create(argv[3], "w");
     if (!in || !out) {
-        fprintf(stderr, "lcm_forge: cannot open the logs\n");
+        fprintf(stderr, "lcm_intake_forge: cannot open the logs\n");
         return 1;
     }
     lcm_eventlog_event_t *e;
@@ -169,6 +169,6 @@ int main(int argc, char **argv)
     lcm_eventlog_destroy(in);
     lcm_eventlog_destroy(out);
     if (rc)
-        fprintf(stderr, "lcm_forge: write failed\n");
+        fprintf(stderr, "lcm_intake_forge: write failed\n");
     return rc ? 1 : 0;
 }
