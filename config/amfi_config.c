@@ -82,8 +82,10 @@ void amfi_config_defaults(amfi_site_config *c)
      * and lets a 10 % stiffness loss into the speed (docs/results/speed-estimation.md). */
     c->speed_estimate = 0;
     amfi_speed_prior_default(&c->speed_prior);
-    for (int i = 0; i < AMFI_MAX_SENSORS; i++)
+    for (int i = 0; i < AMFI_MAX_SENSORS; i++) {
         c->sensor_id[i] = i < c->solver.n_sensors ? i : -1;
+        c->sensor_rate_hz[i] = i < c->solver.n_sensors ? AMFI_CONFIG_DEFAULT_RATE_HZ : 0.0;
+    }
     amfi_daemon_config *d = &c->daemon;
     strcpy(d->ch_accel, "AMFI_ACCEL");
     strcpy(d->ch_vehicle, "AMFI_VEHICLE");
@@ -136,6 +138,21 @@ void amfi_config_defaults(amfi_site_config *c)
     amfi_natfreq_params_default(&d->natfreq);
     d->natfreq_free_s = 2.0;  /* 11 periods of paper-20m's 5.7 Hz (docs/indicators.md) */
     d->natfreq_baseline_n = 200;
+    /* Bounded intake (docs/daemon.md): generous against real traffic. */
+    d->vehicle_ahead_s = 120.0;
+    d->min_speed_mps = 2.0;
+    d->max_length_m = 40.0;
+    d->accel_margin = 4.0;
+    d->vehicles_per_s = 10.0;
+    d->environment_per_s = 10.0;
+    d->truth_per_s = 50.0;
+    d->burst_s = 10.0;
+    d->summary_period_s = 60.0;
+    d->env_min_interval_s = 1.0;
+    d->deck_max_rate_c_min = 2.0;
+    strcpy(d->calibration_sources, "sim_publisher");
+    d->calibration_min_kg = 3500.0;
+    d->calibration_max_kg = 60000.0;
     /* sim_publisher's ideal simulation (docs/simulator.md): every inaccuracy
      * is switched on explicitly. */
     amfi_sim_config *m = &c->sim;
@@ -149,7 +166,7 @@ void amfi_config_defaults(amfi_site_config *c)
     m->environment = 0;
     m->time_compression = 1.0;
     m->environment_period_s = 60.0;
-    m->scan_rate_hz = 1000.0;
+    m->scan_rate_hz = AMFI_CONFIG_DEFAULT_RATE_HZ; /* the sensors' default rate_hz */
     m->noise = 0.0;
     m->speed_err_mean = 0.0;
     m->speed_err_std = 0.0;

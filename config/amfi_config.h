@@ -32,6 +32,11 @@
 extern "C" {
 #endif
 
+/* A sensor's sample rate when the file gives none (sensors[].rate_hz), Hz:
+ * sim_publisher's default scan rate (simulation.scan_rate_hz), so that the
+ * shipped files and the simulator's default stream agree. */
+#define AMFI_CONFIG_DEFAULT_RATE_HZ 1000.0
+
 /* The monitoring daemon's section (daemon: in the site file). */
 typedef struct amfi_daemon_config {
     char lcm_url[256];        /* daemon.lcm_url; "" = LCM's default */
@@ -109,6 +114,33 @@ typedef struct amfi_daemon_config {
                                  the last exit, s, [0, 30]; 0: off */
     int natfreq_baseline_n;   /* daemon.natural_frequency.baseline_n: passages with an
                                  f1 whose temperature fit is the baseline, 10 .. 100000 */
+    /* daemon.intake.*: bounds on what the bus may bring (daemon/intake.c,
+     * docs/daemon.md "Bounded intake"); each refusal is counted and stored
+     * as a periodic summary (table refusals). */
+    double vehicle_ahead_s;   /* vehicle_ahead_s: a vehicle dated more than this after the
+                                 newest data time is refused, s, [1, 3600] */
+    double min_speed_mps;     /* min_speed_mps: slower vehicles are refused, [1, 60) */
+    double max_length_m;      /* max_length_m: longer vehicles (first to last axle)
+                                 are refused, m, [1, 360] */
+    double accel_margin;      /* accel_margin: accelerometer samples per second taken,
+                                 as a multiple of the sensors' rate_hz summed, [1, 1000] */
+    double vehicles_per_s;    /* vehicles_per_s: vehicle_t per second taken, [0.1, 1e5] */
+    double environment_per_s; /* environment_per_s: environment_t per second, [0.1, 1e5] */
+    double truth_per_s;       /* truth_per_s: truth_t per second, [0.1, 1e5] */
+    double burst_s;           /* burst_s: each limit's allowance, seconds of its rate,
+                                 [1, 3600] */
+    double summary_period_s;  /* summary_period_s: refusals summarised every, wall s,
+                                 [1, 86400] */
+    double env_min_interval_s; /* environment_min_interval_s: readings closer than this
+                                 (data time) to the last stored one are not stored,
+                                 s, [0, 86400] */
+    double deck_max_rate_c_min; /* deck_max_rate_c_per_min: a deck temperature changing
+                                 faster than this against the last accepted reading is
+                                 refused, °C per minute of data time, (0, 1e6] */
+    char calibration_sources[256]; /* calibration_sources: comma-separated vehicle_t
+                                 sources whose reference_gvw_kg is taken; "" none */
+    double calibration_min_kg, calibration_max_kg; /* calibration_min_kg, _max_kg: a
+                                 reference GVW outside is not taken, kg, [1000, 100000] */
 } amfi_daemon_config;
 
 /* The simulator's section (simulation: in the site file). Only
@@ -214,6 +246,10 @@ typedef struct amfi_site_config {
     int sensor_id[AMFI_MAX_SENSORS]; /* sensors[i].id, 0 .. 255, unique;
                                         entry i belongs to solver.sensor_x_m[i];
                                         −1 past solver.n_sensors */
+    double sensor_rate_hz[AMFI_MAX_SENSORS]; /* sensors[i].rate_hz: the sample rate
+                                        the sensor sends at, Hz, (0, 100000], one for
+                                        all sensors; default 1000 (sim_publisher's
+                                        default scan rate); 0 past n_sensors */
     amfi_daemon_config daemon;       /* daemon.* */
     amfi_sim_config sim;             /* simulation.* */
     amfi_report_config report;       /* report.* */

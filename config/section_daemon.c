@@ -86,6 +86,32 @@ static const field natfreq_fields[] = {
      .hi = 100000},
     {.key = NULL}};
 
+static const field intake_fields[] = {
+    {.key = "vehicle_ahead_s", .kind = &K_DOUBLE, .off = DC(vehicle_ahead_s), .lo = 1,
+     .hi = 3600},
+    {.key = "min_speed_mps", .kind = &K_DOUBLE, .off = DC(min_speed_mps), .lo = 1, .hi = 60,
+     .flags = F_HI_OPEN},
+    {.key = "max_length_m", .kind = &K_DOUBLE, .off = DC(max_length_m), .lo = 1, .hi = 360},
+    {.key = "accel_margin", .kind = &K_DOUBLE, .off = DC(accel_margin), .lo = 1, .hi = 1000},
+    {.key = "vehicles_per_s", .kind = &K_DOUBLE, .off = DC(vehicles_per_s), .lo = 0.1,
+     .hi = 1e5},
+    {.key = "environment_per_s", .kind = &K_DOUBLE, .off = DC(environment_per_s), .lo = 0.1,
+     .hi = 1e5},
+    {.key = "truth_per_s", .kind = &K_DOUBLE, .off = DC(truth_per_s), .lo = 0.1, .hi = 1e5},
+    {.key = "burst_s", .kind = &K_DOUBLE, .off = DC(burst_s), .lo = 1, .hi = 3600},
+    {.key = "summary_period_s", .kind = &K_DOUBLE, .off = DC(summary_period_s), .lo = 1,
+     .hi = 86400},
+    {.key = "environment_min_interval_s", .kind = &K_DOUBLE, .off = DC(env_min_interval_s),
+     .lo = 0, .hi = 86400},
+    {.key = "deck_max_rate_c_per_min", .kind = &K_DOUBLE, .off = DC(deck_max_rate_c_min),
+     .lo = 0, .hi = 1e6, .flags = F_LO_OPEN},
+    STR("calibration_sources", calibration_sources, 0),
+    {.key = "calibration_min_kg", .kind = &K_DOUBLE, .off = DC(calibration_min_kg),
+     .lo = 1000, .hi = 100000},
+    {.key = "calibration_max_kg", .kind = &K_DOUBLE, .off = DC(calibration_max_kg),
+     .lo = 1000, .hi = 100000},
+    {.key = NULL}};
+
 const field daemon_fields[] = {
     STR("lcm_url", lcm_url, 0),
     {.key = "channels", .kind = &K_MAP, .aux = channel_fields},
@@ -116,6 +142,7 @@ const field daemon_fields[] = {
      .hi = 3600},
     {.key = "indicators", .kind = &K_MAP, .aux = indicator_fields},
     {.key = "natural_frequency", .kind = &K_MAP, .aux = natfreq_fields},
+    {.key = "intake", .kind = &K_MAP, .aux = intake_fields},
     {.key = NULL}};
 
 int daemon_check(ctx *x, amfi_site_config *c)
@@ -141,6 +168,42 @@ int daemon_check(ctx *x, amfi_site_config *c)
                     "%g s after an event of up to daemon.max_event_s (%g s) is not below "
                     "daemon.ring_s (%g s): the free vibration would leave the ring first",
                     c->daemon.natfreq_free_s, c->daemon.max_event_s, c->daemon.ring_s);
+
+    /* the calibration trucks' range, and their sources: names separated by
+     * commas, each 1 .. 63 bytes of A-Z a-z 0-9 _ . - (vehicle_t.source) */
+    if (c->daemon.calibration_min_kg > c->daemon.calibration_max_kg)
+        return fail(x,
+                    first_noted(x, "daemon.intake.calibration_max_kg",
+                                "daemon.intake.calibration_min_kg", "daemon"),
+                    "daemon.intake.calibration_max_kg", "%g kg is below calibration_min_kg (%g kg)",
+                    c->daemon.calibration_max_kg, c->daemon.calibration_min_kg);
+    {
+        const char *s = c->daemon.calibration_sources;
+        size_t len = 0;
+        for (const char *p = s;; p++) {
+            if (*p == ',' || *p == '\0') {
+                if (len == 0 && (*p == ',' || p != s))
+                    return fail(x, first_noted(x, "daemon.intake.calibration_sources", "daemon", NULL),
+                                "daemon.intake.calibration_sources",
+                                "an empty name in '%s' (names separated by single commas)", s);
+                if (len > 63)
+                    return fail(x, first_noted(x, "daemon.intake.calibration_sources", "daemon", NULL),
+                                "daemon.intake.calibration_sources",
+                                "a name longer than 63 bytes in '%s'", s);
+                if (*p == '\0')
+                    break;
+                len = 0;
+            } else if ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') ||
+                       (*p >= '0' && *p <= '9') || *p == '_' || *p == '.' || *p == '-') {
+                len++;
+            } else {
+                return fail(x, first_noted(x, "daemon.intake.calibration_sources", "daemon", NULL),
+                            "daemon.intake.calibration_sources",
+                            "'%c' in '%s': names are A-Z a-z 0-9 _ . - separated by commas", *p,
+                            s);
+            }
+        }
+    }
 
     /* the band's two ends (each key's own range is the table's) */
     if (amfi_natfreq_params_check(&c->daemon.natfreq, why, sizeof why) != 0)

@@ -21,11 +21,12 @@
 /* Enums are written as ints: */
 _Static_assert(sizeof(amfi_coords) == sizeof(int), "amfi_coords is written as an int");
 
-/* sensors: a list of {id, at_m, weight} */
+/* sensors: a list of {id, at_m, weight, rate_hz} */
 typedef struct sensor_item {
-    int id;        /* 0 .. 255 */
-    double at_m;   /* m, >= 0 (<= span checked in check_site) */
-    double weight; /* > 0, default 1 */
+    int id;         /* 0 .. 255 */
+    double at_m;    /* m, >= 0 (<= span checked in check_site) */
+    double weight;  /* > 0, default 1 */
+    double rate_hz; /* (0, 100000], default AMFI_CONFIG_DEFAULT_RATE_HZ; one for all */
 } sensor_item;
 
 static const field sensor_fields[] = {
@@ -35,6 +36,8 @@ static const field sensor_fields[] = {
      .hi = HUGE_VAL, .flags = F_HI_OPEN | F_REQUIRED},
     {.key = "weight", .kind = &K_DOUBLE, .off = offsetof(sensor_item, weight), .lo = 0,
      .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
+    {.key = "rate_hz", .kind = &K_DOUBLE, .off = offsetof(sensor_item, rate_hz), .lo = 0,
+     .hi = 100000, .flags = F_LO_OPEN},
     {.key = NULL}};
 
 static int p_sensors(ctx *x, yaml_node_t *v, const char *path, const field *f,
@@ -57,9 +60,18 @@ static int p_sensors(ctx *x, yaml_node_t *v, const char *path, const field *f,
         if (!it)
             return fail(x, line_of(v), ip, "malformed list");
         note_line(x, ip, line_of(it));
-        s[i] = (sensor_item){.id = 0, .at_m = 0.0, .weight = 1.0};
+        s[i] = (sensor_item){.id = 0, .at_m = 0.0, .weight = 1.0,
+                             .rate_hz = AMFI_CONFIG_DEFAULT_RATE_HZ};
         if (walk_map(x, it, ip, sensor_fields, &s[i]))
             return -1;
+        /* the solver takes one sample rate for every sensor of a window */
+        if (i > 0 && s[i].rate_hz != s[0].rate_hz) {
+            pathf(idp, "%s.rate_hz", ip);
+            return fail(x, noted(x, idp) ? noted(x, idp) : line_of(it), idp,
+                        "%g Hz differs from %s[0].rate_hz (%g Hz): every sensor must send "
+                        "at one rate",
+                        s[i].rate_hz, path, s[0].rate_hz);
+        }
         for (int j = 0; j < i; j++)
             if (s[j].id == s[i].id) {
                 pathf(idp, "%s.id", ip);
@@ -71,6 +83,7 @@ static int p_sensors(ctx *x, yaml_node_t *v, const char *path, const field *f,
         c->solver.sensor_x_m[i] = i < n ? s[i].at_m : 0.0;
         c->solver.sensor_weight[i] = i < n ? s[i].weight : 0.0;
         c->sensor_id[i] = i < n ? s[i].id : -1;
+        c->sensor_rate_hz[i] = i < n ? s[i].rate_hz : 0.0;
     }
     c->solver.n_sensors = n;
     return 0;
@@ -90,7 +103,8 @@ static void v_sensors(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "one sensor, id 0, at mid-span");
 }
 
-static const sensor_item sensor_default = {.id = 0, .at_m = 0.0, .weight = 1.0};
+static const sensor_item sensor_default = {.id = 0, .at_m = 0.0, .weight = 1.0,
+                                           .rate_hz = AMFI_CONFIG_DEFAULT_RATE_HZ};
 const list_schema sensors_list = {sensor_fields, &sensor_default};
 const kind K_SENSORS = {"list", p_sensors, d_sensors, v_sensors, NEST_LIST};
 

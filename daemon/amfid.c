@@ -217,6 +217,7 @@ static int start_runtime(daemon_s *d)
         LOG_ERR("out of memory at start-up");
         return 1;
     }
+    intake_limits(d); /* the rate limits of the inputs: full buckets */
     char url[512];
     bus_url(&d->cfg.daemon, url, sizeof url);
     d->lcm = lcm_create(url);
@@ -333,6 +334,16 @@ int amfid_drain(daemon_s *d)
                  (long long)d->env.received, (long long)d->env.rejected,
                  (long long)d->env.stored,
                  d->env.lost + d->env.n > 0 ? ", some not stored (the store refused them)" : "");
+    if (d->env.thinned > 0)
+        LOG_INFO("environment: %lld accepted readings not stored (within "
+                 "daemon.intake.environment_min_interval_s of a stored one)",
+                 (long long)d->env.thinned);
+    if (d->vehicles_evicted + d->references_refused + d->invalid_unstored > 0)
+        LOG_INFO("intake: %lld waiting vehicles evicted (stored as overload), %lld calibration "
+                 "references not taken, %lld refused vehicles over the rate limit (summarised, "
+                 "no row)",
+                 (long long)d->vehicles_evicted, (long long)d->references_refused,
+                 (long long)d->invalid_unstored);
     if (d->env.lost + d->env.n > 0)
         LOG_WARN("environment: %lld readings dropped while the store refused them, %d still "
                  "buffered at stop: not stored",

@@ -74,14 +74,34 @@ void amfid_parse_options(int argc, char **argv, amfid_options *o);
 enum { REJECT_ACCEL, REJECT_VEHICLE, REJECT_TRUTH, REJECT_ENVIRONMENT, REJECT_NINPUTS };
 #define REJECT_INVALID AMFI_MSG_NREASONS
 #define REJECT_QUARANTINE (AMFI_MSG_NREASONS + 1) /* an accel block far from the stream */
-#define REJECT_NREASONS (AMFI_MSG_NREASONS + 2)
+#define REJECT_RATE (AMFI_MSG_NREASONS + 2)       /* over its channel's rate limit */
+#define REJECT_SOURCE (AMFI_MSG_NREASONS + 3)     /* a value from a source not configured */
+#define REJECT_IMPLAUSIBLE (AMFI_MSG_NREASONS + 4) /* against the recent readings */
+#define REJECT_NREASONS (AMFI_MSG_NREASONS + 5)
+#define REJECT_EXAMPLE 512
 typedef struct reject_state {
     int64_t count[REJECT_NINPUTS][REJECT_NREASONS]; /* since start */
     int64_t total;
     int64_t held, held_by[REJECT_NINPUTS][REJECT_NREASONS]; /* not logged this period */
     int logged;                                             /* lines logged this period */
     double period_start;                                    /* amfi_mono_s() */
+    /* the store's summary (table refusals), every daemon.intake.summary_period_s */
+    int64_t sum_count[REJECT_NINPUTS][REJECT_NREASONS];     /* this summary period */
+    char sum_example[REJECT_NINPUTS][REJECT_NREASONS][REJECT_EXAMPLE]; /* the first's line */
+    double sum_start;                                       /* amfi_mono_s() */
+    int64_t sum_start_wall;                                 /* µs, wall clock */
+    int64_t summaries_stored, summaries_lost;               /* rows */
 } reject_state;
+
+/* A token bucket of one input channel (intake.c): `rate` tokens a second,
+ * at most `cap`; refilled by the wall time or the data time that passed,
+ * whichever is more (a replay at any speed keeps the data's own rate; a
+ * flood cannot move the data time). */
+typedef struct bucket {
+    double tokens, rate, cap;
+    double last_wall;     /* amfi_mono_s() of the last refill */
+    int64_t last_data;    /* newest_utime at the last refill */
+} bucket;
 
 /* Environment readings waiting to be stored (environment.c). */
 #define ENV_BUF 64
@@ -90,6 +110,16 @@ typedef struct env_state {
     int n;                 /* readings in buf, oldest first */
     int failing;           /* the last flush failed (logged once) */
     int64_t received, rejected, stored, lost; /* since start */
+    int64_t thinned;       /* accepted, not stored: within environment_min_interval_s */
+    int have_ref;          /* a reading was accepted: ref_* hold it */
+    int64_t ref_utime, last_kept_utime;
+    double ref_deck;
+    /* implausible readings that agree with each other: adopted at the third
+     * in a row (a deck sensor replaced or recalibrated, a first reading that
+     * was wrong), as the rings adopt a time jump */
+    int cand_n;
+    int64_t cand_utime;
+    double cand_deck;
 } env_state;
 
 /* The scale indicator and the known-truck runs (scaleind.c). */
@@ -176,6 +206,10 @@ typedef struct daemon_s {
     int64_t blocks_received, blocks_rejected, vehicles_received, vehicles_rejected;
     int64_t messages_malformed, passages_stored, passages_ok, truth_received;
     int64_t messages_in;           /* every message the three inputs handed over */
+    bucket lim[REJECT_NINPUTS];    /* rate limits per input channel (intake.c) */
+    int64_t vehicles_evicted;      /* the tracker was full: the stalest went (stored) */
+    int64_t references_refused;    /* calibration references not taken (source, range) */
+    int64_t invalid_unstored;      /* refused vehicles over the rate: summarised only */
     int64_t newest_utime;
     int64_t udp_drops, udp_drops_logged; /* kernel drops on our sockets */
     reject_state rej;
@@ -233,7 +267,8 @@ int64_t bus_udp_drops(void);
  * last_error and is logged within the rate limit. */
 void reject_note(daemon_s *d, int input, int reason, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
-/* The period's summary line when the period is over (from the loop). */
+/* The period's summary line when the period is over, and the store's
+ * summary rows when daemon.intake.summary_period_s is (from the loop). */
 void reject_tick(daemon_s *d);
 /* The last summary and the totals by channel and reason (at stop). */
 void reject_final(daemon_s *d);
@@ -244,6 +279,10 @@ const char *reject_reason_name(int reason);
 /* Subscribe the three inputs with queues of daemon.bus_queue messages:
  * 0, or −1 (logged). */
 int intake_subscribe(daemon_s *d);
+/* The rate limits from the configuration (start, reload): full buckets. */
+void intake_limits(daemon_s *d);
+/* Take `cost` from input's bucket: 1 taken, 0 over the limit. */
+int intake_take(daemon_s *d, int input, double cost);
 /* Count a message of `input` and decode it (the raw bytes checked against
  * the type first): 0, or −1 when malformed (counted, logged, nothing left
  * to free). tname: the type's name for the message. */

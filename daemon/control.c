@@ -186,7 +186,8 @@ void reload(daemon_s *d)
     memcpy(n.daemon.lcm_url, d->cfg.daemon.lcm_url, sizeof n.daemon.lcm_url);
     if (memcmp(&n.bridge, &d->cfg.bridge, sizeof n.bridge) ||
         memcmp(&n.solver, &d->cfg.solver, sizeof n.solver) ||
-        memcmp(n.sensor_id, d->cfg.sensor_id, sizeof n.sensor_id))
+        memcmp(n.sensor_id, d->cfg.sensor_id, sizeof n.sensor_id) ||
+        memcmp(n.sensor_rate_hz, d->cfg.sensor_rate_hz, sizeof n.sensor_rate_hz))
         LOG_WARN("reload: bridge, sensors and solver changes take effect at the next start");
     if (strcmp(n.site.id, d->cfg.site.id) || strcmp(n.site.name, d->cfg.site.name))
         LOG_WARN("reload: site.id and site.name take effect at the next start (a store "
@@ -213,6 +214,27 @@ void reload(daemon_s *d)
     d->cfg.daemon.status_period_s = n.daemon.status_period_s;
     d->cfg.daemon.max_wait_s = n.daemon.max_wait_s;
     d->cfg.daemon.environment_max_skew_s = n.daemon.environment_max_skew_s;
+    /* the intake's bounds (daemon.intake.*): now, the buckets kept (a
+     * lower limit cuts what is left of the allowance) */
+    {
+        amfi_daemon_config *c = &d->cfg.daemon;
+        const amfi_daemon_config *m = &n.daemon;
+        c->vehicle_ahead_s = m->vehicle_ahead_s;
+        c->min_speed_mps = m->min_speed_mps;
+        c->max_length_m = m->max_length_m;
+        c->accel_margin = m->accel_margin;
+        c->vehicles_per_s = m->vehicles_per_s;
+        c->environment_per_s = m->environment_per_s;
+        c->truth_per_s = m->truth_per_s;
+        c->burst_s = m->burst_s;
+        c->summary_period_s = m->summary_period_s;
+        c->env_min_interval_s = m->env_min_interval_s;
+        c->deck_max_rate_c_min = m->deck_max_rate_c_min;
+        memcpy(c->calibration_sources, m->calibration_sources, sizeof c->calibration_sources);
+        c->calibration_min_kg = m->calibration_min_kg;
+        c->calibration_max_kg = m->calibration_max_kg;
+        intake_limits(d);
+    }
     amfi_indicator_params ip;
     indicator_params(&n.daemon, &ip);
     if (!amfi_indicator_params_equal(&ip, &d->ind_params) ||

@@ -38,6 +38,12 @@ void release_windows(daemon_s *d, int flush)
 {
     amfi_window w;
     const int ns = d->cfg.solver.n_sensors;
+    /* Before the first sample nothing is decided: the vehicles queued so
+     * far are checked against the data time when it comes (on_accel), and
+     * one dated far ahead is refused then, never stored as a passage at
+     * its forged date. */
+    if (!flush && d->newest_utime == 0)
+        return;
     while (amfi_tracker_next(d->tracker, d->rings, flush, &w)) {
         d->released++;
         job *j = calloc(1, sizeof *j);
@@ -82,6 +88,58 @@ void release_windows(daemon_s *d, int flush)
     }
 }
 
+/* ---- rate limits per input channel -------------------------------------- */
+
+void intake_limits(daemon_s *d)
+{
+    const amfi_daemon_config *c = &d->cfg.daemon;
+    double samples = 0.0;
+    for (int i = 0; i < d->cfg.solver.n_sensors; i++)
+        samples += d->cfg.sensor_rate_hz[i];
+    double rate[REJECT_NINPUTS];
+    rate[REJECT_ACCEL] = c->accel_margin * samples; /* samples a second */
+    rate[REJECT_VEHICLE] = c->vehicles_per_s;
+    rate[REJECT_TRUTH] = c->truth_per_s;
+    rate[REJECT_ENVIRONMENT] = c->environment_per_s;
+    const double now = amfi_mono_s();
+    for (int i = 0; i < REJECT_NINPUTS; i++) {
+        bucket *b = &d->lim[i];
+        const int fresh = b->cap == 0.0;
+        b->rate = rate[i];
+        b->cap = fmax(rate[i] * c->burst_s, 1.0);
+        if (fresh || b->tokens > b->cap)
+            b->tokens = b->cap;
+        b->last_wall = now;
+        b->last_data = d->newest_utime;
+    }
+    if (d->rej.sum_start == 0.0) {
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        d->rej.sum_start = now;
+        d->rej.sum_start_wall = (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+    }
+}
+
+int intake_take(daemon_s *d, int input, double cost)
+{
+    bucket *b = &d->lim[input];
+    if (b->cap == 0.0)
+        return 1; /* no limits set (tests that drive the handlers alone) */
+    const double now = amfi_mono_s();
+    double dt = now - b->last_wall;
+    if (d->newest_utime > b->last_data)
+        dt = fmax(dt, 1e-6 * (double)(d->newest_utime - b->last_data));
+    if (dt > 0)
+        b->tokens = fmin(b->cap, b->tokens + b->rate * dt);
+    b->last_wall = now;
+    b->last_data = d->newest_utime; /* back too, after a confirmed jump: no refill */
+    if (b->tokens >= cost) {
+        b->tokens -= cost;
+        return 1;
+    }
+    return 0;
+}
+
 /* ---- bus handlers: validate at the boundary ---------------------------- */
 
 int intake_decode(daemon_s *d, amfi_msg_type type, int input, const char *tname,
@@ -97,6 +155,9 @@ int intake_decode(daemon_s *d, amfi_msg_type type, int input, const char *tname,
                 rb->data_size, cwhy);
     return -1;
 }
+
+static void store_refused(daemon_s *d, int64_t vehicle_id, int64_t utime, int lane,
+                          const char *status, const char *reason);
 
 static int sensor_index(const daemon_s *d, int id)
 {
@@ -114,20 +175,41 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
         return;
     d->blocks_received++;
     const char *why = NULL;
+    char wbuf[160];
     int idx = sensor_index(d, m.sensor_id);
     if (idx < 0)
         why = "sensor_id not in the configuration";
     else if (!(m.sample_rate_hz > 0 && m.sample_rate_hz <= 100000))
         why = "sample_rate_hz out of (0, 100000]";
-    else if (m.n < 1 || m.n > MAX_BLOCK)
+    else if (!(fabs(m.sample_rate_hz - d->cfg.sensor_rate_hz[idx]) <=
+               1e-6 * d->cfg.sensor_rate_hz[idx])) {
+        /* the rate is the site file's, never the bus's (one block at another
+         * rate once fixed a sensor's rate until restart) */
+        snprintf(wbuf, sizeof wbuf, "sample_rate_hz %.6g differs from sensors[%d].rate_hz (%.6g Hz)",
+                 m.sample_rate_hz, idx, d->cfg.sensor_rate_hz[idx]);
+        why = wbuf;
+    } else if (m.n < 1 || m.n > MAX_BLOCK)
         why = "n out of 1 .. 4096";
     else if (m.utime <= 0 || m.utime > AMFI_STORE_MAX_UTIME)
         why = "utime out of (0, year 9999]";
     for (int i = 0; !why && i < m.n; i++)
         if (!isfinite(m.accel[i]) || fabs(m.accel[i]) > 1000.0)
             why = "accel has a non-finite or absurd (> 1000 m/s²) value";
+    /* The channel's rate, in samples, charged for the blocks that pass the
+     * checks (a refused block costs its check only and takes nothing from
+     * the real stream's allowance). */
+    if (!why && !intake_take(d, REJECT_ACCEL, (double)m.n)) {
+        d->blocks_rejected++;
+        reject_note(d, REJECT_ACCEL, REJECT_RATE,
+                    "%s: accel_block_t sensor %d seq %lld refused: over the channel's rate limit "
+                    "(daemon.intake.accel_margin %g × the sensors' rate_hz: %.0f samples/s)",
+                    ch, m.sensor_id, (long long)m.seq, d->cfg.daemon.accel_margin,
+                    d->lim[REJECT_ACCEL].rate);
+        amfi_accel_block_t_decode_cleanup(&m);
+        return;
+    }
     if (!why && !d->rings[idx]) {
-        d->rings[idx] = amfi_ring_create(m.sample_rate_hz, d->cfg.daemon.ring_s);
+        d->rings[idx] = amfi_ring_create(d->cfg.sensor_rate_hz[idx], d->cfg.daemon.ring_s);
         if (!d->rings[idx])
             why = "cannot create the sample ring";
     }
@@ -161,7 +243,24 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
                     if (u > (double)newest)
                         newest = (int64_t)u;
                 }
+            const int64_t before = d->newest_utime;
             d->newest_utime = newest;
+            /* vehicles queued before the data came (or before it caught
+             * up) and dated past it by more than vehicle_ahead_s: refused
+             * now, as they would have been on arrival */
+            amfi_vehicle_ev ev;
+            const double limit = (double)newest + 1e6 * d->cfg.daemon.vehicle_ahead_s;
+            while (newest > before && amfi_tracker_take_after(d->tracker, (int64_t)fmin(limit, 9e18), &ev)) {
+                char reason[200];
+                d->vehicles_rejected++;
+                snprintf(reason, sizeof reason,
+                         "%s: vehicle_t %lld rejected: utime %.0f s past the newest data time "
+                         "(daemon.intake.vehicle_ahead_s %g s)",
+                         d->cfg.daemon.ch_vehicle, (long long)ev.vehicle_id,
+                         1e-6 * (double)(ev.utime - newest), d->cfg.daemon.vehicle_ahead_s);
+                reject_note(d, REJECT_VEHICLE, REJECT_INVALID, "%s", reason);
+                store_refused(d, ev.vehicle_id, ev.utime, ev.lane, "invalid", reason);
+            }
         }
     }
     if (why) {
@@ -172,18 +271,22 @@ static void on_accel(const lcm_recv_buf_t *rb, const char *ch, void *user)
     amfi_accel_block_t_decode_cleanup(&m);
 }
 
-static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
+/* A vehicle that will not be weighed, stored now with its status and reason
+ * (outside the entry order): at its own time if it is plausible (at most
+ * daemon.intake.vehicle_ahead_s after the newest data time, and a time the
+ * store can hold), else at the newest data time, else the wall clock: the
+ * row must exist, and a forged date must not move the store's time span. */
+static void store_refused(daemon_s *d, int64_t vehicle_id, int64_t utime, int lane,
+                          const char *status, const char *reason)
 {
-    /* A rejected vehicle is still a stored passage, with the reason; the raw
-     * values that failed are in the reason, not in the typed columns. */
     job *j = calloc(1, sizeof *j);
     if (!j)
         return;
-    j->w.v.vehicle_id = m->vehicle_id;
-    /* Its own time if the store can hold it, else the newest data time, else
-     * the wall clock: never a time the store refuses (the row must exist). */
-    if (m->utime > 0 && m->utime <= AMFI_STORE_MAX_UTIME)
-        j->w.v.utime = m->utime;
+    j->w.v.vehicle_id = vehicle_id;
+    const int ahead = d->newest_utime > 0 &&
+                      (double)utime > (double)d->newest_utime + 1e6 * d->cfg.daemon.vehicle_ahead_s;
+    if (utime > 0 && utime <= AMFI_STORE_MAX_UTIME && !ahead)
+        j->w.v.utime = utime;
     else if (d->newest_utime > 0 && d->newest_utime <= AMFI_STORE_MAX_UTIME)
         j->w.v.utime = d->newest_utime;
     else {
@@ -191,16 +294,42 @@ static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
         clock_gettime(CLOCK_REALTIME, &ts);
         j->w.v.utime = (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
     }
-    j->w.v.lane = m->lane; /* int16_t on the bus */
+    j->w.v.lane = lane;
     j->w.v.speed_mps = NAN;
     j->w.v.n_axles = 0;
     j->gvw_kg = NAN;
-    snprintf(j->status, sizeof j->status, "invalid");
-    snprintf(j->reason, sizeof j->reason,
-             "%.90s (speed_mps %.6g, n_axles %d, utime %lld, reference_gvw_kg %.6g)", why,
-             m->speed_mps, m->n_axles, (long long)m->utime, m->reference_gvw_kg);
-    /* outside the entry order: stored now */
+    snprintf(j->status, sizeof j->status, "%s", status);
+    snprintf(j->reason, sizeof j->reason, "%s", reason);
     pipeline_store_now(d, j); /* takes the job */
+}
+
+static void store_invalid(daemon_s *d, const amfi_vehicle_t *m, const char *why)
+{
+    /* A rejected vehicle is still a stored passage, with the reason; the raw
+     * values that failed are in the reason, not in the typed columns. */
+    char reason[400]; /* cut to the job's reason by store_refused */
+    snprintf(reason, sizeof reason,
+             "%.128s (speed_mps %.6g, n_axles %d, utime %lld, reference_gvw_kg %.6g)", why,
+             m->speed_mps, m->n_axles, (long long)m->utime, m->reference_gvw_kg);
+    store_refused(d, m->vehicle_id, m->utime, m->lane, "invalid", reason);
+}
+
+/* 1 when `src` is one of daemon.intake.calibration_sources (comma-separated). */
+static int calibration_source(const daemon_s *d, const char *src)
+{
+    const char *list = d->cfg.daemon.calibration_sources;
+    const size_t n = src ? strlen(src) : 0;
+    if (n == 0)
+        return 0;
+    for (const char *p = list; *p;) {
+        const size_t len = strcspn(p, ",");
+        if (len == n && strncmp(p, src, n) == 0)
+            return 1;
+        p += len;
+        if (*p == ',')
+            p++;
+    }
+    return 0;
 }
 
 static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
@@ -212,8 +341,22 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
     if (intake_decode(d, AMFI_MSG_VEHICLE_T, REJECT_VEHICLE, "vehicle_t", rb, ch, &m))
         return;
     d->vehicles_received++;
+    const amfi_daemon_config *c = &d->cfg.daemon;
+    /* Over the channel's rate: counted and summarised, no row (a flood of
+     * refused vehicles once wrote one fsync'd row each). */
+    if (!intake_take(d, REJECT_VEHICLE, 1.0)) {
+        d->vehicles_rejected++;
+        d->invalid_unstored++;
+        reject_note(d, REJECT_VEHICLE, REJECT_RATE,
+                    "%s: vehicle_t %lld refused: over the channel's rate limit "
+                    "(daemon.intake.vehicles_per_s %g)",
+                    ch, (long long)m.vehicle_id, c->vehicles_per_s);
+        amfi_vehicle_t_decode_cleanup(&m);
+        return;
+    }
     const char *why = NULL;
-    char buf[200];
+    char buf[200], wbuf[160];
+    double length_m = 0.0;
     if (!(m.speed_mps >= 1.0 && m.speed_mps <= 60.0))
         why = "speed_mps out of [1, 60]";
     else if (m.n_axles < 1 || m.n_axles > d->cfg.solver.max_axles)
@@ -222,16 +365,60 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
         why = "n_spacings must be n_axles - 1";
     else if (m.utime <= 0 || m.utime > AMFI_STORE_MAX_UTIME)
         why = "utime out of (0, year 9999]";
-    for (int a = 0; !why && a < m.n_spacings; a++)
+    for (int a = 0; !why && a < m.n_spacings; a++) {
         if (!(m.axle_spacing_m[a] >= 0.5 && m.axle_spacing_m[a] <= 30.0))
             why = "axle_spacing_m out of [0.5, 30]";
+        length_m += m.axle_spacing_m[a];
+    }
+    /* Plausible for the span: a crawling or endless "vehicle" would hold the
+     * span for every real one around it (one at 1 m/s once made 12 real
+     * passages multiple); and not dated past the data (256 dated 2286 once
+     * filled the tracker). */
+    if (!why && m.speed_mps < c->min_speed_mps) {
+        snprintf(wbuf, sizeof wbuf, "speed_mps %.3g below daemon.intake.min_speed_mps (%g m/s)",
+                 m.speed_mps, c->min_speed_mps);
+        why = wbuf;
+    } else if (!why && length_m > c->max_length_m) {
+        snprintf(wbuf, sizeof wbuf,
+                 "first to last axle %.1f m, more than daemon.intake.max_length_m (%g m)",
+                 length_m, c->max_length_m);
+        why = wbuf;
+    } else if (!why && d->newest_utime > 0 &&
+               (double)m.utime > (double)d->newest_utime + 1e6 * c->vehicle_ahead_s) {
+        snprintf(wbuf, sizeof wbuf,
+                 "utime %.0f s past the newest data time ("
+                 "daemon.intake.vehicle_ahead_s %g s)",
+                 1e-6 * (double)(m.utime - d->newest_utime), c->vehicle_ahead_s);
+        why = wbuf;
+    }
     /* a calibration truck's reference: 0 or NaN none, else finite in 1 .. 100 t */
-    const int has_ref = m.reference_gvw_kg != 0.0 && !isnan(m.reference_gvw_kg);
+    int has_ref = m.reference_gvw_kg != 0.0 && !isnan(m.reference_gvw_kg);
     if (!why && has_ref &&
         !(m.reference_gvw_kg >= AMFI_STORE_MIN_REF_KG && m.reference_gvw_kg <= AMFI_STORE_MAX_REF_KG))
         why = "reference_gvw_kg out of [1000, 100000] kg";
+    /* ... taken only from a configured source and within the calibration
+     * trucks' range; otherwise the vehicle is weighed without it (a
+     * detector that flags every vehicle would mask damage), counted */
+    if (!why && has_ref && !calibration_source(d, m.source)) {
+        has_ref = 0;
+        d->references_refused++;
+        reject_note(d, REJECT_VEHICLE, REJECT_SOURCE,
+                    "%s: vehicle_t %lld: reference_gvw_kg %.6g not taken: source '%.64s' is not "
+                    "in daemon.intake.calibration_sources; weighed without it",
+                    ch, (long long)m.vehicle_id, m.reference_gvw_kg, m.source ? m.source : "");
+    } else if (!why && has_ref && !(m.reference_gvw_kg >= c->calibration_min_kg &&
+                                    m.reference_gvw_kg <= c->calibration_max_kg)) {
+        has_ref = 0;
+        d->references_refused++;
+        reject_note(d, REJECT_VEHICLE, REJECT_IMPLAUSIBLE,
+                    "%s: vehicle_t %lld: reference_gvw_kg %.6g not taken: outside "
+                    "daemon.intake.calibration_min_kg .. calibration_max_kg (%g .. %g kg); "
+                    "weighed without it",
+                    ch, (long long)m.vehicle_id, m.reference_gvw_kg, c->calibration_min_kg,
+                    c->calibration_max_kg);
+    }
     if (!why) {
-        amfi_vehicle_ev v;
+        amfi_vehicle_ev v, ev;
         memset(&v, 0, sizeof v);
         v.vehicle_id = m.vehicle_id;
         v.utime = m.utime;
@@ -242,8 +429,16 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
             v.spacing_m[a] = m.axle_spacing_m[a];
         v.reference_gvw_kg = has_ref ? m.reference_gvw_kg : 0.0;
         const char *twhy = NULL;
-        if (amfi_tracker_add(d->tracker, &v, &twhy) != 0)
+        int trc = amfi_tracker_add(d->tracker, &v, &ev, &twhy);
+        if (trc < 0) {
             why = twhy;
+        } else if (trc == 1) { /* the stalest waiting vehicle made room: stored, never lost */
+            d->vehicles_evicted++;
+            snprintf(buf, sizeof buf, "%s: vehicle_t %lld %s", ch, (long long)ev.vehicle_id, twhy);
+            if (d->vehicles_evicted <= 5)
+                LOG_WARN("%s%s", buf, d->vehicles_evicted == 5 ? " (further ones counted)" : "");
+            store_refused(d, ev.vehicle_id, ev.utime, ev.lane, "overload", buf);
+        }
     }
     if (why) {
         d->vehicles_rejected++;
@@ -262,7 +457,12 @@ static void on_truth(const lcm_recv_buf_t *rb, const char *ch, void *user)
     if (intake_decode(d, AMFI_MSG_TRUTH_T, REJECT_TRUTH, "truth_t", rb, ch, &m))
         return;
     char err[256];
-    if (!(m.gvw_kg > 0 && m.gvw_kg < 1e6) || m.n_axles < 1 || m.n_axles > AMFI_MAX_AXLES)
+    if (!intake_take(d, REJECT_TRUTH, 1.0))
+        reject_note(d, REJECT_TRUTH, REJECT_RATE,
+                    "%s: truth_t %lld refused: over the channel's rate limit "
+                    "(daemon.intake.truth_per_s %g)",
+                    ch, (long long)m.vehicle_id, d->cfg.daemon.truth_per_s);
+    else if (!(m.gvw_kg > 0 && m.gvw_kg < 1e6) || m.n_axles < 1 || m.n_axles > AMFI_MAX_AXLES)
         reject_note(d, REJECT_TRUTH, REJECT_INVALID,
                     "%s: truth_t %lld rejected: gvw or n_axles out of range", ch,
                     (long long)m.vehicle_id);

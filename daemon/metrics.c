@@ -156,6 +156,18 @@ static void write_all(daemon_s *d, FILE *f)
             if (d->rej.count[i][k] > 0)
                 fprintf(f, "amfi_messages_refused_total{input=\"%s\",reason=\"%s\"} %lld\n",
                         inputs[i], reject_reason_name(k), (long long)d->rej.count[i][k]);
+    head(f, "amfi_intake_bounded_total", "counter",
+         "What the intake's bounds did (daemon.intake): waiting vehicles evicted from a full "
+         "tracker, calibration references not taken, environment readings accepted but not "
+         "stored, refusal summary rows lost.");
+    fprintf(f, "amfi_intake_bounded_total{what=\"vehicles_evicted\"} %lld\n",
+            (long long)d->vehicles_evicted);
+    fprintf(f, "amfi_intake_bounded_total{what=\"references_refused\"} %lld\n",
+            (long long)d->references_refused);
+    fprintf(f, "amfi_intake_bounded_total{what=\"environment_thinned\"} %lld\n",
+            (long long)d->env.thinned);
+    fprintf(f, "amfi_intake_bounded_total{what=\"summaries_lost\"} %lld\n",
+            (long long)d->rej.summaries_lost);
     head(f, "amfi_datagrams_dropped_total", "counter",
          "UDP datagrams the kernel dropped on amfid's sockets.");
     fprintf(f, "amfi_datagrams_dropped_total %lld\n",

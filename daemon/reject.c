@@ -6,6 +6,10 @@
  * message's last_error; the log gets at most REJECT_LOG_BURST lines in full
  * per REJECT_LOG_PERIOD_S seconds of wall time, and then, once the period
  * is over, one summary line with what was held back, by channel and reason.
+ * The store gets the same counts as rows of the table refusals, one per
+ * channel and reason every daemon.intake.summary_period_s of wall time and
+ * at stop, with the first refused message's line: a flood costs a few rows
+ * a period, never one fsync'd row per message.
  *
  * Thread: the main thread only (the bus handlers, the heartbeat, the drain).
  * Owns d->rej.
@@ -13,6 +17,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 #include "amfi_msg_check.h"
 #include "amfid.h"
@@ -23,8 +28,21 @@
 static const char *const input_name[REJECT_NINPUTS] = {"accel", "vehicle", "truth",
                                                          "environment"};
 
+/* the intake's bounds (intake.c, environment.c) */
+static const char *intake_reason_name(int reason)
+{
+    switch (reason) {
+    case REJECT_RATE: return "rate_limited";
+    case REJECT_SOURCE: return "source";
+    case REJECT_IMPLAUSIBLE: return "implausible";
+    default: return NULL;
+    }
+}
+
 const char *reject_reason_name(int reason)
 {
+    if (intake_reason_name(reason))
+        return intake_reason_name(reason);
     if (reason == REJECT_INVALID)
         return "invalid";
     if (reason == REJECT_QUARANTINE)
@@ -65,6 +83,49 @@ static void summarise(daemon_s *d, double now)
     r->period_start = now;
 }
 
+static int64_t wall_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+/* The summary period's rows into the store, one transaction (the counts
+ * are kept for the next try when the store refuses, up to one more period). */
+static void store_summary(daemon_s *d, double now)
+{
+    reject_state *r = &d->rej;
+    amfi_refusal_row rows[REJECT_NINPUTS * REJECT_NREASONS];
+    int n = 0;
+    const int64_t end = wall_us();
+    if (r->sum_start_wall == 0)
+        r->sum_start_wall = end;
+    for (int i = 0; i < REJECT_NINPUTS; i++)
+        for (int k = 0; k < REJECT_NREASONS; k++)
+            if (r->sum_count[i][k] > 0)
+                rows[n++] = (amfi_refusal_row){r->sum_start_wall,
+                                               end < r->sum_start_wall ? r->sum_start_wall : end,
+                                               channel_of(d, i), input_name[i],
+                                               reject_reason_name(k), r->sum_count[i][k],
+                                               r->sum_example[i][k]};
+    if (n > 0 && d->store) {
+        char err[256];
+        if (amfi_store_add_refusals(d->store, rows, n, err, sizeof err) != 0) {
+            if (now - r->sum_start < 2.0 * d->cfg.daemon.summary_period_s)
+                return; /* kept, retried at the next tick (the counts grow) */
+            LOG_WARN("store: the summary of refused messages (%d rows) is lost: %s (the "
+                     "counts since start are in the log at stop and in the status message)",
+                     n, err);
+            r->summaries_lost += n;
+        } else {
+            r->summaries_stored += n;
+        }
+    }
+    memset(r->sum_count, 0, sizeof r->sum_count);
+    r->sum_start = now;
+    r->sum_start_wall = end;
+}
+
 void reject_note(daemon_s *d, int input, int reason, const char *fmt, ...)
 {
     reject_state *r = &d->rej;
@@ -76,6 +137,8 @@ void reject_note(daemon_s *d, int input, int reason, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(d->last_error, sizeof d->last_error, fmt, ap);
     va_end(ap);
+    if (r->sum_count[input][reason]++ == 0)
+        snprintf(r->sum_example[input][reason], REJECT_EXAMPLE, "%s", d->last_error);
     double now = amfi_mono_s();
     if (now - r->period_start >= REJECT_LOG_PERIOD_S)
         summarise(d, now);
@@ -96,11 +159,18 @@ void reject_tick(daemon_s *d)
     double now = amfi_mono_s();
     if (now - d->rej.period_start >= REJECT_LOG_PERIOD_S)
         summarise(d, now);
+    if (d->rej.sum_start == 0.0) {
+        d->rej.sum_start = now;
+        d->rej.sum_start_wall = wall_us();
+    }
+    if (now - d->rej.sum_start >= d->cfg.daemon.summary_period_s)
+        store_summary(d, now);
 }
 
 void reject_final(daemon_s *d)
 {
     summarise(d, amfi_mono_s());
+    store_summary(d, 1e300); /* at stop: stored now or lost (counted) */
     const reject_state *r = &d->rej;
     for (int i = 0; i < REJECT_NINPUTS; i++)
         for (int k = 0; k < REJECT_NREASONS; k++)

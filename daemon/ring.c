@@ -7,13 +7,31 @@
 
 #include "ring.h"
 
+/* Samples live in chunks of CHUNK, allocated when a sample of theirs is
+ * first written and freed once they fall out of the window (newest − cap,
+ * newest]: a ring costs memory for the data it holds, not for its capacity
+ * (a sensor that never sends costs nothing, one that stops costs what it
+ * last held). Chunk c (samples c·CHUNK .. c·CHUNK + CHUNK − 1) sits in
+ * table entry c mod n_chunks, tagged with c; an entry of another tag or
+ * none is missing data (NaN). n_chunks covers the window with one to spare,
+ * so two chunks of the window never share an entry. */
+#define CHUNK 4096
+
+typedef struct chunk {
+    int64_t tag;        /* the chunk number held, −1: none */
+    double *x;          /* CHUNK samples, NaN = missing; NULL: none */
+} chunk;
+
 struct amfi_ring {
     double rate;        /* Hz */
     int64_t origin;     /* µs of sample 0 */
     int started;
     int64_t cap;        /* samples held */
     int64_t newest;     /* index of the newest sample, −1 before any */
-    double *buf;        /* cap, sample k at buf[k mod cap]; NaN = missing */
+    chunk *tab;         /* n_chunks entries */
+    int64_t n_chunks;
+    int64_t held;       /* chunks allocated now */
+    int64_t freed_below; /* every chunk below this number is freed */
     amfi_ring_stats st;
     /* a jump under test: blocks far from the stream that continue each other */
     int cand_count;     /* 0: none */
@@ -30,22 +48,41 @@ amfi_ring *amfi_ring_create(double rate_hz, double seconds)
     r->rate = rate_hz;
     r->cap = (int64_t)ceil(seconds * rate_hz);
     r->newest = -1;
-    r->buf = malloc(sizeof(double) * (size_t)r->cap);
-    if (!r->buf) {
+    r->n_chunks = (r->cap + CHUNK - 1) / CHUNK + 2;
+    r->tab = calloc((size_t)r->n_chunks, sizeof *r->tab);
+    if (!r->tab) {
         free(r);
         return NULL;
     }
-    for (int64_t i = 0; i < r->cap; i++)
-        r->buf[i] = NAN;
+    for (int64_t i = 0; i < r->n_chunks; i++)
+        r->tab[i].tag = -1;
     return r;
+}
+
+static void drop_all(amfi_ring *r)
+{
+    for (int64_t i = 0; i < r->n_chunks; i++) {
+        free(r->tab[i].x);
+        r->tab[i].x = NULL;
+        r->tab[i].tag = -1;
+    }
+    r->held = 0;
+    r->freed_below = 0;
 }
 
 void amfi_ring_destroy(amfi_ring *r)
 {
     if (!r)
         return;
-    free(r->buf);
+    drop_all(r);
+    free(r->tab);
     free(r);
+}
+
+int64_t amfi_ring_bytes(const amfi_ring *r)
+{
+    return r->held * (int64_t)(CHUNK * sizeof(double)) +
+           r->n_chunks * (int64_t)sizeof(chunk) + (int64_t)sizeof *r;
 }
 
 double amfi_ring_rate(const amfi_ring *r) { return r->rate; }
@@ -70,10 +107,51 @@ double amfi_ring_utime(const amfi_ring *r, int64_t k)
     return (double)r->origin + (double)k * 1e6 / r->rate;
 }
 
-static double *slot(const amfi_ring *r, int64_t k)
+/* Sample k (>= 0) to read: NULL when its chunk is not held (missing). */
+static const double *slot_r(const amfi_ring *r, int64_t k)
 {
-    int64_t i = k % r->cap;
-    return &r->buf[i < 0 ? i + r->cap : i];
+    const int64_t c = k / CHUNK;
+    const chunk *e = &r->tab[c % r->n_chunks];
+    return e->tag == c ? &e->x[k % CHUNK] : NULL;
+}
+
+/* Sample k (>= 0) to write: its chunk allocated (NaN-filled) if need be,
+ * replacing a chunk of the entry that left the window; NULL: out of memory. */
+static double *slot_w(amfi_ring *r, int64_t k)
+{
+    const int64_t c = k / CHUNK;
+    chunk *e = &r->tab[c % r->n_chunks];
+    if (e->tag != c) {
+        if (!e->x) {
+            e->x = malloc(sizeof(double) * CHUNK);
+            if (!e->x)
+                return NULL;
+            r->held++;
+        }
+        for (int i = 0; i < CHUNK; i++)
+            e->x[i] = NAN;
+        e->tag = c;
+    }
+    return &e->x[k % CHUNK];
+}
+
+/* Free the chunks wholly older than the window (after newest moved on). */
+static void trim(amfi_ring *r)
+{
+    const int64_t below = amfi_ring_oldest(r) / CHUNK; /* chunks < below are out */
+    if (below - r->freed_below > r->n_chunks)
+        r->freed_below = below - r->n_chunks;
+    for (int64_t c = r->freed_below; c < below; c++) {
+        chunk *e = &r->tab[c % r->n_chunks];
+        if (e->tag >= 0 && e->tag < below) {
+            free(e->x);
+            e->x = NULL;
+            e->tag = -1;
+            r->held--;
+        }
+    }
+    if (below > r->freed_below)
+        r->freed_below = below;
 }
 
 int amfi_ring_put(amfi_ring *r, int64_t utime, double rate_hz, int n, const double *x,
@@ -119,8 +197,7 @@ int amfi_ring_put(amfi_ring *r, int64_t utime, double rate_hz, int n, const doub
         r->st.last_jump_s = ((double)utime - amfi_ring_utime(r, r->newest + 1)) * 1e-6;
         r->origin = utime;
         r->newest = -1;
-        for (int64_t i = 0; i < r->cap; i++)
-            r->buf[i] = NAN;
+        drop_all(r);
         r->st.restarts++;
         r->st.restart_utime = utime;
         r->cand_count = 0;
@@ -145,13 +222,19 @@ int amfi_ring_put(amfi_ring *r, int64_t utime, double rate_hz, int n, const doub
         int64_t fills = 0;
         for (int i = 0; i < n; i++) {
             int64_t k = k0 + i;
-            if (k < amfi_ring_oldest(r))
+            if (k < amfi_ring_oldest(r) || isnan(x[i]))
                 continue;
-            double *p = slot(r, k);
-            if (isnan(*p) && !isnan(x[i])) {
-                *p = x[i];
-                fills++;
+            const double *q = slot_r(r, k);
+            if (q && !isnan(*q))
+                continue;
+            double *p = slot_w(r, k);
+            if (!p) {
+                *why = "out of memory for the samples";
+                r->st.rejected++;
+                return AMFI_RING_REJECT;
             }
+            *p = x[i];
+            fills++;
         }
         if (fills == 0) {
             r->st.duplicates++;
@@ -162,31 +245,48 @@ int amfi_ring_put(amfi_ring *r, int64_t utime, double rate_hz, int n, const doub
         r->st.blocks++;
         return AMFI_RING_OK;
     }
-    /* Extends the newest: mark a gap, then store. */
-    if (r->newest >= 0 && k0 > r->newest + 1) {
-        int64_t gap = k0 - r->newest - 1;
-        r->st.missing += gap;
-        int64_t from = gap > r->cap ? k0 - r->cap : r->newest + 1;
-        for (int64_t k = from; k < k0; k++)
-            *slot(r, k) = NAN;
-    }
+    /* Extends the newest: a gap is what was never written (NaN, or a chunk
+     * not held); count it, then store. */
+    if (r->newest >= 0 && k0 > r->newest + 1)
+        r->st.missing += k0 - r->newest - 1;
     for (int i = 0; i < n; i++) {
         int64_t k = k0 + i;
         if (r->newest >= 0 && k <= r->newest) { /* overlap with what we hold */
-            double *p = slot(r, k);
-            if (isnan(*p) && k >= amfi_ring_oldest(r)) {
+            if (k < amfi_ring_oldest(r) || isnan(x[i]))
+                continue;
+            const double *q = slot_r(r, k);
+            if (!q || isnan(*q)) {
+                double *p = slot_w(r, k);
+                if (!p)
+                    goto oom;
                 *p = x[i];
                 r->st.filled++;
                 r->st.missing--;
             }
             continue;
         }
-        *slot(r, k) = x[i];
+        /* samples that would leave the window at once (a block longer than
+         * the ring) are not written */
+        if (k <= k1 - r->cap)
+            continue;
+        double *p = slot_w(r, k);
+        if (!p)
+            goto oom;
+        *p = x[i];
     }
     if (k1 > r->newest)
         r->newest = k1;
+    trim(r);
     r->st.blocks++;
     return restarted ? AMFI_RING_RESTART : AMFI_RING_OK;
+oom:
+    /* what was written stays (newest moves over it: the rest is missing) */
+    if (k1 > r->newest)
+        r->newest = k1;
+    trim(r);
+    *why = "out of memory for the samples";
+    r->st.rejected++;
+    return AMFI_RING_REJECT;
 }
 
 int amfi_ring_get(const amfi_ring *r, int64_t k0, int n, double *out)
@@ -195,7 +295,8 @@ int amfi_ring_get(const amfi_ring *r, int64_t k0, int n, double *out)
         return -1;
     int missing = 0;
     for (int i = 0; i < n; i++) {
-        out[i] = *slot(r, k0 + i);
+        const double *q = slot_r(r, k0 + i);
+        out[i] = q ? *q : NAN;
         missing += isnan(out[i]) != 0;
     }
     return missing;

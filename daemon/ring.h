@@ -2,13 +2,17 @@
 /*
  * ring.h: one sensor's recent samples, indexed by absolute sample number.
  *
- * Sample k is at utime origin + k·1e6/rate µs; the first block fixes origin
- * and rate. Blocks normally arrive in order; a block that starts after the
+ * Sample k is at utime origin + k·1e6/rate µs; the rate is given at
+ * creation, the first block fixes the origin. Blocks normally arrive in order; a block that starts after the
  * newest sample leaves a gap (its samples are missing, NaN, and counted); a
  * block that starts earlier fills missing samples (out-of-order arrival) or
  * is a duplicate (counted, ignored); a block older than the ring holds is
- * late (counted, dropped). Capacity is fixed at creation: nothing is
- * allocated per block. Not thread-safe: the bus thread owns it.
+ * late (counted, dropped). The capacity is fixed at creation, the memory
+ * is not: samples are kept in chunks allocated as data arrive and freed
+ * once they leave the window (a ring of an hour at a high rate costs
+ * nothing until data come, and what it holds after). The rate is the
+ * sensor's configured one (sensors[].rate_hz): a block at another rate is
+ * refused, never adopted. Not thread-safe: the bus thread owns it.
  *
  * Time that jumps (docs/daemon.md, "Time that jumps"): a block that starts
  * more than AMFI_RING_FAR_S (or the ring's length, if longer) after the
@@ -62,6 +66,7 @@ int amfi_ring_put(amfi_ring *r, int64_t utime, double rate_hz, int n, const doub
                   const char **why);
 
 double amfi_ring_rate(const amfi_ring *r);
+int64_t amfi_ring_bytes(const amfi_ring *r);   /* memory held now (samples, table) */
 int amfi_ring_started(const amfi_ring *r);      /* 1 once a block was stored */
 int64_t amfi_ring_newest(const amfi_ring *r);   /* newest sample index, −1 if none */
 int64_t amfi_ring_oldest(const amfi_ring *r);   /* oldest index still held */

@@ -12,6 +12,8 @@
 #include "tracker.h"
 
 #define RECENT 64
+#define AMFI_STR_(x) #x
+#define AMFI_STR(x) AMFI_STR_(x)
 
 typedef struct span {
     int64_t id;
@@ -25,6 +27,7 @@ struct amfi_tracker {
     span recent[RECENT]; /* released vehicles, for multiple presence */
     int n_recent, recent_head;
     int64_t seq;
+    int64_t arrivals;    /* vehicles queued so far */
 };
 
 amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p)
@@ -86,19 +89,32 @@ static span reach_of(const amfi_tracker *t, const amfi_vehicle_ev *v)
     return s;
 }
 
-int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, const char **why)
+int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, amfi_vehicle_ev *evicted,
+                     const char **why)
 {
     const char *dummy;
     if (!why)
         why = &dummy;
+    *why = "";
     for (int i = 0; i < t->n_pend; i++)
         if (t->pend[i].vehicle_id == v->vehicle_id) {
             *why = "vehicle id already pending";
             return -1;
         }
+    int rc = 0;
     if (t->n_pend == AMFI_TRACKER_MAX_PENDING) {
-        *why = "too many vehicles waiting for their data";
-        return -1;
+        int stale = 0;
+        for (int i = 1; i < t->n_pend; i++)
+            if (t->pend[i].arrival < t->pend[stale].arrival)
+                stale = i;
+        if (evicted)
+            *evicted = t->pend[stale];
+        memmove(t->pend + stale, t->pend + stale + 1,
+                sizeof *t->pend * (size_t)(t->n_pend - stale - 1));
+        t->n_pend--;
+        *why = "evicted: the tracker was full (" AMFI_STR(AMFI_TRACKER_MAX_PENDING)
+               " vehicles waiting for their data) and this one had waited longest";
+        rc = 1;
     }
     int i = t->n_pend;
     while (i > 0 && t->pend[i - 1].utime > v->utime) {
@@ -106,8 +122,17 @@ int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, const char **why
         i--;
     }
     t->pend[i] = *v;
+    t->pend[i].arrival = ++t->arrivals;
     t->n_pend++;
-    return 0;
+    return rc;
+}
+
+int amfi_tracker_take_after(amfi_tracker *t, int64_t limit, amfi_vehicle_ev *out)
+{
+    if (t->n_pend == 0 || t->pend[t->n_pend - 1].utime <= limit)
+        return 0;
+    *out = t->pend[--t->n_pend];
+    return 1;
 }
 
 static int in_event(const amfi_window *w, int64_t id)

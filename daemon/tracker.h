@@ -49,6 +49,7 @@ typedef struct amfi_vehicle_ev {
     int n_axles;
     double spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1 */
     double reference_gvw_kg; /* a calibration truck's pre-weighed GVW, kg; 0: none */
+    int64_t arrival;     /* set by amfi_tracker_add: the order vehicles were queued in */
 } amfi_vehicle_ev;
 
 typedef struct amfi_tracker_params {
@@ -104,9 +105,20 @@ typedef struct amfi_tracker amfi_tracker;
 amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p);
 void amfi_tracker_destroy(amfi_tracker *t);
 
-/* Queue a validated vehicle event. Returns 0, or −1 when the queue is full
- * or the id is already pending (then `why` says which). */
-int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, const char **why);
+/* Queue a validated vehicle event. Returns 0; 1 when the queue was full
+ * (AMFI_TRACKER_MAX_PENDING vehicles waiting for their data): the stalest
+ * one, queued first of those waiting, was evicted into *evicted (to be
+ * stored with the reason, never lost) and v queued in its place; or −1
+ * when the id is already pending (then `why` says so). Bounded either way:
+ * vehicles that never get data (a detector ahead of a dead DAQ, forged
+ * events dated in the future) cannot lock out the ones that do. */
+int amfi_tracker_add(amfi_tracker *t, const amfi_vehicle_ev *v, amfi_vehicle_ev *evicted,
+                     const char **why);
+
+/* Take out the pending vehicle dated latest if its utime is after `limit`
+ * (µs): 1 with it in *out, else 0 (the data time caught up with a queue
+ * that vehicles dated far ahead had entered before any data). */
+int amfi_tracker_take_after(amfi_tracker *t, int64_t limit, amfi_vehicle_ev *out);
 
 /* Release the next window (one vehicle, or an event of several) if it is
  * decided (1), or none (0). rings: one per

@@ -67,7 +67,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 8
+#define AMFI_STORE_SCHEMA_VERSION 9
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -222,6 +222,21 @@ int amfi_store_add_environment(amfi_store *s, const amfi_environment_row *rows, 
  * otherwise (or no readings) NaN. 0, or a status. */
 int amfi_store_deck_c_at(amfi_store *s, int64_t utime, int64_t max_gap_us, double *deck_c,
                          char *err, size_t errlen);
+
+/* One period's refused bus messages of one input and reason (amfid's
+ * daemon.intake.summary_period_s). */
+typedef struct amfi_refusal_row {
+    int64_t period_start, period_end; /* wall clock, µs, start <= end */
+    const char *channel;   /* the bus channel, 1 .. 63 bytes */
+    const char *input;     /* accel, vehicle, truth or environment */
+    const char *reason;    /* 1 .. 63 bytes (amfid's reason names) */
+    int64_t count;         /* >= 1 */
+    const char *example;   /* the first refused message's log line (cut at 512 bytes) */
+} amfi_refusal_row;
+
+/* Store n summaries in one transaction (all or nothing; n 0: nothing). */
+int amfi_store_add_refusals(amfi_store *s, const amfi_refusal_row *rows, int n, char *err,
+                            size_t errlen);
 
 typedef struct amfi_environment_summary {
     int64_t n;                    /* readings */

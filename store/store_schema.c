@@ -269,6 +269,25 @@ static const char schema_v8[] =
     "ALTER TABLE passages ADD COLUMN gvw_comp_kg REAL\n"
     "  CHECK (gvw_comp_kg > 0 AND gvw_comp_kg <= 1000000);\n";
 
+/* Version 9: the refused bus messages, summarised once per
+ * daemon.intake.summary_period_s (wall clock) by input channel and reason,
+ * with the first one's log line: a flood of refused messages costs one row
+ * per channel and reason a period, not one fsync'd row each. */
+static const char schema_v9[] =
+    "CREATE TABLE refusals (\n"
+    "  id           INTEGER PRIMARY KEY,\n"
+    "  period_start INTEGER NOT NULL  -- wall clock, µs: the period's start\n"
+    "               CHECK (period_start BETWEEN 0 AND 253402300799999999),\n"
+    "  period_end   INTEGER NOT NULL  -- wall clock, µs: when it was summarised\n"
+    "               CHECK (period_end BETWEEN period_start AND 253402300799999999),\n"
+    "  channel      TEXT NOT NULL CHECK (length(channel) BETWEEN 1 AND 63),  -- the bus channel\n"
+    "  input        TEXT NOT NULL CHECK (input IN ('accel', 'vehicle', 'truth', 'environment')),\n"
+    "  reason       TEXT NOT NULL CHECK (length(reason) BETWEEN 1 AND 63),\n"
+    "  count        INTEGER NOT NULL CHECK (count >= 1),  -- refused in the period for this reason\n"
+    "  example      TEXT NOT NULL CHECK (length(example) <= 512)  -- the first one's log line\n"
+    ") STRICT;\n"
+    "CREATE INDEX refusals_period ON refusals (period_start);\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
@@ -280,6 +299,7 @@ const st_migration st_migrations[] = {
      schema_v6},
     {7, "passages: f1_hz, f1_comp_hz, f1_zeta, f1_r2 (natural frequency)", schema_v7},
     {8, "passages: gvw_comp_kg (the weight the STD and mean rules were fed)", schema_v8},
+    {9, "refusals: refused bus messages summarised per period, channel and reason", schema_v9},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

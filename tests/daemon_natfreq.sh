@@ -21,7 +21,8 @@ N=16
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 q() { sqlite3 "$dir/a.db" "$1"; }
 
-sed -e "s|^    baseline_n: 200 .*|    baseline_n: 10|" "$config" > "$dir/amfid.yaml"
+sed -e "s|^    baseline_n: 200 .*|    baseline_n: 10|" \
+    -e "s/^    deck_max_rate_c_per_min: 2 /    deck_max_rate_c_per_min: 1000000 /" "$config" > "$dir/amfid.yaml"
 grep -q "^    baseline_n: 10" "$dir/amfid.yaml" || fail "no natural_frequency.baseline_n in $config"
 start_amfid() {
   "$amfid" --config "$dir/amfid.yaml" --db "$dir/a.db" 2> "$dir/amfid.log" &

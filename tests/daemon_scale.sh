@@ -39,6 +39,7 @@ sed -e "s|^  # textfile: .*|  textfile: $dir/amfid.prom|" \
     -e "/^  scale:/,/^  known_truck:/s/^    false_alarms_per_year: 0.05 /    false_alarms_per_year: 10 /" \
     -e "s/^    vehicles_per_day: 2000 /    vehicles_per_day: 500 /" \
     -e "s/^  queue_size: 256 /  queue_size: 4096 /" \
+    -e "s/^    deck_max_rate_c_per_min: 2 /    deck_max_rate_c_per_min: 1000000 /" \
     "$config" > "$dir/amfid.yaml"
 for k in "block: 50 " "baseline_blocks: 4 " "design_shift: 0.1 " "false_alarms_per_year: 10 " \
          "vehicles_per_day: 500 "; do

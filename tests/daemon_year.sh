@@ -35,6 +35,7 @@ sed -e "s/^    baseline_n: 10000 /    baseline_n: 1000 /" \
     -e "s/^    block: 500 /    block: 100 /" -e "s/^    baseline_blocks: 40 /    baseline_blocks: 10 /" \
     -e "s/^    vehicles_per_day: 2000 /    vehicles_per_day: $PER_DAY /" \
     -e "s/^  queue_size: 256 /  queue_size: 100000 /" \
+    -e "s/^    deck_max_rate_c_per_min: 2 /    deck_max_rate_c_per_min: 1000000 /" \
     "$config" > "$dir/amfid.yaml"
 for k in "baseline_n: 1000 " "block: 100 " "baseline_blocks: 10 " "vehicles_per_day: $PER_DAY "; do
   grep -q "^    $k" "$dir/amfid.yaml" || fail "the test's $k did not apply"

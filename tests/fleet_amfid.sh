@@ -28,7 +28,8 @@ die() { echo "FAIL: $*"; tail -n 5 "$tmp/amfid.log" "$tmp/sync.log" "$tmp/sim.lo
 # the shipped amfid.yaml with this test's site, store and small windows
 sed -e "s/^  id: local .*/  id: live-1/" -e "s|^    path: amfi.db .*|    path: $tmp/live.db|" \
     -e "s/^    window: 500/    window: 10/" -e "s/^    every: 100/    every: 5/" \
-    -e "s/^    baseline_n: 10000/    baseline_n: 10/" "$config" > "$tmp/live.yaml"
+    -e "s/^    baseline_n: 10000/    baseline_n: 10/" \
+    -e "s/^    deck_max_rate_c_per_min: 2 /    deck_max_rate_c_per_min: 1000000 /" "$config" > "$tmp/live.yaml"
 grep -q "^  id: live-1$" "$tmp/live.yaml" && grep -q "path: $tmp/live.db" "$tmp/live.yaml" ||
     die "the test's site and store did not apply"
 "$amfid" --config "$tmp/live.yaml" 2> "$tmp/amfid.log" &

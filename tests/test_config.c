@@ -900,6 +900,25 @@ static const bad_case bad_cases[] = {
     {"two_documents", "bridge: {}\n---\nsolver: {}\n", 2, NULL, "second YAML document"},
     {"too_deep", "bridge:\n  damping:\n    modes: [[[[[[[[[[[[[[[[[[1]]]]]]]]]]]]]]]]]]\n", 3, NULL,
      "nested deeper than 16 levels"},
+    /* bounded intake (daemon.intake.*, sensors[].rate_hz) */
+    {"sensor_rate_zero", "sensors:\n  - {id: 0, at_m: 5, rate_hz: 0}\n", 2, "sensors[0].rate_hz",
+     "(0, 100000]"},
+    {"sensor_rates_differ", "sensors:\n  - {id: 0, at_m: 5, rate_hz: 500}\n"
+     "  - {id: 1, at_m: 10}\n", 3, "sensors[1].rate_hz",
+     "1000 Hz differs from sensors[0].rate_hz (500 Hz): every sensor must send at one rate"},
+    {"intake_min_speed", "daemon:\n  intake:\n    min_speed_mps: 60\n", 3,
+     "daemon.intake.min_speed_mps", "[1, 60)"},
+    {"intake_unknown", "daemon:\n  intake:\n    max_speed_mps: 60\n", 3,
+     "daemon.intake.max_speed_mps", "unknown key"},
+    {"intake_deck_rate_zero", "daemon:\n  intake:\n    deck_max_rate_c_per_min: 0\n", 3,
+     "daemon.intake.deck_max_rate_c_per_min", "(0, 1e+06]"},
+    {"intake_calibration_range", "daemon:\n  intake:\n    calibration_min_kg: 20000\n"
+     "    calibration_max_kg: 10000\n", 4, "daemon.intake.calibration_max_kg",
+     "10000 kg is below calibration_min_kg (20000 kg)"},
+    {"intake_sources_space", "daemon:\n  intake:\n    calibration_sources: \"wim 1\"\n", 3,
+     "daemon.intake.calibration_sources", "' ' in 'wim 1'"},
+    {"intake_sources_empty_name", "daemon:\n  intake:\n    calibration_sources: \"a,,b\"\n", 3,
+     "daemon.intake.calibration_sources", "an empty name in 'a,,b'"},
     {"empty", "", 1, NULL, "empty file"},
     {"comments_only", "# nothing\n\n", 1, NULL, "empty file"},
 };

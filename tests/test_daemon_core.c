@@ -174,7 +174,7 @@ static void tracker_after_poisoned_first_block(void **state)
     block(x, 100, 0.5);
     assert_int_equal(amfi_ring_put(r, T0 + 3600000000LL, RATE, 100, x, NULL), AMFI_RING_OK);
     amfi_vehicle_ev a = vehicle(1, 0.5);
-    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL, NULL), 0);
     amfi_window w;
     assert_int_equal(amfi_ring_put(r, T0, RATE, 100, x, NULL), AMFI_RING_QUARANTINE);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0); /* waits: a jump under test */
@@ -188,7 +188,7 @@ static void tracker_after_poisoned_first_block(void **state)
     assert_non_null(strstr(w.reason, "stream jumped"));
     /* a vehicle after the restart is ok */
     amfi_vehicle_ev b = vehicle(2, 1.8);
-    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL, NULL), 0);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_string_equal(w.status, "ok");
     amfi_ring_destroy(r);
@@ -205,9 +205,9 @@ static void tracker_windows(void **state)
     amfi_window w;
     /* two vehicles far apart, added out of order: released by entry time */
     amfi_vehicle_ev b = vehicle(2, 1.9), a = vehicle(1, 0.5);
-    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
-    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
-    assert_int_equal(amfi_tracker_add(t, &a, NULL), -1); /* duplicate id */
+    assert_int_equal(amfi_tracker_add(t, &b, NULL, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL, NULL), -1); /* duplicate id */
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_int_equal(w.v.vehicle_id, 1);
     assert_string_equal(w.status, "ok");
@@ -222,7 +222,7 @@ static void tracker_windows(void **state)
     assert_string_equal(w.status, "ok");
     /* a third, whose data has not all arrived: waits */
     amfi_vehicle_ev c = vehicle(3, 2.5);
-    assert_int_equal(amfi_tracker_add(t, &c, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &c, NULL, NULL), 0);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0);
     /* on shutdown it is released as a gap */
     assert_int_equal(amfi_tracker_next(t, rings, 1, &w), 1);
@@ -247,8 +247,8 @@ static void tracker_slow_frac(void **state)
     /* b enters 1.1 s after a: a has left at its measured speed (1.0 s), not
      * at 20 m/s (1.25 s); both ok, not multiple */
     amfi_vehicle_ev a = vehicle(1, 0.5), b = vehicle(2, 1.6);
-    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
-    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL, NULL), 0);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_int_equal(w.v.vehicle_id, 1);
     assert_string_equal(w.status, "ok");
@@ -281,7 +281,7 @@ static void tracker_free_vibration(void **state)
     amfi_ring *rings[1] = {r};
     amfi_window w;
     amfi_vehicle_ev a = vehicle(1, 0.5), b = vehicle(2, 5.0), c = vehicle(3, 6.6);
-    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL, NULL), 0);
     /* a's solve window (to 1.55 s) is in, its free vibration (1.5 .. 3.5 s)
      * not: held */
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0);
@@ -289,8 +289,8 @@ static void tracker_free_vibration(void **state)
     block(x, 100, 0);
     for (int k = 30; k < 70; k++) /* to 7 s */
         amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL);
-    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
-    assert_int_equal(amfi_tracker_add(t, &c, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &c, NULL, NULL), 0);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_int_equal(w.v.vehicle_id, 1);
     assert_string_equal(w.status, "ok");
@@ -333,8 +333,8 @@ static void tracker_multiple_and_late(void **state)
     amfi_window w;
     /* two vehicles 0.4 s apart: both on the span at once */
     amfi_vehicle_ev a = vehicle(1, 1.0), b = vehicle(2, 1.4);
-    amfi_tracker_add(t, &a, NULL);
-    amfi_tracker_add(t, &b, NULL);
+    amfi_tracker_add(t, &a, NULL, NULL);
+    amfi_tracker_add(t, &b, NULL, NULL);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_string_equal(w.status, "multiple");
     assert_non_null(strstr(w.reason, "vehicle 2"));
@@ -350,13 +350,13 @@ static void tracker_multiple_and_late(void **state)
     amfi_ring *srings[1] = {s};
     t = amfi_tracker_create(&p);
     amfi_vehicle_ev old = vehicle(9, 1.0);
-    amfi_tracker_add(t, &old, NULL);
+    amfi_tracker_add(t, &old, NULL, NULL);
     assert_int_equal(amfi_tracker_next(t, srings, 0, &w), 1);
     assert_string_equal(w.status, "late");
     /* data arriving block by block, the tracker asked after each (as the
      * daemon does): released as soon as its window is covered */
     amfi_vehicle_ev next = vehicle(10, 9.0); /* window to 10.05 s */
-    amfi_tracker_add(t, &next, NULL);
+    amfi_tracker_add(t, &next, NULL, NULL);
     assert_int_equal(amfi_tracker_next(t, srings, 0, &w), 0);
     int released_at = -1;
     for (int k = 100; k < 120 && released_at < 0; k++) {
@@ -378,7 +378,7 @@ static void tracker_multiple_and_late(void **state)
         amfi_ring_put(a2, T0 + k * 100000LL, RATE, 100, x, NULL);
     }
     amfi_vehicle_ev v2 = vehicle(11, 1.5); /* window to 2.55 s */
-    amfi_tracker_add(t, &v2, NULL);
+    amfi_tracker_add(t, &v2, NULL, NULL);
     int k = 20;
     for (; k < 120; k++) {
         amfi_ring_put(a1, T0 + k * 100000LL, RATE, 100, x, NULL);
@@ -414,8 +414,8 @@ static void pair_released_as(amfi_tracker *t, amfi_ring **rings, amfi_vehicle_ev
                              amfi_vehicle_ev b, const char *status, int n, const char *why)
 {
     amfi_window w;
-    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
-    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL, NULL), 0);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_string_equal(w.status, status);
     assert_int_equal(w.n_vehicles, n);
@@ -440,10 +440,10 @@ static void tracker_events_chain_and_lanes(void **state)
     /* each on the span 1.0 s (25 m + 5 m at 25 m/s) */
     amfi_vehicle_ev a = vehicle(1, 1.0), b = vehicle(2, 1.8), c = vehicle(3, 2.6),
                     d = vehicle(4, 5.0);
-    assert_int_equal(amfi_tracker_add(t, &c, NULL), 0);
-    assert_int_equal(amfi_tracker_add(t, &d, NULL), 0);
-    assert_int_equal(amfi_tracker_add(t, &a, NULL), 0);
-    assert_int_equal(amfi_tracker_add(t, &b, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &c, NULL, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &d, NULL, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &a, NULL, NULL), 0);
+    assert_int_equal(amfi_tracker_add(t, &b, NULL, NULL), 0);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_string_equal(w.status, "ok");
     assert_int_equal(w.n_vehicles, 3);
@@ -463,8 +463,8 @@ static void tracker_events_chain_and_lanes(void **state)
     assert_int_equal(w.seq, 2);
     /* two lanes, side by side: one event */
     amfi_vehicle_ev e = vehicle_in(5, 7.0, 1, 25.0, 2), f = vehicle_in(6, 7.0, 2, 20.0, 3);
-    amfi_tracker_add(t, &e, NULL);
-    amfi_tracker_add(t, &f, NULL);
+    amfi_tracker_add(t, &e, NULL, NULL);
+    amfi_tracker_add(t, &f, NULL, NULL);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_string_equal(w.status, "ok");
     assert_int_equal(w.n_vehicles, 2);
@@ -503,12 +503,12 @@ static void tracker_event_limits(void **state)
     amfi_ring *rings[1] = {r};
     amfi_window w;
     amfi_vehicle_ev v1 = vehicle(1, 1.0), v2 = vehicle(2, 1.8);
-    amfi_tracker_add(t, &v1, NULL);
-    amfi_tracker_add(t, &v2, NULL);
+    amfi_tracker_add(t, &v1, NULL, NULL);
+    amfi_tracker_add(t, &v2, NULL, NULL);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 0); /* 1.8 s: waits for data */
     amfi_vehicle_ev v3 = vehicle(3, 2.6), v4 = vehicle(4, 3.4);
-    amfi_tracker_add(t, &v3, NULL);
-    amfi_tracker_add(t, &v4, NULL);
+    amfi_tracker_add(t, &v3, NULL, NULL);
+    amfi_tracker_add(t, &v4, NULL, NULL);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1); /* 2.6 s > 2 s: at once */
     assert_string_equal(w.status, "multiple");
     assert_int_equal(w.n_vehicles, 3);
@@ -540,9 +540,9 @@ static void tracker_event_limits(void **state)
     amfi_tracker_params p4 = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 4, 0.0, 0.0};
     t = amfi_tracker_create(&p4);
     amfi_vehicle_ev c1 = vehicle(31, 1.0), c2 = vehicle(32, 2.2), c3 = vehicle(33, 2.5);
-    amfi_tracker_add(t, &c1, NULL);
-    amfi_tracker_add(t, &c2, NULL);
-    amfi_tracker_add(t, &c3, NULL);
+    amfi_tracker_add(t, &c1, NULL, NULL);
+    amfi_tracker_add(t, &c2, NULL, NULL);
+    amfi_tracker_add(t, &c3, NULL, NULL);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_string_equal(w.status, "ok");
     assert_int_equal(w.n_vehicles, 1);
@@ -568,7 +568,7 @@ static void tracker_event_limits(void **state)
     t = amfi_tracker_create(&pv);
     for (int i = 0; i < 9; i++) {
         amfi_vehicle_ev v = vehicle_in(20 + i, 1.0 + 0.1 * i, 1, 25.0, 1);
-        assert_int_equal(amfi_tracker_add(t, &v, NULL), 0);
+        assert_int_equal(amfi_tracker_add(t, &v, NULL, NULL), 0);
     }
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_string_equal(w.status, "multiple");
@@ -627,9 +627,9 @@ static void tracker_inseparable(void **state)
     /* a chain of three on one lane, 0.8 s apart at 25 m/s, 5 m spacing:
      * the leader's rear axle 15 m ahead of the follower's front */
     amfi_vehicle_ev a = vehicle(45, 6.0), b = vehicle(46, 6.8), c = vehicle(47, 7.6);
-    amfi_tracker_add(t, &a, NULL);
-    amfi_tracker_add(t, &b, NULL);
-    amfi_tracker_add(t, &c, NULL);
+    amfi_tracker_add(t, &a, NULL, NULL);
+    amfi_tracker_add(t, &b, NULL, NULL);
+    amfi_tracker_add(t, &c, NULL, NULL);
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_string_equal(w.status, "ok");
     assert_int_equal(w.n_vehicles, 3);
@@ -639,6 +639,117 @@ static void tracker_inseparable(void **state)
         assert_true(fabs(nr.min_gap_m - 15.0) < 0.03);
         assert_int_equal(w.outside[i], 0);
     }
+    amfi_tracker_destroy(t);
+    amfi_ring_destroy(r);
+}
+
+/* The rate is the sensor's declared one: a block at another rate is
+ * refused and leaves the ring as it was (not started, no origin), so the
+ * real stream that follows is stored (one 999 Hz block once fixed a
+ * sensor's rate until restart). */
+static void ring_rate_is_declared(void **state)
+{
+    (void)state;
+    amfi_ring *r = amfi_ring_create(RATE, 60.0);
+    double x[137];
+    block(x, 137, 0.5);
+    const char *why = NULL;
+    assert_int_equal(amfi_ring_put(r, T0 - 1000000, 999.0, 137, x, &why), AMFI_RING_REJECT);
+    assert_non_null(strstr(why, "rate"));
+    assert_int_equal(amfi_ring_started(r), 0);
+    for (int k = 0; k < 10; k++)
+        assert_int_equal(amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL), AMFI_RING_OK);
+    assert_int_equal(amfi_ring_newest(r), 999);
+    assert_true(amfi_ring_utime(r, 0) == (double)T0);
+    double out[1000];
+    assert_int_equal(amfi_ring_get(r, 0, 1000, out), 0);
+    assert_int_equal(amfi_ring_stats_of(r)->rejected, 1);
+    amfi_ring_destroy(r);
+}
+
+/* Memory follows the data: an hour's ring at 100 kHz costs (almost) nothing
+ * before data come, a few chunks after the first seconds, and no more than
+ * its window however long the stream runs; a gap frees what left the window. */
+static void ring_memory_as_data_arrive(void **state)
+{
+    (void)state;
+    const double rate = 100000.0;
+    amfi_ring *r = amfi_ring_create(rate, 3600.0);
+    assert_non_null(r);
+    assert_true(amfi_ring_bytes(r) < 2 << 20); /* 2.9 GB when NaN-filled at creation */
+    static double x[4000];
+    block(x, 4000, 0.25);
+    for (int k = 0; k < 250; k++) /* 10 s */
+        assert_int_equal(amfi_ring_put(r, T0 + k * 40000LL, rate, 4000, x, NULL), AMFI_RING_OK);
+    const int64_t ten_s = amfi_ring_bytes(r);
+    assert_true(ten_s > 8 * 1000000);  /* the samples are held: 8 MB */
+    assert_true(ten_s < 10 * 1000000); /* and not much more */
+    double out[4000];
+    assert_int_equal(amfi_ring_get(r, 996000, 4000, out), 0);
+    assert_true(out[3999] == x[3999]);
+    /* a small ring wraps many times: its memory stays at its window */
+    amfi_ring *s = amfi_ring_create(RATE, 10.0);
+    for (int k = 0; k < 1000; k++) /* 100 s into a 10 s ring */
+        assert_int_equal(amfi_ring_put(s, T0 + k * 100000LL, RATE, 100, x, NULL), AMFI_RING_OK);
+    assert_true(amfi_ring_bytes(s) <= (10000 / 4096 + 2) * 4096 * 8 + 4096);
+    assert_int_equal(amfi_ring_get(s, 99900, 100, out), 0);
+    assert_int_equal(amfi_ring_get(s, 90000, 10, out), 0);
+    assert_int_equal(amfi_ring_get(s, 80000, 10, out), -1); /* left the window */
+    /* 300 s of silence, then one block: everything before left the window,
+     * its chunks are freed; the hole reads as missing */
+    assert_int_equal(amfi_ring_put(s, T0 + 400000000LL, RATE, 100, x, NULL), AMFI_RING_OK);
+    assert_true(amfi_ring_bytes(s) <= 2 * 4096 * 8 + 4096);
+    assert_int_equal(amfi_ring_get(s, amfi_ring_newest(s) - 199, 100, out), 100);
+    amfi_ring_destroy(s);
+    amfi_ring_destroy(r);
+}
+
+/* A full tracker evicts the vehicle that has waited longest instead of
+ * refusing every new one: 256 vehicles that never get data (forged, dated
+ * in 2286) once made every real vehicle invalid. */
+static void tracker_full_evicts_stalest(void **state)
+{
+    (void)state;
+    amfi_tracker_params p = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0, 0.0, 0.0};
+    amfi_tracker *t = amfi_tracker_create(&p);
+    amfi_ring *r = amfi_ring_create(RATE, 60.0);
+    amfi_ring *rings[1] = {r};
+    for (int i = 0; i < AMFI_TRACKER_MAX_PENDING; i++) {
+        amfi_vehicle_ev f = vehicle(900000 + i, 1e10 + i); /* year 2286 */
+        assert_int_equal(amfi_tracker_add(t, &f, NULL, NULL), 0);
+    }
+    double x[100];
+    block(x, 100, 0.5);
+    int ok = 0, evicted = 0;
+    amfi_window w;
+    for (int v = 0; v < 20; v++) {
+        amfi_vehicle_ev a = vehicle(1 + v, 1.0 + 3.0 * v), ev;
+        const char *why = NULL;
+        memset(&ev, 0, sizeof ev);
+        /* full: the one queued first goes (stored by amfid, with the reason) */
+        const int full = amfi_tracker_pending(t) == AMFI_TRACKER_MAX_PENDING;
+        assert_int_equal(amfi_tracker_add(t, &a, &ev, &why), full);
+        if (full) {
+            assert_int_equal(ev.vehicle_id, 900000 + evicted++);
+            assert_non_null(strstr(why, "evicted"));
+        }
+        /* another vehicle that never gets data fills it again */
+        amfi_vehicle_ev f = vehicle(910000 + v, 2e10 + v);
+        const int rc = amfi_tracker_add(t, &f, &ev, NULL);
+        assert_true(rc >= 0);
+        if (rc == 1)
+            assert_int_equal(ev.vehicle_id, 900000 + evicted++);
+        for (int k = 30 * v; k < 30 * (v + 1) + 20; k++)
+            if (amfi_ring_newest(r) < (int64_t)(k + 1) * 100 - 1)
+                assert_true(amfi_ring_put(r, T0 + k * 100000LL, RATE, 100, x, NULL) >= 0);
+        while (amfi_tracker_next(t, rings, 0, &w) == 1)
+            ok += strcmp(w.status, "ok") == 0 && w.v.vehicle_id == 1 + v;
+    }
+    assert_int_equal(ok, 20);
+    assert_true(evicted >= 20);
+    /* a duplicate id is still refused, and evicts nothing */
+    amfi_vehicle_ev dup = vehicle(900100, 1e10 + 100);
+    assert_int_equal(amfi_tracker_add(t, &dup, NULL, NULL), -1);
     amfi_tracker_destroy(t);
     amfi_ring_destroy(r);
 }
@@ -658,6 +769,9 @@ int main(void)
         cmocka_unit_test(tracker_inseparable),
         cmocka_unit_test(tracker_slow_frac),
         cmocka_unit_test(tracker_free_vibration),
+        cmocka_unit_test(ring_rate_is_declared),
+        cmocka_unit_test(ring_memory_as_data_arrive),
+        cmocka_unit_test(tracker_full_evicts_stalest),
     };
     return cmocka_run_group_tests_name("daemon core", tests, NULL, NULL);
 }

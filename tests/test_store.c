@@ -817,20 +817,20 @@ static void test_runs_and_migration_from_v1(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
                  "DELETE FROM schema_migrations WHERE version >= 2; PRAGMA user_version = 1");
     sqlite3_close(db);
 
     /* read-only openers do not migrate: they say so */
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 1 is older than this program's 8"));
+    assert_non_null(strstr(err, "schema version 1 is older than this program's 9"));
     assert_null(ro);
 
     /* read-write: migrated, the data kept */
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM runs"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
     sqlite3_close(db);
@@ -879,18 +879,18 @@ static void test_speed_given_and_migration_from_v2(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
                  "DELETE FROM schema_migrations WHERE version >= 3; PRAGMA user_version = 2");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 2 is older than this program's 8"));
+    assert_non_null(strstr(err, "schema version 2 is older than this program's 9"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE speed_given_mps = 25.0 "
                                     "AND speed_mps = 25.0 AND speed_estimated = 0"));
     sqlite3_close(db);
@@ -940,18 +940,18 @@ static void test_event_columns_and_migration_from_v3(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
                  "DELETE FROM schema_migrations WHERE version >= 4; PRAGMA user_version = 3");
     sqlite3_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 3 is older than this program's 8"));
+    assert_non_null(strstr(err, "schema version 3 is older than this program's 9"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages WHERE n_vehicles = 1 "
                                     "AND quality IS NULL"));
     sqlite3_close(db);
@@ -1043,17 +1043,17 @@ static void test_environment_and_migration_from_v4(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
                  "DELETE FROM schema_migrations WHERE version >= 5; PRAGMA user_version = 4");
     sqlite3_close(db);
     amfi_store *ro = NULL;
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 4 is older than this program's 8"));
+    assert_non_null(strstr(err, "schema version 4 is older than this program's 9"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM environment"));
     sqlite3_close(db);
     assert_int_equal(0, amfi_store_add_environment(f->s, rows, 2, err, sizeof err));
@@ -1182,17 +1182,17 @@ static void test_scale_rows_and_migration_from_v5(void **state)
                  "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
                  "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
                  "DELETE FROM schema_migrations WHERE version >= 6; PRAGMA user_version = 5");
     sqlite3_close(db);
     amfi_store *ro = NULL;
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 5 is older than this program's 8"));
+    assert_non_null(strstr(err, "schema version 5 is older than this program's 9"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE deck_c IS NULL AND "
                                     "reference_gvw_kg IS NULL"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM scale_evals"));
@@ -1290,16 +1290,16 @@ static void test_f1_and_migration_from_v6(void **state)
     /* make it a version-6 file, as amfid before the natural frequency left it */
     raw_exec(db, "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
                  "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
+                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
                  "DELETE FROM schema_migrations WHERE version >= 7; PRAGMA user_version = 6");
     sqlite3_close(db);
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 6 is older than this program's 8"));
+    assert_non_null(strstr(err, "schema version 6 is older than this program's 9"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(8, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE f1_hz IS NULL"));
     sqlite3_close(db);
     assert_int_equal(0, amfi_store_f1_series(f->s, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err,
@@ -1361,12 +1361,12 @@ static void test_gvw_comp_and_migration_from_v7(void **state)
                          sqlite3_exec(db, "UPDATE passages SET gvw_comp_kg = 0 WHERE vehicle_id = 2",
                                       NULL, NULL, NULL));
     /* make it a version-7 file, as amfid before compensated rules left it */
-    raw_exec(db, "ALTER TABLE passages DROP COLUMN gvw_comp_kg; "
+    raw_exec(db, "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
                  "DELETE FROM schema_migrations WHERE version >= 8; PRAGMA user_version = 7");
     sqlite3_close(db);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(8, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE gvw_comp_kg IS NULL"));
     sqlite3_close(db);
     /* rows of before: their GVW is what the rules were fed */
