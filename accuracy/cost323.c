@@ -30,6 +30,7 @@ static const struct {
 };
 #define N_NAMED (int)(sizeof named / sizeof named[0])
 
+/* index of s in names[0 .. n), or −1 */
 static int parse_name(const char *s, const char *const *names, int n)
 {
     if (!s)
@@ -40,47 +41,29 @@ static int parse_name(const char *s, const char *const *names, int n)
     return -1;
 }
 
-const char *amfi_cost323_criterion_name(amfi_cost323_criterion c)
+/* names[i] for 0 <= i < n, else "?" */
+static const char *name_of(int i, const char *const *names, int n)
 {
-    return (unsigned)c < AMFI_COST323_N_CRITERIA ? criterion_names[c] : "?";
+    return i >= 0 && i < n ? names[i] : "?";
 }
 
-int amfi_cost323_criterion_parse(const char *s, amfi_cost323_criterion *out)
-{
-    int i = parse_name(s, criterion_names, AMFI_COST323_N_CRITERIA);
-    if (i < 0)
-        return -1;
-    *out = (amfi_cost323_criterion)i;
-    return 0;
-}
-
-const char *amfi_cost323_condition_name(amfi_cost323_condition c)
-{
-    return (unsigned)c < AMFI_COST323_N_CONDITIONS ? condition_names[c] : "?";
-}
-
-int amfi_cost323_condition_parse(const char *s, amfi_cost323_condition *out)
-{
-    int i = parse_name(s, condition_names, AMFI_COST323_N_CONDITIONS);
-    if (i < 0)
-        return -1;
-    *out = (amfi_cost323_condition)i;
-    return 0;
-}
-
-const char *amfi_cost323_environment_name(amfi_cost323_environment e)
-{
-    return (unsigned)e < AMFI_COST323_N_ENVIRONMENTS ? environment_names[e] : "?";
-}
-
-int amfi_cost323_environment_parse(const char *s, amfi_cost323_environment *out)
-{
-    int i = parse_name(s, environment_names, AMFI_COST323_N_ENVIRONMENTS);
-    if (i < 0)
-        return -1;
-    *out = (amfi_cost323_environment)i;
-    return 0;
-}
+/* The three enums' names and parsers, one pair each. */
+#define NAMED_ENUM(type, fn, names, count)                                  \
+    const char *amfi_cost323_##fn##_name(type v)                            \
+    {                                                                       \
+        return name_of((int)v, names, count);                               \
+    }                                                                       \
+    int amfi_cost323_##fn##_parse(const char *s, type *out)                 \
+    {                                                                       \
+        int i = parse_name(s, names, count);                                \
+        if (i >= 0)                                                         \
+            *out = (type)i;                                                 \
+        return i >= 0 ? 0 : -1;                                             \
+    }
+NAMED_ENUM(amfi_cost323_criterion, criterion, criterion_names, AMFI_COST323_N_CRITERIA)
+NAMED_ENUM(amfi_cost323_condition, condition, condition_names, AMFI_COST323_N_CONDITIONS)
+NAMED_ENUM(amfi_cost323_environment, environment, environment_names, AMFI_COST323_N_ENVIRONMENTS)
+#undef NAMED_ENUM
 
 /* t/√n: the two-sided 95 % Student quantile over √n */
 static double t_term(int n)
