@@ -167,7 +167,7 @@ void heartbeat(daemon_s *d)
     m.state = (char *)d->state;
     m.last_error = d->last_error;
     m.site_id = d->cfg.site.id;
-    amfi_status_t_publish(d->lcm, d->cfg.daemon.ch_status, &m);
+    BUS_PUBLISH(d, amfi_status_t, d->cfg.daemon.ch_status, &m);
     sd_notifyf(0, "STATUS=%s: %lld passages stored (%lld ok), %d queued, %lld blocks",
                d->state, (long long)d->passages_stored, (long long)d->passages_ok,
                m.queue_depth, (long long)d->blocks_received);

@@ -13,6 +13,7 @@ pkgs=(
   gnuplot-nox                    # plots of the experiments (amfi-paper)
   liblcm-dev                     # LCM C library: the amfi bus (messages/)
   libglib2.0-dev                 # lcm.pc requires glib-2.0; liblcm-dev does not pull it in
+  libsodium-dev                  # HMAC-SHA-512-256 of the signed bus (messages/amfi_auth.c)
   liblcm-bin                     # lcm-gen, lcm-logger, lcm-logplayer
   liblcm-java                    # lcm.jar: lcm-spy (tools/ops/amfi-spy)
   default-jdk-headless           # javac, jar: amfi_types.jar for lcm-spy

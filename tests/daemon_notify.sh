@@ -22,6 +22,7 @@ set -u
 amfid=$1 sim=$2 config=$3 check=$4
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log" 2>/dev/null; exit 1; }
 "$sim" --lcm-url none --log "$dir/t.lcmlog" --vehicles 60 --headway 2 --speedup max \
   --damage 0.3 --damage-step-at 30 --seed 3 2> "$dir/sim.log" || fail "sim_publisher"

@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "amfi_auth.h" /* a signed log: the message without its trailer */
 #include "amfi_messages.h"
 #include "amfi_msg_check.h"
 
@@ -42,7 +43,7 @@ static int print_sites(lcm_eventlog_t *in)
                 amfi_status_t s;
             } m;
             char why[160];
-            if (amfi_msg_decode_checked(outs[k].type, e->data, (size_t)e->datalen, &m, why,
+            if (amfi_msg_decode_checked(outs[k].type, e->data, amfi_auth_bare_len(e->data, (size_t)e->datalen), &m, why,
                                         sizeof why) != AMFI_MSG_OK) {
                 fprintf(stderr, "lcm_passages: event %lld: %s\n", (long long)e->eventnum, why);
                 bad = 1;
@@ -91,7 +92,7 @@ int main(int argc, char **argv)
         if (strcmp(e->channel, AMFI_CHANNEL_PASSAGE) == 0) {
             amfi_passage_t m;
             char why[160];
-            if (amfi_msg_decode_checked(AMFI_MSG_PASSAGE_T, e->data, (size_t)e->datalen, &m, why,
+            if (amfi_msg_decode_checked(AMFI_MSG_PASSAGE_T, e->data, amfi_auth_bare_len(e->data, (size_t)e->datalen), &m, why,
                                         sizeof why) != AMFI_MSG_OK) {
                 fprintf(stderr, "lcm_passages: event %lld: %s\n", (long long)e->eventnum, why);
                 bad = 1;
