@@ -364,7 +364,7 @@ int amfi_auth_log_write(lcm_eventlog_t *log, amfi_auth_signer *s, int64_t eventn
     pthread_mutex_unlock(&s->mu);
     if (!buf)
         return -1;
-    long n = amfi_auth_sign_into(s, channel, data, len, ts > 0 ? ts : 1, buf, s->cap);
+    long n = amfi_auth_sign_into(s, channel, data, len, 0, buf, s->cap);
     if (n < 0)
         return -1;
     ev.datalen = (int32_t)n;

@@ -8,9 +8,9 @@
  *   0       4     magic "AMFA"
  *   4       1     version, 1
  *   5       16    producer id: 1 .. 16 bytes of [A-Za-z0-9._-], NUL-padded
- *   21      8     sequence, unsigned big-endian: the producer's clock in µs
- *                 since 1970 (wall clock on a bus, the event's timestamp in
- *                 an LCM log), made strictly increasing per producer
+ *   21      8     sequence, unsigned big-endian: the producer's wall clock
+ *                 in µs since 1970 when it signs, made strictly increasing
+ *                 per producer (on the bus and in the LCM logs it writes)
  *   29      32    MAC: HMAC-SHA-512-256 (libsodium crypto_auth) keyed by the
  *                 site key, over channel name, one 0 byte, the encoded
  *                 message, the 16 producer bytes and the 8 sequence bytes
@@ -102,10 +102,10 @@ long amfi_auth_sign_into(amfi_auth_signer *s, const char *channel, const void *d
 int amfi_auth_publish(lcm_t *lcm, amfi_auth_signer *s, const char *channel, const void *data,
                       size_t len);
 
-/* Write one event to an LCM log: signed when s is not NULL, the sequence
- * taken from the event's timestamp ts (so that a reader replaying the log
- * through file:// sees it at the time it claims). lcm_eventlog_write_event's
- * result, or -1. */
+/* Write one event (timestamp ts) to an LCM log: signed when s is not NULL,
+ * the sequence from the wall clock as on the bus (a log played onto a live
+ * bus soon after is accepted; the same log played later is a replay and
+ * refused as skew). lcm_eventlog_write_event's result, or -1. */
 int amfi_auth_log_write(lcm_eventlog_t *log, amfi_auth_signer *s, int64_t eventnum, int64_t ts,
                         const char *channel, const void *data, size_t len);
 

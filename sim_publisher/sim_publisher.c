@@ -47,8 +47,8 @@
  * file:// provider; --lcm-url none publishes nothing. Every message is
  * signed with the site's bus key (messages/amfi_auth.h: --bus-key FILE, else
  * the configuration's daemon.bus.key_file, else the systemd credential
- * amfi-bus-key; without one, unsigned with a warning), on the bus with the
- * wall clock as sequence, in the log with the event's timestamp. Vehicles follow each
+ * amfi-bus-key; without one, unsigned with a warning), the same bytes on
+ * the bus and in the log, the wall clock as sequence. Vehicles follow each
  * other --headway seconds apart (default: the population's timestamps),
  * or arrive at random with --flow vehicles/h per lane on --lanes 1 or 2
  * (at least --min-headway apart within a lane, no overtaking: flow.h;
@@ -503,6 +503,8 @@ typedef struct bus {
     lcm_t *lcm;          /* NULL: not publishing */
     lcm_eventlog_t *log; /* NULL: no log */
     amfi_auth_signer *signer; /* NULL: unsigned (no key) */
+    unsigned char *sbuf;      /* the signed message */
+    size_t scap;
     int64_t eventnum;
     int64_t sent;        /* messages emitted (bus and/or log) */
     unsigned char *buf;
@@ -512,11 +514,28 @@ typedef struct bus {
 /* Send one encoded message to the bus and/or the log (timestamp = data time). */
 static int emit(bus *b, const char *channel, int64_t utime, const void *data, int len)
 {
-    if (b->lcm && amfi_auth_publish(b->lcm, b->signer, channel, data, (size_t)len) != 0)
+    if (b->signer) { /* signed once, the same bytes on the bus and in the log */
+        if ((size_t)len + AMFI_AUTH_TRAILER_BYTES > b->scap) {
+            unsigned char *n = realloc(b->sbuf, (size_t)len + AMFI_AUTH_TRAILER_BYTES);
+            if (!n)
+                return -1;
+            b->sbuf = n;
+            b->scap = (size_t)len + AMFI_AUTH_TRAILER_BYTES;
+        }
+        long n = amfi_auth_sign_into(b->signer, channel, data, (size_t)len, 0, b->sbuf, b->scap);
+        if (n < 0)
+            return -1;
+        data = b->sbuf;
+        len = (int)n;
+    }
+    if (b->lcm && lcm_publish(b->lcm, channel, data, (unsigned)len) != 0)
         return -1;
-    if (b->log && amfi_auth_log_write(b->log, b->signer, b->eventnum++, utime, channel, data,
-                                      (size_t)len) != 0)
-        return -1;
+    if (b->log) {
+        lcm_eventlog_event_t ev = {b->eventnum++, utime, (int32_t)strlen(channel), len,
+                                   (char *)channel, (void *)data};
+        if (lcm_eventlog_write_event(b->log, &ev) != 0)
+            return -1;
+    }
     b->sent++;
     return 0;
 }
@@ -860,6 +879,7 @@ out:
     if (b.signer)
         amfi_auth_signer_free(b.signer);
     free(b.signer);
+    free(b.sbuf);
     free(b.buf);
     free(plan);
     gsl_rng_free(rng);

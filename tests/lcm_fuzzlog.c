@@ -152,8 +152,8 @@ int main(int argc, char **argv)
                 auth_raw++;
             } else if (attack == 2) { /* signed, then one bit changed */
                 static unsigned char sb[8192 + AMFI_AUTH_TRAILER_BYTES];
-                long n = amfi_auth_sign_into(test_signer, channels[ch], b, (size_t)len,
-                                             e->timestamp, sb, sizeof sb);
+                long n = amfi_auth_sign_into(test_signer, channels[ch], b, (size_t)len, 0,
+                                             sb, sizeof sb);
                 if (n > 0) {
                     sb[rnd() % (unsigned)n] ^= (unsigned char)(1u << (rnd() % 8));
                     rc |= test_put_raw(out, &num, e->timestamp, channels[ch], sb, (int)n);

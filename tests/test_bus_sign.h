@@ -10,9 +10,10 @@
  *
  * test_put() takes off any trailer the input message had (sim_publisher's
  * logs are signed) and signs the message again as the program's own
- * producer, the sequence from the event's timestamp made strictly
- * increasing: events copied out of order or twice stay acceptable to the
- * authentication and reach the intake's own checks.
+ * producer, the sequence from the wall clock made strictly increasing:
+ * events copied out of order or twice stay acceptable to the authentication
+ * and reach the intake's own checks, through file:// and, played soon after,
+ * on a live bus.
  */
 #ifndef TEST_BUS_SIGN_H
 #define TEST_BUS_SIGN_H
