@@ -22,6 +22,7 @@ pkgs=(
   xvfb                           # headless X server for the amfi_spy test
   x11-apps                       # xwd: the amfi_spy test's screenshot
   iproute2                       # ip: the amfi_spy test's private network namespace
+  nftables                       # nft: the contrib_nft test checks contrib/amfi-bus.nft
   libsystemd-dev                 # sd_notify, watchdog, journal (amfid)
   libsqlite3-dev                 # the store of passages, indicators, alerts (store/)
   sqlite3                        # sqlite3 CLI: queries on the store, report_cli test fixture
