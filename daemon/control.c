@@ -202,6 +202,12 @@ void reload(daemon_s *d)
         n.daemon.max_event_axles != d->cfg.daemon.max_event_axles)
         LOG_WARN("reload: channels, workers, queue, ring, event limits and store changes take "
                  "effect at the next start");
+    if (n.daemon.bus_auth != d->cfg.daemon.bus_auth ||
+        strcmp(n.daemon.bus_key_file, d->cfg.daemon.bus_key_file) ||
+        n.daemon.bus_max_skew_s != d->cfg.daemon.bus_max_skew_s ||
+        n.daemon.simulation != d->cfg.daemon.simulation)
+        LOG_WARN("reload: daemon.bus (authentication, key, skew) and daemon.simulation take "
+                 "effect at the next start");
     /* λ policy, output channels, heartbeat, waits: now. The λ policy is
      * copied into each job at release (intake.c): passages released from
      * now on are solved with the new one, those already queued with theirs. */

@@ -102,5 +102,17 @@ grep -q "bus authentication required, key $tmp/khex (from the option)" "$tmp/err
     problem "hex key not taken: $(head -5 "$tmp/err")"
 kill -TERM $hpid 2>/dev/null; wait $hpid || problem "amfid with a hex key exited $?"
 
+# daemon.bus.auth: off (a lab bus) starts without a key, with a warning
+name=auth-off
+sed "s/^    auth: required .*/    auth: off/" "$config" > "$tmp/off.yaml"
+grep -q "^    auth: off$" "$tmp/off.yaml" || problem "the test's daemon.bus.auth did not apply"
+"$amfid" -c "$tmp/off.yaml" -d "$tmp/o.db" -u memq:// 2> "$tmp/err" &
+opid=$!
+i=0; until grep -q running "$tmp/err"; do
+    i=$((i + 1)); [ $i -lt 300 ] && kill -0 $opid 2>/dev/null || break; sleep 0.1; done
+grep -q "daemon.bus.auth is off: every message on the bus is accepted unchecked" "$tmp/err" ||
+    problem "no warning: $(head -5 "$tmp/err")"
+kill -TERM $opid 2>/dev/null; wait $opid || problem "amfid with auth off exited $?"
+
 echo "amfid_cli.sh: $failures failed"
 [ "$failures" -eq 0 ]
