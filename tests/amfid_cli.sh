@@ -87,7 +87,7 @@ refused key-mode-644 "bus key $tmp/k644: mode 0644 lets group or others read it;
 refused key-size "bus key $tmp/k31: 31 bytes: neither 32 raw bytes nor 64 hex digits" \
     --bus-key "$tmp/k31"
 refused key-missing "bus key $tmp/none: cannot open" --bus-key "$tmp/none"
-refused no-key "daemon.bus.auth is required but there is no bus key" 
+refused no-key "daemon.bus.auth is required but there is no bus key"
 mkdir -p "$tmp/cred" && cp "$tmp/k644" "$tmp/cred/amfi-bus-key"
 CREDENTIALS_DIRECTORY=$tmp/cred refused credential-mode \
     "bus key $tmp/cred/amfi-bus-key: mode 0644 .*\(from the credential\)"
