@@ -16,14 +16,19 @@
 # Asserted: no forged row is stored; every real vehicle has one row, ok; no
 # truth row (production: the truth channel is not subscribed); the refusals
 # counted by reason equal what was sent (unsigned, bad_mac, replay).
+# Then, with NFT_EXAMPLE (contrib/amfi-bus.nft) and nft installed, the
+# example is loaded in the site's namespace (the sensors: this host's own
+# address on the site's interface) and the attacker sends its unsigned
+# vehicles again: the filter's drop counter must count every one, and amfid
+# none (its refusal counts stay those of the first attack).
 # An amfid without --make-bus-key (before the authenticated bus) runs the
 # same attack unsigned, to show what it stores.
-# Usage: daemon_forged.sh AMFID SIM_PUBLISHER LCM_FORGE CONFIG
+# Usage: daemon_forged.sh AMFID SIM_PUBLISHER LCM_FORGE CONFIG [NFT_EXAMPLE]
 set -u
 if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
   exec unshare --net sh -c 'ip link set lo up && AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
 fi
-amfid=$1 sim=$2 forge=$3 config=$4
+amfid=$1 sim=$2 forge=$3 config=$4 nftfile=${5:-}
 N=8
 dir=$(mktemp -d)
 pids=""
@@ -89,6 +94,23 @@ done
 sent() { cat "$dir"/sent.$1.* | awk '{s += $2} END {print s + 0}'; }
 echo "attack from 10.231.0.2: $(sent unsigned) unsigned forged vehicles, $(sent wrongkey) signed" \
   "with a wrong key, $(sent replay) replayed messages (unicast to 10.231.0.1:7667 and multicast)"
+# the nftables example in front of amfid: the sensor network is this host's
+# own address on amfi-site (where its looped-back multicast comes in), the
+# attacker's 10.231.0.2 is outside it
+filtered=none
+if [ -n "$nftfile" ] && command -v nft > /dev/null 2>&1; then
+  sed -e 's|^define SENSOR_IF = .*|define SENSOR_IF = "amfi-site"|' \
+      -e 's|^define SENSOR_NET = .*|define SENSOR_NET = 10.231.0.1/32|' "$nftfile" > "$dir/bus.nft"
+  grep -q '^define SENSOR_NET = 10.231.0.1/32$' "$dir/bus.nft" || fail "the test's nft defines did not apply"
+  nft -f "$dir/bus.nft" || fail "nft -f $nftfile"
+  for addr in 10.231.0.1 239.255.76.67; do
+    att "$forge" unsigned $addr "$dir/snap.lcmlog" > "$dir/nft.$addr" || fail "lcm_forge behind nft"
+  done
+  filtered=$(cat "$dir"/nft.* | awk '{s += $2} END {print s + 0}')
+  dropped=$(nft list chain inet amfi_bus input | sed -n 's/.*counter packets \([0-9]*\) bytes .* drop.*/\1/p')
+  echo "behind contrib/amfi-bus.nft: $filtered more forged datagrams sent, ${dropped:-no} dropped by the filter"
+  [ "${dropped:-0}" -eq "$filtered" ] || fail "the nftables example dropped ${dropped:-no} of $filtered"
+fi
 wait $spid || fail "sim_publisher"
 kill -TERM $apid
 i=0; while kill -0 $apid 2>/dev/null; do
