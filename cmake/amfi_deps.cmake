@@ -35,6 +35,7 @@ amfi_require_pkg(SYSTEMD libsystemd libsystemd-dev)
 amfi_require_pkg(JANSSON jansson libjansson-dev)
 amfi_require_pkg(PQ libpq libpq-dev)  # amfi-sync (fleet/): the central PostgreSQL
 amfi_require_pkg(LCM lcm "liblcm-dev libglib2.0-dev")
+amfi_require_pkg(SODIUM libsodium libsodium-dev)  # the signed bus (messages/amfi_auth.c)
 amfi_require_program(LCM_GEN_EXECUTABLE lcm-gen liblcm-bin)
 amfi_require_program(AMFI_SCDOC scdoc scdoc)
 

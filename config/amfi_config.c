@@ -96,6 +96,9 @@ void amfi_config_defaults(amfi_site_config *c)
     strcpy(d->ch_status, "AMFI_STATUS");
     strcpy(d->ch_environment, "AMFI_ENVIRONMENT");
     strcpy(d->db_path, "amfi.db");
+    d->simulation = 0;
+    d->bus_auth = 1;
+    d->bus_max_skew_s = 300.0;
     d->sync_full = 1;
     d->workers = 2;
     d->queue_size = 256;
@@ -223,10 +226,10 @@ typedef struct visit_arg {
 } visit_arg;
 
 static int visit_one(const char *path, const char *type, const char *range,
-                     const char *dflt, void *arg)
+                     const char *dflt, int required, void *arg)
 {
     const visit_arg *va = arg;
-    amfi_config_key k = {path, type, range, dflt};
+    amfi_config_key k = {path, type, range, dflt, required};
 
     return va->visit(&k, va->arg);
 }

@@ -43,6 +43,15 @@ typedef struct amfi_daemon_config {
     char ch_accel[64], ch_vehicle[64], ch_truth[64]; /* daemon.channels.* (inputs) */
     char ch_passage[64], ch_indicator[64], ch_alert[64], ch_status[64]; /* outputs */
     char ch_environment[64]; /* daemon.channels.environment: in, air/deck temperature */
+    int simulation;           /* daemon.simulation: on (1): a simulation, amfid subscribes
+                                 the truth channel; off (0, production): not subscribed */
+    int bus_auth;             /* daemon.bus.auth: required (1): unsigned, wrongly signed
+                                 and replayed messages are refused; off (0): a lab bus */
+    char bus_key_file[512];   /* daemon.bus.key_file: the site key; "" = the systemd
+                                 credential amfi-bus-key ($CREDENTIALS_DIRECTORY) */
+    double bus_max_skew_s;    /* daemon.bus.max_skew_s: a signed message whose sequence
+                                 is further than this from its receive time is
+                                 refused, s, [1, 86400] */
     char db_path[512];        /* daemon.store.path */
     int sync_full;            /* daemon.store.sync: full (1) | normal (0) */
     int workers;              /* daemon.workers: solver threads, 1 .. 64 */

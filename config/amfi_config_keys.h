@@ -22,6 +22,8 @@ typedef struct amfi_config_key {
     const char *type;  /* "number", "integer", "name", "string", "file path", "list", ... */
     const char *range; /* the values allowed */
     const char *dflt;  /* the default ("required" for a required list-item key) */
+    int required;      /* 1: a required key (dflt "required"), 0: dflt is the default
+                          (which may be the name "required", daemon.bus.auth) */
 } amfi_config_key;
 
 /* Call visit for every key, depth first in the order of the loader's

@@ -26,6 +26,14 @@ static const field channel_fields[] = {
     STR("status", ch_status, 1),   STR("environment", ch_environment, 1),
     {.key = NULL}};
 
+static const enum_name auth_names[] = {{"off", 0}, {"required", 1}, {NULL, 0}};
+
+static const field bus_fields[] = {
+    {.key = "auth", .kind = &K_ENUM, .off = DC(bus_auth), .aux = auth_names},
+    STR("key_file", bus_key_file, 1),
+    {.key = "max_skew_s", .kind = &K_DOUBLE, .off = DC(bus_max_skew_s), .lo = 1, .hi = 86400},
+    {.key = NULL}};
+
 static const enum_name sync_names[] = {{"normal", 0}, {"full", 1}, {NULL, 0}};
 
 static const field store_fields[] = {
@@ -37,6 +45,7 @@ static const field store_fields[] = {
 #define IND(m) DC(indicators.m)
 
 const enum_name onoff_names[] = {{"off", 0}, {"on", 1}, {NULL, 0}};
+static const enum_name bool_names[] = {{"false", 0}, {"true", 1}, {NULL, 0}};
 static const enum_name temperature_names[] = {{"raw", 0}, {"compensated", 1}, {NULL, 0}};
 
 static const field indicator_fields[] = {
@@ -115,6 +124,8 @@ static const field intake_fields[] = {
 const field daemon_fields[] = {
     STR("lcm_url", lcm_url, 0),
     {.key = "channels", .kind = &K_MAP, .aux = channel_fields},
+    {.key = "bus", .kind = &K_MAP, .aux = bus_fields},
+    {.key = "simulation", .kind = &K_ENUM, .off = DC(simulation), .aux = bool_names},
     {.key = "store", .kind = &K_MAP, .aux = store_fields},
     {.key = "workers", .kind = &K_INT, .off = DC(workers), .lo = 1, .hi = 64},
     {.key = "queue_size", .kind = &K_INT, .off = DC(queue_size), .lo = 1, .hi = 100000},

@@ -269,7 +269,7 @@ int describe_table(const field *table, const char *prefix, const void *base,
                 snprintf(dflt, sizeof dflt, "%s", (f->flags & F_REQUIRED) ? "required" : "");
             if ((f->flags & F_REQUIRED))
                 snprintf(dflt, sizeof dflt, "required");
-            rc = visit(path, f->kind->type, range, dflt, arg);
+            rc = visit(path, f->kind->type, range, dflt, (f->flags & F_REQUIRED) != 0, arg);
             if (!rc && f->kind->nest == NEST_LIST) {
                 const list_schema *ls = f->aux;
                 pathf(path, "%s%s%s[]", prefix, *prefix ? "." : "", f->key);

@@ -135,7 +135,7 @@ int walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *b
  * base; "required" for a required item key). Stops at and returns the first
  * non-zero value of visit. */
 typedef int (*key_visit)(const char *path, const char *type, const char *range,
-                         const char *dflt, void *arg);
+                         const char *dflt, int required, void *arg);
 int describe_table(const field *table, const char *prefix, const void *base,
                    key_visit visit, void *arg);
 

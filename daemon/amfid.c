@@ -2,7 +2,8 @@
 /*
  * amfid: the bridge monitoring daemon.
  *
- *   amfid [--config FILE] [--db PATH] [--lcm-url URL] [--check-config]
+ *   amfid [--config FILE] [--db PATH] [--lcm-url URL] [--bus-key FILE] [--check-config]
+ *   amfid --make-bus-key FILE
  *         [--help] [--version]
  *
  * Listens on LCM to accelerometer blocks and vehicle events (and, from a
@@ -225,6 +226,9 @@ static int start_runtime(daemon_s *d)
         LOG_ERR("cannot open the LCM bus '%s'", url);
         return 1;
     }
+    int arc = bus_auth_start(d, d->bus_key_option);
+    if (arc)
+        return arc;
     if (intake_subscribe(d))
         return 1;
     if (pool_start(&d->pool, d->bridge, &d->cfg.solver, d->cfg.daemon.workers,
@@ -349,11 +353,13 @@ int amfid_drain(daemon_s *d)
                  "buffered at stop: not stored",
                  (long long)d->env.lost, d->env.n);
     LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld messages received: "
-             "%lld blocks, %lld vehicles, %lld rejected messages",
+             "%lld blocks, %lld vehicles, %lld rejected messages, %lld refused by the bus "
+             "authentication",
              (long long)d->passages_stored, (long long)d->passages_ok,
              (long long)d->passages_lost, (long long)d->messages_in,
              (long long)d->blocks_received, (long long)d->vehicles_received,
-             (long long)(d->blocks_rejected + d->vehicles_rejected + d->messages_malformed));
+             (long long)(d->blocks_rejected + d->vehicles_rejected + d->messages_malformed),
+             (long long)d->auth_refused);
     return rc;
 }
 
@@ -370,6 +376,7 @@ void amfid_stop(daemon_s *d)
     pool_stop(&d->pool);
     if (d->lcm)
         lcm_destroy(d->lcm);
+    bus_auth_stop(d);
     if (d->pending)
         for (int i = 0; i < d->pend_cap; i++)
             job_free(d->pending[i]);
@@ -387,6 +394,18 @@ void amfid_stop(daemon_s *d)
 
 int amfid_start(daemon_s *d, const amfid_options *o)
 {
+    if (o->make_bus_key) {
+        char err[PATH_MAX + 200];
+        if (amfi_auth_key_make(o->make_bus_key, err, sizeof err)) {
+            fprintf(stderr, "amfid: %s\n", err);
+            return 1;
+        }
+        printf("amfid: new bus key %s (mode 0600): give it to every producer of the bus and "
+               "to amfid (docs/messages.md)\n",
+               o->make_bus_key);
+        return 0;
+    }
+    d->bus_key_option = o->bus_key;
     int rc = start_config(d, o);
     if (rc == 0 && o->check_only)
         printf("amfid: %s: ok (site %s, bridge %s, %d sensor(s), %d worker(s), store %s)\n", o->config,

@@ -26,6 +26,7 @@
 #include <systemd/sd-daemon.h>
 
 #include "amfi/amfi.h"
+#include "amfi_auth.h"
 #include "amfi_config.h"
 #include "amfi_msg_check.h"
 #include "amfi_time.h" /* amfi_mono_s: timeouts, backoff, periods (wall time) */
@@ -60,6 +61,9 @@ typedef struct amfid_options {
     const char *db;       /* --db, NULL: the file's */
     const char *lcm_url;  /* --lcm-url, NULL: the file's */
     int check_only;       /* --check-config */
+    const char *bus_key;  /* --bus-key FILE, NULL: daemon.bus.key_file, then the
+                             systemd credential */
+    const char *make_bus_key; /* --make-bus-key FILE: create a site key and exit */
 } amfid_options;
 
 /* 0: run. --help and --version print and exit 0; a bad command line is
@@ -77,7 +81,10 @@ enum { REJECT_ACCEL, REJECT_VEHICLE, REJECT_TRUTH, REJECT_ENVIRONMENT, REJECT_NI
 #define REJECT_RATE (AMFI_MSG_NREASONS + 2)       /* over its channel's rate limit */
 #define REJECT_SOURCE (AMFI_MSG_NREASONS + 3)     /* a value from a source not configured */
 #define REJECT_IMPLAUSIBLE (AMFI_MSG_NREASONS + 4) /* against the recent readings */
-#define REJECT_NREASONS (AMFI_MSG_NREASONS + 5)
+/* refused by the bus authentication (bus.c): REJECT_AUTH + amfi_auth_reason
+ * (unsigned, bad_mac, replay, skew, producers; amfi_auth.h) */
+#define REJECT_AUTH (AMFI_MSG_NREASONS + 5)
+#define REJECT_NREASONS (REJECT_AUTH + AMFI_AUTH_NREASONS)
 #define REJECT_EXAMPLE 512
 typedef struct reject_state {
     int64_t count[REJECT_NINPUTS][REJECT_NREASONS]; /* since start */
@@ -213,6 +220,18 @@ typedef struct daemon_s {
     int64_t newest_utime;
     int64_t udp_drops, udp_drops_logged; /* kernel drops on our sockets */
     reject_state rej;
+    /* the bus authentication (bus.c): the verifier with daemon.bus.auth
+     * required (NULL: off), the signer of what amfid publishes (NULL: no
+     * key), each input's subscription context */
+    amfi_auth_verifier *auth;
+    amfi_auth_signer *signer;
+    int64_t auth_refused;          /* messages refused by the authentication */
+    const char *bus_key_option;    /* --bus-key (argv), NULL none */
+    struct bus_sub {
+        struct daemon_s *d;
+        lcm_msg_handler_t fn;
+        int input;
+    } bus_subs[REJECT_NINPUTS];
     env_state env;                 /* environment readings (environment.c) */
     scale_state sc;                /* scale indicator, known truck (scaleind.c) */
     freevib_state fv;              /* the natural frequency (freevib.c) */
@@ -260,6 +279,30 @@ void amfid_stop(daemon_s *d);
 void bus_url(const amfi_daemon_config *dc, char *url, size_t n);
 /* UDP datagrams the kernel dropped on this process's sockets, or -1. */
 int64_t bus_udp_drops(void);
+/* The bus authentication: the site key (key_option, else daemon.bus.key_file,
+ * else the systemd credential amfi-bus-key) loaded into the verifier (when
+ * daemon.bus.auth is required) and the signer of amfid's own messages; with
+ * auth off a warning, and the signer only if a key is found. 0, or 2
+ * (reported: no key, or a key file refused). */
+int bus_auth_start(daemon_s *d, const char *key_option);
+void bus_auth_stop(daemon_s *d);
+/* lcm_subscribe through the authentication: fn sees only messages that
+ * passed it, with the trailer taken off (refusals counted under `input`,
+ * by reason); with auth off, a trailer is taken off unchecked. NULL on
+ * failure. */
+lcm_subscription_t *bus_subscribe(daemon_s *d, const char *channel, lcm_msg_handler_t fn,
+                                  int input);
+/* Publish an encoded message, signed when amfid has a key. */
+int bus_publish(daemon_s *d, const char *channel, const void *data, size_t len);
+/* Encode a message of lcm-gen type T and bus_publish it. */
+#define BUS_PUBLISH(d, T, channel, msg)                                                  \
+    do {                                                                                 \
+        int len_ = T##_encoded_size(msg);                                                \
+        void *buf_ = len_ > 0 ? malloc((size_t)len_) : NULL;                             \
+        if (buf_ && T##_encode(buf_, 0, len_, msg) == len_)                              \
+            bus_publish(d, channel, buf_, (size_t)len_);                                 \
+        free(buf_);                                                                      \
+    } while (0)
 
 /* ---- refused messages (reject.c), main thread ----------------------------- */
 

@@ -4,12 +4,19 @@
  * recv_buf_size option from daemon.recv_buf_bytes, checked against the
  * kernel's cap net.core.rmem_max with a warning that says what to set), and
  * the datagrams the kernel dropped on amfid's own UDP sockets, read from
- * /proc/net/udp (and udp6): the loss nobody else can see.
+ * /proc/net/udp (and udp6): the loss nobody else can see. And the bus
+ * authentication (messages/amfi_auth.h, docs/messages.md): every input is
+ * subscribed through bus_subscribe, which refuses (counts per channel and
+ * reason, reject.c) unsigned, wrongly signed, replayed and time-skewed
+ * messages when daemon.bus.auth is required, before any decoder sees them;
+ * what amfid publishes is signed.
  *
- * Thread: the main thread only (start-up and the heartbeat). Owns nothing
- * but the URL it builds.
+ * Thread: the main thread (start-up, the bus handlers, the heartbeat);
+ * bus_publish also from wherever amfid publishes (the signer has a mutex).
+ * Owns the verifier and the signer.
  */
 #include <dirent.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -102,4 +109,115 @@ int64_t bus_udp_drops(void)
         fclose(f);
     }
     return drops;
+}
+
+/* ---- the authenticated bus ---------------------------------------------- */
+
+int bus_auth_start(daemon_s *d, const char *key_option)
+{
+    const amfi_daemon_config *dc = &d->cfg.daemon;
+    char path[PATH_MAX], err[PATH_MAX + 200];
+    const char *origin = NULL;
+    const char *kp = amfi_auth_key_path(key_option, dc->bus_key_file, path, sizeof path, &origin);
+    if (!kp && dc->bus_auth) {
+        LOG_ERR("daemon.bus.auth is required but there is no bus key: give --bus-key FILE, "
+                "daemon.bus.key_file in %s, or the systemd credential %s "
+                "(LoadCredential=%s:/etc/amfid/bus.key); make one with amfid --make-bus-key "
+                "FILE",
+                d->config_path, AMFI_AUTH_CREDENTIAL, AMFI_AUTH_CREDENTIAL);
+        return 2;
+    }
+    if (!dc->bus_auth)
+        LOG_WARN("daemon.bus.auth is off: every message on the bus is accepted unchecked, "
+                 "forged ones too; only for a lab bus (docs/messages.md)");
+    if (!kp)
+        return 0; /* auth off and no key: amfid publishes unsigned */
+    /* LCM's file:// provider hands a replayed log's messages over with the
+     * wall clock of the replay as receive time, not the log's: the time
+     * cannot be checked there (the signatures and the order can) */
+    const int replay = strncmp(dc->lcm_url, "file://", 7) == 0;
+    amfi_auth_key key;
+    if (amfi_auth_key_load(kp, &key, err, sizeof err)) {
+        LOG_ERR("%s (from the %s)", err, origin);
+        return 2;
+    }
+    char producer[AMFI_AUTH_PRODUCER_BYTES + 1];
+    amfi_auth_producer_name(producer, "amfid.", d->cfg.site.id);
+    d->signer = calloc(1, sizeof *d->signer);
+    if (!d->signer || amfi_auth_signer_init(d->signer, &key, producer, err, sizeof err)) {
+        LOG_ERR("bus key: %s", d->signer ? err : "out of memory");
+        free(d->signer);
+        d->signer = NULL;
+        return 2;
+    }
+    if (dc->bus_auth) {
+        d->auth = malloc(sizeof *d->auth);
+        if (!d->auth ||
+            amfi_auth_verifier_init(d->auth, &key, replay ? 0.0 : dc->bus_max_skew_s)) {
+            LOG_ERR("bus key: %s", d->auth ? "libsodium cannot be initialised" : "out of memory");
+            return 2;
+        }
+    }
+    memset(&key, 0, sizeof key);
+    LOG_INFO("bus authentication %s, key %s (from the %s), amfid signs as '%s'%s",
+             dc->bus_auth ? "required" : "off (outgoing messages signed)", kp, origin, producer,
+             dc->bus_auth && replay
+                 ? "; replaying a log: signatures and each producer's order checked, not the "
+                   "time (file:// gives no receive time of the log)"
+                 : "");
+    return 0;
+}
+
+void bus_auth_stop(daemon_s *d)
+{
+    if (d->signer)
+        amfi_auth_signer_free(d->signer);
+    free(d->signer);
+    d->signer = NULL;
+    if (d->auth)
+        memset(d->auth, 0, sizeof *d->auth);
+    free(d->auth);
+    d->auth = NULL;
+}
+
+static void on_bus_message(const lcm_recv_buf_t *rb, const char *ch, void *user)
+{
+    struct bus_sub *s = user;
+    daemon_s *d = s->d;
+    lcm_recv_buf_t bare = *rb;
+    if (!d->auth) {
+        bare.data_size = (uint32_t)amfi_auth_bare_len(rb->data, rb->data_size);
+        s->fn(&bare, ch, d);
+        return;
+    }
+    size_t len = rb->data_size;
+    char why[256];
+    int r = amfi_auth_verify(d->auth, ch, rb->data, rb->data_size, rb->recv_utime, &len, why,
+                             sizeof why);
+    if (r != AMFI_AUTH_OK) {
+        d->messages_in++;
+        d->auth_refused++;
+        reject_note(d, s->input, REJECT_AUTH + r, "%s: message of %u bytes refused: %s", ch,
+                    rb->data_size, why);
+        return;
+    }
+    bare.data_size = (uint32_t)len;
+    s->fn(&bare, ch, d);
+}
+
+lcm_subscription_t *bus_subscribe(daemon_s *d, const char *channel, lcm_msg_handler_t fn,
+                                  int input)
+{
+    if (input < 0 || input >= REJECT_NINPUTS)
+        return NULL;
+    struct bus_sub *s = &d->bus_subs[input];
+    s->d = d;
+    s->fn = fn;
+    s->input = input;
+    return lcm_subscribe(d->lcm, channel, on_bus_message, s);
+}
+
+int bus_publish(daemon_s *d, const char *channel, const void *data, size_t len)
+{
+    return amfi_auth_publish(d->lcm, d->signer, channel, data, len);
 }

@@ -167,7 +167,7 @@ void heartbeat(daemon_s *d)
     m.state = (char *)d->state;
     m.last_error = d->last_error;
     m.site_id = d->cfg.site.id;
-    amfi_status_t_publish(d->lcm, d->cfg.daemon.ch_status, &m);
+    BUS_PUBLISH(d, amfi_status_t, d->cfg.daemon.ch_status, &m);
     sd_notifyf(0, "STATUS=%s: %lld passages stored (%lld ok), %d queued, %lld blocks",
                d->state, (long long)d->passages_stored, (long long)d->passages_ok,
                m.queue_depth, (long long)d->blocks_received);
@@ -202,6 +202,12 @@ void reload(daemon_s *d)
         n.daemon.max_event_s != d->cfg.daemon.max_event_s ||
         n.daemon.max_event_axles != d->cfg.daemon.max_event_axles)
         LOG_WARN("reload: channels, workers, queue, ring, event limits and store changes take "
+                 "effect at the next start");
+    if (n.daemon.bus_auth != d->cfg.daemon.bus_auth ||
+        strcmp(n.daemon.bus_key_file, d->cfg.daemon.bus_key_file) ||
+        n.daemon.bus_max_skew_s != d->cfg.daemon.bus_max_skew_s ||
+        n.daemon.simulation != d->cfg.daemon.simulation)
+        LOG_WARN("reload: daemon.bus (authentication, key, skew) and daemon.simulation take "
                  "effect at the next start");
     /* λ policy, output channels, heartbeat, waits: now. The λ policy is
      * copied into each job at release (intake.c): passages released from

@@ -2,7 +2,8 @@
 /*
  * intake.c: amfid's bus intake: the LCM handlers of accelerometer blocks,
  * vehicle events and (simulations) the truth (the environment's handler is
- * in environment.c, subscribed here), each message validated where
+ * in environment.c, subscribed here; the truth only when daemon.simulation
+ * is true), each message authenticated first (bus.c) and validated where
  * it enters (messages name the channel and the field); samples into the
  * rings, vehicles into the tracker; and the windows the tracker decides,
  * filled from the rings into jobs for the solver pool (or straight to the
@@ -484,8 +485,13 @@ int intake_subscribe(daemon_s *d)
     const char *ch[4] = {d->cfg.daemon.ch_accel, d->cfg.daemon.ch_vehicle,
                          d->cfg.daemon.ch_truth, d->cfg.daemon.ch_environment};
     lcm_msg_handler_t fn[4] = {on_accel, on_vehicle, on_truth, environment_on_message};
+    const int input[4] = {REJECT_ACCEL, REJECT_VEHICLE, REJECT_TRUTH, REJECT_ENVIRONMENT};
     for (int i = 0; i < 4; i++) {
-        lcm_subscription_t *s = lcm_subscribe(d->lcm, ch[i], fn[i], d);
+        /* the truth is a simulation's: in production not even subscribed */
+        if (input[i] == REJECT_TRUTH && !d->cfg.daemon.simulation)
+            continue;
+        /* through the bus authentication (bus.c) */
+        lcm_subscription_t *s = bus_subscribe(d, ch[i], fn[i], input[i]);
         if (!s || lcm_subscription_set_queue_capacity(s, d->cfg.daemon.bus_queue) != 0) {
             LOG_ERR("cannot subscribe to '%s' with a queue of %d messages", ch[i],
                     d->cfg.daemon.bus_queue);

@@ -19,7 +19,7 @@ int main(int argc, char **argv)
     amfid_parse_options(argc, argv, &o);
     static daemon_s d; /* large; zeroed */
     int rc = amfid_start(&d, &o);
-    if (rc == 0 && !o.check_only)
+    if (rc == 0 && !o.check_only && !o.make_bus_key)
         rc = amfid_run(&d);
     amfid_stop(&d);
     return rc;

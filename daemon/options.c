@@ -15,7 +15,8 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: amfid [-c FILE] [-d PATH] [-u URL] [-C] [-h] [-V]\n"
+            "usage: amfid [-c FILE] [-d PATH] [-u URL] [-k FILE] [-C] [-h] [-V]\n"
+            "       amfid --make-bus-key FILE\n"
             "\n"
             "The bridge monitoring daemon: weighs every vehicle from the bridge's\n"
             "accelerations (LCM bus), stores the passages in SQLite, watches the spread\n"
@@ -25,6 +26,11 @@ static void usage(FILE *f)
             "  -d, --db PATH       the store, over daemon.db_path of the file\n"
             "  -u, --lcm-url URL   the LCM bus, over daemon.lcm_url of the file\n"
             "                      (file://LOG?speed=0 replays a log)\n"
+            "  -k, --bus-key FILE  the site's bus key, over daemon.bus.key_file and the\n"
+            "                      systemd credential amfi-bus-key\n"
+            "      --make-bus-key FILE\n"
+            "                      create a new site bus key (32 random bytes, mode\n"
+            "                      0600; never overwrites) and exit\n"
             "  -C, --check-config  check the configuration (bridge, solver, indicators)\n"
             "                      and exit\n"
             "  -h, --help          this help\n"
@@ -42,6 +48,8 @@ void amfid_parse_options(int argc, char **argv, amfid_options *o)
         {"db", required_argument, NULL, 'd'},
         {"lcm-url", required_argument, NULL, 'u'},
         {"check-config", no_argument, NULL, 'C'},
+        {"bus-key", required_argument, NULL, 'k'},
+        {"make-bus-key", required_argument, NULL, 'K'},
         AMFI_CLI_END,
     };
     memset(o, 0, sizeof *o);
@@ -53,9 +61,15 @@ void amfid_parse_options(int argc, char **argv, amfid_options *o)
         case 'c':
         case 'd':
         case 'u':
+        case 'k':
+        case 'K':
             if (!*optarg)
                 amfi_cli_fail(&c, "empty value");
-            if (k == 'c')
+            if (k == 'k')
+                o->bus_key = optarg;
+            else if (k == 'K')
+                o->make_bus_key = optarg;
+            else if (k == 'c')
                 o->config = optarg;
             else if (k == 'd')
                 o->db = optarg;

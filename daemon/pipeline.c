@@ -71,7 +71,7 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id, const amfi_pa
     m.reference_gvw_kg = j->w.v.reference_gvw_kg > 0 ? j->w.v.reference_gvw_kg : NAN;
     m.f1_hz = r->f1_hz;
     m.f1_comp_hz = r->f1_comp_hz;
-    amfi_passage_t_publish(d->lcm, d->cfg.daemon.ch_passage, &m);
+    BUS_PUBLISH(d, amfi_passage_t, d->cfg.daemon.ch_passage, &m);
 }
 
 /* The STD and mean rules get gvw_kg: the passage's GVW, at the calibration
@@ -112,7 +112,7 @@ static void feed_indicators(daemon_s *d, const job *j, double gvw_kg)
         amfi_indicator_t m = {j->w.v.utime, ind_id, ev.n, ev.mean_kg, ev.std_kg,
                               ev.baseline_mean_kg, ev.baseline_std_kg, ev.std_ratio,
                               ev.p_value, (char *)ev.state, d->cfg.site.id};
-        amfi_indicator_t_publish(d->lcm, d->cfg.daemon.ch_indicator, &m);
+        BUS_PUBLISH(d, amfi_indicator_t, d->cfg.daemon.ch_indicator, &m);
         metrics_indicator(d, ev.std_ratio, ev.p_value,
                           ev.baseline_mean_kg > 0 ? ev.mean_kg / ev.baseline_mean_kg : NAN);
     }
@@ -129,7 +129,7 @@ void emit_alert(daemon_s *d, int64_t utime, const amfi_alert_event *a, int64_t i
         set_error(d, "store: %s", err);
     amfi_alert_t m = {utime, aid, (char *)a->level, (char *)a->kind, (char *)a->message, ind_id,
                       (int8_t)a->raised, d->cfg.site.id};
-    amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
+    BUS_PUBLISH(d, amfi_alert_t, d->cfg.daemon.ch_alert, &m);
     metrics_alert(d, a->kind, a->raised);
     notify_alert(d, utime, aid, a->level, a->kind, a->message, ind_id, a->raised);
     if (a->raised)
@@ -235,7 +235,7 @@ static void publish_store_alert(daemon_s *d, int raised, const char *msg)
     }
     amfi_alert_t m = {now, aid, (char *)"warning", (char *)"store_degraded",
                       (char *)msg, 0, (int8_t)raised, d->cfg.site.id};
-    amfi_alert_t_publish(d->lcm, d->cfg.daemon.ch_alert, &m);
+    BUS_PUBLISH(d, amfi_alert_t, d->cfg.daemon.ch_alert, &m);
     metrics_alert(d, "store_degraded", raised);
     notify_alert(d, now, aid, "warning", "store_degraded", msg, 0, raised);
     if (raised)

@@ -47,6 +47,8 @@ const char *reject_reason_name(int reason)
         return "invalid";
     if (reason == REJECT_QUARANTINE)
         return "quarantined";
+    if (reason >= REJECT_AUTH && reason < REJECT_NREASONS)
+        return amfi_auth_reason_name(reason - REJECT_AUTH);
     return amfi_msg_reason_name(reason);
 }
 

@@ -13,6 +13,7 @@ pkgs=(
   gnuplot-nox                    # plots of the experiments (amfi-paper)
   liblcm-dev                     # LCM C library: the amfi bus (messages/)
   libglib2.0-dev                 # lcm.pc requires glib-2.0; liblcm-dev does not pull it in
+  libsodium-dev                  # HMAC-SHA-512-256 of the signed bus (messages/amfi_auth.c)
   liblcm-bin                     # lcm-gen, lcm-logger, lcm-logplayer
   liblcm-java                    # lcm.jar: lcm-spy (tools/ops/amfi-spy)
   default-jdk-headless           # javac, jar: amfi_types.jar for lcm-spy
@@ -21,6 +22,7 @@ pkgs=(
   xvfb                           # headless X server for the amfi_spy test
   x11-apps                       # xwd: the amfi_spy test's screenshot
   iproute2                       # ip: the amfi_spy test's private network namespace
+  nftables                       # nft: the contrib_nft test checks contrib/amfi-bus.nft
   libsystemd-dev                 # sd_notify, watchdog, journal (amfid)
   libsqlite3-dev                 # the store of passages, indicators, alerts (store/)
   sqlite3                        # sqlite3 CLI: queries on the store, report_cli test fixture

@@ -44,7 +44,11 @@
  * --start-utime; pacing is real time divided by --speedup (or none with
  * max). --log FILE writes the same events to an LCM log (timestamps = data
  * time), replayable with lcm-logplayer and readable by amfid through LCM's
- * file:// provider; --lcm-url none publishes nothing. Vehicles follow each
+ * file:// provider; --lcm-url none publishes nothing. Every message is
+ * signed with the site's bus key (messages/amfi_auth.h: --bus-key FILE, else
+ * the configuration's daemon.bus.key_file, else the systemd credential
+ * amfi-bus-key; without one, unsigned with a warning), the same bytes on
+ * the bus and in the log, the wall clock as sequence. Vehicles follow each
  * other --headway seconds apart (default: the population's timestamps),
  * or arrive at random with --flow vehicles/h per lane on --lanes 1 or 2
  * (at least --min-headway apart within a lane, no overtaking: flow.h;
@@ -95,6 +99,7 @@
 #include <sys/stat.h>
 
 #include <lcm/eventlog.h>
+#include "amfi_auth.h"
 #include <lcm/lcm.h>
 #include <signal.h>
 #include <time.h>
@@ -135,6 +140,7 @@ typedef struct opts {
     double gap_lo, gap_hi, pre, post, dt;
     /* streaming */
     const char *lcm_url, *log; /* NULL: LCM's default URL / no log */
+    const char *bus_key;  /* --bus-key FILE; NULL: the configuration's, the credential */
     int lcm_url_flag;     /* lcm_url came from --lcm-url (for messages) */
     double speedup;       /* <= 0: as fast as possible */
     double headway;       /* <= 0: the population's timestamps */
@@ -194,6 +200,9 @@ static void usage(FILE *f)
             "      --dt SEC                   integration step\n"
             "  -u, --lcm-url URL|none         LCM bus to publish on (none: no bus)\n"
             "  -l, --log FILE                 also write the events to an LCM log\n"
+            "  -k, --bus-key FILE             the site's bus key: every message signed\n"
+            "                                 (else daemon.bus.key_file, else the\n"
+            "                                 credential amfi-bus-key)\n"
             "      --speedup X|max            pacing: data time / wall time\n"
             "      --headway SEC              time between vehicles\n"
             "      --flow VEH_PER_H           Poisson arrivals per lane (overrides --headway)\n"
@@ -257,6 +266,7 @@ static const struct option longopts[] = {
     {"dt", required_argument, NULL, O_DT},
     {"lcm-url", required_argument, NULL, 'u'},
     {"log", required_argument, NULL, 'l'},
+    {"bus-key", required_argument, NULL, 'k'},
     {"speedup", required_argument, NULL, O_SPEEDUP},
     {"headway", required_argument, NULL, O_HEADWAY},
     {"flow", required_argument, NULL, O_FLOW},
@@ -427,6 +437,7 @@ static void apply_flags(int argc, char **argv, opts *o)
             o->lcm_url_flag = 1;
             break;
         case 'l': o->log = v; break;
+        case 'k': o->bus_key = v; break;
         case O_SPEEDUP:
             o->speedup = !strcmp(v, "max") ? 0.0 : amfi_cli_num(&c, v, 0.01, 1e6);
             break;
@@ -607,6 +618,9 @@ static void on_signal(int sig)
 typedef struct bus {
     lcm_t *lcm;          /* NULL: not publishing */
     lcm_eventlog_t *log; /* NULL: no log */
+    amfi_auth_signer *signer; /* NULL: unsigned (no key) */
+    unsigned char *sbuf;      /* the signed message */
+    size_t scap;
     int64_t eventnum;
     int64_t sent;        /* messages emitted (bus and/or log) */
     unsigned char *buf;
@@ -616,6 +630,20 @@ typedef struct bus {
 /* Send one encoded message to the bus and/or the log (timestamp = data time). */
 static int emit(bus *b, const char *channel, int64_t utime, const void *data, int len)
 {
+    if (b->signer) { /* signed once, the same bytes on the bus and in the log */
+        if ((size_t)len + AMFI_AUTH_TRAILER_BYTES > b->scap) {
+            unsigned char *n = realloc(b->sbuf, (size_t)len + AMFI_AUTH_TRAILER_BYTES);
+            if (!n)
+                return -1;
+            b->sbuf = n;
+            b->scap = (size_t)len + AMFI_AUTH_TRAILER_BYTES;
+        }
+        long n = amfi_auth_sign_into(b->signer, channel, data, (size_t)len, 0, b->sbuf, b->scap);
+        if (n < 0)
+            return -1;
+        data = b->sbuf;
+        len = (int)n;
+    }
     if (b->lcm && lcm_publish(b->lcm, channel, data, (unsigned)len) != 0)
         return -1;
     if (b->log) {
@@ -719,6 +747,34 @@ static int stream(const opts *o, const amfi_site_config *cfg, const world *w,
             fprintf(stderr, "%s: cannot open the LCM bus '%s'\n", PROG,
                     o->lcm_url ? o->lcm_url : "(default)");
             goto out;
+        }
+    }
+    {
+        char kbuf[4096], kerr[4300];
+        const char *origin = NULL;
+        const char *kp = amfi_auth_key_path(o->bus_key, cfg->daemon.bus_key_file, kbuf,
+                                            sizeof kbuf, &origin);
+        amfi_auth_key key;
+        if (kp && amfi_auth_key_load(kp, &key, kerr, sizeof kerr)) {
+            fprintf(stderr, "%s: %s (from the %s)\n", PROG, kerr, origin);
+            goto out;
+        }
+        if (kp) {
+            char producer[AMFI_AUTH_PRODUCER_BYTES + 1], pid[32];
+            snprintf(pid, sizeof pid, "%ld", (long)getpid());
+            amfi_auth_producer_name(producer, "sim.", pid);
+            b.signer = calloc(1, sizeof *b.signer);
+            if (!b.signer || amfi_auth_signer_init(b.signer, &key, producer, kerr, sizeof kerr)) {
+                fprintf(stderr, "%s: bus key: %s\n", PROG, b.signer ? kerr : "out of memory");
+                free(b.signer);
+                b.signer = NULL;
+                goto out;
+            }
+            memset(&key, 0, sizeof key);
+        } else {
+            fprintf(stderr, "%s: no bus key (--bus-key, daemon.bus.key_file, credential %s): "
+                    "the messages are unsigned; amfid with daemon.bus.auth required refuses "
+                    "them\n", PROG, AMFI_AUTH_CREDENTIAL);
         }
     }
     if (o->log) {
@@ -966,6 +1022,10 @@ out:
         lcm_eventlog_destroy(b.log);
     if (b.lcm)
         lcm_destroy(b.lcm);
+    if (b.signer)
+        amfi_auth_signer_free(b.signer);
+    free(b.signer);
+    free(b.sbuf);
     free(b.buf);
     free(plan);
     gsl_rng_free(rng);

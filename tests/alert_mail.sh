@@ -14,6 +14,7 @@ set -u
 script=$1
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 fail() { echo "FAIL: $*"; for f in "$dir"/out "$dir"/err "$dir"/args "$dir"/mail; do
   [ -f "$f" ] && { echo "--- $f"; cat "$f"; }; done; exit 1; }
 [ -x "$script" ] || fail "$script is not executable"

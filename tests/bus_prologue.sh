@@ -3,8 +3,10 @@
 # programs on the LCM bus (tests/daemon_*.sh). It re-runs the sourcing
 # script inside a private network namespace with loopback up and LCM's
 # multicast routed to it (nothing leaves the namespace), then gives the
-# script a temporary folder $dir, a list $pids of processes to kill, and a
-# cleanup at exit that kills them and removes $dir. As the script's first
+# script a temporary folder $dir, a list $pids of processes to kill, a
+# cleanup at exit that kills them and removes $dir, and the test's bus key
+# (tests/bus_key.sh: $bus_key, found by every program through
+# CREDENTIALS_DIRECTORY). As the script's first
 # command after `set -u`:
 #   . "$(dirname "$0")/bus_prologue.sh"
 if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
@@ -15,6 +17,7 @@ dir=$(mktemp -d)
 pids=""
 cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
 trap cleanup EXIT
+. "$(dirname "$0")/bus_key.sh"
 # amfid_start AMFID CONFIG: amfid on the bus in the background, store
 # $dir/s.db, log $dir/amfid.log, pid $apid (killed at exit); returns once it
 # runs. amfid_stop: SIGTERM, wait for its drain (up to 300 s: minutes under

@@ -10,6 +10,11 @@ set -u
 amfid=$1 sim=$2 inject=$3 config=$4
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
+# a simulation: the truth channel is subscribed (and its decoder exercised)
+sed "s/^  simulation: false .*/  simulation: true/" "$config" > "$dir/sim.yaml"
+grep -q "^  simulation: true$" "$dir/sim.yaml" || { echo "FAIL: daemon.simulation did not apply"; exit 1; }
+config=$dir/sim.yaml
 fail() { echo "FAIL: $*"; tail -30 "$dir/amfid.log"; exit 1; }
 "$sim" --lcm-url none --log "$dir/clean.log" --vehicles 3 --headway 4 --speedup max --seed 2 \
   2> "$dir/sim.log" || fail "sim_publisher"

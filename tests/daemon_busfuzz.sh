@@ -21,6 +21,7 @@ dir=$(mktemp -d)
 pids=""
 cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
 trap cleanup EXIT
+. "$(dirname "$0")/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 "$sim" --lcm-url none --log "$dir/clean.log" --vehicles "$nveh" --headway 3 --speedup max --seed 8 \
   2> "$dir/sim.log" || fail "sim_publisher"

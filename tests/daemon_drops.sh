@@ -51,7 +51,11 @@ grep -q "^bus .* [0-9]* messages received, [0-9]* refused, $n kernel drops, " "$
 echo "paused with a 4 kB receive buffer: the kernel dropped $n datagrams, reported in the log (status_t.datagrams_dropped carries the same count); $rows of 4 vehicles reached amfid"
 
 # (3) the shipped buffer and LCM queue: a burst after a pause loses nothing silently
-"$amfid" --config "$config" --db "$dir/c.db" 2> "$dir/burst.log" &
+# (a simulation: the truth channel is subscribed too, so that every message
+# sent is one amfid reads)
+sed "s/^  simulation: false .*/  simulation: true/" "$config" > "$dir/sim.yaml"
+grep -q "^  simulation: true$" "$dir/sim.yaml" || fail "daemon.simulation did not apply"
+"$amfid" --config "$dir/sim.yaml" --db "$dir/c.db" 2> "$dir/burst.log" &
 bpid=$!; pids="$pids $bpid"
 i=0; until grep -q running "$dir/burst.log"; do i=$((i + 1)); [ $i -lt 100 ] || fail "no start"; sleep 0.1; done
 kill -STOP $bpid

@@ -19,8 +19,10 @@ N=12
 # (every row ok, none lost or "overload").
 sed -e "s/^    window: 500/    window: 10/" -e "s/^    every: 100/    every: 5/" \
     -e "s/^    baseline_n: 10000/    baseline_n: 10/" -e "s/^  queue_size: 256/  queue_size: 4/" \
-    "$config" > "$dir/amfid.yaml"
+    -e "s/^  simulation: false .*/  simulation: true/" "$config" > "$dir/amfid.yaml"
 grep -q "^  queue_size: 4 " "$dir/amfid.yaml" || fail "the test's queue size did not apply"
+# a simulation: the truth channel subscribed and stored
+grep -q "^  simulation: true$" "$dir/amfid.yaml" || fail "daemon.simulation did not apply"
 grep -q "^    baseline_n: 10 " "$dir/amfid.yaml" || fail "the test's indicator settings did not apply"
 "$amfid" --config "$dir/amfid.yaml" --check-config >/dev/null || fail "check-config"
 

@@ -14,6 +14,10 @@ amfid=$1 sim=$2 config=$3
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
 N=60
 
+# a simulation: the truth channel is subscribed (and its decoder exercised)
+sed "s/^  simulation: false .*/  simulation: true/" "$config" > "$dir/sim.yaml"
+grep -q "^  simulation: true$" "$dir/sim.yaml" || { echo "FAIL: daemon.simulation did not apply"; exit 1; }
+config=$dir/sim.yaml
 amfid_start "$amfid" "$config"
 timeout 300 "$sim" --vehicles $N --flow 1200 --lanes 1 --speedup 20 --seed 5 \
   2> "$dir/sim.log" || fail "sim_publisher exited $?"

@@ -10,8 +10,9 @@ set -u
 . "$(dirname "$0")/bus_prologue.sh"
 amfid=$1 sim=$2 config=$3 check=$4
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
+# (a simulation: the truth is read too, every message sent is counted)
 sed -e "s|^  # textfile: .*|  textfile: $dir/m/amfid.prom|" -e "s/^  interval_s: 15 /  interval_s: 1 /" \
-  "$config" > "$dir/a.yaml"
+  -e "s/^  simulation: false .*/  simulation: true/" "$config" > "$dir/a.yaml"
 grep -q "^  interval_s: 1 " "$dir/a.yaml" || fail "the test's metrics settings did not apply"
 mkdir "$dir/m"
 "$amfid" --config "$dir/a.yaml" --db "$dir/a.db" 2> "$dir/amfid.log" &

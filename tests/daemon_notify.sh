@@ -28,17 +28,19 @@ set -u
 amfid=$1 sim=$2 config=$3 check=$4
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log" 2>/dev/null; exit 1; }
 "$sim" --lcm-url none --log "$dir/t.lcmlog" --vehicles 60 --headway 2 --speedup max \
   --damage 0.3 --damage-step-at 30 --seed 3 2> "$dir/sim.log" || fail "sim_publisher"
 # CONF COMMAND TIMEOUT: the shipped file with small windows, the command, the metrics file
+# (a simulation: the truth is read too, every message sent is counted)
 conf() {
   sed -e "s/^    window: 500/    window: 10/" -e "s/^    every: 100/    every: 2/" \
       -e "s/^    baseline_n: 10000/    baseline_n: 20/" -e "s/^    raise_after: 6 /    raise_after: 1 /" \
       -e "s/^    clear_after: 6 /    clear_after: 1 /" -e "s|^  # command: .*|  command: $1|" \
       -e "s|^  command_timeout_s: 30 |  command_timeout_s: $2 |" \
       -e "s|^  # textfile: .*|  textfile: $dir/amfid.prom|" -e "s/^  id: local /  id: notify-test /" \
-      "$config"
+      -e "s/^  simulation: false .*/  simulation: true/" "$config"
 }
 run() { # NAME: amfid on the stream with $dir/NAME.yaml into $dir/NAME.db
   rm -f "$dir/$1.db"

@@ -21,6 +21,7 @@ dir=$(mktemp -d)
 apid=""
 cleanup() { [ -n "$apid" ] && kill -9 "$apid" 2>/dev/null; rm -rf "$dir"; }
 trap cleanup EXIT
+. "$(dirname "$0")/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -30 "$f"; done; exit 1; }
 N=${AMFI_RELOAD_VEHICLES:-120}
 L1=7.94e-9 L2=2.5e-8

@@ -13,7 +13,9 @@ amfid=$1 sim=$2 config=$3
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
 N=4
 
-sed -e "s/^  speed: measured /  speed: estimate /" "$config" > "$dir/amfid.yaml"
+sed -e "s/^  speed: measured /  speed: estimate /" -e "s/^  simulation: false .*/  simulation: true/" \
+  "$config" > "$dir/amfid.yaml"
+grep -q "^  simulation: true$" "$dir/amfid.yaml" || fail "daemon.simulation did not apply"
 grep -q "^  speed: estimate " "$dir/amfid.yaml" || fail "the test's solver.speed did not apply"
 amfid_start "$amfid" "$dir/amfid.yaml"
 timeout 120 "$sim" --vehicles $N --headway 3 --speedup 10 --seed 7 --speed-error 0.04,0 \

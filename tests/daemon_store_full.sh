@@ -17,6 +17,7 @@ amfid=$1 sim=$2 config=$3
 command -v unshare >/dev/null || { echo "no unshare"; exit 1; }
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 "$sim" --lcm-url none --log "$dir/traffic.log" --vehicles 16 --headway 2 --speedup max --seed 4 \
   2> "$dir/sim.log" || { echo "FAIL: sim_publisher"; exit 1; }
 unshare --mount sh -s "$amfid" "$config" "$dir" <<'INNER'

@@ -13,6 +13,7 @@ set -u
 amfid=$1 sim=$2 shift_=$3 config=$4
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 q() { sqlite3 "$dir/$1" "$2"; }
 "$sim" --lcm-url none --log "$dir/clean.log" --vehicles 8 --headway 4 --speedup max --seed 3 \

@@ -21,6 +21,7 @@ command -v sqlite3 > /dev/null || { echo "fleet_amfid.sh: no sqlite3: skipped"; 
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/pg_server.sh"
 pg_tmp fleet_amfid
+dir=$tmp; . "$here/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 die() { echo "FAIL: $*"; tail -n 5 "$tmp/amfid.log" "$tmp/sync.log" "$tmp/sim.log"; exit 1; }

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "amfi_auth.h" /* a signed log: the message without its trailer */
 #include "amfi_messages.h"
 #include "amfi_msg_check.h"
 
@@ -38,7 +39,8 @@ int main(int argc, char **argv)
     while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
         if (strcmp(e->channel, AMFI_CHANNEL_ENVIRONMENT) == 0) {
             amfi_environment_t m;
-            if (amfi_msg_decode_checked(AMFI_MSG_ENVIRONMENT_T, e->data, (size_t)e->datalen, &m,
+            if (amfi_msg_decode_checked(AMFI_MSG_ENVIRONMENT_T, e->data,
+                                        amfi_auth_bare_len(e->data, (size_t)e->datalen), &m,
                                         why, sizeof why) != AMFI_MSG_OK) {
                 fprintf(stderr, "lcm_environment: event %lld: %s\n", (long long)e->eventnum, why);
                 bad = 1;
@@ -63,7 +65,8 @@ int main(int argc, char **argv)
             }
         } else if (strcmp(e->channel, AMFI_CHANNEL_TRUTH) == 0) {
             amfi_truth_t m;
-            if (amfi_msg_decode_checked(AMFI_MSG_TRUTH_T, e->data, (size_t)e->datalen, &m, why,
+            if (amfi_msg_decode_checked(AMFI_MSG_TRUTH_T, e->data,
+                                        amfi_auth_bare_len(e->data, (size_t)e->datalen), &m, why,
                                         sizeof why) != AMFI_MSG_OK) {
                 fprintf(stderr, "lcm_environment: event %lld: %s\n", (long long)e->eventnum, why);
                 bad = 1;

@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amfi_auth.h" /* a signed log: the message without its trailer */
 #include "amfi_messages.h"
 #include "amfi_msg_check.h"
 
@@ -54,7 +55,8 @@ int main(int argc, char **argv)
     while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
         if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0) {
             amfi_vehicle_t m;
-            if (amfi_msg_decode_checked(AMFI_MSG_VEHICLE_T, e->data, (size_t)e->datalen, &m, why,
+            if (amfi_msg_decode_checked(AMFI_MSG_VEHICLE_T, e->data,
+                                        amfi_auth_bare_len(e->data, (size_t)e->datalen), &m, why,
                                         sizeof why) != AMFI_MSG_OK) {
                 fprintf(stderr, "lcm_flow: event %lld: %s\n", (long long)e->eventnum, why);
                 bad = 1;

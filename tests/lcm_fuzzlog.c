@@ -9,6 +9,14 @@
  * tests/daemon_busfuzz.sh). The real events are copied unchanged, so every
  * real vehicle must still be weighed.
  *
+ * The bus authentication (messages/amfi_auth.h): every event is signed with
+ * the test key (tests/test_bus_sign.h), the mutated ones after the mutation,
+ * so that they reach amfid's decoders; and a sixteenth of the mutated
+ * messages attack the authentication itself instead, in turn: written
+ * without a new signature (the mutated bytes with whatever trailer they
+ * have: unsigned or a wrong MAC), signed and then altered (bad_mac), or the
+ * last real event again byte for byte (replay). The counts are printed.
+ *
  *   lcm_fuzzlog IN.log OUT.log COUNT SEED
  */
 #include <lcm/eventlog.h>
@@ -17,6 +25,7 @@
 #include <string.h>
 
 #include "amfi_messages.h"
+#include "test_bus_sign.h"
 
 static unsigned long long rng_state;
 static unsigned rnd(void)
@@ -25,12 +34,8 @@ static unsigned rnd(void)
     return (unsigned)(rng_state >> 33);
 }
 
-static int put(lcm_eventlog_t *out, int64_t *num, int64_t ts, const char *ch, const void *data,
-               int len)
-{
-    lcm_eventlog_event_t e = {(*num)++, ts, (int32_t)strlen(ch), len, (char *)ch, (void *)data};
-    return lcm_eventlog_write_event(out, &e);
-}
+/* Every event signed with the test key (test_bus_sign.h). */
+#define put test_put
 
 #define KEEP 64 /* recent real messages kept as seeds */
 static unsigned char seed_buf[KEEP][4096];
@@ -82,6 +87,8 @@ static int mutate(unsigned char *b, int cap, int *ch)
 
 int main(int argc, char **argv)
 {
+    if (test_sign_init("test.fuzzlog"))
+        return 1;
     if (argc != 5) {
         fprintf(stderr, "usage: lcm_fuzzlog IN.log OUT.log COUNT SEED\n");
         return 2;
@@ -110,21 +117,54 @@ int main(int argc, char **argv)
     int64_t num = 0;
     long long done = 0, k = 0;
     int rc = 0;
-    static unsigned char b[8192];
+    static unsigned char b[8192], last[8192 + AMFI_AUTH_TRAILER_BYTES];
+    long long auth_raw = 0, auth_altered = 0, auth_replayed = 0;
+    int last_len = 0;
+    const char *last_ch = NULL;
     while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
         rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
+        /* what was just written, signed: replayed later */
+        size_t bare = amfi_auth_bare_len(e->data, (size_t)e->datalen);
+        if (test_signer && bare + AMFI_AUTH_TRAILER_BYTES <= sizeof last) {
+            last_len = (int)(bare + AMFI_AUTH_TRAILER_BYTES);
+            memcpy(last, test_signer->buf, (size_t)last_len);
+            last_ch = channels[0];
+            for (int c = 0; c < 3; c++)
+                if (strcmp(e->channel, channels[c]) == 0)
+                    last_ch = channels[c];
+            if (strcmp(e->channel, last_ch) != 0)
+                last_len = 0; /* not an input channel: not replayed */
+        }
         for (int c = 0; c < 3; c++)
             if (strcmp(e->channel, channels[c]) == 0 && e->datalen <= 4096) {
                 int s = n_seeds < KEEP ? n_seeds++ : (int)(rnd() % KEEP);
                 memcpy(seed_buf[s], e->data, (size_t)e->datalen);
-                seed_len[s] = e->datalen;
+                seed_len[s] = (int)amfi_auth_bare_len(e->data, (size_t)e->datalen);
                 seed_ch[s] = c;
             }
         k++;
         long long due = count * k / events;
         for (; done < due; done++) {
             int ch, len = mutate(b, sizeof b, &ch);
-            rc |= put(out, &num, e->timestamp, channels[ch], b, len);
+            unsigned attack = test_signer && rnd() % 16 == 0 ? 1 + rnd() % 3 : 0;
+            if (attack == 1) { /* as mutated, no new signature */
+                rc |= test_put_raw(out, &num, e->timestamp, channels[ch], b, len);
+                auth_raw++;
+            } else if (attack == 2) { /* signed, then one bit changed */
+                static unsigned char sb[8192 + AMFI_AUTH_TRAILER_BYTES];
+                long n = amfi_auth_sign_into(test_signer, channels[ch], b, (size_t)len, 0,
+                                             sb, sizeof sb);
+                if (n > 0) {
+                    sb[rnd() % (unsigned)n] ^= (unsigned char)(1u << (rnd() % 8));
+                    rc |= test_put_raw(out, &num, e->timestamp, channels[ch], sb, (int)n);
+                }
+                auth_altered++;
+            } else if (attack == 3 && last_len > 0) { /* the last real event again */
+                rc |= test_put_raw(out, &num, e->timestamp, last_ch, last, last_len);
+                auth_replayed++;
+            } else {
+                rc |= put(out, &num, e->timestamp, channels[ch], b, len);
+            }
         }
         lcm_eventlog_free_event(e);
     }
@@ -134,6 +174,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "lcm_fuzzlog: write failed\n");
         return 1;
     }
-    printf("%lld real events, %lld mutated messages\n", events, done);
+    printf("%lld real events, %lld mutated messages (of which against the bus "
+           "authentication: %lld unsigned or with a stale trailer, %lld signed then altered, "
+           "%lld replays)\n",
+           events, done, auth_raw, auth_altered, auth_replayed);
     return 0;
 }

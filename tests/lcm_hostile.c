@@ -16,13 +16,10 @@
 #include <string.h>
 
 #include "amfi_messages.h"
+#include "test_bus_sign.h"
 
-static int put(lcm_eventlog_t *out, int64_t *num, int64_t ts, const char *ch, const void *data,
-               int len)
-{
-    lcm_eventlog_event_t e = {(*num)++, ts, (int32_t)strlen(ch), len, (char *)ch, (void *)data};
-    return lcm_eventlog_write_event(out, &e);
-}
+/* Every event signed with the test key (test_bus_sign.h). */
+#define put test_put
 
 /* A big-endian int16 at byte `at` (after the 8-byte fingerprint). */
 static void put16(unsigned char *b, int at, int v)
@@ -33,6 +30,8 @@ static void put16(unsigned char *b, int at, int v)
 
 int main(int argc, char **argv)
 {
+    if (test_sign_init("test.hostile"))
+        return 1;
     if (argc != 5) {
         fprintf(stderr, "usage: lcm_hostile IN.log OUT.log ISSUE9_VEHICLE_FILE COUNT\n");
         return 2;

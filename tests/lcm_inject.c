@@ -51,12 +51,10 @@
 #include <string.h>
 
 #include "amfi_messages.h"
+#include "test_bus_sign.h"
 
-static int put(lcm_eventlog_t *out, int64_t *num, int64_t ts, const char *ch, void *data, int len)
-{
-    lcm_eventlog_event_t e = {(*num)++, ts, (int32_t)strlen(ch), len, (char *)ch, data};
-    return lcm_eventlog_write_event(out, &e);
-}
+/* Every event signed with the test key (test_bus_sign.h). */
+#define put test_put
 
 /* Open IN for reading and OUT for writing: 0, or 1 (reported, both closed). */
 static int open_logs(const char *inp, const char *outp, lcm_eventlog_t **in,
@@ -272,6 +270,8 @@ static int bad_reference(const char *inp, const char *outp)
 
 int main(int argc, char **argv)
 {
+    if (test_sign_init("test.inject"))
+        return 1;
     if (argc == 4 && strcmp(argv[1], "--bad-reference") == 0)
         return bad_reference(argv[2], argv[3]);
     if (argc == 4 && strcmp(argv[1], "--bad-environment") == 0)

@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amfi_auth.h"
+
 int main(int argc, char **argv)
 {
     if (argc != 3 && argc != 4) {
@@ -40,10 +42,12 @@ int main(int argc, char **argv)
         for (int c = 0; c < 4; c++) {
             if (strcmp(e->channel, names[c]) || e->datalen < 0 || e->datalen > 65535)
                 continue;
-            unsigned char h[3] = {(unsigned char)c, (unsigned char)(e->datalen & 0xff),
-                                  (unsigned char)(e->datalen >> 8)};
+            /* the bare message: fuzz_intake signs what it publishes */
+            size_t len = amfi_auth_bare_len(e->data, (size_t)e->datalen);
+            unsigned char h[3] = {(unsigned char)c, (unsigned char)(len & 0xff),
+                                  (unsigned char)(len >> 8)};
             fwrite(h, 1, 3, out);
-            fwrite(e->data, 1, (size_t)e->datalen, out);
+            fwrite(e->data, 1, len, out);
             n++;
         }
         lcm_eventlog_free_event(e);

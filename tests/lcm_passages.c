@@ -6,7 +6,10 @@
  * message is checked before it is decoded. With --site, one line
  * "CHANNEL SITE_ID" per passage, indicator, alert and status message instead
  * (tests/daemon_site.sh). With --f1, "PASSAGE_ID VEHICLE_ID STATUS F1_HZ
- * F1_COMP_HZ" (%.6f, nan when none; tests/daemon_natfreq.sh).
+ * F1_COMP_HZ" (%.6f, nan when none; tests/daemon_natfreq.sh). With --site
+ * and the test's bus key ($CREDENTIALS_DIRECTORY/amfi-bus-key), every
+ * message must also carry amfid's valid signature (the trailer verified, each
+ * producer's sequence increasing; docs/messages.md).
  *
  *   lcm_passages [--site | --f1] LOG
  */
@@ -14,6 +17,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "amfi_auth.h" /* a signed log: the message without its trailer */
 #include "amfi_messages.h"
 #include "amfi_msg_check.h"
 
@@ -30,11 +34,30 @@ static int print_sites(lcm_eventlog_t *in)
                 {AMFI_CHANNEL_STATUS, AMFI_MSG_STATUS_T}};
     lcm_eventlog_event_t *e;
     int bad = 0;
+    /* amfid signs what it publishes: verified with the test's key */
+    static amfi_auth_verifier v;
+    char kpath[4096], kerr[4400];
+    amfi_auth_key key;
+    int verify = amfi_auth_key_path(NULL, NULL, kpath, sizeof kpath, NULL) != NULL;
+    if (verify && (amfi_auth_key_load(kpath, &key, kerr, sizeof kerr) ||
+                   amfi_auth_verifier_init(&v, &key, 0.0))) {
+        fprintf(stderr, "lcm_passages: %s\n", kerr);
+        return 1;
+    }
 
     while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
         for (size_t k = 0; k < sizeof outs / sizeof outs[0]; k++) {
             if (strcmp(e->channel, outs[k].channel))
                 continue;
+            size_t len = amfi_auth_bare_len(e->data, (size_t)e->datalen);
+            char awhy[256];
+            if (verify && amfi_auth_verify(&v, e->channel, e->data, (size_t)e->datalen, 0, &len,
+                                           awhy, sizeof awhy) != AMFI_AUTH_OK) {
+                fprintf(stderr, "lcm_passages: event %lld on %s: %s\n", (long long)e->eventnum,
+                        e->channel, awhy);
+                bad = 1;
+                continue;
+            }
             union {
                 amfi_passage_t p;
                 amfi_indicator_t i;
@@ -42,8 +65,8 @@ static int print_sites(lcm_eventlog_t *in)
                 amfi_status_t s;
             } m;
             char why[160];
-            if (amfi_msg_decode_checked(outs[k].type, e->data, (size_t)e->datalen, &m, why,
-                                        sizeof why) != AMFI_MSG_OK) {
+            if (amfi_msg_decode_checked(outs[k].type, e->data, len, &m, why, sizeof why) !=
+                AMFI_MSG_OK) {
                 fprintf(stderr, "lcm_passages: event %lld: %s\n", (long long)e->eventnum, why);
                 bad = 1;
                 continue;
@@ -91,7 +114,8 @@ int main(int argc, char **argv)
         if (strcmp(e->channel, AMFI_CHANNEL_PASSAGE) == 0) {
             amfi_passage_t m;
             char why[160];
-            if (amfi_msg_decode_checked(AMFI_MSG_PASSAGE_T, e->data, (size_t)e->datalen, &m, why,
+            if (amfi_msg_decode_checked(AMFI_MSG_PASSAGE_T, e->data,
+                                        amfi_auth_bare_len(e->data, (size_t)e->datalen), &m, why,
                                         sizeof why) != AMFI_MSG_OK) {
                 fprintf(stderr, "lcm_passages: event %lld: %s\n", (long long)e->eventnum, why);
                 bad = 1;

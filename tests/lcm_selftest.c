@@ -34,7 +34,38 @@
 
 #include <lcm/lcm.h>
 
+#include "amfi_auth.h"
 #include "amfi_messages.h"
+
+/* Every message is signed (messages/amfi_auth.h) with this program's own
+ * key, and the round trip verifies and strips the trailer before decoding:
+ * lcm-spy (tests/test_spy.sh) decodes the signed messages as they are. */
+static amfi_auth_signer signer;
+static amfi_auth_verifier verifier;
+
+static int auth_init(void)
+{
+    amfi_auth_key k;
+    memcpy(k.k, "lcm_selftest: not a site's key.", AMFI_AUTH_KEY_BYTES);
+    char err[256];
+    if (amfi_auth_signer_init(&signer, &k, "lcm_selftest", err, sizeof err) ||
+        amfi_auth_verifier_init(&verifier, &k, 300.0)) {
+        fprintf(stderr, "lcm_selftest: %s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
+/* Encode a message of type T and publish it signed: 0 or -1. */
+#define PUBLISH(T, lcm, channel, msg)                                                    \
+    ({                                                                                   \
+        int len_ = T##_encoded_size(msg), rc_ = -1;                                      \
+        void *buf_ = len_ > 0 ? malloc((size_t)len_) : NULL;                             \
+        if (buf_ && T##_encode(buf_, 0, len_, msg) == len_)                              \
+            rc_ = amfi_auth_publish(lcm, &signer, channel, buf_, (size_t)len_);          \
+        free(buf_);                                                                      \
+        rc_;                                                                             \
+    })
 
 #define T0_UTIME   INT64_C(1763800000000000) /* µs, 2025-11-22 08:26:40 UTC */
 #define ROUND_US   INT64_C(100000)           /* 10 Hz */
@@ -341,16 +372,16 @@ static void print_round(const struct round *r)
 static int publish_round(lcm_t *lcm, const struct round *r, int all)
 {
     int bad = 0;
-    bad += amfi_accel_block_t_publish(lcm, AMFI_CHANNEL_ACCEL, &r->accel) != 0;
-    bad += amfi_vehicle_t_publish(lcm, AMFI_CHANNEL_VEHICLE, &r->vehicle) != 0;
-    bad += amfi_truth_t_publish(lcm, AMFI_CHANNEL_TRUTH, &r->truth) != 0;
-    bad += amfi_passage_t_publish(lcm, AMFI_CHANNEL_PASSAGE, &r->passage) != 0;
+    bad += PUBLISH(amfi_accel_block_t, lcm, AMFI_CHANNEL_ACCEL, &r->accel) != 0;
+    bad += PUBLISH(amfi_vehicle_t, lcm, AMFI_CHANNEL_VEHICLE, &r->vehicle) != 0;
+    bad += PUBLISH(amfi_truth_t, lcm, AMFI_CHANNEL_TRUTH, &r->truth) != 0;
+    bad += PUBLISH(amfi_passage_t, lcm, AMFI_CHANNEL_PASSAGE, &r->passage) != 0;
     if (all)
-        bad += amfi_passage_t_publish(lcm, AMFI_CHANNEL_PASSAGE, &r->unsolved) != 0;
-    bad += amfi_indicator_t_publish(lcm, AMFI_CHANNEL_INDICATOR, &r->indicator) != 0;
-    bad += amfi_alert_t_publish(lcm, AMFI_CHANNEL_ALERT, &r->alert) != 0;
-    bad += amfi_status_t_publish(lcm, AMFI_CHANNEL_STATUS, &r->status) != 0;
-    bad += amfi_environment_t_publish(lcm, AMFI_CHANNEL_ENVIRONMENT, &r->environment) != 0;
+        bad += PUBLISH(amfi_passage_t, lcm, AMFI_CHANNEL_PASSAGE, &r->unsolved) != 0;
+    bad += PUBLISH(amfi_indicator_t, lcm, AMFI_CHANNEL_INDICATOR, &r->indicator) != 0;
+    bad += PUBLISH(amfi_alert_t, lcm, AMFI_CHANNEL_ALERT, &r->alert) != 0;
+    bad += PUBLISH(amfi_status_t, lcm, AMFI_CHANNEL_STATUS, &r->status) != 0;
+    bad += PUBLISH(amfi_environment_t, lcm, AMFI_CHANNEL_ENVIRONMENT, &r->environment) != 0;
     return bad;
 }
 
@@ -548,11 +579,22 @@ struct rx {
         T##_decode_cleanup(&got);                                                                  \
     } while (0)
 
-static void on_amfi(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+static void on_amfi(const lcm_recv_buf_t *signed_buf, const char *channel, void *user)
 {
     struct rx *rx = user;
     const struct round *w = rx->want;
     rx->round_msgs++;
+    size_t bare = 0;
+    char why[256];
+    if (amfi_auth_verify(&verifier, channel, signed_buf->data, signed_buf->data_size,
+                         signed_buf->recv_utime, &bare, why, sizeof why) != AMFI_AUTH_OK) {
+        fprintf(stderr, "FAIL %s: %s\n", channel, why);
+        rx->failures++;
+        return;
+    }
+    lcm_recv_buf_t stripped = *signed_buf;
+    stripped.data_size = (uint32_t)bare;
+    const lcm_recv_buf_t *rbuf = &stripped;
     if (strcmp(channel, AMFI_CHANNEL_ACCEL) == 0) {
         DECODE_CHECK(amfi_accel_block_t, same_accel, &w->accel, K_ACCEL);
     } else if (strcmp(channel, AMFI_CHANNEL_VEHICLE) == 0) {
@@ -663,7 +705,8 @@ static int run_roundtrip(const char *url, int rounds)
         fprintf(stderr, "messages_roundtrip: %d failures on %s\n", fails, url);
         return 1;
     }
-    printf("messages_roundtrip: %d rounds x 9 messages (8 types) on %s: every field equal; "
+    printf("messages_roundtrip: %d rounds x 9 messages (8 types) on %s: signed, verified, every "
+           "field equal; "
            "wrong type and short buffers refused\n", rounds, url);
     return 0;
 }
@@ -708,6 +751,8 @@ int main(int argc, char **argv)
     }
     const int nargs = argc - optind;
     char **args = argv + optind;
+    if (auth_init())
+        return 1;
     if (expect >= 0) {
         if (nargs != 0 || roundtrip) {
             usage(stderr);

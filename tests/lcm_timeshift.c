@@ -14,15 +14,12 @@
 #include <string.h>
 
 #include "amfi_messages.h"
+#include "test_bus_sign.h"
 
 #define HOUR INT64_C(3600000000)
 
-static int put(lcm_eventlog_t *out, int64_t *num, int64_t ts, const char *ch, const void *data,
-               int len)
-{
-    lcm_eventlog_event_t e = {(*num)++, ts, (int32_t)strlen(ch), len, (char *)ch, (void *)data};
-    return lcm_eventlog_write_event(out, &e);
-}
+/* Every event signed with the test key (test_bus_sign.h). */
+#define put test_put
 
 /* Re-encode the event with its utime moved by dt; 0 on success. */
 static int shifted(const lcm_eventlog_event_t *e, int64_t dt, unsigned char *buf, int cap, int *len)
@@ -59,6 +56,8 @@ static int shifted(const lcm_eventlog_event_t *e, int64_t dt, unsigned char *buf
 
 int main(int argc, char **argv)
 {
+    if (test_sign_init("test.timeshift"))
+        return 1;
     int poison = argc == 4 && strcmp(argv[1], "poison") == 0;
     int outage = argc == 5 && strcmp(argv[1], "outage") == 0;
     if (!poison && !outage) {

@@ -679,7 +679,7 @@ static const bad_case bad_cases[] = {
      3, "simulation.stream.lcm_url", "must be 0 .. 255 characters long, got 264"},
     {"sim_log_quoted_control", "simulation:\n  stream: {log: \"a\\tb\"}\n", 2,
      "simulation.stream.log", "control characters"},
-    {"unknown_daemon_key", "daemon:\n  bus: udpm://\n", 2, "daemon.bus",
+    {"unknown_daemon_key", "daemon:\n  bux: udpm://\n", 2, "daemon.bux",
      "unknown key (known: lcm_url, channels"},
     {"daemon_workers_zero", "daemon:\n  workers: 0\n", 2, "daemon.workers", "1 .. 64"},
     {"daemon_channel_empty", "daemon:\n  channels: {accel: \"\"}\n", 2,

@@ -33,7 +33,7 @@ typedef struct page {
 
 static void entry(const amfi_config_key *k, char *buf, size_t len)
 {
-    if (strcmp(k->dflt, "required") == 0)
+    if (k->required)
         snprintf(buf, len, "*%s* (%s; %s; required)", k->path, k->type, k->range);
     else
         snprintf(buf, len, "*%s* (%s; %s; default %s)", k->path, k->type, k->range, k->dflt);

@@ -37,6 +37,10 @@ shift 3
 top=$(cd "$(dirname "$0")/../.." && pwd)
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
+# the run's bus key (docs/messages.md): sim_publisher signs, amfid requires it
+mkdir -p "$out/cred" && rm -f "$out/cred/amfi-bus-key" &&
+  "$build/daemon/amfid" --make-bus-key "$out/cred/amfi-bus-key" > /dev/null || exit 1
+export CREDENTIALS_DIRECTORY="$out/cred"
 export AMFI_DATA_DIR="$top/config:$top/sim_publisher/data"
 sed -e "s|^    baseline_n: 200 .*|    baseline_n: ${BASELINE_N:-200}|" \
     -e "s|^    min_r2: [0-9.]* .*|    min_r2: ${MIN_R2:-0.8}|" \
