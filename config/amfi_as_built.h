@@ -73,10 +73,11 @@ int amfi_as_built_load(const char *path, const amfi_site_config *design, amfi_as
 
 /* The keys of an as-built file (for sim_publisher(1) and its test): visit
  * is called with each key path ("detector.clock_offset_s", list items as
- * "sensors[].at_m"), its type, range and default; the first non-zero return
+ * "sensors[].at_m"), its type, range, default and whether an item must
+ * give it; the first non-zero return
  * stops the walk and is returned. */
 int amfi_as_built_keys(int (*visit)(const char *path, const char *type, const char *range,
-                                    const char *dflt, void *arg),
+                                    const char *dflt, int required, void *arg),
                        void *arg);
 
 #ifdef __cplusplus

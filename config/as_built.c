@@ -179,7 +179,7 @@ int amfi_as_built_load(const char *path, const amfi_site_config *design, amfi_as
 }
 
 int amfi_as_built_keys(int (*visit)(const char *path, const char *type, const char *range,
-                                    const char *dflt, void *arg),
+                                    const char *dflt, int required, void *arg),
                        void *arg)
 {
     amfi_as_built *d = malloc(sizeof *d);

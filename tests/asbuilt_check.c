@@ -210,8 +210,9 @@ static int logdump(const char *path)
 }
 
 static int print_key(const char *path, const char *type, const char *range,
-                     const char *dflt, void *arg)
+                     const char *dflt, int required, void *arg)
 {
+    (void)required;
     (void)type;
     (void)range;
     (void)dflt;

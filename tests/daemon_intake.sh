@@ -22,6 +22,7 @@ cases=${*:-rate future slow flood environment reference}
 N=12
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+. "$(dirname "$0")/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 fail() { echo "FAIL: $case: $*"; tail -20 "$dir/$case.log" 2>/dev/null; exit 1; }
 q() { sqlite3 "$dir/$case.db" "$1"; }
 case=clean
