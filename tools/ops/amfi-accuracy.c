@@ -189,6 +189,8 @@ int main(int argc, char **argv)
     char msg[512] = "";
     if (read_input(input, err, msg, sizeof msg) != 0) {
         fprintf(stderr, PROG ": %s\n", msg);
+        for (int c = 0; c < AMFI_COST323_N_CRITERIA; c++)
+            free(err[c].v);
         return 1;
     }
     int worst = -1, classed = 0, failed = 0;
@@ -229,8 +231,11 @@ int main(int argc, char **argv)
                 }
             }
         }
-        if (amfi_json_print(stdout, o) != 0)
+        if (amfi_json_print(stdout, o) != 0) {
+            for (int k = 0; k < AMFI_COST323_N_CRITERIA; k++)
+                free(err[k].v);
             return 1;
+        }
     }
     json_t *o = json_object();
     json_object_set_new(o, "criterion", json_string("overall"));
