@@ -48,10 +48,10 @@ awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
 {
     cat "$tmp/ddl.sql"
     cat <<'EOF'
-PRAGMA user_version = 8;
+PRAGMA user_version = 9;
 INSERT INTO schema_migrations (version, description) VALUES (1, 'fixture'), (2, 'runs'),
     (3, 'speed_given_mps'), (4, 'n_vehicles'), (5, 'environment'), (6, 'scale_evals'), (7, 'f1_hz'),
-    (8, 'gvw_comp_kg');
+    (8, 'gvw_comp_kg'), (9, 'refusals');
 WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 20)
 INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status,
                       reason, lambda, residual_rms, formulation, solve_ms, speed_given_mps)
