@@ -23,6 +23,9 @@ trap cleanup EXIT
 # runs. amfid_stop: SIGTERM, wait for its drain (up to 300 s: minutes under
 # ASan) and require exit status 0. Both call the script's `fail`.
 amfid_start() {
+  # emptied here, not only by the background child's redirection: the wait
+  # below must not see an earlier run's "running" (a restart's race)
+  : > "$dir/amfid.log"
   "$1" --config "$2" --db "$dir/s.db" 2> "$dir/amfid.log" &
   apid=$!; pids="$pids $apid"
   _i=0; until grep -q "running" "$dir/amfid.log"; do

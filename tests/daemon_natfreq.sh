@@ -25,6 +25,9 @@ sed -e "s|^    baseline_n: 200 .*|    baseline_n: 10|" \
     -e "s/^    deck_max_rate_c_per_min: 2 /    deck_max_rate_c_per_min: 1000000 /" "$config" > "$dir/amfid.yaml"
 grep -q "^    baseline_n: 10" "$dir/amfid.yaml" || fail "no natural_frequency.baseline_n in $config"
 start_amfid() {
+  # emptied here, not only by the background child's redirection: the wait
+  # below must not see the previous run's "running" (a restart's race)
+  : > "$dir/amfid.log"
   "$amfid" --config "$dir/amfid.yaml" --db "$dir/a.db" 2> "$dir/amfid.log" &
   apid=$!; pids="$pids $apid"
   i=0; until grep -q "running" "$dir/amfid.log"; do
