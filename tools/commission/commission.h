@@ -104,8 +104,10 @@ enum {
 typedef struct cm_options {
     int fit[CM_N_PARAMS];    /* 1: fitted, 0: held at the design's */
     double tail_s;           /* free vibration in the window, s (default 1.0) */
-    double search_rate_hz;   /* calculation rate during the search (default 2000) */
-    int max_search_runs;     /* runs used while searching (default 12, spread in speed) */
+    double search_rate_hz;   /* calculation rate of the search (0, the default:
+                                the site's calc_rate_hz; the bearing scan at
+                                2000 Hz at most) */
+    int max_search_runs;     /* runs used while searching (default 8, spread in speed) */
     int verbose;             /* progress on stderr */
 } cm_options;
 
@@ -116,6 +118,8 @@ typedef struct cm_eval {
     double gvw_err_pct[CM_MAX_RUNS]; /* 100 (GVW − known)/known */
     double axle_err_pct[CM_MAX_RUNS][AMFI_MAX_AXLES];
     double resid_rel[CM_MAX_RUNS];   /* residual RMS / signal RMS, with the tail */
+    double free_rel[CM_MAX_RUNS];    /* residual RMS over the free vibration only (a
+                                        stretch fixed on the file's clock) / signal RMS */
     double f1_hz;                    /* the model's first natural frequency */
     double mean_abs_gvw_pct, worst_gvw_pct, mean_gvw_pct, mean_resid_rel;
 } cm_eval;
