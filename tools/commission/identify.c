@@ -568,6 +568,7 @@ static int evaluate_both(const amfi_site_config *site, const double *p, const cm
         cm_evaluate(site, p, runs, o, site->solver.calc_rate_hz, NULL, &fit, err, errlen) != 0)
         return -1;
     memcpy(ev->resid_rel, fit.resid_rel, sizeof fit.resid_rel);
+    memcpy(ev->free_rel, fit.free_rel, sizeof fit.free_rel);
     ev->mean_resid_rel = fit.mean_resid_rel;
     return 0;
 }
@@ -796,16 +797,16 @@ int cm_identify(const amfi_site_config *design0, const cm_runs *runs,
     static const double grid[] = {1e-10, 3e-10, 1e-9, 3e-9, 7.94e-9, 2e-8, 6e-8, 2e-7, 6e-7};
     enum { NG = sizeof grid / sizeof grid[0] };
     static double err_g[NG][CM_MAX_RUNS];
+    static cm_eval ev_g[NG]; /* the chosen λ's is the commissioned model's weighing */
     amfi_site_config s = res->site;
     s.lambda.automatic = 0;
     s.lambda.ref_rate_hz = design.lambda.ref_rate_hz;
     for (int g = 0; g < NG; g++) {
-        cm_eval ev;
         s.lambda.lambda_ref = grid[g];
-        if (cm_evaluate(&s, p, runs, &o_weigh, design.solver.calc_rate_hz, NULL, &ev, err,
+        if (cm_evaluate(&s, p, runs, &o_weigh, design.solver.calc_rate_hz, NULL, &ev_g[g], err,
                         errlen) != 0)
             return -1;
-        memcpy(err_g[g], ev.gvw_err_pct, sizeof ev.gvw_err_pct);
+        memcpy(err_g[g], ev_g[g].gvw_err_pct, sizeof ev_g[g].gvw_err_pct);
     }
     int best = 0;
     double best_lcost = INFINITY;
@@ -832,8 +833,16 @@ int cm_identify(const amfi_site_config *design0, const cm_runs *runs,
     res->lambda_ref = grid[best];
     res->site.lambda.automatic = 0;
     res->site.lambda.lambda_ref = grid[best];
-    if (evaluate_both(&res->site, p, runs, &o, &o_weigh, &res->after, err, errlen) != 0)
+    /* the weighing at that λ is the grid's (not solved again); the fit with
+     * the free vibration in the window */
+    cm_eval fit;
+    res->after = ev_g[best];
+    if (cm_evaluate(&res->site, p, runs, &o, design.solver.calc_rate_hz, NULL, &fit, err,
+                    errlen) != 0)
         return -1;
+    memcpy(res->after.resid_rel, fit.resid_rel, sizeof fit.resid_rel);
+    memcpy(res->after.free_rel, fit.free_rel, sizeof fit.free_rel);
+    res->after.mean_resid_rel = fit.mean_resid_rel;
     res->seconds = now_s() - t_start;
     return 0;
 }
