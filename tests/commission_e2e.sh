@@ -40,6 +40,9 @@ near "$ms" 1.00 0.03 || fail "mass x$ms, as built x1.00"
 near "$ck" 0.010 0.002 || fail "clock offset $ck s, as built 0.010 s"
 near "$ss" 1.00 0.01 || fail "speed scale x$ss, as built x1.00"
 grep -q '^detector:' "$dir/site.yaml" || fail "site.yaml has no detector section"
+# λ stays the design's (the runs' choice weighed traffic 0.3-0.6 % heavy)
+l=$(sed -n 's/^  lambda: \([-0-9.e+]*\).*/\1/p' "$dir/site.yaml")
+near "$l" 7.94e-9 1e-12 || fail "site.yaml: lambda $l, not the design's 7.94e-9"
 [ -s "$dir/report/report.md" ] || fail "no report"
 
 # traffic on the same as-built bridge, weighed with the design and the site
@@ -51,13 +54,15 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
     print $c["name"], $c["entry_time_s"], $c["speed_mps"], sp, $c["gvw_kg"] }' \
   "$dir/traffic/meta.csv" > "$dir/vehicles.txt"
 [ "$(wc -l < "$dir/vehicles.txt")" -eq 30 ] || fail "meta.csv: not 30 vehicles"
+head -n 10 "$dir/vehicles.txt" > "$dir/design.txt" # the design's bias: 10 are plenty
+cp "$dir/vehicles.txt" "$dir/site.txt"
 for cfg in design site; do
   echo "criterion,measured_kg,reference_kg" > "$dir/$cfg.csv"
   while read -r name entry speed sp gvw; do
     r=$("$solve" --config "$dir/$cfg.yaml" --accel "$dir/traffic/$name.csv" \
           --vehicle "$entry:$speed:$sp" 2> "$dir/err") || fail "amfi-solve $cfg $name: $(cat "$dir/err")"
     echo "gross,$(printf '%s' "$r" | sed 's/.*"gvw_kg":\([-0-9.e+]*\).*/\1/'),$gvw"
-  done < "$dir/vehicles.txt" >> "$dir/$cfg.csv"
+  done < "$dir/$cfg.txt" >> "$dir/$cfg.csv"
 done
 stats() {
   awk -F, 'NR > 1 { e = 100 * ($2 - $3) / $3; n++; s += e; a += (e < 0 ? -e : e)
