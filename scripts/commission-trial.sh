@@ -46,8 +46,14 @@ t1=$(date +%s.%N)
 
 # every vehicle weighed with the commissioned site file
 echo "criterion,measured_kg,reference_kg" > "$out/gross.csv"
+# the detector's spacings: axle_spacing_m carries its errors; the list of
+# every spacing (axle_spacings_m) is the truth, so a multi-axle vehicle's
+# list is scaled by the detector's first spacing over the true one
 awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
-  { sp = $c["axle_spacings_m"]; gsub(/;/, ",", sp)
+  { n = split($c["axle_spacings_m"], s, ";")
+    k = ("axle_spacing_true_m" in c) ? $c["axle_spacing_m"] / $c["axle_spacing_true_m"] : 1
+    sp = ""
+    for (i = 1; i <= n; i++) sp = sp (i > 1 ? "," : "") (n == 1 ? $c["axle_spacing_m"] : s[i] * k)
     print $c["name"], $c["entry_time_s"], $c["speed_mps"], sp, $c["gvw_kg"] }' \
   "$out/traffic/meta.csv" > "$out/vehicles.txt" || die "meta.csv"
 while read -r name entry speed sp gvw; do
