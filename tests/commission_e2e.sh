@@ -49,9 +49,9 @@ near "$l" 7.94e-9 1e-12 || fail "site.yaml: lambda $l, not the design's 7.94e-9"
 "$sim" --config "$dir/design.yaml" --as-built "$dir/as-built.yaml" --out "$dir/traffic" \
   --vehicles 30 --population "$pop" --seed 11 2> "$dir/err" ||
   fail "sim_publisher --out: $(cat "$dir/err")"
+# the detector's values (axle_spacing_m; the two-axle population)
 awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
-  { sp = $c["axle_spacings_m"]; gsub(/;/, ",", sp)
-    print $c["name"], $c["entry_time_s"], $c["speed_mps"], sp, $c["gvw_kg"] }' \
+  { print $c["name"], $c["entry_time_s"], $c["speed_mps"], $c["axle_spacing_m"], $c["gvw_kg"] }' \
   "$dir/traffic/meta.csv" > "$dir/vehicles.txt"
 [ "$(wc -l < "$dir/vehicles.txt")" -eq 30 ] || fail "meta.csv: not 30 vehicles"
 head -n 10 "$dir/vehicles.txt" > "$dir/design.txt" # the design's bias: 10 are plenty
