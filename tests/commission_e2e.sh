@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # commission_e2e.sh: a simulated as-built bridge commissioned end to end,
 # on a coarse setting short enough for the suite (the design at 2000 Hz,
-# 3 runs of each default truck, 30 traffic vehicles):
+# 3 runs of each default truck, bearings, sensor and speed scale held, 30
+# traffic vehicles):
 #   sim_publisher --as-built --calibration-runs -> amfi-commission ->
 #   sim_publisher --as-built --out (traffic on the same bridge) ->
 #   amfi-solve with SITE.yaml -> amfi-accuracy.
@@ -29,7 +30,10 @@ detector:
 EOF
 "$sim" --config "$dir/design.yaml" --as-built "$dir/as-built.yaml" --calibration-runs "$dir/cal" \
   --runs-per-truck 3 2> "$dir/err" || fail "sim_publisher --calibration-runs: $(cat "$dir/err")"
+# coarse: the bearings, the sensor and the speed scale held (the scans and
+# the search over them took 15 min under the sanitizers on a loaded machine)
 "$com" --config "$dir/design.yaml" --runs "$dir/cal/RUNS.csv" --out "$dir/site.yaml" \
+  --hold bearings --hold sensor --hold speed \
   --report "$dir/report" > "$dir/com.json" 2> "$dir/err" ||
   fail "amfi-commission exited $?: $(cat "$dir/err")"
 cat "$dir/com.json"
@@ -38,7 +42,7 @@ st=$(num stiffness_scale) ms=$(num mass_scale) ck=$(num clock_offset_s) ss=$(num
 near "$st" 1.10 0.03 || fail "stiffness x$st, as built x1.10"
 near "$ms" 1.00 0.03 || fail "mass x$ms, as built x1.00"
 near "$ck" 0.010 0.002 || fail "clock offset $ck s, as built 0.010 s"
-near "$ss" 1.00 0.01 || fail "speed scale x$ss, as built x1.00"
+near "$ss" 1.00 1e-9 || fail "speed scale x$ss, held at the design's 1"
 grep -q '^detector:' "$dir/site.yaml" || fail "site.yaml has no detector section"
 # λ stays the design's (the runs' choice weighed traffic 0.3-0.6 % heavy)
 l=$(sed -n 's/^  lambda: \([-0-9.e+]*\).*/\1/p' "$dir/site.yaml")
