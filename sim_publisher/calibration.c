@@ -13,6 +13,7 @@
 
 #include "calibration.h"
 #include "passage.h"
+#include "vclass.h"
 
 static int failf(char *err, size_t errlen, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
@@ -227,21 +228,41 @@ int amfi_cal_runs_write(const char *dir, const amfi_bridge *b, const amfi_profil
                                  ? 0.5 * (p->speed_lo + p->speed_hi)
                                  : p->speed_lo + (p->speed_hi - p->speed_lo) * j /
                                                      (p->runs_per_truck - 1);
-            double mean_force[AMFI_MAX_AXLES], entry_true, speed_meas;
+            double mean_force[AMFI_MAX_AXLES], static_kg[AMFI_MAX_AXLES], entry_true,
+                speed_meas;
             long lost = 0;
             int n = 0, track = -1;
             const char *model;
             seed_run(rng, p->seed, run);
             free(acc);
             acc = NULL;
-            if (t->n_axles == 2) {
-                /* the half-car over the carpet (passage.c) */
+            /* the vehicle model: the half-car for two axles, the class model
+             * (vclass.h, the class's mean properties) for a layout a class
+             * fits, else constant moving forces */
+            const int cls = t->n_axles > 2 ? amfi_vclass_guess(t->n_axles, t->spacing_m) : -1;
+            for (int a = 0; a < t->n_axles; a++)
+                static_kg[a] = t->axle_kg[a];
+            if (t->n_axles == 2 || cls >= 0) {
+                /* over the carpet (passage.c) */
                 amfi_passage_spec spec;
                 memset(&spec, 0, sizeof spec);
-                if (amfi_halfcar_from_weights(t->axle_kg[0] + t->axle_kg[1], t->axle_kg[0],
-                                              t->axle_kg[1], t->spacing_m[0], dist, NULL,
-                                              &spec.car, err, errlen))
-                    goto out;
+                if (t->n_axles == 2) {
+                    if (amfi_halfcar_from_weights(t->axle_kg[0] + t->axle_kg[1], t->axle_kg[0],
+                                                  t->axle_kg[1], t->spacing_m[0], dist, NULL,
+                                                  &spec.car, err, errlen))
+                        goto out;
+                    model = "halfcar";
+                } else {
+                    const amfi_vclass *c = amfi_vclass_get(cls);
+                    if (amfi_vclass_truck(c, t->axle_kg, t->spacing_m, NULL, &spec.truck, err,
+                                          errlen))
+                        goto out;
+                    /* the class model equalises each load-sharing group (its
+                     * sum kept): those are the static loads a weighbridge gives */
+                    for (int a = 0; a < t->n_axles; a++)
+                        static_kg[a] = spec.truck.W_N[a] / AMFI_GRAVITY;
+                    model = c->name;
+                }
                 spec.speed_mps = v;
                 spec.track = prof ? amfi_profile_draw_track(prof, p->track_std, rng) : 0;
                 spec.pre_s = p->pre_s;
@@ -260,11 +281,11 @@ int amfi_cal_runs_write(const char *dir, const amfi_bridge *b, const amfi_profil
                 n = pr.n;
                 entry_true = -pr.t_first_s;
                 speed_meas = pr.speed_measured_mps;
-                mean_force[0] = pr.truth.mean_force_N[0];
-                mean_force[1] = pr.truth.mean_force_N[1];
-                lost = pr.truth.lost_contact_steps[0] + pr.truth.lost_contact_steps[1];
+                for (int a = 0; a < t->n_axles; a++) {
+                    mean_force[a] = pr.truth.mean_force_N[a];
+                    lost += pr.truth.lost_contact_steps[a];
+                }
                 track = spec.track;
-                model = "halfcar";
                 add_noise(acc, n, ns, 0.0, p->noise_ms2, rng);
             } else {
                 if (run_forces(b, sp, t, v, p->pre_s, p->tail_s, &acc, &n, err, errlen))
@@ -293,12 +314,12 @@ int amfi_cal_runs_write(const char *dir, const amfi_bridge *b, const amfi_profil
             fprintf(runs, "%s,%.6f,", name, det_speed);
             put_list(runs, det_sp, t->n_axles - 1, "%.4f");
             fprintf(runs, ",%.6f,", det_entry);
-            put_list(runs, t->axle_kg, t->n_axles, "%.1f");
+            put_list(runs, static_kg, t->n_axles, "%.1f");
             fputc('\n', runs);
             fprintf(truth, "%s,%d,%s,%.6f,%.6f,", name, ti + 1, model, v, entry_true);
             put_list(truth, t->spacing_m, t->n_axles - 1, "%.4f");
             fputc(',', truth);
-            put_list(truth, t->axle_kg, t->n_axles, "%.1f");
+            put_list(truth, static_kg, t->n_axles, "%.1f");
             fputc(',', truth);
             put_list(truth, mean_force, t->n_axles, "%.3f");
             fputc(',', truth);

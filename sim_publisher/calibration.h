@@ -13,10 +13,14 @@
  *
  * Vehicles: a two-axle truck is the simulator's half-car (vehicle.h, Table 2
  * means: the same truck at every run) driving over the road carpet (vbi.h);
- * a truck of three or more axles is, until the simulator has a multi-axle
- * vehicle model, a set of constant moving forces (its static axle loads) on
- * the bridge, integrated by libamfi's amfi_forward_newmark (no suspension,
- * no road roughness). The truth file names the model of each run.
+ * a truck of three or more axles whose spacings fit a class of vclass.h is
+ * that class's model (amfi_vclass_truck with the class's mean properties,
+ * each load-sharing group's static load equalised, its sum kept: RUNS.csv
+ * gives those equalised loads, what a weighbridge weighs) over the carpet;
+ * any other layout is a set of constant moving forces (its static axle
+ * loads) on the bridge, integrated by libamfi's amfi_forward_newmark (no
+ * suspension, no road roughness). The truth file names the model of each
+ * run (halfcar, the class's name, or forces).
  *
  * Workload: N runs of a few seconds each, a few seconds of CPU in all; the
  * ambient record a few minutes of data in about a second. Main thread only.

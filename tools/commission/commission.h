@@ -17,8 +17,9 @@
  *       - each run's A-MFI residual with the free vibration after the last
  *         axle inside the window: a model that does not fit the bridge
  *         cannot explain the free vibration with any force history.
- *  3. λ from the runs: the regularisation that weighs the runs best, chosen
- *     on the runs left out (leave one run out).
+ *  3. λ: the design's, or (fit_lambda, or a design with λ auto) the
+ *     regularisation that weighs the runs best, chosen on the runs left out
+ *     (leave one run out).
  * The covariance of the fit (J^T J)^-1 scaled by the residual variance gives
  * each parameter's uncertainty; parameters whose correlation is above 0.98
  * trade against each other and the set is refused, naming them.
@@ -104,8 +105,12 @@ enum {
 typedef struct cm_options {
     int fit[CM_N_PARAMS];    /* 1: fitted, 0: held at the design's */
     double tail_s;           /* free vibration in the window, s (default 1.0) */
-    double search_rate_hz;   /* calculation rate during the search (default 2000) */
-    int max_search_runs;     /* runs used while searching (default 12, spread in speed) */
+    double search_rate_hz;   /* calculation rate of the search (0, the default:
+                                the site's calc_rate_hz; the bearing scan at
+                                2000 Hz at most) */
+    int max_search_runs;     /* runs used while searching (default 8, spread in speed) */
+    int fit_lambda;          /* 1: λ from the runs (leave one out); 0 (default): the
+                                design's (the runs' λ weighed traffic 0.3-0.6 % heavy) */
     int verbose;             /* progress on stderr */
 } cm_options;
 
@@ -116,6 +121,8 @@ typedef struct cm_eval {
     double gvw_err_pct[CM_MAX_RUNS]; /* 100 (GVW − known)/known */
     double axle_err_pct[CM_MAX_RUNS][AMFI_MAX_AXLES];
     double resid_rel[CM_MAX_RUNS];   /* residual RMS / signal RMS, with the tail */
+    double free_rel[CM_MAX_RUNS];    /* residual RMS over the free vibration only (a
+                                        stretch fixed on the file's clock) / signal RMS */
     double f1_hz;                    /* the model's first natural frequency */
     double mean_abs_gvw_pct, worst_gvw_pct, mean_gvw_pct, mean_resid_rel;
 } cm_eval;
@@ -131,6 +138,7 @@ typedef struct cm_result {
     double f1_meas_hz, f1_meas_sd_hz, zeta_meas, zeta_meas_sd;
     int n_modal;                /* records whose free vibration was fitted */
     double lambda_ref;          /* chosen λ at the site's lambda_ref_rate_hz */
+    int lambda_fitted;          /* 1: λ chosen from the runs; 0: the design's */
     amfi_site_config site;      /* the commissioned site */
     cm_eval before, after;      /* the design model and the commissioned one, all runs */
     double loo_gvw_err_pct[CM_MAX_RUNS]; /* leave one run out */

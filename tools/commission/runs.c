@@ -74,17 +74,63 @@ static void resolve(const char *runs_path, const char *file, char *out, size_t o
         snprintf(out, outlen, "%.*s/%s", (int)(slash - runs_path), runs_path, file);
 }
 
+static void add_id(char *list, size_t len, const char *prefix, int id)
+{
+    size_t used = strlen(list);
+    if (used < len)
+        snprintf(list + used, len - used, "%s%s%d", used ? ", " : "", prefix, id);
+}
+
+/* The column of each site sensor in a run file: 't,accel' is the sensor of
+ * a one-sensor site; otherwise every sensor needs its column 'accel_ID' and
+ * every column its sensor (as amfi-solve reads them). 0, or −1 with the
+ * problem in why. */
+static int map_channels(const amfi_site_config *site, const accel_csv *c, int *col, char *why,
+                        size_t whylen)
+{
+    const int ns = site->solver.n_sensors;
+    char ids[128] = "", missing[128] = "", unknown[160] = "";
+    for (int i = 0; i < ns; i++)
+        add_id(ids, sizeof ids, "", site->sensor_id[i]);
+    if (c->channel_id[0] < 0) { /* 't,accel' */
+        if (ns == 1) {
+            col[0] = 0;
+            return 0;
+        }
+        snprintf(why, whylen,
+                 "one column 't,accel', but the site has %d sensors (ids %s): give each its "
+                 "column, 't,accel_ID,...'",
+                 ns, ids);
+        return -1;
+    }
+    for (int k = 0; k < c->n_channels; k++) {
+        int i = 0;
+        while (i < ns && site->sensor_id[i] != c->channel_id[k])
+            i++;
+        if (i == ns)
+            add_id(unknown, sizeof unknown, "accel_", c->channel_id[k]);
+    }
+    for (int i = 0; i < ns; i++) {
+        int k = 0;
+        while (k < c->n_channels && c->channel_id[k] != site->sensor_id[i])
+            k++;
+        if (k == c->n_channels)
+            add_id(missing, sizeof missing, "", site->sensor_id[i]);
+        col[i] = k;
+    }
+    if (!missing[0] && !unknown[0])
+        return 0;
+    snprintf(why, whylen, "the site has sensors %s:%s%s%s%s%s", ids,
+             missing[0] ? " no column for sensor(s) " : "", missing,
+             missing[0] && unknown[0] ? ";" : "",
+             unknown[0] ? " column(s) of no sensor of the site: " : "", unknown);
+    return -1;
+}
+
 int cm_runs_read(const char *path, const amfi_site_config *site, cm_runs *out, char *err,
                  size_t errlen)
 {
     memset(out, 0, sizeof *out);
-    if (site->solver.n_sensors != 1) {
-        snprintf(err, errlen,
-                 "%s: the site has %d sensors; this version reads one-channel run files "
-                 "only (t,accel)",
-                 path, site->solver.n_sensors);
-        return -1;
-    }
     amfi_csv *r = amfi_csv_open(path, AMFI_CSV_MAX_LINE, err, errlen);
     if (!r)
         return -1;
@@ -182,10 +228,21 @@ int cm_runs_read(const char *path, const amfi_site_config *site, cm_runs *out, c
             amfi_csv_fail(r, ln, "file", "%s", aerr);
             goto fail;
         }
+        int col[AMFI_MAX_SENSORS];
+        if (map_channels(site, &c, col, aerr, sizeof aerr) != 0) {
+            accel_csv_free(&c);
+            amfi_csv_fail(r, ln, "file", "%s:1: %s", full, aerr);
+            goto fail;
+        }
         run->n_samples = c.n;
         run->rate_hz = c.rate_hz;
         run->t0_s = c.t0_s;
-        run->accel[0] = c.accel;
+        /* the site's sensors take their columns; the others are freed */
+        for (int i = 0; i < site->solver.n_sensors; i++) {
+            run->accel[i] = c.channel[col[i]];
+            c.channel[col[i]] = NULL;
+        }
+        accel_csv_free(&c);
         out->n++;
         amfi_passage_times w =
             amfi_passage_window(span, run->speed_mps, run->n_axles, run->spacing_m, PRE_S, POST_S);

@@ -41,7 +41,8 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: " PROG " --config DESIGN.yaml --runs RUNS.csv [--ambient FILE.csv ...]\n"
-            "                       --out SITE.yaml [--report DIR] [--hold NAME ...] [--verbose]\n"
+            "                       --out SITE.yaml [--report DIR] [--hold NAME ...] [--fit-lambda]\n"
+            "                       [--verbose]\n"
             "Commission a site's bridge model from calibration trucks of known axle loads and\n"
             "the bridge's free vibration (docs/commissioning.md).\n"
             "  --config FILE     the site file from the drawings (bridge, sensors, solver)\n"
@@ -53,6 +54,8 @@ static void usage(FILE *f)
             "  --report DIR      also write report.md, runs.csv and accuracy.csv there\n"
             "  --hold NAME       keep a parameter at the design's value: stiffness, mass,\n"
             "                    bearings, sensor, clock or speed (repeatable)\n"
+            "  --fit-lambda      choose lambda from the runs (leaving each out) instead of\n"
+            "                    keeping the design's\n"
             "  --verbose         the search's progress on stderr\n"
             "Exit 0 commissioned, 1 bad input or runs that cannot identify the model, 2 bad\n"
             "command line.\n");
@@ -251,8 +254,12 @@ static void put_header(text *t, const char *design, const char *runs_path, int n
         }
         put(t, "%s\n", isfinite(sd) ? "" : " (held at the design's)");
     }
-    put(t, "#   lambda %.3g (the runs' best, chosen leaving each run out in turn)\n",
-        r->lambda_ref);
+    if (r->lambda_fitted)
+        put(t, "#   lambda %.3g (the runs' best, chosen leaving each run out in turn)\n",
+            r->lambda_ref);
+    else
+        put(t, "#   lambda %.3g (the design's; --fit-lambda chooses it from the runs)\n",
+            r->lambda_ref);
     put(t, "# Fit quality: residual/signal with the free vibration %.4f (design %.4f);\n",
         r->after.mean_resid_rel, r->before.mean_resid_rel);
     put(t, "# calibration GVW error mean %+.2f %%, mean |.| %.2f %%, worst %+.2f %% "
@@ -418,6 +425,7 @@ int main(int argc, char **argv)
                                          {"report", required_argument, NULL, 256},
                                          {"hold", required_argument, NULL, 257},
                                          {"verbose", no_argument, NULL, 'v'},
+                                         {"fit-lambda", no_argument, NULL, 258},
                                          AMFI_CLI_END};
     amfi_cli cli;
     amfi_cli_init(&cli, PROG, argc, argv, opts, usage);
@@ -433,6 +441,7 @@ int main(int argc, char **argv)
         case 'o': out = optarg; break;
         case 'v': o.verbose = 1; break;
         case 256: report = optarg; break;
+        case 258: o.fit_lambda = 1; break;
         case 'a':
             if (n_amb == MAX_AMBIENT)
                 amfi_cli_fail(&cli, "at most %d records", MAX_AMBIENT);
