@@ -94,6 +94,9 @@ CREDENTIALS_DIRECTORY=$tmp/cred refused credential-mode \
 # a hex key is accepted (and the run then reads the in-memory bus until SIGTERM)
 name=hex-key
 od -An -tx1 -v "$tmp/k1" | tr -d ' \n' > "$tmp/khex" && echo >> "$tmp/khex" && chmod 600 "$tmp/khex"
+# the file is emptied here, not by the background job's redirection, which may
+# run after the first grep below and let it see the previous run's "running"
+: > "$tmp/err"
 "$amfid" -c "$config" -d "$tmp/h.db" -u memq:// --bus-key "$tmp/khex" 2> "$tmp/err" &
 hpid=$!
 i=0; until grep -q running "$tmp/err"; do
@@ -106,6 +109,7 @@ kill -TERM $hpid 2>/dev/null; wait $hpid || problem "amfid with a hex key exited
 name=auth-off
 sed "s/^    auth: required .*/    auth: off/" "$config" > "$tmp/off.yaml"
 grep -q "^    auth: off$" "$tmp/off.yaml" || problem "the test's daemon.bus.auth did not apply"
+: > "$tmp/err"
 "$amfid" -c "$tmp/off.yaml" -d "$tmp/o.db" -u memq:// 2> "$tmp/err" &
 opid=$!
 i=0; until grep -q running "$tmp/err"; do
