@@ -36,16 +36,16 @@
 
 /* The top level of a site file. */
 static const field top_fields[] = {
-    {.key = "site", .kind = &K_MAP, .aux = site_fields},
-    {.key = "bridge", .kind = &K_MAP, .aux = bridge_fields},
-    {.key = "sensors", .kind = &K_SENSORS, .aux = &sensors_list},
-    {.key = "solver", .kind = &K_MAP, .aux = solver_fields},
-    {.key = "daemon", .kind = &K_MAP, .aux = daemon_fields},
-    {.key = "simulation", .kind = &K_MAP, .aux = sim_fields},
-    {.key = "alerts", .kind = &K_MAP, .aux = alerts_fields},
-    {.key = "metrics", .kind = &K_MAP, .aux = metrics_fields},
-    {.key = "report", .kind = &K_MAP, .aux = report_fields},
-    {.key = "detector", .kind = &K_MAP, .aux = detector_fields},
+    {.key = "site", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_site_fields},
+    {.key = "bridge", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_bridge_fields},
+    {.key = "sensors", .kind = &amfi_cfg_k_sensors, .aux = &amfi_cfg_sensors_list},
+    {.key = "solver", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_solver_fields},
+    {.key = "daemon", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_daemon_fields},
+    {.key = "simulation", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_sim_fields},
+    {.key = "alerts", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_alerts_fields},
+    {.key = "metrics", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_metrics_fields},
+    {.key = "report", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_report_fields},
+    {.key = "detector", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_detector_fields},
     {.key = NULL}};
 
 /* Checks that involve several keys, once the whole file is read; each finds
@@ -56,10 +56,10 @@ static int check_site(ctx *x, void *base)
 {
     amfi_site_config *c = base;
 
-    if (bridge_check(x, c) || sensors_check(x, c) || solver_check(x, c) ||
-        daemon_check(x, c) || sim_check(x, c) || site_check(x, c) || ops_check(x, c))
+    if (amfi_cfg_bridge_check(x, c) || amfi_cfg_sensors_check(x, c) || amfi_cfg_solver_check(x, c) ||
+        amfi_cfg_daemon_check(x, c) || amfi_cfg_sim_check(x, c) || amfi_cfg_site_check(x, c) || amfi_cfg_ops_check(x, c))
         return -1;
-    return model_check(x, c);
+    return amfi_cfg_model_check(x, c);
 }
 
 void amfi_config_defaults(amfi_site_config *c)
@@ -213,7 +213,7 @@ int amfi_config_load(const char *path, amfi_site_config *c, char *err, size_t er
     x->err = err;
     x->errlen = errlen;
     amfi_config_defaults(&tmp);
-    rc = walk_file(x, top_fields, &tmp, check_site);
+    rc = amfi_cfg_walk_file(x, top_fields, &tmp, check_site);
     if (rc == 0)
         memcpy(c, &tmp, sizeof tmp);
     free(x);
@@ -240,5 +240,5 @@ int amfi_config_keys(int (*visit)(const amfi_config_key *k, void *arg), void *ar
     visit_arg va = {visit, arg};
 
     amfi_config_defaults(&d);
-    return describe_table(top_fields, "", &d, visit_one, &va);
+    return amfi_cfg_describe_table(top_fields, "", &d, visit_one, &va);
 }

@@ -22,7 +22,7 @@ static int p_name(ctx *x, yaml_node_t *v, const char *path, const field *f, void
     amfi_site_config *c = base;
 
     (void)f;
-    return get_name(x, v, path, c->name, sizeof c->name);
+    return amfi_cfg_get_name(x, v, path, c->name, sizeof c->name);
 }
 
 /* bridge.damping.modes: [a, b], two distinct 1-based mode numbers */
@@ -35,24 +35,24 @@ static int p_rayleigh_modes(ctx *x, yaml_node_t *v, const char *path, const fiel
 
     (void)f;
     if (v->type != YAML_SEQUENCE_NODE)
-        return fail(x, line_of(v), path, "expected a list of two mode numbers such "
-                    "as [1, 2], got %s", what(v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected a list of two mode numbers such "
+                    "as [1, 2], got %s", amfi_cfg_what(v));
     if (v->data.sequence.items.top - v->data.sequence.items.start != 2)
-        return fail(x, line_of(v), path, "expected two mode numbers, got %d",
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected two mode numbers, got %d",
                     (int)(v->data.sequence.items.top - v->data.sequence.items.start));
     for (int i = 0; i < 2; i++) {
         yaml_node_t *it = yaml_document_get_node(x->doc, v->data.sequence.items.start[i]);
-        join_index(ip, path, (size_t)i);
+        amfi_cfg_join_index(ip, path, (size_t)i);
         if (!it)
-            return fail(x, line_of(v), ip, "malformed list");
-        if (get_long(x, it, ip, &m[i]))
+            return amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
+        if (amfi_cfg_get_long(x, it, ip, &m[i]))
             return -1;
         if (m[i] < 1 || m[i] > MAX_MODE_NO)
-            return fail(x, line_of(it), ip, "must be a mode number 1 .. %d, got %ld",
+            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "must be a mode number 1 .. %d, got %ld",
                         MAX_MODE_NO, m[i]);
     }
     if (m[0] == m[1])
-        return fail(x, line_of(v), path, "the two modes must differ, got %ld twice",
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "the two modes must differ, got %ld twice",
                     m[0]);
     c->bridge.rayleigh_mode_a = (int)m[0];
     c->bridge.rayleigh_mode_b = (int)m[1];
@@ -107,13 +107,13 @@ static const enum_name support_types[] = {
     {"elastic", SUPPORT_ELASTIC}, {NULL, 0}};
 
 static const field support_fields[] = {
-    {.key = "at_m", .kind = &K_DOUBLE, .off = offsetof(support_item, at_m), .lo = 0,
+    {.key = "at_m", .kind = &amfi_cfg_k_double, .off = offsetof(support_item, at_m), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN | F_REQUIRED},
-    {.key = "type", .kind = &K_ENUM, .off = offsetof(support_item, type),
+    {.key = "type", .kind = &amfi_cfg_k_enum, .off = offsetof(support_item, type),
      .aux = support_types, .flags = F_REQUIRED},
-    {.key = "k_w_npm", .kind = &K_DOUBLE, .off = offsetof(support_item, k_w_npm), .lo = 0,
+    {.key = "k_w_npm", .kind = &amfi_cfg_k_double, .off = offsetof(support_item, k_w_npm), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN},
-    {.key = "k_theta_nmprad", .kind = &K_DOUBLE, .off = offsetof(support_item, k_theta_nmprad),
+    {.key = "k_theta_nmprad", .kind = &amfi_cfg_k_double, .off = offsetof(support_item, k_theta_nmprad),
      .lo = 0, .hi = HUGE_VAL, .flags = F_HI_OPEN},
     {.key = NULL}};
 
@@ -127,7 +127,7 @@ static int p_supports(ctx *x, yaml_node_t *v, const char *path, const field *f,
     int n = 0;
 
     (void)f;
-    items = list_items(x, v, path, "supports", AMFI_MAX_SUPPORTS, &n);
+    items = amfi_cfg_list_items(x, v, path, "supports", AMFI_MAX_SUPPORTS, &n);
     if (!items)
         return -1;
     memset(s, 0, sizeof s);
@@ -135,22 +135,22 @@ static int p_supports(ctx *x, yaml_node_t *v, const char *path, const field *f,
         yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
         support_item si = {0.0, SUPPORT_PINNED, 0.0, 0.0};
 
-        join_index(ip, path, (size_t)i);
+        amfi_cfg_join_index(ip, path, (size_t)i);
         if (!it)
-            return fail(x, line_of(v), ip, "malformed list");
-        note_line(x, ip, line_of(it));
-        if (walk_map(x, it, ip, support_fields, &si))
+            return amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
+        amfi_cfg_note_line(x, ip, amfi_cfg_line_of(it));
+        if (amfi_cfg_walk_map(x, it, ip, support_fields, &si))
             return -1;
         if (si.type == SUPPORT_ELASTIC && !(si.k_w_npm > 0))
-            return fail(x, line_of(it), ip, "an elastic support needs k_w_npm > 0 "
+            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "an elastic support needs k_w_npm > 0 "
                         "(its vertical stiffness, N/m)");
         if (si.type != SUPPORT_ELASTIC && si.k_w_npm > 0)
-            return fail(x, line_of(it), ip, "k_w_npm is the spring of an elastic support; "
+            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "k_w_npm is the spring of an elastic support; "
                         "a %s support holds the vertical displacement",
                         si.type == SUPPORT_FIXED ? "fixed" : si.type == SUPPORT_ROLLER ? "roller"
                                                                                    : "pinned");
         if (si.type == SUPPORT_FIXED && si.k_theta_nmprad > 0)
-            return fail(x, line_of(it), ip, "a fixed support holds the rotation: no "
+            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "a fixed support holds the rotation: no "
                         "k_theta_nmprad (use pinned with k_theta_nmprad for a partly "
                         "fixed bearing)");
         s[i].x_m = si.at_m;
@@ -184,13 +184,13 @@ static const kind K_SUPPORTS = {"list", p_supports, d_supports, v_supports, NEST
 
 /* bridge.segments: a list of {from_m, to_m, EI_nm2, mass_kgpm} */
 static const field segment_fields[] = {
-    {.key = "from_m", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, x0_m), .lo = 0,
+    {.key = "from_m", .kind = &amfi_cfg_k_double, .off = offsetof(amfi_segment, x0_m), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN | F_REQUIRED},
-    {.key = "to_m", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, x1_m), .lo = 0,
+    {.key = "to_m", .kind = &amfi_cfg_k_double, .off = offsetof(amfi_segment, x1_m), .lo = 0,
      .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN | F_REQUIRED},
-    {.key = "EI_nm2", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, EI_nm2), .lo = 0,
+    {.key = "EI_nm2", .kind = &amfi_cfg_k_double, .off = offsetof(amfi_segment, EI_nm2), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN},
-    {.key = "mass_kgpm", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, mass_kgpm), .lo = 0,
+    {.key = "mass_kgpm", .kind = &amfi_cfg_k_double, .off = offsetof(amfi_segment, mass_kgpm), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN},
     {.key = NULL}};
 
@@ -203,24 +203,24 @@ static int p_segments(ctx *x, yaml_node_t *v, const char *path, const field *f, 
     int n = 0;
 
     (void)f;
-    items = list_items(x, v, path, "segments", AMFI_MAX_SEGMENTS, &n);
+    items = amfi_cfg_list_items(x, v, path, "segments", AMFI_MAX_SEGMENTS, &n);
     if (!items)
         return -1;
     memset(g, 0, sizeof g);
     for (int i = 0; i < n; i++) {
         yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
 
-        join_index(ip, path, (size_t)i);
+        amfi_cfg_join_index(ip, path, (size_t)i);
         if (!it)
-            return fail(x, line_of(v), ip, "malformed list");
-        note_line(x, ip, line_of(it));
-        if (walk_map(x, it, ip, segment_fields, &g[i]))
+            return amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
+        amfi_cfg_note_line(x, ip, amfi_cfg_line_of(it));
+        if (amfi_cfg_walk_map(x, it, ip, segment_fields, &g[i]))
             return -1;
         if (!(g[i].x1_m > g[i].x0_m))
-            return fail(x, line_of(it), ip, "to_m (%g) must be beyond from_m (%g)", g[i].x1_m,
+            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "to_m (%g) must be beyond from_m (%g)", g[i].x1_m,
                         g[i].x0_m);
         if (g[i].EI_nm2 == 0 && g[i].mass_kgpm == 0)
-            return fail(x, line_of(it), ip, "gives neither EI_nm2 nor mass_kgpm");
+            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "gives neither EI_nm2 nor mass_kgpm");
     }
     memcpy(b->segments, g, sizeof g);
     b->n_segments = n;
@@ -246,33 +246,33 @@ static const list_schema segment_list = {segment_fields, &segment_default};
 static const kind K_SEGMENTS = {"list", p_segments, d_segments, v_segments, NEST_LIST};
 
 static const field damping_fields[] = {
-    {.key = "ratio", .kind = &K_DOUBLE, .off = SC(bridge.damping_ratio), .lo = 0,
+    {.key = "ratio", .kind = &amfi_cfg_k_double, .off = SC(bridge.damping_ratio), .lo = 0,
      .hi = 1, .flags = F_HI_OPEN},
     {.key = "modes", .kind = &K_RAYLEIGH},
     {.key = NULL}};
 
-const field bridge_fields[] = {
+const field amfi_cfg_bridge_fields[] = {
     {.key = "name", .kind = &K_NAME},
-    {.key = "span_m", .kind = &K_DOUBLE, .off = SC(bridge.span_m), .lo = 0,
+    {.key = "span_m", .kind = &amfi_cfg_k_double, .off = SC(bridge.span_m), .lo = 0,
      .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "elements", .kind = &K_INT, .off = SC(bridge.n_elements), .lo = 1,
+    {.key = "elements", .kind = &amfi_cfg_k_int, .off = SC(bridge.n_elements), .lo = 1,
      .hi = 1000},
-    {.key = "E_pa", .kind = &K_DOUBLE, .off = SC(bridge.E_pa), .lo = 0, .hi = HUGE_VAL,
+    {.key = "E_pa", .kind = &amfi_cfg_k_double, .off = SC(bridge.E_pa), .lo = 0, .hi = HUGE_VAL,
      .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "A_m2", .kind = &K_DOUBLE, .off = SC(bridge.A_m2), .lo = 0, .hi = HUGE_VAL,
+    {.key = "A_m2", .kind = &amfi_cfg_k_double, .off = SC(bridge.A_m2), .lo = 0, .hi = HUGE_VAL,
      .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "I_m4", .kind = &K_DOUBLE, .off = SC(bridge.I_m4), .lo = 0, .hi = HUGE_VAL,
+    {.key = "I_m4", .kind = &amfi_cfg_k_double, .off = SC(bridge.I_m4), .lo = 0, .hi = HUGE_VAL,
      .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "density_kgm3", .kind = &K_DOUBLE, .off = SC(bridge.density_kgm3), .lo = 0,
+    {.key = "density_kgm3", .kind = &amfi_cfg_k_double, .off = SC(bridge.density_kgm3), .lo = 0,
      .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "damping", .kind = &K_MAP, .aux = damping_fields},
+    {.key = "damping", .kind = &amfi_cfg_k_map, .aux = damping_fields},
     {.key = "supports", .kind = &K_SUPPORTS, .aux = &support_list},
     {.key = "segments", .kind = &K_SEGMENTS, .aux = &segment_list},
-    {.key = "damage", .kind = &K_DOUBLE, .off = SC(bridge.damage), .lo = 0, .hi = 1,
+    {.key = "damage", .kind = &amfi_cfg_k_double, .off = SC(bridge.damage), .lo = 0, .hi = 1,
      .flags = F_HI_OPEN},
     {.key = NULL}};
 
-int bridge_free_dofs(const amfi_bridge_params *b)
+int amfi_cfg_bridge_free_dofs(const amfi_bridge_params *b)
 {
     int restrained = 0;
 
@@ -282,54 +282,54 @@ int bridge_free_dofs(const amfi_bridge_params *b)
 }
 
 /* Without `supports` in the file, the roller follows bridge.span_m. */
-int bridge_check(ctx *x, amfi_site_config *c)
+int amfi_cfg_bridge_check(ctx *x, amfi_site_config *c)
 {
     amfi_bridge_params *b = &c->bridge;
     int node[AMFI_MAX_SUPPORTS];
     int ndof;
     char p[PATH_LEN];
 
-    if (!noted(x, "bridge.supports"))
+    if (!amfi_cfg_noted(x, "bridge.supports"))
         b->supports[b->n_supports - 1].x_m = b->span_m;
 
     /* Supports: on the beam, one per node, and the beam not a mechanism. */
     for (int i = 0; i < b->n_supports; i++) {
-        pathf(p, "bridge.supports[%d].at_m", i);
+        amfi_cfg_pathf(p, "bridge.supports[%d].at_m", i);
         if (b->supports[i].x_m > b->span_m)
-            return fail(x, first_noted(x, p, "bridge.span_m", NULL), p,
+            return amfi_cfg_fail(x, amfi_cfg_first_noted(x, p, "bridge.span_m", NULL), p,
                         "%g m is beyond the span (bridge.span_m = %g m)",
                         b->supports[i].x_m, b->span_m);
         node[i] = (int)lround(b->supports[i].x_m / b->span_m * b->n_elements);
         for (int j = 0; j < i; j++)
             if (node[j] == node[i])
-                return fail(x, first_noted(x, p, "bridge.elements", NULL), p,
+                return amfi_cfg_fail(x, amfi_cfg_first_noted(x, p, "bridge.elements", NULL), p,
                             "falls on node %d (of %d elements), like "
                             "bridge.supports[%d]", node[i], b->n_elements, j);
     }
     if (b->n_supports == 1 && !b->supports[0].restrain_theta &&
         !(b->supports[0].k_theta_nmprad > 0))
-        return fail(x, noted(x, "bridge.supports"), "bridge.supports",
+        return amfi_cfg_fail(x, amfi_cfg_noted(x, "bridge.supports"), "bridge.supports",
                     "a single support without a held or sprung rotation leaves the beam "
                     "free to rotate; make it fixed or add a support");
 
     /* Segments: on the beam, apart. */
     for (int i = 0; i < b->n_segments; i++) {
-        pathf(p, "bridge.segments[%d]", i);
+        amfi_cfg_pathf(p, "bridge.segments[%d]", i);
         if (b->segments[i].x1_m > b->span_m)
-            return fail(x, first_noted(x, p, "bridge.span_m", NULL), p,
+            return amfi_cfg_fail(x, amfi_cfg_first_noted(x, p, "bridge.span_m", NULL), p,
                         "to_m %g m is beyond the span (bridge.span_m = %g m)",
                         b->segments[i].x1_m, b->span_m);
         for (int j = 0; j < i; j++)
             if (b->segments[i].x0_m < b->segments[j].x1_m &&
                 b->segments[j].x0_m < b->segments[i].x1_m)
-                return fail(x, noted(x, p), p, "overlaps bridge.segments[%d] ([%g, %g) m)", j,
+                return amfi_cfg_fail(x, amfi_cfg_noted(x, p), p, "overlaps bridge.segments[%d] ([%g, %g) m)", j,
                             b->segments[j].x0_m, b->segments[j].x1_m);
     }
 
     /* Mode numbers within the model's free DOFs. */
-    ndof = bridge_free_dofs(b);
+    ndof = amfi_cfg_bridge_free_dofs(b);
     if (b->rayleigh_mode_a > ndof || b->rayleigh_mode_b > ndof)
-        return fail(x, first_noted(x, "bridge.damping.modes", "bridge.elements", NULL),
+        return amfi_cfg_fail(x, amfi_cfg_first_noted(x, "bridge.damping.modes", "bridge.elements", NULL),
                     "bridge.damping.modes", "the model has only %d modes (free DOFs)",
                     ndof);
     return 0;

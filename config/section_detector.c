@@ -11,7 +11,7 @@
 
 #define DET(m) offsetof(amfi_site_config, detector.m)
 
-const field detector_fields[] = {
-    {.key = "clock_offset_s", .kind = &K_DOUBLE, .off = DET(clock_offset_s), .lo = -1, .hi = 1},
-    {.key = "speed_scale", .kind = &K_DOUBLE, .off = DET(speed_scale), .lo = 0.5, .hi = 2},
+const field amfi_cfg_detector_fields[] = {
+    {.key = "clock_offset_s", .kind = &amfi_cfg_k_double, .off = DET(clock_offset_s), .lo = -1, .hi = 1},
+    {.key = "speed_scale", .kind = &amfi_cfg_k_double, .off = DET(speed_scale), .lo = 0.5, .hi = 2},
     {.key = NULL}};

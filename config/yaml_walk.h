@@ -48,7 +48,7 @@ typedef struct ctx {
 typedef struct field field;
 
 /* Parse value node v of key path `path` into base (the struct the row's
- * offsets are relative to). 0 ok, −1 after fail(). */
+ * offsets are relative to). 0 ok, −1 after amfi_cfg_fail(). */
 typedef int (*parse_fn)(ctx *x, yaml_node_t *v, const char *path, const field *f,
                         void *base);
 
@@ -78,16 +78,16 @@ typedef struct list_schema {
 #define F_LO_OPEN 1u  /* lo itself is not allowed */
 #define F_HI_OPEN 2u  /* hi itself is not allowed */
 #define F_REQUIRED 4u /* the key must be present (list items) */
-#define F_FILE_DIR 8u /* K_PATH: a relative path is joined to the file's folder */
+#define F_FILE_DIR 8u /* amfi_cfg_k_path: a relative path is joined to the file's folder */
 
 struct field {
     const char *key;   /* NULL ends a table */
     const kind *kind;
     size_t off;        /* destination, bytes from base */
-    double lo, hi;     /* K_DOUBLE, K_INT, ...: allowed range (HUGE_VAL: none);
-                          K_STRING, K_PATH: lo minimum length, hi capacity */
+    double lo, hi;     /* amfi_cfg_k_double, amfi_cfg_k_int, ...: allowed range (HUGE_VAL: none);
+                          amfi_cfg_k_string, amfi_cfg_k_path: lo minimum length, hi capacity */
     unsigned flags;    /* F_* */
-    const void *aux;   /* K_MAP and lists: const field[]; K_ENUM: const enum_name[] */
+    const void *aux;   /* amfi_cfg_k_map and lists: const field[]; amfi_cfg_k_enum: const enum_name[] */
 };
 
 typedef struct enum_name {
@@ -99,35 +99,35 @@ typedef struct enum_name {
 
 /* Write "FILE[:LINE]: [path: ]message" into the caller's buffer; returns −1.
  * line <= 0 omits the line, an empty path omits the path. */
-int fail(ctx *x, int line, const char *path, const char *fmt, ...)
+int amfi_cfg_fail(ctx *x, int line, const char *path, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
-int line_of(const yaml_node_t *n);
-const char *show(char *buf, size_t len, const yaml_node_t *v); /* a value, sanitised */
-const char *what(const yaml_node_t *v); /* "a mapping", "a list", ... */
-size_t advance(size_t used, int n, size_t len); /* snprintf bookkeeping */
+int amfi_cfg_line_of(const yaml_node_t *n);
+const char *amfi_cfg_show(char *buf, size_t len, const yaml_node_t *v); /* a value, sanitised */
+const char *amfi_cfg_what(const yaml_node_t *v); /* "a mapping", "a list", ... */
+size_t amfi_cfg_advance(size_t used, int n, size_t len); /* snprintf bookkeeping */
 /* Append ", name" (or "name" at used = 0) to buf[len]; the new length. */
-size_t append_name(char *buf, size_t len, size_t used, const char *name);
-void pathf(char *out, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-void join_index(char *out, const char *path, size_t i);
-void note_line(ctx *x, const char *path, int line);
-int noted(const ctx *x, const char *path); /* line of key path, 0: not given */
+size_t amfi_cfg_append_name(char *buf, size_t len, size_t used, const char *name);
+void amfi_cfg_pathf(char *out, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+void amfi_cfg_join_index(char *out, const char *path, size_t i);
+void amfi_cfg_note_line(ctx *x, const char *path, int line);
+int amfi_cfg_noted(const ctx *x, const char *path); /* line of key path, 0: not given */
 /* The line of the first of a, b, c (b and c may be NULL) given in the file. */
-int first_noted(const ctx *x, const char *a, const char *b, const char *c);
+int amfi_cfg_first_noted(const ctx *x, const char *a, const char *b, const char *c);
 /* The latest line of any key given under `prefix` ("daemon.indicators."). */
-int noted_under(const ctx *x, const char *prefix);
+int amfi_cfg_noted_under(const ctx *x, const char *prefix);
 
 /* Parse mapping m (key path `path`, "" at the top) with `table` into base:
  * type check, unknown, duplicate and required keys, then each row's kind. */
-int walk_map(ctx *x, yaml_node_t *m, const char *path, const field *table, void *base);
+int amfi_cfg_walk_map(ctx *x, yaml_node_t *m, const char *path, const field *table, void *base);
 
-/* The items of list node v, checked to be 1 .. max long; NULL after fail(). */
-yaml_node_item_t *list_items(ctx *x, yaml_node_t *v, const char *path,
+/* The items of list node v, checked to be 1 .. max long; NULL after amfi_cfg_fail(). */
+yaml_node_item_t *amfi_cfg_list_items(ctx *x, yaml_node_t *v, const char *path,
                              const char *what_items, int max, int *n);
 
 /* Read `path` (at most 1 MiB, a single YAML document nested at most 16
  * deep), walk its root with `top` into base in the C numeric locale, then
- * run check(x, base) if not NULL. 0 ok, −1 after fail(). */
-int walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *base));
+ * run check(x, base) if not NULL. 0 ok, −1 after amfi_cfg_fail(). */
+int amfi_cfg_walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *base));
 
 /* Call visit once per key of `table` and of the tables under it, depth
  * first, in table order, with the key's path ("solver.lcurve.lo", list
@@ -136,44 +136,44 @@ int walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *b
  * non-zero value of visit. */
 typedef int (*key_visit)(const char *path, const char *type, const char *range,
                          const char *dflt, int required, void *arg);
-int describe_table(const field *table, const char *prefix, const void *base,
+int amfi_cfg_describe_table(const field *table, const char *prefix, const void *base,
                    key_visit visit, void *arg);
 
 /* ---- scalars and kinds (yaml_scalar.c) ---- */
 
-int is_plain(const yaml_node_t *v);
-int is_null_node(const yaml_node_t *v); /* `key:`, `~`, `null` */
+int amfi_cfg_is_plain(const yaml_node_t *v);
+int amfi_cfg_is_null_node(const yaml_node_t *v); /* `key:`, `~`, `null` */
 /* The text of scalar node v, or NULL after an error saying what was `want`ed.
  * Numbers must be plain (unquoted) scalars: allow_quoted = 0. */
-const char *scalar(ctx *x, const yaml_node_t *v, const char *path, const char *want,
+const char *amfi_cfg_scalar(ctx *x, const yaml_node_t *v, const char *path, const char *want,
                    int allow_quoted);
 /* Strict decimal parsers: 0 ok, −1 not a number, −2 out of range. */
-int to_double(const char *s, double *out);
-int to_llong(const char *s, long long *out);
-int to_long(const char *s, long *out);
-int get_double(ctx *x, const yaml_node_t *v, const char *path, double *out);
+int amfi_cfg_to_double(const char *s, double *out);
+int amfi_cfg_to_llong(const char *s, long long *out);
+int amfi_cfg_to_long(const char *s, long *out);
+int amfi_cfg_get_double(ctx *x, const yaml_node_t *v, const char *path, double *out);
 /* A name (quoted or not) of 1 .. cap − 1 bytes without control characters
- * into dst[cap] (zero-filled); 0, or −1 after fail(). */
-int get_name(ctx *x, const yaml_node_t *v, const char *path, char *dst, size_t cap);
-int get_long(ctx *x, const yaml_node_t *v, const char *path, long *out);
-/* A plain number in scalar v (already checked by scalar()), else "expected
- * `want`" or "number out of range"; 0 or −1 after fail(). */
-int get_number(ctx *x, const yaml_node_t *v, const char *path, const char *want,
+ * into dst[cap] (zero-filled); 0, or −1 after amfi_cfg_fail(). */
+int amfi_cfg_get_name(ctx *x, const yaml_node_t *v, const char *path, char *dst, size_t cap);
+int amfi_cfg_get_long(ctx *x, const yaml_node_t *v, const char *path, long *out);
+/* A plain number in scalar v (already checked by amfi_cfg_scalar()), else "expected
+ * `want`" or "number out of range"; 0 or −1 after amfi_cfg_fail(). */
+int amfi_cfg_get_number(ctx *x, const yaml_node_t *v, const char *path, const char *want,
                double *out);
-int out_of_range(double d, const field *f);
-int range_fail(ctx *x, const yaml_node_t *v, const char *path, const field *f, double d);
+int amfi_cfg_out_of_range(double d, const field *f);
+int amfi_cfg_range_fail(ctx *x, const yaml_node_t *v, const char *path, const field *f, double d);
 /* Row f's [lo, hi] as the messages write it: "[0, 1)", "> 0", "1 .. 64". */
-void describe_interval(const field *f, char *buf);
-void describe_count(const field *f, char *buf);
-void describe_names(const enum_name *names, char *buf); /* "a | b | c" */
-const char *enum_label(const enum_name *names, int value); /* NULL: not listed */
+void amfi_cfg_describe_interval(const field *f, char *buf);
+void amfi_cfg_describe_count(const field *f, char *buf);
+void amfi_cfg_describe_names(const enum_name *names, char *buf); /* "a | b | c" */
+const char *amfi_cfg_enum_label(const enum_name *names, int value); /* NULL: not listed */
 
-extern const kind K_DOUBLE; /* double at off, in [lo, hi] (F_*_OPEN) */
-extern const kind K_INT;    /* int at off, lo .. hi */
-extern const kind K_LLONG;  /* long long at off, lo .. hi */
-extern const kind K_ENUM;   /* int at off, one of aux's names */
-extern const kind K_STRING; /* char[hi] at off, printable, lo .. hi − 1 bytes */
-extern const kind K_PATH;   /* char[hi] at off; "" or null: none */
-extern const kind K_MAP;    /* a mapping walked with aux's table */
+extern const kind amfi_cfg_k_double; /* double at off, in [lo, hi] (F_*_OPEN) */
+extern const kind amfi_cfg_k_int;    /* int at off, lo .. hi */
+extern const kind amfi_cfg_k_llong;  /* long long at off, lo .. hi */
+extern const kind amfi_cfg_k_enum;   /* int at off, one of aux's names */
+extern const kind amfi_cfg_k_string; /* char[hi] at off, printable, lo .. hi − 1 bytes */
+extern const kind amfi_cfg_k_path;   /* char[hi] at off; "" or null: none */
+extern const kind amfi_cfg_k_map;    /* a mapping walked with aux's table */
 
 #endif /* AMFI_YAML_WALK_H */
