@@ -90,8 +90,15 @@ static void v_ab_sensors(const field *f, const void *base, char *buf)
 
 static const ab_sensor ab_sensor_default = {0, NAN, NAN};
 static const list_schema ab_sensor_list = {ab_sensor_fields, &ab_sensor_default};
+static int s_ab_sensors(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){AB(sensor_x_m), sizeof(((amfi_as_built *)0)->sensor_x_m)};
+    return 1;
+}
+
 static const kind K_AB_SENSORS = {"list", p_ab_sensors, d_ab_sensors, v_ab_sensors,
-                                  NEST_LIST};
+                                  NEST_LIST, s_ab_sensors};
 
 /* The names, meanings and ranges of the site file's detector: section
  * (what a commissioning finds), here the truth it should find. */

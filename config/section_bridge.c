@@ -88,9 +88,24 @@ static void v_modes_pair(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "[%d, %d]", b->rayleigh_mode_a, b->rayleigh_mode_b);
 }
 
-static const kind K_NAME = {"string", p_name, d_name, v_name, NEST_NONE};
+static int s_name(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(name), sizeof(((amfi_site_config *)0)->name)};
+    return 1;
+}
+
+static int s_modes_pair(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(bridge.rayleigh_mode_a), sizeof(int)};
+    out[1] = (span){SC(bridge.rayleigh_mode_b), sizeof(int)};
+    return 2;
+}
+
+static const kind K_NAME = {"string", p_name, d_name, v_name, NEST_NONE, s_name};
 static const kind K_RAYLEIGH = {"list", p_rayleigh_modes, d_modes_pair, v_modes_pair,
-                                NEST_NONE};
+                                NEST_NONE, s_modes_pair};
 
 /* bridge.supports: a list of {at_m, type, k_w_npm, k_theta_nmprad} */
 typedef struct support_item {
@@ -180,7 +195,16 @@ static void v_supports(const field *f, const void *base, char *buf)
 
 static const support_item support_default = {0.0, SUPPORT_PINNED, 0.0, 0.0};
 static const list_schema support_list = {support_fields, &support_default};
-static const kind K_SUPPORTS = {"list", p_supports, d_supports, v_supports, NEST_LIST};
+static int s_supports(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(bridge.supports), sizeof(((amfi_bridge_params *)0)->supports)};
+    out[1] = (span){SC(bridge.n_supports), sizeof(int)};
+    return 2;
+}
+
+static const kind K_SUPPORTS = {"list", p_supports, d_supports, v_supports, NEST_LIST,
+                                s_supports};
 
 /* bridge.segments: a list of {from_m, to_m, EI_nm2, mass_kgpm} */
 static const field segment_fields[] = {
@@ -243,7 +267,16 @@ static void v_segments(const field *f, const void *base, char *buf)
 
 static const amfi_segment segment_default = {0.0, 0.0, 0.0, 0.0};
 static const list_schema segment_list = {segment_fields, &segment_default};
-static const kind K_SEGMENTS = {"list", p_segments, d_segments, v_segments, NEST_LIST};
+static int s_segments(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(bridge.segments), sizeof(((amfi_bridge_params *)0)->segments)};
+    out[1] = (span){SC(bridge.n_segments), sizeof(int)};
+    return 2;
+}
+
+static const kind K_SEGMENTS = {"list", p_segments, d_segments, v_segments, NEST_LIST,
+                                s_segments};
 
 static const field damping_fields[] = {
     {.key = "ratio", .kind = &amfi_cfg_k_double, .off = SC(bridge.damping_ratio), .lo = 0,

@@ -15,15 +15,16 @@
 #include <string.h>
 
 #define DC(m) offsetof(amfi_site_config, daemon.m)
-#define STR(k, m, minlen) \
+#define STRF(k, m, minlen, fl) \
     {.key = k, .kind = &amfi_cfg_k_string, .off = DC(m), .lo = minlen, \
-     .hi = sizeof(((amfi_daemon_config *)0)->m)}
+     .hi = sizeof(((amfi_daemon_config *)0)->m), .flags = fl}
+#define STR(k, m, minlen) STRF(k, m, minlen, 0)
 
 static const field channel_fields[] = {
     STR("accel", ch_accel, 1),     STR("vehicle", ch_vehicle, 1),
-    STR("truth", ch_truth, 1),     STR("passage", ch_passage, 1),
-    STR("indicator", ch_indicator, 1), STR("alert", ch_alert, 1),
-    STR("status", ch_status, 1),   STR("environment", ch_environment, 1),
+    STR("truth", ch_truth, 1),     STRF("passage", ch_passage, 1, F_LIVE),
+    STRF("indicator", ch_indicator, 1, F_LIVE), STRF("alert", ch_alert, 1, F_LIVE),
+    STRF("status", ch_status, 1, F_LIVE),   STR("environment", ch_environment, 1),
     {.key = NULL}};
 
 static const enum_name auth_names[] = {{"off", 0}, {"required", 1}, {NULL, 0}};
@@ -97,28 +98,28 @@ static const field natfreq_fields[] = {
 
 static const field intake_fields[] = {
     {.key = "vehicle_ahead_s", .kind = &amfi_cfg_k_double, .off = DC(vehicle_ahead_s), .lo = 1,
-     .hi = 3600},
+     .hi = 3600, .flags = F_LIVE},
     {.key = "min_speed_mps", .kind = &amfi_cfg_k_double, .off = DC(min_speed_mps), .lo = 1, .hi = 60,
-     .flags = F_HI_OPEN},
-    {.key = "max_length_m", .kind = &amfi_cfg_k_double, .off = DC(max_length_m), .lo = 1, .hi = 360},
-    {.key = "accel_margin", .kind = &amfi_cfg_k_double, .off = DC(accel_margin), .lo = 1, .hi = 1000},
+     .flags = F_HI_OPEN | F_LIVE},
+    {.key = "max_length_m", .kind = &amfi_cfg_k_double, .off = DC(max_length_m), .lo = 1, .hi = 360, .flags = F_LIVE},
+    {.key = "accel_margin", .kind = &amfi_cfg_k_double, .off = DC(accel_margin), .lo = 1, .hi = 1000, .flags = F_LIVE},
     {.key = "vehicles_per_s", .kind = &amfi_cfg_k_double, .off = DC(vehicles_per_s), .lo = 0.1,
-     .hi = 1e5},
+     .hi = 1e5, .flags = F_LIVE},
     {.key = "environment_per_s", .kind = &amfi_cfg_k_double, .off = DC(environment_per_s), .lo = 0.1,
-     .hi = 1e5},
-    {.key = "truth_per_s", .kind = &amfi_cfg_k_double, .off = DC(truth_per_s), .lo = 0.1, .hi = 1e5},
-    {.key = "burst_s", .kind = &amfi_cfg_k_double, .off = DC(burst_s), .lo = 1, .hi = 3600},
+     .hi = 1e5, .flags = F_LIVE},
+    {.key = "truth_per_s", .kind = &amfi_cfg_k_double, .off = DC(truth_per_s), .lo = 0.1, .hi = 1e5, .flags = F_LIVE},
+    {.key = "burst_s", .kind = &amfi_cfg_k_double, .off = DC(burst_s), .lo = 1, .hi = 3600, .flags = F_LIVE},
     {.key = "summary_period_s", .kind = &amfi_cfg_k_double, .off = DC(summary_period_s), .lo = 1,
-     .hi = 86400},
+     .hi = 86400, .flags = F_LIVE},
     {.key = "environment_min_interval_s", .kind = &amfi_cfg_k_double, .off = DC(env_min_interval_s),
-     .lo = 0, .hi = 86400},
+     .lo = 0, .hi = 86400, .flags = F_LIVE},
     {.key = "deck_max_rate_c_per_min", .kind = &amfi_cfg_k_double, .off = DC(deck_max_rate_c_min),
-     .lo = 0, .hi = 1e6, .flags = F_LO_OPEN},
-    STR("calibration_sources", calibration_sources, 0),
+     .lo = 0, .hi = 1e6, .flags = F_LO_OPEN | F_LIVE},
+    STRF("calibration_sources", calibration_sources, 0, F_LIVE),
     {.key = "calibration_min_kg", .kind = &amfi_cfg_k_double, .off = DC(calibration_min_kg),
-     .lo = 1000, .hi = 100000},
+     .lo = 1000, .hi = 100000, .flags = F_LIVE},
     {.key = "calibration_max_kg", .kind = &amfi_cfg_k_double, .off = DC(calibration_max_kg),
-     .lo = 1000, .hi = 100000},
+     .lo = 1000, .hi = 100000, .flags = F_LIVE},
     {.key = NULL}};
 
 const field amfi_cfg_daemon_fields[] = {
@@ -134,10 +135,10 @@ const field amfi_cfg_daemon_fields[] = {
     {.key = "bus_queue", .kind = &amfi_cfg_k_int, .off = DC(bus_queue), .lo = 30, .hi = 1000000},
     {.key = "ring_s", .kind = &amfi_cfg_k_double, .off = DC(ring_s), .lo = 5, .hi = 3600},
     {.key = "environment_max_skew_s", .kind = &amfi_cfg_k_double, .off = DC(environment_max_skew_s),
-     .lo = 1, .hi = 864000},
+     .lo = 1, .hi = 864000, .flags = F_LIVE},
     {.key = "window_margin_s", .kind = &amfi_cfg_k_double, .off = DC(margin_s), .lo = 0, .hi = 5},
     {.key = "max_wait_s", .kind = &amfi_cfg_k_double, .off = DC(max_wait_s), .lo = 0, .hi = 3600,
-     .flags = F_LO_OPEN},
+     .flags = F_LO_OPEN | F_LIVE},
     {.key = "max_event_s", .kind = &amfi_cfg_k_double, .off = DC(max_event_s), .lo = 0, .hi = 600},
     {.key = "max_event_axles", .kind = &amfi_cfg_k_int, .off = DC(max_event_axles), .lo = 2,
      .hi = AMFI_MAX_AXLES},
@@ -150,7 +151,7 @@ const field amfi_cfg_daemon_fields[] = {
     {.key = "inseparable_quality_lanes", .kind = &amfi_cfg_k_double,
      .off = DC(inseparable_quality_lanes), .lo = 1, .hi = 1e9},
     {.key = "status_period_s", .kind = &amfi_cfg_k_double, .off = DC(status_period_s), .lo = 0.1,
-     .hi = 3600},
+     .hi = 3600, .flags = F_LIVE},
     {.key = "indicators", .kind = &amfi_cfg_k_map, .aux = indicator_fields},
     {.key = "natural_frequency", .kind = &amfi_cfg_k_map, .aux = natfreq_fields},
     {.key = "intake", .kind = &amfi_cfg_k_map, .aux = intake_fields},

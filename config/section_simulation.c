@@ -196,10 +196,24 @@ static void v_gap(const field *f, const void *base, char *buf)
         snprintf(buf, DOC_LEN, "[%g, %g]", m->gap_lo_s, m->gap_hi_s);
 }
 
-static const kind K_SPEEDUP = {"name or number", p_speedup, d_speedup, v_speedup, NEST_NONE};
-static const kind K_HEADWAY = {"number", p_headway, d_headway, v_double, NEST_NONE};
-static const kind K_STEP = {"name or integer", p_step, d_step, v_step, NEST_NONE};
-static const kind K_GAP = {"number or list", p_gap, d_gap, v_gap, NEST_NONE};
+static int s_gap(const field *f, span *out)
+{
+    const amfi_sim_config *m = NULL;
+
+    (void)f;
+    out[0] = (span){SC(sim.preceding), sizeof m->preceding};
+    out[1] = (span){SC(sim.gap_lo_s), sizeof m->gap_lo_s};
+    out[2] = (span){SC(sim.gap_hi_s), sizeof m->gap_hi_s};
+    return 3;
+}
+
+static const kind K_SPEEDUP = {"name or number", p_speedup, d_speedup, v_speedup, NEST_NONE,
+                               amfi_cfg_spans_double};
+static const kind K_HEADWAY = {"number", p_headway, d_headway, v_double, NEST_NONE,
+                               amfi_cfg_spans_double};
+static const kind K_STEP = {"name or integer", p_step, d_step, v_step, NEST_NONE,
+                            amfi_cfg_spans_int};
+static const kind K_GAP = {"number or list", p_gap, d_gap, v_gap, NEST_NONE, s_gap};
 
 #define SIM(m) offsetof(amfi_site_config, sim.m)
 #define SIM_CAP(m) sizeof(((amfi_sim_config *)0)->m)

@@ -110,9 +110,24 @@ static void v_coord(const field *f, const void *base, char *buf)
         snprintf(buf, DOC_LEN, "%g", d);
 }
 
-static const kind K_SITE_ID = {"string", p_id, d_id, v_id, NEST_NONE};
-static const kind K_SITE_NAME = {"string", p_sname, d_sname, v_sname, NEST_NONE};
-static const kind K_COORD = {"number", p_coord, d_coord, v_coord, NEST_NONE};
+static int s_id(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(site.id), ID_CAP};
+    return 1;
+}
+
+static int s_sname(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(site.name), NAME_CAP};
+    return 1;
+}
+
+static const kind K_SITE_ID = {"string", p_id, d_id, v_id, NEST_NONE, s_id};
+static const kind K_SITE_NAME = {"string", p_sname, d_sname, v_sname, NEST_NONE, s_sname};
+static const kind K_COORD = {"number", p_coord, d_coord, v_coord, NEST_NONE,
+                             amfi_cfg_spans_double};
 
 const field amfi_cfg_site_fields[] = {
     {.key = "id", .kind = &K_SITE_ID},

@@ -106,7 +106,20 @@ static void v_sensors(const field *f, const void *base, char *buf)
 static const sensor_item sensor_default = {.id = 0, .at_m = 0.0, .weight = 1.0,
                                            .rate_hz = AMFI_CONFIG_DEFAULT_RATE_HZ};
 const list_schema amfi_cfg_sensors_list = {sensor_fields, &sensor_default};
-const kind amfi_cfg_k_sensors = {"list", p_sensors, d_sensors, v_sensors, NEST_LIST};
+static int s_sensors(const field *f, span *out)
+{
+    const amfi_site_config *c = NULL;
+
+    (void)f;
+    out[0] = (span){SC(solver.sensor_x_m), sizeof c->solver.sensor_x_m};
+    out[1] = (span){SC(solver.sensor_weight), sizeof c->solver.sensor_weight};
+    out[2] = (span){SC(sensor_id), sizeof c->sensor_id};
+    out[3] = (span){SC(sensor_rate_hz), sizeof c->sensor_rate_hz};
+    out[4] = (span){SC(solver.n_sensors), sizeof c->solver.n_sensors};
+    return 5;
+}
+
+const kind amfi_cfg_k_sensors = {"list", p_sensors, d_sensors, v_sensors, NEST_LIST, s_sensors};
 
 static void formulation_names(char *known, size_t len)
 {
@@ -245,10 +258,38 @@ static void v_lambda(const field *f, const void *base, char *buf)
         snprintf(buf, DOC_LEN, "%g", l->lambda_ref);
 }
 
+static int s_formulation(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(solver.formulation), sizeof(amfi_formulation)};
+    return 1;
+}
+
+static int s_modes(const field *f, span *out)
+{
+    const amfi_site_config *c = NULL;
+
+    (void)f;
+    out[0] = (span){SC(solver.modes), sizeof c->solver.modes};
+    out[1] = (span){SC(solver.n_modes), sizeof c->solver.n_modes};
+    return 2;
+}
+
+static int s_lambda(const field *f, span *out)
+{
+    const amfi_site_config *c = NULL;
+
+    (void)f;
+    out[0] = (span){SC(lambda.automatic), sizeof c->lambda.automatic};
+    out[1] = (span){SC(lambda.lambda_ref), sizeof c->lambda.lambda_ref};
+    return 2;
+}
+
 static const kind K_FORMULATION = {"name", p_formulation, d_formulation, v_formulation,
-                                   NEST_NONE};
-static const kind K_MODES = {"name or integer", p_modes, d_modes, v_modes, NEST_NONE};
-static const kind K_LAMBDA = {"name or number", p_lambda, d_lambda, v_lambda, NEST_NONE};
+                                   NEST_NONE, s_formulation};
+static const kind K_MODES = {"name or integer", p_modes, d_modes, v_modes, NEST_NONE, s_modes};
+static const kind K_LAMBDA = {"name or number", p_lambda, d_lambda, v_lambda, NEST_NONE,
+                              s_lambda};
 
 
 static const enum_name coords_names[] = {
@@ -276,13 +317,13 @@ static const enum_name initial_state_names[] = {{"rest", 0}, {"free", 1}, {NULL,
 
 static const field lcurve_fields[] = {
     {.key = "lo", .kind = &amfi_cfg_k_double, .off = SC(lambda.lcurve_lo), .lo = 0,
-     .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
+     .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN | F_LIVE},
     {.key = "hi", .kind = &amfi_cfg_k_double, .off = SC(lambda.lcurve_hi), .lo = 0,
-     .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
+     .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN | F_LIVE},
     {.key = "per_decade", .kind = &amfi_cfg_k_int, .off = SC(lambda.lcurve_per_decade), .lo = 1,
-     .hi = 100},
+     .hi = 100, .flags = F_LIVE},
     {.key = "refine", .kind = &amfi_cfg_k_int, .off = SC(lambda.lcurve_refine_points), .lo = 0,
-     .hi = 100},
+     .hi = 100, .flags = F_LIVE},
     {.key = NULL}};
 
 const field amfi_cfg_solver_fields[] = {
@@ -304,9 +345,9 @@ const field amfi_cfg_solver_fields[] = {
      .hi = AMFI_MAX_AXLES},
     {.key = "max_duration_s", .kind = &amfi_cfg_k_double, .off = SC(solver.max_duration_s),
      .lo = 0, .hi = MAX_DURATION_S, .flags = F_LO_OPEN},
-    {.key = "lambda", .kind = &K_LAMBDA},
+    {.key = "lambda", .kind = &K_LAMBDA, .flags = F_LIVE},
     {.key = "lambda_ref_rate_hz", .kind = &amfi_cfg_k_double, .off = SC(lambda.ref_rate_hz),
-     .lo = 0, .hi = MAX_RATE_HZ, .flags = F_LO_OPEN},
+     .lo = 0, .hi = MAX_RATE_HZ, .flags = F_LO_OPEN | F_LIVE},
     {.key = "lcurve", .kind = &amfi_cfg_k_map, .aux = lcurve_fields},
     {.key = "speed", .kind = &amfi_cfg_k_enum, .off = SC(speed_estimate), .aux = speed_names},
     {.key = "speed_sd", .kind = &amfi_cfg_k_double, .off = SC(speed_prior.rel_sd), .lo = 0, .hi = 1,

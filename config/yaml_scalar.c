@@ -460,10 +460,42 @@ static void v_path(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "%s", *s ? s : "none");
 }
 
-const kind amfi_cfg_k_double = {"number", p_double, d_interval, v_double, NEST_NONE};
-const kind amfi_cfg_k_int = {"integer", p_int, d_count, v_int, NEST_NONE};
-const kind amfi_cfg_k_llong = {"integer", p_llong, d_count, v_llong, NEST_NONE};
-const kind amfi_cfg_k_enum = {"name", p_enum, d_names, v_enum, NEST_NONE};
-const kind amfi_cfg_k_string = {"string", p_string, d_length, v_string, NEST_NONE};
-const kind amfi_cfg_k_path = {"file path", p_path, d_path_length, v_path, NEST_NONE};
-const kind amfi_cfg_k_map = {"mapping", p_map, d_none, d_none, NEST_MAP};
+/* ---- where the values live ---------------------------------------------- */
+
+static int one_span(size_t off, size_t len, span *out)
+{
+    out[0] = (span){off, len};
+    return 1;
+}
+
+int amfi_cfg_spans_double(const field *f, span *out)
+{
+    return one_span(f->off, sizeof(double), out);
+}
+
+int amfi_cfg_spans_int(const field *f, span *out)
+{
+    return one_span(f->off, sizeof(int), out);
+}
+
+int amfi_cfg_spans_llong(const field *f, span *out)
+{
+    return one_span(f->off, sizeof(long long), out);
+}
+
+int amfi_cfg_spans_chars(const field *f, span *out)
+{
+    return one_span(f->off, (size_t)f->hi, out);
+}
+
+const kind amfi_cfg_k_double = {"number", p_double, d_interval, v_double, NEST_NONE,
+                                amfi_cfg_spans_double};
+const kind amfi_cfg_k_int = {"integer", p_int, d_count, v_int, NEST_NONE, amfi_cfg_spans_int};
+const kind amfi_cfg_k_llong = {"integer", p_llong, d_count, v_llong, NEST_NONE,
+                               amfi_cfg_spans_llong};
+const kind amfi_cfg_k_enum = {"name", p_enum, d_names, v_enum, NEST_NONE, amfi_cfg_spans_int};
+const kind amfi_cfg_k_string = {"string", p_string, d_length, v_string, NEST_NONE,
+                                amfi_cfg_spans_chars};
+const kind amfi_cfg_k_path = {"file path", p_path, d_path_length, v_path, NEST_NONE,
+                              amfi_cfg_spans_chars};
+const kind amfi_cfg_k_map = {"mapping", p_map, d_none, d_none, NEST_MAP, NULL};

@@ -251,35 +251,72 @@ yaml_node_item_t *amfi_cfg_list_items(ctx *x, yaml_node_t *v, const char *path,
     return v->data.sequence.items.start;
 }
 
-int amfi_cfg_describe_table(const field *table, const char *prefix, const void *base,
-                   key_visit visit, void *arg)
+static int walk_rows(const field *table, const char *prefix, int items,
+                     const void *item_default, int parent_live, row_visit visit, void *arg)
 {
-    char path[PATH_LEN], range[DOC_LEN], dflt[DOC_LEN];
+    char path[PATH_LEN];
     int rc;
 
     for (const field *f = table; f->key; f++) {
+        const int live = item_default ? parent_live : (f->flags & F_LIVE) != 0;
+
         amfi_cfg_pathf(path, "%s%s%s", prefix, *prefix ? "." : "", f->key);
         if (f->kind->nest == NEST_MAP) {
-            rc = amfi_cfg_describe_table(f->aux, path, base, visit, arg);
+            rc = walk_rows(f->aux, path, items, item_default, live, visit, arg);
         } else {
-            f->kind->range(f, base, range);
-            if (base)
-                f->kind->dflt(f, base, dflt);
-            else
-                snprintf(dflt, sizeof dflt, "%s", (f->flags & F_REQUIRED) ? "required" : "");
-            if ((f->flags & F_REQUIRED))
-                snprintf(dflt, sizeof dflt, "required");
-            rc = visit(path, f->kind->type, range, dflt, (f->flags & F_REQUIRED) != 0, arg);
-            if (!rc && f->kind->nest == NEST_LIST) {
+            rc = visit(path, f, item_default, live, arg);
+            if (!rc && items && f->kind->nest == NEST_LIST) {
                 const list_schema *ls = f->aux;
                 amfi_cfg_pathf(path, "%s%s%s[]", prefix, *prefix ? "." : "", f->key);
-                rc = amfi_cfg_describe_table(ls->items, path, ls->item_default, visit, arg);
+                rc = walk_rows(ls->items, path, items, ls->item_default, live, visit, arg);
             }
         }
         if (rc)
             return rc;
     }
     return 0;
+}
+
+int amfi_cfg_walk_rows(const field *table, const char *prefix, int items, row_visit visit,
+                       void *arg)
+{
+    return walk_rows(table, prefix, items, NULL, 0, visit, arg);
+}
+
+void amfi_cfg_describe_row(const field *f, const void *base, char *range, char *dflt)
+{
+    f->kind->range(f, base, range);
+    if (base)
+        f->kind->dflt(f, base, dflt);
+    else
+        dflt[0] = '\0';
+    if ((f->flags & F_REQUIRED))
+        snprintf(dflt, DOC_LEN, "required");
+}
+
+typedef struct describe_arg {
+    const void *base;
+    key_visit visit;
+    void *arg;
+} describe_arg;
+
+static int describe_one(const char *path, const field *f, const void *item_default, int live,
+                        void *arg)
+{
+    const describe_arg *da = arg;
+    char range[DOC_LEN], dflt[DOC_LEN];
+
+    (void)live;
+    amfi_cfg_describe_row(f, item_default ? item_default : da->base, range, dflt);
+    return da->visit(path, f->kind->type, range, dflt, (f->flags & F_REQUIRED) != 0, da->arg);
+}
+
+int amfi_cfg_describe_table(const field *table, const char *prefix, const void *base,
+                            key_visit visit, void *arg)
+{
+    describe_arg da = {base, visit, arg};
+
+    return amfi_cfg_walk_rows(table, prefix, 1, describe_one, &da);
 }
 
 /* ---- the file ------------------------------------------------------------ */

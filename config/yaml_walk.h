@@ -58,6 +58,20 @@ typedef void (*describe_fn)(const field *f, const void *base, char *buf);
 
 enum { NEST_NONE, NEST_MAP, NEST_LIST };
 
+/* Bytes [off, off + len) of the struct a row's offsets are relative to. */
+typedef struct span {
+    size_t off, len;
+} span;
+
+#define MAX_SPANS 6 /* spans of one key's value (sensors: five) */
+
+/* Where row f's value lives: fills out[0 .. n) and returns n (1 .. MAX_SPANS).
+ * Everything the row's parse writes lies in these spans and nothing of any
+ * other row does, so two configurations hold the same value of the key
+ * exactly when the spans' bytes are equal (amfi_config_diff), and copying
+ * them copies the key (amfi_config_apply_live). */
+typedef int (*spans_fn)(const field *f, span *out);
+
 /* A kind of value: how to read it and how to describe it. */
 typedef struct kind {
     const char *type;     /* for the manual: "number", "integer", ... */
@@ -66,6 +80,7 @@ typedef struct kind {
     describe_fn dflt;     /* the value at base (the defaults) */
     int nest;             /* NEST_MAP: aux is a field[] under this key;
                              NEST_LIST: aux is a list_schema for its items */
+    spans_fn spans;       /* where the value lives (NULL for NEST_MAP) */
 } kind;
 
 /* A list of mappings (bridge.supports, sensors): the table of an item's
@@ -79,6 +94,9 @@ typedef struct list_schema {
 #define F_HI_OPEN 2u  /* hi itself is not allowed */
 #define F_REQUIRED 4u /* the key must be present (list items) */
 #define F_FILE_DIR 8u /* amfi_cfg_k_path: a relative path is joined to the file's folder */
+#define F_LIVE 16u    /* SIGHUP applies the key at once (amfi_config_apply_live);
+                         without it the key applies at the next start. List
+                         items take their list's flag. */
 
 struct field {
     const char *key;   /* NULL ends a table */
@@ -138,6 +156,29 @@ typedef int (*key_visit)(const char *path, const char *type, const char *range,
                          const char *dflt, int required, void *arg);
 int amfi_cfg_describe_table(const field *table, const char *prefix, const void *base,
                    key_visit visit, void *arg);
+
+/* Call visit once per key of `table` and of the mappings under it, depth
+ * first, in table order, with the key's path, its row and whether it is
+ * live (F_LIVE; list items: their list's flag). With items = 1 the keys of
+ * a list's items follow their list (path "sensors[].at_m", item_default
+ * the list's item of defaults, which the rows' offsets are relative to);
+ * item_default is NULL for every other key. Stops at and returns the first
+ * non-zero value of visit. */
+typedef int (*row_visit)(const char *path, const field *f, const void *item_default, int live,
+                         void *arg);
+int amfi_cfg_walk_rows(const field *table, const char *prefix, int items, row_visit visit,
+                       void *arg);
+
+/* Row f described for the manual: its allowed values into range[DOC_LEN]
+ * and its value at base (the defaults; NULL: none) into dflt[DOC_LEN],
+ * "required" for a required key. */
+void amfi_cfg_describe_row(const field *f, const void *base, char *range, char *dflt);
+
+/* Generic spans: a double, an int, a long long at f->off, char[f->hi] at f->off. */
+int amfi_cfg_spans_double(const field *f, span *out);
+int amfi_cfg_spans_int(const field *f, span *out);
+int amfi_cfg_spans_llong(const field *f, span *out);
+int amfi_cfg_spans_chars(const field *f, span *out);
 
 /* ---- scalars and kinds (yaml_scalar.c) ---- */
 
