@@ -18,7 +18,7 @@
  *
  * Adding a section: its fields in amfi_site_config with their defaults in
  * amfi_config_defaults(), a section_*.c with its table and checks, one row
- * in top_fields[] and its check in check_site(); the key, its range and its
+ * in amfi_cfg_top_fields[] and its check in check_site(); the key, its range and its
  * default then appear in amfi_config_keys(), which the config_man test
  * holds against man/amfid.yaml.5.scd.
  *
@@ -35,7 +35,7 @@
 #include <string.h>
 
 /* The top level of a site file. */
-static const field top_fields[] = {
+const field amfi_cfg_top_fields[] = {
     {.key = "site", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_site_fields},
     {.key = "bridge", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_bridge_fields},
     {.key = "sensors", .kind = &amfi_cfg_k_sensors, .aux = &amfi_cfg_sensors_list},
@@ -213,7 +213,7 @@ int amfi_config_load(const char *path, amfi_site_config *c, char *err, size_t er
     x->err = err;
     x->errlen = errlen;
     amfi_config_defaults(&tmp);
-    rc = amfi_cfg_walk_file(x, top_fields, &tmp, check_site);
+    rc = amfi_cfg_walk_file(x, amfi_cfg_top_fields, &tmp, check_site);
     if (rc == 0)
         memcpy(c, &tmp, sizeof tmp);
     free(x);
@@ -254,7 +254,7 @@ int amfi_config_keys(int (*visit)(const amfi_config_key *k, void *arg), void *ar
     visit_arg va = {.visit = visit, .arg = arg, .dflt = &d};
 
     amfi_config_defaults(&d);
-    return amfi_cfg_walk_rows(top_fields, "", 1, visit_one, &va);
+    return amfi_cfg_walk_rows(amfi_cfg_top_fields, "", 1, visit_one, &va);
 }
 
 /* The spans of row f of the top table (the site config's offsets). */
@@ -292,7 +292,7 @@ int amfi_config_diff(const amfi_site_config *a, const amfi_site_config *b,
     if (!a || !b || !visit)
         return 0;
     amfi_config_defaults(&d);
-    return amfi_cfg_walk_rows(top_fields, "", 0, diff_one, &va);
+    return amfi_cfg_walk_rows(amfi_cfg_top_fields, "", 0, diff_one, &va);
 }
 
 static int apply_one(const char *path, const field *f, const void *item_default, int live,
@@ -318,5 +318,5 @@ void amfi_config_apply_live(amfi_site_config *run, const amfi_site_config *n)
 
     if (!run || !n || run == n)
         return;
-    amfi_cfg_walk_rows(top_fields, "", 0, apply_one, &va);
+    amfi_cfg_walk_rows(amfi_cfg_top_fields, "", 0, apply_one, &va);
 }

@@ -35,6 +35,8 @@
 #define AMFI_CONFIG_MAX_STEPS 10000000.0
 #define AMFI_CONFIG_MAX_WORKSPACE_BYTES (1024.0 * 1024.0 * 1024.0)
 
+/* The top level of a site file (amfi_config.c): the sections under it. */
+extern const field amfi_cfg_top_fields[];
 extern const field amfi_cfg_bridge_fields[]; /* bridge: */
 extern const kind amfi_cfg_k_sensors;        /* sensors: (a list of amfi_cfg_sensors_list) */
 extern const list_schema amfi_cfg_sensors_list;
