@@ -31,46 +31,51 @@ static const field ab_sensor_fields[] = {
      .lo = -HUGE_VAL, .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
     {.key = NULL}};
 
-static int p_ab_sensors(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+/* The design's index of sensor `id`, or -1. */
+static int design_sensor(const amfi_site_config *d, int id)
+{
+    for (int k = 0; k < d->solver.n_sensors; k++)
+        if (d->sensor_id[k] == id)
+            return k;
+    return -1;
+}
+
+/* Item i of sensors: a sensor of the design, listed once, one position. */
+static int check_ab_sensor(ctx *x, yaml_node_t *it, const char *ip, const void *items, int i,
+                           const void *base)
+{
+    const amfi_site_config *d = &((const amfi_as_built *)base)->site;
+    const ab_sensor *s = items;
+    char kp[PATH_LEN];
+    const int k = design_sensor(d, s[i].id);
+
+    amfi_cfg_pathf(kp, "%s.id", ip);
+    if (k < 0)
+        return amfi_cfg_fail(x, amfi_cfg_noted(x, kp), kp, "the design has no sensor with id %d",
+                             s[i].id);
+    for (int j = 0; j < i; j++)
+        if (s[j].id == s[i].id)
+            return amfi_cfg_fail(x, amfi_cfg_noted(x, kp), kp, "sensor %d is listed twice",
+                                 s[i].id);
+    amfi_cfg_pathf(kp, "sensor#%d", k); /* where design sensor k was moved (ab_check) */
+    amfi_cfg_note_line(x, kp, amfi_cfg_line_of(it));
+    if (isnan(s[i].at_m) == isnan(s[i].offset_m))
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "give exactly one of at_m (the true "
+                             "position) and offset_m (true minus design)");
+    return 0;
+}
+
+/* The true positions of the sensors listed; the others stay the design's. */
+static void store_ab_sensors(const void *items, int n, void *base)
 {
     amfi_as_built *a = base;
-    const amfi_site_config *d = &a->site;
-    yaml_node_item_t *items;
-    char ip[PATH_LEN], kp[PATH_LEN];
-    int n = 0, seen[AMFI_MAX_SENSORS] = {0};
+    const ab_sensor *s = items;
 
-    (void)f;
-    items = amfi_cfg_list_items(x, v, path, "sensors", AMFI_MAX_SENSORS, &n);
-    if (!items)
-        return -1;
     for (int i = 0; i < n; i++) {
-        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
-        ab_sensor s = {0, NAN, NAN};
-        int k;
-
-        amfi_cfg_join_index(ip, path, (size_t)i);
-        if (!it)
-            return amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
-        amfi_cfg_note_line(x, ip, amfi_cfg_line_of(it));
-        if (amfi_cfg_walk_map(x, it, ip, ab_sensor_fields, &s))
-            return -1;
-        amfi_cfg_pathf(kp, "%s.id", ip);
-        for (k = 0; k < d->solver.n_sensors; k++)
-            if (d->sensor_id[k] == s.id)
-                break;
-        if (k == d->solver.n_sensors)
-            return amfi_cfg_fail(x, amfi_cfg_noted(x, kp), kp, "the design has no sensor with id %d", s.id);
-        if (seen[k])
-            return amfi_cfg_fail(x, amfi_cfg_noted(x, kp), kp, "sensor %d is listed twice", s.id);
-        seen[k] = 1;
-        amfi_cfg_pathf(kp, "sensor#%d", k); /* where design sensor k was moved (ab_check) */
-        amfi_cfg_note_line(x, kp, amfi_cfg_line_of(it));
-        if (isnan(s.at_m) == isnan(s.offset_m))
-            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "give exactly one of at_m (the true position) "
-                        "and offset_m (true minus design)");
-        a->sensor_x_m[k] = isnan(s.at_m) ? d->solver.sensor_x_m[k] + s.offset_m : s.at_m;
+        const int k = design_sensor(&a->site, s[i].id); /* checked: >= 0 */
+        a->sensor_x_m[k] =
+            isnan(s[i].at_m) ? a->site.solver.sensor_x_m[k] + s[i].offset_m : s[i].at_m;
     }
-    return 0;
 }
 
 static void d_ab_sensors(const field *f, const void *base, char *buf)
@@ -89,7 +94,9 @@ static void v_ab_sensors(const field *f, const void *base, char *buf)
 }
 
 static const ab_sensor ab_sensor_default = {0, NAN, NAN};
-static const list_schema ab_sensor_list = {ab_sensor_fields, &ab_sensor_default};
+static const list_schema ab_sensor_list = {ab_sensor_fields, &ab_sensor_default,
+                                           sizeof(ab_sensor), AMFI_MAX_SENSORS, "sensors",
+                                           check_ab_sensor, store_ab_sensors};
 static int s_ab_sensors(const field *f, span *out)
 {
     (void)f;
@@ -97,18 +104,21 @@ static int s_ab_sensors(const field *f, span *out)
     return 1;
 }
 
-static const kind K_AB_SENSORS = {"list", p_ab_sensors, d_ab_sensors, v_ab_sensors,
+static const kind K_AB_SENSORS = {"list", amfi_cfg_parse_list, d_ab_sensors, v_ab_sensors,
                                   NEST_LIST, s_ab_sensors};
 
-/* The names, meanings and ranges of the site file's detector: section
- * (what a commissioning finds), here the truth it should find. */
+/* The site file's detector: section (section_detector.c: what a
+ * commissioning finds), here the truth it should find, and the spacings'
+ * own scale. */
+_Static_assert(offsetof(amfi_detector_error, clock_offset_s) ==
+                       offsetof(amfi_detector_config, clock_offset_s) &&
+                   offsetof(amfi_detector_error, speed_scale) ==
+                       offsetof(amfi_detector_config, speed_scale),
+               "amfi_detector_error starts as amfi_detector_config");
 static const field ab_detector_fields[] = {
-    {.key = "clock_offset_s", .kind = &amfi_cfg_k_double, .off = AB(detector.clock_offset_s),
-     .lo = -1, .hi = 1},
-    {.key = "speed_scale", .kind = &amfi_cfg_k_double, .off = AB(detector.speed_scale), .lo = 0.5,
-     .hi = 2},
-    {.key = "spacing_scale", .kind = &amfi_cfg_k_double, .off = AB(detector.spacing_scale), .lo = 0.5,
-     .hi = 2},
+    AMFI_CFG_DETECTOR_ROWS(AB(detector)),
+    {.key = "spacing_scale", .kind = &amfi_cfg_k_double, .off = AB(detector.spacing_scale),
+     .lo = 0.5, .hi = 2},
     {.key = NULL}};
 
 static const field ab_top[] = {

@@ -132,51 +132,44 @@ static const field support_fields[] = {
      .lo = 0, .hi = HUGE_VAL, .flags = F_HI_OPEN},
     {.key = NULL}};
 
-static int p_supports(ctx *x, yaml_node_t *v, const char *path, const field *f,
-                      void *base)
+/* Item i of bridge.supports: the springs its type allows. */
+static int check_support(ctx *x, yaml_node_t *it, const char *ip, const void *items, int i,
+                         const void *base)
+{
+    const support_item *si = (const support_item *)items + i;
+
+    (void)base;
+    if (si->type == SUPPORT_ELASTIC && !(si->k_w_npm > 0))
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "an elastic support needs k_w_npm > 0 "
+                    "(its vertical stiffness, N/m)");
+    if (si->type != SUPPORT_ELASTIC && si->k_w_npm > 0)
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "k_w_npm is the spring of an elastic support; "
+                    "a %s support holds the vertical displacement",
+                    si->type == SUPPORT_FIXED ? "fixed" : si->type == SUPPORT_ROLLER ? "roller"
+                                                                                : "pinned");
+    if (si->type == SUPPORT_FIXED && si->k_theta_nmprad > 0)
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "a fixed support holds the rotation: no "
+                    "k_theta_nmprad (use pinned with k_theta_nmprad for a partly "
+                    "fixed bearing)");
+    return 0;
+}
+
+/* The supports read, as libamfi's amfi_support. */
+static void store_supports(const void *items, int n, void *base)
 {
     amfi_bridge_params *b = &((amfi_site_config *)base)->bridge;
-    amfi_support s[AMFI_MAX_SUPPORTS];
-    yaml_node_item_t *items;
-    char ip[PATH_LEN];
-    int n = 0;
+    const support_item *si = items;
 
-    (void)f;
-    items = amfi_cfg_list_items(x, v, path, "supports", AMFI_MAX_SUPPORTS, &n);
-    if (!items)
-        return -1;
-    memset(s, 0, sizeof s);
+    memset(b->supports, 0, sizeof b->supports);
     for (int i = 0; i < n; i++) {
-        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
-        support_item si = {0.0, SUPPORT_PINNED, 0.0, 0.0};
-
-        amfi_cfg_join_index(ip, path, (size_t)i);
-        if (!it)
-            return amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
-        amfi_cfg_note_line(x, ip, amfi_cfg_line_of(it));
-        if (amfi_cfg_walk_map(x, it, ip, support_fields, &si))
-            return -1;
-        if (si.type == SUPPORT_ELASTIC && !(si.k_w_npm > 0))
-            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "an elastic support needs k_w_npm > 0 "
-                        "(its vertical stiffness, N/m)");
-        if (si.type != SUPPORT_ELASTIC && si.k_w_npm > 0)
-            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "k_w_npm is the spring of an elastic support; "
-                        "a %s support holds the vertical displacement",
-                        si.type == SUPPORT_FIXED ? "fixed" : si.type == SUPPORT_ROLLER ? "roller"
-                                                                                   : "pinned");
-        if (si.type == SUPPORT_FIXED && si.k_theta_nmprad > 0)
-            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "a fixed support holds the rotation: no "
-                        "k_theta_nmprad (use pinned with k_theta_nmprad for a partly "
-                        "fixed bearing)");
-        s[i].x_m = si.at_m;
-        s[i].restrain_w = si.type != SUPPORT_ELASTIC;
-        s[i].restrain_theta = si.type == SUPPORT_FIXED;
-        s[i].k_w_npm = si.type == SUPPORT_ELASTIC ? si.k_w_npm : 0.0;
-        s[i].k_theta_nmprad = si.k_theta_nmprad;
+        amfi_support *s = &b->supports[i];
+        s->x_m = si[i].at_m;
+        s->restrain_w = si[i].type != SUPPORT_ELASTIC;
+        s->restrain_theta = si[i].type == SUPPORT_FIXED;
+        s->k_w_npm = si[i].type == SUPPORT_ELASTIC ? si[i].k_w_npm : 0.0;
+        s->k_theta_nmprad = si[i].k_theta_nmprad;
     }
-    memcpy(b->supports, s, sizeof s);
     b->n_supports = n;
-    return 0;
 }
 
 static void d_supports(const field *f, const void *base, char *buf)
@@ -194,7 +187,9 @@ static void v_supports(const field *f, const void *base, char *buf)
 }
 
 static const support_item support_default = {0.0, SUPPORT_PINNED, 0.0, 0.0};
-static const list_schema support_list = {support_fields, &support_default};
+static const list_schema support_list = {support_fields, &support_default, sizeof(support_item),
+                                         AMFI_MAX_SUPPORTS, "supports", check_support,
+                                         store_supports};
 static int s_supports(const field *f, span *out)
 {
     (void)f;
@@ -203,7 +198,7 @@ static int s_supports(const field *f, span *out)
     return 2;
 }
 
-static const kind K_SUPPORTS = {"list", p_supports, d_supports, v_supports, NEST_LIST,
+static const kind K_SUPPORTS = {"list", amfi_cfg_parse_list, d_supports, v_supports, NEST_LIST,
                                 s_supports};
 
 /* bridge.segments: a list of {from_m, to_m, EI_nm2, mass_kgpm} */
@@ -218,37 +213,28 @@ static const field segment_fields[] = {
      .hi = HUGE_VAL, .flags = F_HI_OPEN},
     {.key = NULL}};
 
-static int p_segments(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+/* Item i of bridge.segments: a length and something on it. */
+static int check_segment(ctx *x, yaml_node_t *it, const char *ip, const void *items, int i,
+                         const void *base)
+{
+    const amfi_segment *g = (const amfi_segment *)items + i;
+
+    (void)base;
+    if (!(g->x1_m > g->x0_m))
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "to_m (%g) must be beyond from_m (%g)",
+                             g->x1_m, g->x0_m);
+    if (g->EI_nm2 == 0 && g->mass_kgpm == 0)
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "gives neither EI_nm2 nor mass_kgpm");
+    return 0;
+}
+
+static void store_segments(const void *items, int n, void *base)
 {
     amfi_bridge_params *b = &((amfi_site_config *)base)->bridge;
-    amfi_segment g[AMFI_MAX_SEGMENTS];
-    yaml_node_item_t *items;
-    char ip[PATH_LEN];
-    int n = 0;
 
-    (void)f;
-    items = amfi_cfg_list_items(x, v, path, "segments", AMFI_MAX_SEGMENTS, &n);
-    if (!items)
-        return -1;
-    memset(g, 0, sizeof g);
-    for (int i = 0; i < n; i++) {
-        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
-
-        amfi_cfg_join_index(ip, path, (size_t)i);
-        if (!it)
-            return amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
-        amfi_cfg_note_line(x, ip, amfi_cfg_line_of(it));
-        if (amfi_cfg_walk_map(x, it, ip, segment_fields, &g[i]))
-            return -1;
-        if (!(g[i].x1_m > g[i].x0_m))
-            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "to_m (%g) must be beyond from_m (%g)", g[i].x1_m,
-                        g[i].x0_m);
-        if (g[i].EI_nm2 == 0 && g[i].mass_kgpm == 0)
-            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "gives neither EI_nm2 nor mass_kgpm");
-    }
-    memcpy(b->segments, g, sizeof g);
+    memset(b->segments, 0, sizeof b->segments);
+    memcpy(b->segments, items, (size_t)n * sizeof b->segments[0]);
     b->n_segments = n;
-    return 0;
 }
 
 static void d_segments(const field *f, const void *base, char *buf)
@@ -266,7 +252,9 @@ static void v_segments(const field *f, const void *base, char *buf)
 }
 
 static const amfi_segment segment_default = {0.0, 0.0, 0.0, 0.0};
-static const list_schema segment_list = {segment_fields, &segment_default};
+static const list_schema segment_list = {segment_fields, &segment_default, sizeof(amfi_segment),
+                                         AMFI_MAX_SEGMENTS, "segments", check_segment,
+                                         store_segments};
 static int s_segments(const field *f, span *out)
 {
     (void)f;
@@ -275,7 +263,7 @@ static int s_segments(const field *f, span *out)
     return 2;
 }
 
-static const kind K_SEGMENTS = {"list", p_segments, d_segments, v_segments, NEST_LIST,
+static const kind K_SEGMENTS = {"list", amfi_cfg_parse_list, d_segments, v_segments, NEST_LIST,
                                 s_segments};
 
 static const field damping_fields[] = {

@@ -40,45 +40,36 @@ static const field sensor_fields[] = {
      .hi = 100000, .flags = F_LO_OPEN},
     {.key = NULL}};
 
-static int p_sensors(ctx *x, yaml_node_t *v, const char *path, const field *f,
-                     void *base)
+/* Item i of sensors: one rate for all, distinct ids. */
+static int check_sensor(ctx *x, yaml_node_t *it, const char *ip, const void *items, int i,
+                        const void *base)
+{
+    const sensor_item *s = items;
+    char idp[PATH_LEN];
+
+    (void)base;
+    /* the solver takes one sample rate for every sensor of a window */
+    if (i > 0 && s[i].rate_hz != s[0].rate_hz) {
+        amfi_cfg_pathf(idp, "%s.rate_hz", ip);
+        return amfi_cfg_fail(x, amfi_cfg_noted(x, idp) ? amfi_cfg_noted(x, idp) : amfi_cfg_line_of(it), idp,
+                    "%g Hz differs from sensors[0].rate_hz (%g Hz): every sensor must send "
+                    "at one rate",
+                    s[i].rate_hz, s[0].rate_hz);
+    }
+    for (int j = 0; j < i; j++)
+        if (s[j].id == s[i].id) {
+            amfi_cfg_pathf(idp, "%s.id", ip);
+            return amfi_cfg_fail(x, amfi_cfg_noted(x, idp), idp, "duplicate id %d (also sensors[%d])",
+                        s[i].id, j);
+        }
+    return 0;
+}
+
+static void store_sensors(const void *items, int n, void *base)
 {
     amfi_site_config *c = base;
-    sensor_item s[AMFI_MAX_SENSORS];
-    yaml_node_item_t *items;
-    char ip[PATH_LEN], idp[PATH_LEN];
-    int n = 0;
+    const sensor_item *s = items;
 
-    (void)f;
-    items = amfi_cfg_list_items(x, v, path, "sensors", AMFI_MAX_SENSORS, &n);
-    if (!items)
-        return -1;
-    for (int i = 0; i < n; i++) {
-        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
-
-        amfi_cfg_join_index(ip, path, (size_t)i);
-        if (!it)
-            return amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
-        amfi_cfg_note_line(x, ip, amfi_cfg_line_of(it));
-        s[i] = (sensor_item){.id = 0, .at_m = 0.0, .weight = 1.0,
-                             .rate_hz = AMFI_CONFIG_DEFAULT_RATE_HZ};
-        if (amfi_cfg_walk_map(x, it, ip, sensor_fields, &s[i]))
-            return -1;
-        /* the solver takes one sample rate for every sensor of a window */
-        if (i > 0 && s[i].rate_hz != s[0].rate_hz) {
-            amfi_cfg_pathf(idp, "%s.rate_hz", ip);
-            return amfi_cfg_fail(x, amfi_cfg_noted(x, idp) ? amfi_cfg_noted(x, idp) : amfi_cfg_line_of(it), idp,
-                        "%g Hz differs from %s[0].rate_hz (%g Hz): every sensor must send "
-                        "at one rate",
-                        s[i].rate_hz, path, s[0].rate_hz);
-        }
-        for (int j = 0; j < i; j++)
-            if (s[j].id == s[i].id) {
-                amfi_cfg_pathf(idp, "%s.id", ip);
-                return amfi_cfg_fail(x, amfi_cfg_noted(x, idp), idp, "duplicate id %d (also %s[%d])",
-                            s[i].id, path, j);
-            }
-    }
     for (int i = 0; i < AMFI_MAX_SENSORS; i++) {
         c->solver.sensor_x_m[i] = i < n ? s[i].at_m : 0.0;
         c->solver.sensor_weight[i] = i < n ? s[i].weight : 0.0;
@@ -86,7 +77,6 @@ static int p_sensors(ctx *x, yaml_node_t *v, const char *path, const field *f,
         c->sensor_rate_hz[i] = i < n ? s[i].rate_hz : 0.0;
     }
     c->solver.n_sensors = n;
-    return 0;
 }
 
 static void d_sensors(const field *f, const void *base, char *buf)
@@ -105,7 +95,9 @@ static void v_sensors(const field *f, const void *base, char *buf)
 
 static const sensor_item sensor_default = {.id = 0, .at_m = 0.0, .weight = 1.0,
                                            .rate_hz = AMFI_CONFIG_DEFAULT_RATE_HZ};
-const list_schema amfi_cfg_sensors_list = {sensor_fields, &sensor_default};
+const list_schema amfi_cfg_sensors_list = {sensor_fields, &sensor_default, sizeof(sensor_item),
+                                           AMFI_MAX_SENSORS, "sensors", check_sensor,
+                                           store_sensors};
 static int s_sensors(const field *f, span *out)
 {
     const amfi_site_config *c = NULL;
@@ -119,7 +111,7 @@ static int s_sensors(const field *f, span *out)
     return 5;
 }
 
-const kind amfi_cfg_k_sensors = {"list", p_sensors, d_sensors, v_sensors, NEST_LIST, s_sensors};
+const kind amfi_cfg_k_sensors = {"list", amfi_cfg_parse_list, d_sensors, v_sensors, NEST_LIST, s_sensors};
 
 static void formulation_names(char *known, size_t len)
 {

@@ -48,6 +48,16 @@ extern const field amfi_cfg_alerts_fields[]; /* alerts: */
 extern const field amfi_cfg_metrics_fields[]; /* metrics: */
 extern const field amfi_cfg_report_fields[]; /* report: */
 extern const field amfi_cfg_detector_fields[]; /* detector: */
+
+/* The rows of detector.clock_offset_s and detector.speed_scale (names,
+ * meanings, ranges), for an amfi_detector_config at byte `at` of the base:
+ * the site file's detector: section and the as-built file's (whose
+ * amfi_detector_error starts alike, checked in as_built.c). */
+#define AMFI_CFG_DETECTOR_ROWS(at)                                                   \
+    {.key = "clock_offset_s", .kind = &amfi_cfg_k_double,                            \
+     .off = (at) + offsetof(amfi_detector_config, clock_offset_s), .lo = -1, .hi = 1}, \
+    {.key = "speed_scale", .kind = &amfi_cfg_k_double,                               \
+     .off = (at) + offsetof(amfi_detector_config, speed_scale), .lo = 0.5, .hi = 2}
 extern const enum_name amfi_cfg_onoff_names[]; /* off | on (section_daemon.c) */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */

@@ -233,7 +233,7 @@ int amfi_cfg_walk_map(ctx *x, yaml_node_t *m, const char *path, const field *tab
 }
 
 /* The items of list node v, checked to be 1 .. max long; NULL after amfi_cfg_fail(). */
-yaml_node_item_t *amfi_cfg_list_items(ctx *x, yaml_node_t *v, const char *path,
+static yaml_node_item_t *list_items(ctx *x, yaml_node_t *v, const char *path,
                                     const char *what_items, int max, int *n)
 {
     ptrdiff_t len;
@@ -249,6 +249,41 @@ yaml_node_item_t *amfi_cfg_list_items(ctx *x, yaml_node_t *v, const char *path,
     }
     *n = (int)len;
     return v->data.sequence.items.start;
+}
+
+int amfi_cfg_parse_list(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    const list_schema *ls = f->aux;
+    yaml_node_item_t *items;
+    unsigned char *buf;
+    char ip[PATH_LEN];
+    int n = 0, rc = 0;
+
+    items = list_items(x, v, path, ls->what, ls->max, &n);
+    if (!items)
+        return -1;
+    buf = calloc((size_t)ls->max, ls->item_size);
+    if (!buf)
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "out of memory");
+    for (int i = 0; i < n && rc == 0; i++) {
+        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
+        void *item = buf + (size_t)i * ls->item_size;
+
+        amfi_cfg_join_index(ip, path, (size_t)i);
+        if (!it) {
+            rc = amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
+            break;
+        }
+        amfi_cfg_note_line(x, ip, amfi_cfg_line_of(it));
+        memcpy(item, ls->item_default, ls->item_size);
+        rc = amfi_cfg_walk_map(x, it, ip, ls->items, item);
+        if (rc == 0 && ls->check)
+            rc = ls->check(x, it, ip, buf, i, base);
+    }
+    if (rc == 0)
+        ls->store(buf, n, base);
+    free(buf);
+    return rc;
 }
 
 static int walk_rows(const field *table, const char *prefix, int items,

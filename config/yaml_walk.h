@@ -84,10 +84,24 @@ typedef struct kind {
 } kind;
 
 /* A list of mappings (bridge.supports, sensors): the table of an item's
- * keys and an item holding their defaults. */
+ * keys, an item holding their defaults, and what to do with the items read.
+ * amfi_cfg_parse_list (the parse of every list kind) reads 1 .. max items,
+ * each a mapping walked with `items` over a copy of item_default into an
+ * array of item_size-byte items, calls check after each item and store once
+ * with them all; the sections write only check and store. */
 typedef struct list_schema {
     const field *items;
     const void *item_default;
+    size_t item_size;
+    int max;            /* items at most */
+    const char *what;   /* "supports": for "expected 1 .. max supports" */
+    /* Item i (key path ip, node it) read, items[0 .. i] so far: the checks
+     * between an item's keys and against the earlier items; NULL: none.
+     * 0, or -1 after amfi_cfg_fail(). Writes nothing to base. */
+    int (*check)(ctx *x, yaml_node_t *it, const char *ip, const void *items, int i,
+                 const void *base);
+    /* The n items read into base (the caller's struct). */
+    void (*store)(const void *items, int n, void *base);
 } list_schema;
 
 #define F_LO_OPEN 1u  /* lo itself is not allowed */
@@ -138,9 +152,10 @@ int amfi_cfg_noted_under(const ctx *x, const char *prefix);
  * type check, unknown, duplicate and required keys, then each row's kind. */
 int amfi_cfg_walk_map(ctx *x, yaml_node_t *m, const char *path, const field *table, void *base);
 
-/* The items of list node v, checked to be 1 .. max long; NULL after amfi_cfg_fail(). */
-yaml_node_item_t *amfi_cfg_list_items(ctx *x, yaml_node_t *v, const char *path,
-                             const char *what_items, int max, int *n);
+/* The parse of every list kind: list node v (key path `path`) read with row
+ * f's list_schema (f->aux) into base; 0, or -1 after amfi_cfg_fail() (base
+ * untouched). */
+int amfi_cfg_parse_list(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base);
 
 /* Read `path` (at most 1 MiB, a single YAML document nested at most 16
  * deep), walk its root with `top` into base in the C numeric locale, then
