@@ -15,11 +15,13 @@
  * inferred GVW against the truth (simulations); sets a manual baseline from
  * the last N ok passages or from explicit values; checks the file's
  * integrity; lists passages (filtered by time, status, lane), the GVW
- * histogram per lane and the overloads against legal limits (report_export.c);
- * shows the speed corrections of the passages whose speed amfid estimated
- * (report_speed.c).
+ * histogram per lane and the overloads against legal limits; shows the
+ * speed corrections of the passages whose speed amfid estimated; draws the
+ * store with gnuplot (--plot).
  * Every section prints as a table, CSV (one section at a time) or one JSON
- * document. With no option: summary, trend and alerts, and the speed
+ * document. The sections are the rows of one table below (sections[]);
+ * each lives in its subject's file (report.h lists them and who calls
+ * whom). With no option: summary, trend and alerts, and the speed
  * corrections when the store holds estimated speeds. The table format ends
  * with the sqlite3 queries one would type next. Schema: docs/schema.md.
  *

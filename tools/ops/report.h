@@ -7,12 +7,10 @@
  * times, one message per failure) from report_util.c, which calls no other
  * report file.
  *
- * The files (call graph checked by tests/report/report_calls.sh: no circle;
- * report_plot.c, report_cols.c and report_util.c call no report file):
+ * The files, one per subject:
  *   amfi-report.c        options, the table of sections, dispatch, baseline,
- *                        check; calls every subject file
- *   report_summary.c     --summary and --errors (calls report_scale.c,
- *                        report_natfreq.c for their summary lines)
+ *                        check
+ *   report_summary.c     --summary and --errors
  *   report_indicators.c  --trend and --alerts; trend.png
  *   report_passages.c    --passages, --histogram, --overloads; gvw.png,
  *                        gvw_histogram.png, passages_per_hour.png, speed.png
@@ -22,7 +20,21 @@
  *   report_natfreq.c     the natural-frequency lines; natfreq.png
  *   report_pg.c          --pg: the fleet and one site from PostgreSQL
  *   report_cols.c        CSV and JSON of a column list (report_cols.h)
- *   report_plot.c        gnuplot helpers (report_plot.h)
+ *   report_plot.c        gnuplot helpers and the plot frame (report_plot.h)
+ *   report_util.c        statistics, times, the failure message
+ *
+ * Who calls whom (tests/report/report_calls.sh reads it from the objects
+ * with nm, fails on a circle and when this list differs; report_cols.c,
+ * report_plot.c, report_util.c and report_pg.c call no report file):
+ *   amfi-report.c -> report_indicators.c report_natfreq.c report_passages.c report_pg.c
+ *   amfi-report.c -> report_plot.c report_scale.c report_speed.c report_summary.c
+ *   amfi-report.c -> report_util.c
+ *   report_indicators.c -> report_cols.c report_plot.c report_util.c
+ *   report_natfreq.c -> report_plot.c
+ *   report_passages.c -> report_cols.c report_plot.c report_util.c
+ *   report_scale.c -> report_plot.c
+ *   report_speed.c -> report_cols.c report_plot.c report_util.c
+ *   report_summary.c -> report_cols.c report_natfreq.c report_scale.c report_util.c
  *
  * Single-threaded, the caller's thread; the store is read through store/.
  */
