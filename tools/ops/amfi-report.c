@@ -272,15 +272,14 @@ static void usage(FILE *f)
 /* "amfi-report: OPT: problem" on stderr; returns −1 */
 #define usage_error(opt, ...) (amfi_cli_error(PROG, opt, __VA_ARGS__), -1)
 
-static const char *g_db = "?"; /* for messages */
+static int data_error(const report_ctx *c, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
 
-static int data_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-
-/* "amfi-report: PATH: problem" on stderr; returns −1 */
-static int data_error(const char *fmt, ...)
+/* "amfi-report: PATH: problem" (the site with --pg) on stderr; returns −1 */
+static int data_error(const report_ctx *c, const char *fmt, ...)
 {
     va_list ap;
-    fprintf(stderr, PROG ": %s: ", g_db);
+    fprintf(stderr, PROG ": %s: ", c->name);
     va_start(ap, fmt);
     vfprintf(stderr, fmt, ap);
     va_end(ap);
@@ -507,7 +506,7 @@ static int parse_args(int argc, char **argv, options *o)
     return 0;
 }
 
-static int set_baseline(const options *o)
+static int set_baseline(const options *o, const report_ctx *c)
 {
     amfi_store *s = NULL;
     amfi_baseline b;
@@ -522,13 +521,13 @@ static int set_baseline(const options *o)
     if (o->baseline_last) {
         g = malloc((size_t)o->baseline_last * sizeof *g);
         if (!g)
-            rc = data_error("out of memory");
+            rc = data_error(c, "out of memory");
         if (rc == 0
             && amfi_store_recent_ok_gvw(s, o->baseline_last, g, &n, err,
                                         sizeof err) != 0)
-            rc = data_error("%s", err);
+            rc = data_error(c, "%s", err);
         if (rc == 0 && n < o->baseline_last)
-            rc = data_error("only %d ok passages stored, --set-baseline-last "
+            rc = data_error(c, "only %d ok passages stored, --set-baseline-last "
                             "asked for %d", n, o->baseline_last);
         if (rc == 0) {
             report_mean_std(g, (size_t)n, &b.mean_kg, &b.std_kg);
@@ -543,7 +542,7 @@ static int set_baseline(const options *o)
     if (rc == 0) {
         amfi_passage_summary sum;
         if (amfi_store_passage_summary(s, &sum, err, sizeof err) != 0)
-            rc = data_error("%s", err);
+            rc = data_error(c, "%s", err);
         else
             b.utime_set = sum.utime_last;
     }
@@ -551,7 +550,7 @@ static int set_baseline(const options *o)
         snprintf(b.source, sizeof b.source, "manual");
         snprintf(b.note, sizeof b.note, "%s", o->note ? o->note : "");
         if (amfi_store_set_baseline(s, &b, err, sizeof err) != 0)
-            rc = data_error("%s", err);
+            rc = data_error(c, "%s", err);
     }
     if (rc == 0) {
         char t[32];
@@ -662,13 +661,13 @@ static int export_all(const options *o, report_ctx *c)
         for (int k = 0; k < N_SECTIONS; k++)
             if (o->sel[k]) {
                 context_for(c, o, k);
-                return sections[k].export(c) ? data_error("%s", c->err) : 0;
+                return sections[k].export(c) ? data_error(c, "%s", c->err) : 0;
             }
         return 0;
     }
     json_t *root = json_object();
     if (!root)
-        return data_error("out of memory");
+        return data_error(c, "out of memory");
     c->root = root;
     char site[256] = "";
     int found = 0, rc = 0, streamed = 0;
@@ -684,11 +683,11 @@ static int export_all(const options *o, report_ctx *c)
     }
     if (rc != 0) {
         json_decref(root);
-        return data_error("%s", c->err);
+        return data_error(c, "%s", c->err);
     }
     if (!streamed)
         return amfi_json_print(stdout, root) != 0
-                   ? data_error("cannot write the JSON document") : 0;
+                   ? data_error(c, "cannot write the JSON document") : 0;
     /* the document without its closing brace, then each streamed section */
     char *head = json_dumps(root, JSON_COMPACT | JSON_PRESERVE_ORDER
                                       | JSON_REAL_PRECISION(10));
@@ -697,7 +696,7 @@ static int export_all(const options *o, report_ctx *c)
     size_t hl = head ? strlen(head) : 0;
     if (hl < 2 || head[hl - 1] != '}') {
         free(head);
-        return data_error("cannot write the JSON document");
+        return data_error(c, "cannot write the JSON document");
     }
     fwrite(head, 1, hl - 1, stdout);
     free(head);
@@ -707,10 +706,10 @@ static int export_all(const options *o, report_ctx *c)
         printf(",\"%s\":", sections[k].name);
         context_for(c, o, k);
         if (sections[k].export(c) != 0)
-            return data_error("%s", c->err);
+            return data_error(c, "%s", c->err);
     }
     if (fputs("}\n", stdout) == EOF || ferror(stdout))
-        return data_error("cannot write the JSON document");
+        return data_error(c, "cannot write the JSON document");
     return 0;
 }
 
@@ -727,13 +726,13 @@ static int run_section(const options *o, report_ctx *c, int k, int *printed)
             putchar('\n');
         c->out = stdout;
         *printed = 1;
-        return sections[k].table(c) ? data_error("%s", c->err) : 0;
+        return sections[k].table(c) ? data_error(c, "%s", c->err) : 0;
     }
     char *buf = NULL;
     size_t len = 0;
     c->out = open_memstream(&buf, &len);
     if (!c->out)
-        return data_error("out of memory");
+        return data_error(c, "out of memory");
     int rc = sections[k].table(c);
     fclose(c->out);
     c->out = stdout;
@@ -743,7 +742,7 @@ static int run_section(const options *o, report_ctx *c, int k, int *printed)
         fwrite(buf, 1, len, stdout);
         *printed = 1;
     } else {
-        data_error("%s", c->err);
+        data_error(c, "%s", c->err);
     }
     free(buf);
     return rc;
@@ -752,15 +751,16 @@ static int run_section(const options *o, report_ctx *c, int k, int *printed)
 /* --plot: site name from the store's meta (site.name), else the config's
  * bridge.name, else the database's file name; thresholds from --config or
  * the indicator defaults. Every section's plots, in their places. */
-static int plot(const options *o, const amfi_site_config *cfg, amfi_store *s)
+static int plot(const options *o, const amfi_site_config *cfg, const report_ctx *c)
 {
+    amfi_store *s = c->s;
     char site[4097], err[1024]; /* meta values hold at most 4096 bytes */
     int found = 0;
     amfi_indicator_params ip;
     amfi_indicator_params_default(&ip);
     if (amfi_store_meta_get(s, "site.name", site, sizeof site, &found, err,
                             sizeof err) != 0)
-        return data_error("%s", err);
+        return data_error(c, "%s", err);
     if (cfg) {
         ip = cfg->daemon.indicators;
         if (!found) {
@@ -859,7 +859,7 @@ static int report_main(options *op)
     char err[512];
     int rc = 0, printed = 0;
     memset(&c, 0, sizeof c);
-    g_db = o.pg ? o.site : o.db;
+    c.name = o.pg ? o.site : o.db;
     /* --config: thresholds, names, legal limits; else the defaults */
     amfi_site_config *cfg = malloc(sizeof *cfg);
     if (!cfg) {
@@ -895,7 +895,7 @@ static int report_main(options *op)
             continue;
         int yes = 0;
         if (sections[k].default_if(c.s, &yes, err, sizeof err) != 0) {
-            data_error("%s", err);
+            data_error(&c, "%s", err);
             amfi_store_close(c.s);
             free(cfg);
             return EXIT_DATA;
@@ -910,7 +910,7 @@ static int report_main(options *op)
         return rc == 0 ? 0 : EXIT_DATA;
     }
     if (o.baseline_last || o.baseline_given) {
-        rc = set_baseline(&o);
+        rc = set_baseline(&o, &c);
         printed = rc == 0;
     }
     for (int k = 0; rc == 0 && k < N_SECTIONS; k++)
@@ -919,7 +919,7 @@ static int report_main(options *op)
     if (rc == 0 && o.plot_dir) {
         if (printed)
             printf("\n");
-        rc = plot(&o, o.config ? cfg : NULL, c.s);
+        rc = plot(&o, o.config ? cfg : NULL, &c);
         printed = 1;
     }
     if (rc == 0 && o.check) {
@@ -929,7 +929,7 @@ static int report_main(options *op)
             printf("\n");
         printf("integrity    %s\n", result);
         if (st != 0 || strcmp(result, "ok") != 0)
-            rc = data_error("integrity check failed: %s", result);
+            rc = data_error(&c, "integrity check failed: %s", result);
     }
     if (rc == 0 && (o.sel[SEC_SUMMARY] || o.sel[SEC_TREND] || o.sel[SEC_ALERTS]
                     || o.sel[SEC_ERRORS] || o.baseline_last || o.baseline_given))

@@ -69,6 +69,7 @@ typedef struct export_opts {
 typedef struct report_ctx {
     amfi_store *s;                /* the store, opened read-only */
     const char *db;               /* its path */
+    const char *name;             /* what messages name: db, or the site with --pg */
     const char *site;             /* --site with --pg, else NULL */
     export_opts ex;               /* the filter and parameters of this section */
     int format;                   /* FMT_* */
