@@ -69,8 +69,10 @@ static const report_col passage_cols[] = {
     REPORT_COL("speed_mps", COL_NUM, "m/s", "%.3f", COL_BOTH, p_speed),
     REPORT_COL("n_axles", COL_INT, "", NULL, COL_BOTH, p_axles),
     REPORT_COL("gvw_kg", COL_NUM, "kg", "%.1f", COL_BOTH, p_gvw),
-    REPORT_COL("axle%d_kg", COL_NUMS, "kg", "%.1f", COL_BOTH, p_loads, .json = "axle_kg", .width = AMFI_MAX_AXLES),
-    REPORT_COL("spacing%d_m", COL_NUMS, "m", "%.3f", COL_BOTH, p_spacing, .json = "spacing_m", .width = AMFI_MAX_AXLES - 1),
+    REPORT_COL("axle%d_kg", COL_NUMS, "kg", "%.1f", COL_BOTH, p_loads,
+               .json = "axle_kg", .width = AMFI_MAX_AXLES),
+    REPORT_COL("spacing%d_m", COL_NUMS, "m", "%.3f", COL_BOTH, p_spacing,
+               .json = "spacing_m", .width = AMFI_MAX_AXLES - 1),
     REPORT_COL("status", COL_TEXT, "", NULL, COL_BOTH, p_status),
     REPORT_COL("reason", COL_TEXT, "", NULL, COL_BOTH, p_reason),
     REPORT_COL("speed_given_mps", COL_NUM, "m/s", "%.3f", COL_BOTH, p_given),
@@ -266,7 +268,8 @@ static void b_all(const void *w, report_val *v) { v->i = ((const bin_row *)w)->a
 static const report_col bin_cols[] = {
     REPORT_COL("gvw_from_kg", COL_NUM, "kg", "%.0f", COL_BOTH, b_lo),
     REPORT_COL("gvw_to_kg", COL_NUM, "kg", "%.0f", COL_BOTH, b_hi),
-    REPORT_COL("lane_%d", COL_INTS, "", NULL, COL_BOTH, b_counts, .json = "counts"), /* one per lane */
+    REPORT_COL("lane_%d", COL_INTS, "", NULL, COL_BOTH, b_counts,
+               .json = "counts"), /* one per lane */
     REPORT_COL("all", COL_INT, "", NULL, COL_BOTH, b_all),
 };
 
