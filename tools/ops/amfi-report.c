@@ -332,6 +332,8 @@ static int parse_baseline(const char *arg, options *o)
     return 0;
 }
 
+static int check_args(options *o);
+
 static int parse_args(int argc, char **argv, options *o)
 {
     struct option longopts[N_OPTION_ROWS + N_SECTIONS + 1];
@@ -451,6 +453,13 @@ static int parse_args(int argc, char **argv, options *o)
             break;
         }
     }
+    return check_args(o);
+}
+
+/* The rules between options, in the order they are checked; then the
+ * default sections when none was asked for. */
+static int check_args(options *o)
+{
     int asked = 0, n_status = 0; /* sections asked for; of them, those --status filters */
     for (int k = 0; k < N_SECTIONS; k++)
         asked += o->sel[k];
