@@ -80,7 +80,7 @@
  * script's settings, so they are drawn in this order whatever the section
  * order), its PNG, what it shows, and the function that writes it. */
 typedef struct plot_def {
-    int place; /* 1, 2, ...; 0 ends a row's list */
+    int place; /* > 0; 0 ends a row's list */
     const char *png, *what;
     report_plot_fn draw;
 } plot_def;
@@ -112,46 +112,61 @@ enum { SEC_SUMMARY, SEC_TREND, SEC_ALERTS, SEC_ERRORS, SEC_PASSAGES, SEC_HISTOGR
        SEC_SPEED, N_SECTIONS };
 
 static const section sections[N_SECTIONS] = {
-    [SEC_SUMMARY] = {"summary", 's', "passages by status, GVW of the ok ones, time span, baseline",
-                     summary_table, summary_export,
-                     {{7, "scale.png", "scale indicator: raw and temperature-compensated scale, "
-                       "CUSUM and threshold", scale_plot_scale},
-                      {8, "known_truck.png", "known-truck runs: ratio inferred / reference, raw "
-                       "and compensated", scale_plot_known_truck},
-                      {9, "temperature.png", "deck and air temperature", scale_plot_temperature},
-                      {10, "natfreq.png", "natural frequency per passage, raw and "
-                       "temperature-compensated", natfreq_plot}},
-                     0, 1, NULL, NULL, 0},
-    [SEC_TREND] = {"trend", 't', "the last " STR(REPORT_TREND_ROWS) " indicators", trend_table,
-                   trend_export,
-                   {{2, "trend.png", "indicator trend, thresholds, alerts raised and cleared",
-                     indicators_plot_trend}},
-                   0, 1, NULL, NULL, 0},
-    [SEC_ALERTS] = {"alerts", 'a', "the last " STR(REPORT_ALERT_ROWS) " alerts and those open now",
-                    alerts_table, alerts_export, {{0}}, 0, 1, NULL, NULL, 0},
-    [SEC_ERRORS] = {"errors", 'e', "inferred GVW against the truth (simulations)", errors_table,
-                    errors_export, {{0}}, 0, 0, NULL, NULL, 0},
-    [SEC_PASSAGES] = {"passages", 'P', "one line per passage: time, lane, speed, axles, GVW,\n"
-                      "axle loads, status, reason", passages_table, passages_export,
-                      {{1, "gvw.png", "inferred GVW per passage over time, baseline band",
-                        passages_plot_gvw},
-                       {4, "passages_per_hour.png", "passages per hour by status",
-                        passages_plot_per_hour},
-                       {5, "speed.png", "speed distribution", passages_plot_speed}},
-                      F_RANGE | F_STATUS, 0, NULL, NULL, 1},
-    [SEC_HISTOGRAM] = {"histogram", 'H', "GVW histogram of the ok passages per lane",
-                       histogram_table, histogram_export,
-                       {{3, "gvw_histogram.png", "GVW histogram, baseline against the latest "
-                         "window", passages_plot_histogram}},
-                       F_RANGE, 0, NULL, NULL, 0},
-    [SEC_OVERLOADS] = {"overloads", 'O', "ok passages over the legal GVW or axle limit (--config)",
-                       overloads_table, overloads_export, {{0}}, F_RANGE, 0, NULL, NULL, 0},
-    [SEC_SPEED] = {"speed", 'C', "speed corrections of the estimated passages (speed used /\n"
-                   "detector's - 1): distribution, one line per day", speed_table, speed_export,
-                   {{6, "speed_correction.png", "daily median speed correction, p5 .. p95",
-                     speed_plot_correction}},
-                   F_RANGE, 1, amfi_store_has_estimated,
-                   "when the store has estimated speeds", 0},
+    [SEC_SUMMARY] = {
+        .name = "summary", .key = 's',
+        .help = "passages by status, GVW of the ok ones, time span, baseline",
+        .table = summary_table, .export = summary_export,
+        .plots = {{7, "scale.png", "scale indicator: raw and temperature-compensated scale, "
+                   "CUSUM and threshold", scale_plot_scale},
+                  {8, "known_truck.png", "known-truck runs: ratio inferred / reference, raw and "
+                   "compensated", scale_plot_known_truck},
+                  {9, "temperature.png", "deck and air temperature", scale_plot_temperature},
+                  {10, "natfreq.png", "natural frequency per passage, raw and "
+                   "temperature-compensated", natfreq_plot}},
+        .by_default = 1},
+    [SEC_TREND] = {
+        .name = "trend", .key = 't', .help = "the last " STR(REPORT_TREND_ROWS) " indicators",
+        .table = trend_table, .export = trend_export,
+        .plots = {{2, "trend.png", "indicator trend, thresholds, alerts raised and cleared",
+                   indicators_plot_trend}},
+        .by_default = 1},
+    [SEC_ALERTS] = {
+        .name = "alerts", .key = 'a',
+        .help = "the last " STR(REPORT_ALERT_ROWS) " alerts and those open now",
+        .table = alerts_table, .export = alerts_export, .by_default = 1},
+    [SEC_ERRORS] = {
+        .name = "errors", .key = 'e', .help = "inferred GVW against the truth (simulations)",
+        .table = errors_table, .export = errors_export},
+    [SEC_PASSAGES] = {
+        .name = "passages", .key = 'P',
+        .help = "one line per passage: time, lane, speed, axles, GVW,\n"
+                "axle loads, status, reason",
+        .table = passages_table, .export = passages_export,
+        .plots = {{1, "gvw.png", "inferred GVW per passage over time, baseline band",
+                   passages_plot_gvw},
+                  {4, "passages_per_hour.png", "passages per hour by status",
+                   passages_plot_per_hour},
+                  {5, "speed.png", "speed distribution", passages_plot_speed}},
+        .filters = F_RANGE | F_STATUS, .streamed = 1},
+    [SEC_HISTOGRAM] = {
+        .name = "histogram", .key = 'H', .help = "GVW histogram of the ok passages per lane",
+        .table = histogram_table, .export = histogram_export,
+        .plots = {{3, "gvw_histogram.png", "GVW histogram, baseline against the latest window",
+                   passages_plot_histogram}},
+        .filters = F_RANGE},
+    [SEC_OVERLOADS] = {
+        .name = "overloads", .key = 'O',
+        .help = "ok passages over the legal GVW or axle limit (--config)",
+        .table = overloads_table, .export = overloads_export, .filters = F_RANGE},
+    [SEC_SPEED] = {
+        .name = "speed", .key = 'C',
+        .help = "speed corrections of the estimated passages (speed used /\n"
+                "detector's - 1): distribution, one line per day",
+        .table = speed_table, .export = speed_export,
+        .plots = {{6, "speed_correction.png", "daily median speed correction, p5 .. p95",
+                   speed_plot_correction}},
+        .filters = F_RANGE, .by_default = 1, .default_if = amfi_store_has_estimated,
+        .default_when = "when the store has estimated speeds"},
 };
 
 /* ---- the other options ------------------------------------------------------- */
@@ -781,23 +796,24 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
         const char *b = strrchr(o->db, '/');
         snprintf(site, sizeof site, "%s", b ? b + 1 : o->db);
     }
-    enum { MAX_PLOTS = 32 };
-    const plot_def *made[MAX_PLOTS];
-    int n_made = 0, rc = 0;
+    /* every section's plots in their places */
+    enum { MAX_PLOTS = N_SECTIONS * 4 };
+    const plot_def *order[MAX_PLOTS], *made[MAX_PLOTS];
+    int n_plots = 0, n_made = 0, rc = 0;
+    for (int k = 0; k < N_SECTIONS; k++)
+        for (int j = 0; j < 4 && sections[k].plots[j].place > 0; j++) {
+            int i = n_plots++;
+            for (; i > 0 && order[i - 1]->place > sections[k].plots[j].place; i--)
+                order[i] = order[i - 1];
+            order[i] = &sections[k].plots[j];
+        }
     report_plot_frame p;
     rc = report_plot_begin(&p, s, o->plot_dir, site, &ip, err, sizeof err);
-    for (int place = 1; rc == 0; place++) {
-        const plot_def *d = NULL;
-        for (int k = 0; k < N_SECTIONS && !d; k++)
-            for (int j = 0; j < 4 && sections[k].plots[j].place; j++)
-                if (sections[k].plots[j].place == place)
-                    d = &sections[k].plots[j];
-        if (!d)
-            break; /* the places are 1, 2, ... without a gap */
+    for (int i = 0; rc == 0 && i < n_plots; i++) {
         int drawn = 0;
-        rc = d->draw(&p, &drawn, err, sizeof err);
-        if (rc == 0 && drawn && n_made < MAX_PLOTS)
-            made[n_made++] = d;
+        rc = order[i]->draw(&p, &drawn, err, sizeof err);
+        if (rc == 0 && drawn)
+            made[n_made++] = order[i];
     }
     if (rc == 0)
         rc = report_plot_run(&p, err, sizeof err);
