@@ -1,3 +1,4 @@
+-- SPDX-License-Identifier: GPL-3.0-or-later
 -- report_golden fixture: every section of amfi-report has rows (values chosen
 -- so that their statistics are exact in binary floating point).
 -- 48 passages half an hour apart from 2025-11-22 00:00 UTC, lanes 1 and 2;
