@@ -61,7 +61,8 @@ typedef struct report_val {
 typedef struct report_col {
     const char *name;   /* CSV header or item; and JSON key unless json is set */
     report_col_type type;
-    const char *unit;   /* "kg", "us", "m/s", "%", "Hz", "" */
+    const char *unit;   /* "kg", "us", "m/s", "%", "Hz", "": what the value is in (the
+                         * names say it too: mean_kg); for the reader of the list */
     const char *fmt;    /* CSV printf of a number (COL_NUM, COL_NUMS) */
     unsigned in;        /* COL_CSV | COL_JSON | COL_JSON2 */
     void (*get)(const void *row, report_val *v);
