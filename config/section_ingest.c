@@ -129,7 +129,7 @@ static void d_channels(const field *f, const void *base, char *buf)
 {
     (void)f;
     (void)base;
-    snprintf(buf, DOC_LEN, "0 .. %d channels", AMFI_INGEST_MAX_CHANNELS);
+    snprintf(buf, DOC_LEN, "1 .. %d channels", AMFI_INGEST_MAX_CHANNELS);
 }
 
 static void v_channels(const field *f, const void *base, char *buf)
