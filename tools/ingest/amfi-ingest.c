@@ -453,8 +453,10 @@ static int run_service(const opts *o, ingest *g)
             }
         }
         ingest_flush(g, 1.0); /* a partial block waits at most a second of silence */
-        if (open_streams == 0 && n_ms > 0 && lfd < 0 && sfd < 0)
-            break; /* the streams were everything, and they ended */
+        if (open_streams == 0 && lfd < 0 && sfd < 0) {
+            fprintf(stderr, "%s: every input ended\n", PROG);
+            break; /* the streams and the serial line were everything, and they ended */
+        }
     }
     ingest_flush(g, 0);
     rc = 0;
