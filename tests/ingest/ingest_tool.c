@@ -24,6 +24,8 @@
  *       give it: DIR/sSENSOR.mseed (Steim-2, 512-byte records, 1e-6 m/s²
  *       per count, channel XX.BRG.00.HN<sensor>), DIR/vehicles.txt (V lines)
  *       and DIR/truth.csv (vehicle_id,gvw_kg).
+ *   ingest_tool cut IN.mseed OUT.mseed UTIME
+ *       IN without the 512-byte record that holds data time UTIME.
  *   ingest_tool send HOST PORT FILE
  *       FILE's bytes to a TCP listener, then close.
  *   ingest_tool pty FILE NAMEFILE GOFILE DONEFILE
@@ -485,6 +487,37 @@ static int from_log(const char *logp, const char *dir)
     return ntr ? 0 : 1;
 }
 
+/* ---- cut: a record lost ---- */
+
+/* IN without the record (512 bytes each, as from-log writes them) that
+ * holds data time UTIME; prints the record's number and sample range. */
+static int cut(const char *in, const char *out, long long utime)
+{
+    FILE *f = fopen(in, "rb"), *o = fopen(out, "wb");
+    char r[512];
+    int n = 0, cut_at = 0;
+    if (!f || !o)
+        return 1;
+    while (fread(r, 1, sizeof r, f) == sizeof r) {
+        n++;
+        MSRecord *m = NULL;
+        if (msr_unpack(r, (int)sizeof r, &m, 0, 0) != MS_NOERROR)
+            return 1;
+        const long long t0 = (long long)m->starttime;
+        const long long t1 = t0 + (long long)llround((double)m->samplecnt * 1e6 / m->samprate);
+        if (!cut_at && utime >= t0 && utime < t1) {
+            cut_at = n;
+            printf("record %d: %lld .. %lld cut\n", n, t0, t1);
+        } else {
+            fwrite(r, 1, sizeof r, o);
+        }
+        msr_free(&m);
+    }
+    fclose(f);
+    fclose(o);
+    return cut_at ? 0 : 1;
+}
+
 /* ---- send, pty ---- */
 
 static int send_file(const char *host, int port, const char *path)
@@ -548,11 +581,13 @@ int main(int argc, char **argv)
         return verify(argc - 2, argv + 2);
     if (argc == 4 && !strcmp(argv[1], "from-log"))
         return from_log(argv[2], argv[3]);
+    if (argc == 5 && !strcmp(argv[1], "cut"))
+        return cut(argv[2], argv[3], atoll(argv[4]));
     if (argc == 5 && !strcmp(argv[1], "send"))
         return send_file(argv[2], atoi(argv[3]), argv[4]);
     if (argc == 6 && !strcmp(argv[1], "pty"))
         return pty(argv[2], argv[3], argv[4], argv[5]);
     fprintf(stderr, "usage: ingest_tool gen DIR | verify LOG KEY T0_US [S=OFF]... | "
-            "from-log SIMLOG DIR | send HOST PORT FILE | pty FILE NAMEFILE GO DONE\n");
+            "from-log SIMLOG DIR | cut IN OUT UTIME | send HOST PORT FILE | pty FILE NAMEFILE GO DONE\n");
     return 2;
 }
