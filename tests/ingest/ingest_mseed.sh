@@ -5,7 +5,7 @@
 # channels in five files given out of order; a 0.25 s gap; a record
 # repeated and one overlapping by 30 samples; a record with corrupted Steim
 # data and one with a destroyed header; a channel not configured; a channel
-# with a latency. The messages go to an LCM log (LCM's file:// provider: no
+# with a latency, a record at another rate than the sensor's. The messages go to an LCM log (LCM's file:// provider: no
 # network at all) and are verified sample by sample: signed, every value
 # the generator's, every sample once, a gap a gap (no sample invented), the
 # corrupt records' samples missing and named by file:record. Then the same
@@ -67,7 +67,10 @@ grep -q "b.mseed:record 38 (XX.BRG.00.HNN): sensor 5: overlap: 30 of $rep sample
 nrec=$(awk '/^records/ {print $2}' "$dir/expect.txt")
 grep -q "amfi-ingest: $nrec records, 0 lines; published .* signed" "$dir/ingest.log" ||
   fail "summary: expected $nrec records"
-grep -q "bad record 2, bad line 0, unmapped channel 1, gap 3 .*, overlap 2 ($((rep + 30)) samples dropped), time jump 0, time back 0, wall clock 0, publish failed 0" \
+c2n=$(( $(wc -c < "$dir/c2.mseed") / 512 ))
+grep -q "c2.mseed:record $c2n (XX.BRG.00.HNE): sample rate: 500 Hz differs from sensors\[2\].rate_hz (1000 Hz) of sensor 7: refused" \
+  "$dir/ingest.log" || fail "the record at another rate is not named"
+grep -q "bad record 3, bad line 0, unmapped channel 1, gap 3 .*, overlap 2 ($((rep + 30)) samples dropped), time jump 0, time back 0, wall clock 0, publish failed 0" \
   "$dir/ingest.log" || fail "summary counts: $(tail -1 "$dir/ingest.log")"
 
 # The same channel as a stream on stdin, record by record: the same samples.

@@ -9,7 +9,8 @@
  *       of a channel not configured; XX.BRG.00.HNN (sensor 5) int32 in
  *       b.mseed with a record repeated (overlap), a record whose header is
  *       destroyed, and a last record that overlaps by 30 samples;
- *       XX.BRG.00.HNE (sensor 7) float32 in c1.mseed, float64 in c2.mseed.
+ *       XX.BRG.00.HNE (sensor 7) float32 in c1.mseed, float64 in c2.mseed
+ *       (its last record at 500 Hz, not the sensor's rate).
  *       Sample k of sensor s: round(1000 sin(2π k / 50 + s)) counts at
  *       T0 + k ms. DIR/expect.txt: "SENSOR INTERVALS" of the samples that
  *       must arrive (the corrupted records' missing).
@@ -88,6 +89,8 @@ static void collect(char *record, int reclen, void *arg)
 
 /* Pack samples k0 .. k0+n-1 of sensor s on channel cha with encoding enc
  * into rs (appended), each record's sample range noted. */
+static double pack_rate = RATE; /* the records' sample rate */
+
 static void pack(recs *rs, int s, const char *cha, long k0, long n, int enc, int reclen)
 {
     MSRecord *m = msr_init(NULL);
@@ -96,7 +99,7 @@ static void pack(recs *rs, int s, const char *cha, long k0, long n, int enc, int
     strcpy(m->location, "00");
     strcpy(m->channel, cha);
     m->starttime = (hptime_t)(T0_US + k0 * 1000);
-    m->samprate = RATE;
+    m->samprate = pack_rate;
     m->reclen = reclen;
     m->encoding = (int8_t)enc;
     m->byteorder = 1;
@@ -234,6 +237,9 @@ static int gen(const char *dir)
     /* sensor 7: float32 0 .. 1999 then float64 2000 .. 3999 */
     pack(&c1, 7, "HNE", 0, 2000, DE_FLOAT32, 512);
     pack(&c2, 7, "HNE", 2000, 2000, DE_FLOAT64, 512);
+    pack_rate = 500.0; /* a record at another rate than the sensor's: refused */
+    pack(&c2, 7, "HNE", 4000, 50, DE_FLOAT64, 512);
+    pack_rate = RATE;
     kept[2][nk[2]][0] = 0, kept[2][nk[2]++][1] = 3999;
     write_recs(dir, "c1.mseed", &c1);
     write_recs(dir, "c2.mseed", &c2);

@@ -147,8 +147,7 @@ typedef struct line_src {
 } line_src;
 
 /* One line (NUL-terminated, without the newline) from `where` ("NAME:line N"):
- * parsed, checked and published. 0 ok (or a comment), -1 refused (counted).
- * *utime_us gets the line's data time (0 for a comment). */
+ * parsed, checked and published. 0 ok (or a comment), -1 refused (counted). */
 int line_handle(ingest *g, char *line, const char *where);
 /* The data time of a line without publishing it (for the merge of files):
  * 0 when it has none (comment, unparsable). */

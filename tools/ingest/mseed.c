@@ -264,7 +264,11 @@ void mseed_publish(mseed_src *m, ingest *g)
                                           : ((const double *)r->datasamples)[k];
         v[k] = x * m->gain;
     }
-    const double rate = msr_samprate(r);
+    /* the nominal rate (the header's factor and multiplier), not blockette
+     * 100's measured one: the samples are placed by each record's own start
+     * time, so a logger whose clock runs a few ppm off is followed record by
+     * record, and the rate on the bus stays the sensor's rate_hz */
+    const double rate = msr_nomsamprate(r);
     if (!(rate > 0)) {
         ingest_note(g, BAD_RECORD, where, "sample rate", "%g Hz in the header", rate);
     } else {
