@@ -83,13 +83,20 @@ cat "$dir/a1.mseed" "$dir/a2.mseed" | "$ingest" --config "$dir/site.yaml" \
 grep -q "stdin: end of the stream" "$dir/stream.log" || fail "stdin: no end of the stream"
 # the data are from 2026-01-01, the service checks them against the wall clock
 grep -q "wall clock [1-9]" "$dir/stream.log" || fail "a stream far from the wall clock not counted"
-# a FIFO written in pieces
+# A FIFO written in pieces by two writers one after the other (a logger that
+# restarts): the service holds it open, one stream; SIGTERM ends it.
 mkfifo "$dir/fifo"
 "$ingest" --config "$dir/site.yaml" --lcm-url "file://$dir/fifo.lcmlog?mode=w" \
   --mseed-stream "$dir/fifo" --listen none 2> "$dir/fifo.log" &
 ipid=$!
-{ head -c 700 "$dir/c1.mseed"; sleep 0.3; tail -c +701 "$dir/c1.mseed"; cat "$dir/c2.mseed"; } > "$dir/fifo"
-wait $ipid || fail "stream from a FIFO: exit status $?"
+sleep 0.3  # the service waits for a writer without ending
+kill -0 $ipid || fail "the service ended before the FIFO had a writer"
+{ head -c 700 "$dir/c1.mseed"; sleep 0.3; tail -c +701 "$dir/c1.mseed"; } > "$dir/fifo"
+cat "$dir/c2.mseed" > "$dir/fifo"
+nf=$(( ($(wc -c < "$dir/c1.mseed") + $(wc -c < "$dir/c2.mseed")) / 512 ))
+i=0; until kill -USR1 $ipid && sleep 0.2 && grep -q "amfi-ingest: $nf records" "$dir/fifo.log"; do
+  i=$((i + 1)); [ $i -lt 300 ] || fail "the FIFO was not read to its end"; done
+kill -TERM $ipid; wait $ipid || fail "stream from a FIFO: exit status $?"
 "$tool" verify "$dir/fifo.lcmlog" "$bus_key" $T0 7=500000 > "$dir/got3.log" || fail "verify (FIFO)"
 grep -q "^sensor 7 intervals 0-3999$" "$dir/got3.log" || fail "FIFO: sensor 7 incomplete"
 

@@ -53,7 +53,10 @@ int mseed_open(mseed_src *m, const char *path, int follow, char *err, size_t err
     memset(m, 0, sizeof *m);
     m->idx = -1;
     snprintf(m->name, sizeof m->name, "%s", strcmp(path, "-") ? path : "stdin");
-    m->fd = strcmp(path, "-") ? open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK) : 0;
+    /* files: blocking reads; a service's streams: non-blocking, read when
+     * poll() says so (a followed regular file every turn) */
+    const int nb = follow ? O_NONBLOCK : 0;
+    m->fd = strcmp(path, "-") ? open(path, O_RDONLY | O_CLOEXEC | nb) : 0;
     if (m->fd < 0) {
         snprintf(err, errlen, "%s: %s", path, strerror(errno));
         return -1;
@@ -64,6 +67,24 @@ int mseed_open(mseed_src *m, const char *path, int follow, char *err, size_t err
         if (m->fd > 0)
             close(m->fd);
         return -1;
+    }
+    if (follow && S_ISFIFO(sb.st_mode) && m->fd > 0) {
+        /* A named FIFO of the service is held open for writing too: no end
+         * of file when its writer closes or has not opened it yet (a logger
+         * that restarts reopens it and the stream goes on). */
+        int rw = open(path, O_RDWR | O_CLOEXEC | O_NONBLOCK);
+        if (rw < 0) {
+            snprintf(err, errlen, "%s: %s", path, strerror(errno));
+            close(m->fd);
+            return -1;
+        }
+        close(m->fd);
+        m->fd = rw;
+    }
+    if (follow && m->fd == 0) {
+        int fl = fcntl(0, F_GETFL);
+        if (fl >= 0)
+            fcntl(0, F_SETFL, fl | O_NONBLOCK);
     }
     m->follow = follow && S_ISREG(sb.st_mode);
     return 0;
