@@ -113,23 +113,50 @@ kill -TERM $ipid; wait $ipid || fail "SIGTERM: exit status $?"
 grep -q "^sensor 7 intervals 0-3999$" "$dir/got4.log" || fail "growing file: sensor 7 incomplete"
 
 # The configuration's refusals name the file and line.
-check_bad() { # LINE-EXPECTED MESSAGE-PATTERN; the YAML on stdin
-  cat > "$dir/bad.yaml"
+check_bad() { # LINE-EXPECTED MESSAGE-PATTERN; the YAML in $dir/bad.yaml
   "$ingest" --config "$dir/bad.yaml" --check-config > /dev/null 2> "$dir/bad.log" &&
     fail "accepted: $(cat "$dir/bad.yaml")"
   grep -q "bad.yaml:$1: $2" "$dir/bad.log" || fail "expected 'bad.yaml:$1: $2', got: $(cat "$dir/bad.log")"
 }
-printf 'sensors:\n  - {id: 3, at_m: 5}\ningest:\n  channels:\n    - {seed: XX.BRG.00.HNZ, sensor: 4, gain: 1}\n' |
-  check_bad 5 "ingest.channels\[0\].sensor: sensor 4 is not in sensors:"
-printf 'sensors:\n  - {id: 3, at_m: 5}\ningest:\n  channels:\n    - {seed: XX.BRG.HNZ, sensor: 3, gain: 1}\n' |
-  check_bad 5 "ingest.channels\[0\].seed: must be NET.STA.LOC.CHA"
-printf 'sensors:\n  - {id: 3, at_m: 5}\ningest:\n  channels:\n    - {seed: XX.BRG.00.HNZ, sensor: 3}\n' |
-  check_bad 5 "ingest.channels\[0\].gain: required"
-printf 'ingest:\n  line:\n    listen: localhost:80\n' |
-  check_bad 3 "ingest.line.listen: must be IPV4-ADDRESS:PORT"
-printf 'ingest:\n  line:\n    baud: 9601\n' | check_bad 3 "ingest.line.baud:"
-printf 'ingest:\n  block: 161\n' | check_bad 2 "ingest.block:"
-printf 'ingest:\n  producer: "a b"\n' | check_bad 2 "ingest.producer: must be"
+printf 'sensors:\n  - {id: 3, at_m: 5}\ningest:\n  channels:\n    - {seed: XX.BRG.00.HNZ, sensor: 4, gain: 1}\n' > "$dir/bad.yaml"
+check_bad 5 "ingest.channels\[0\].sensor: sensor 4 is not in sensors:"
+printf 'sensors:\n  - {id: 3, at_m: 5}\ningest:\n  channels:\n    - {seed: XX.BRG.HNZ, sensor: 3, gain: 1}\n' > "$dir/bad.yaml"
+check_bad 5 "ingest.channels\[0\].seed: must be NET.STA.LOC.CHA"
+printf 'sensors:\n  - {id: 3, at_m: 5}\ningest:\n  channels:\n    - {seed: XX.BRG.00.HNZ, sensor: 3}\n' > "$dir/bad.yaml"
+check_bad 5 "ingest.channels\[0\].gain: missing (required)"
+printf 'sensors:\n  - {id: 3, at_m: 5}\n  - {id: 4, at_m: 6}\ningest:\n  channels:\n    - {seed: XX.BRG.00.HNZ, sensor: 3, gain: 1}\n    - {seed: XX.BRG.00.HNZ, sensor: 4, gain: 1}\n' > "$dir/bad.yaml"
+check_bad 7 "ingest.channels\[1\].seed: duplicate channel XX.BRG.00.HNZ (also ingest.channels\[0\])"
+printf 'sensors:\n  - {id: 3, at_m: 5}\ningest:\n  channels:\n    - {seed: XX.BRG.00.HNZ, sensor: 3, gain: 1}\n    - {seed: XX.BRG.00.HNN, sensor: 3, gain: 1}\n' > "$dir/bad.yaml"
+check_bad 6 "ingest.channels\[1\].sensor: sensor 3 is fed by ingest.channels\[0\] already"
+printf 'ingest:\n  line:\n    listen: localhost:80\n' > "$dir/bad.yaml"
+check_bad 3 "ingest.line.listen: must be IPV4-ADDRESS:PORT"
+printf 'ingest:\n  line:\n    baud: 9601\n' > "$dir/bad.yaml"
+check_bad 3 "ingest.line.baud:"
+printf 'ingest:\n  block: 161\n' > "$dir/bad.yaml"
+check_bad 2 "ingest.block:"
+printf 'ingest:\n  producer: "a b"\n' > "$dir/bad.yaml"
+check_bad 2 "ingest.producer: must be"
+printf 'ingest:\n  max_jump_s: 0\n' > "$dir/bad.yaml"
+check_bad 2 "ingest.max_jump_s:"
+
+# Hostile input: the files with bytes changed (24 variants), random bytes,
+# random lines: every one read to its end, counted, nothing crashes (the
+# ASan tree runs this too).
+cat "$dir/a1.mseed" "$dir/a2.mseed" "$dir/b.mseed" "$dir/c1.mseed" "$dir/c2.mseed" > "$dir/all.mseed"
+s=0; while [ $s -lt 24 ]; do
+  "$tool" mutate "$dir/all.mseed" "$dir/m.mseed" $s || fail "mutate"
+  "$ingest" --config "$dir/site.yaml" --lcm-url "file://$dir/m.lcmlog?mode=w" "$dir/m.mseed" \
+    2> "$dir/hostile.log" || fail "mutated file $s: exit status $?"
+  grep -q "^amfi-ingest: bad record [0-9]*, " "$dir/hostile.log" || fail "mutated file $s: no summary"
+  s=$((s + 1))
+done
+head -c 100000 /dev/urandom > "$dir/random.bin"
+awk 'BEGIN { srand(7); split("A V 3 5 7 1767225600000000 -1 1000 nan inf 1e400 0.1 id= ref=5000 12 13 0 99999999999999999999 x -0 1e-320", t, " ")
+  for (i = 0; i < 2000; i++) { n = int(rand() * 30); l = ""; for (j = 0; j < n; j++) l = l " " t[1 + int(rand() * 21)]; print l } }' > "$dir/random.txt"
+"$ingest" --config "$dir/site.yaml" --lcm-url "file://$dir/r.lcmlog?mode=w" "$dir/random.bin" \
+  --lines "$dir/random.txt" --lines "$dir/random.bin" 2> "$dir/hostile.log" || fail "random input: exit status $?"
+grep -q "^amfi-ingest: bad record [1-9][0-9]*, bad line [1-9][0-9]*, " "$dir/hostile.log" ||
+  fail "random input: not counted as bad"
 
 # Without a key it does not publish (unless told --unsigned).
 env -u CREDENTIALS_DIRECTORY "$ingest" --config "$dir/site.yaml" --lcm-url "file://$dir/x.lcmlog?mode=w" \

@@ -27,6 +27,9 @@
  *       and DIR/truth.csv (vehicle_id,gvw_kg).
  *   ingest_tool cut IN.mseed OUT.mseed UTIME
  *       IN without the 512-byte record that holds data time UTIME.
+ *   ingest_tool mutate IN OUT SEED
+ *       IN with 1, 5, 50 or 500 bytes changed (by SEED), every fourth
+ *       seed also cut short.
  *   ingest_tool send HOST PORT FILE
  *       FILE's bytes to a TCP listener, then close.
  *   ingest_tool pty FILE NAMEFILE GOFILE DONEFILE
@@ -524,6 +527,39 @@ static int cut(const char *in, const char *out, long long utime)
     return cut_at ? 0 : 1;
 }
 
+/* ---- mutate: hostile input ---- */
+
+/* IN with bytes changed (a linear congruential generator seeded with SEED:
+ * 1, 5, 50 or 500 bytes set to random values, every fourth copy also cut
+ * short) into OUT. */
+static unsigned long long lcg;
+static unsigned rnd(void)
+{
+    lcg = lcg * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (unsigned)(lcg >> 33);
+}
+
+static int mutate(const char *in, const char *out, unsigned seed)
+{
+    FILE *f = fopen(in, "rb");
+    if (!f)
+        return 1;
+    static unsigned char b[1 << 22];
+    size_t n = fread(b, 1, sizeof b, f);
+    fclose(f);
+    lcg = 0x9e3779b97f4a7c15ULL ^ seed;
+    const int changes[4] = {1, 5, 50, 500};
+    for (int i = changes[seed % 4]; i > 0 && n; i--)
+        b[rnd() % n] = (unsigned char)rnd();
+    if (seed % 4 == 3 && n)
+        n = rnd() % n;
+    FILE *o = fopen(out, "wb");
+    if (!o || fwrite(b, 1, n, o) != n)
+        return 1;
+    fclose(o);
+    return 0;
+}
+
 /* ---- send, pty ---- */
 
 static int send_file(const char *host, int port, const char *path)
@@ -589,11 +625,13 @@ int main(int argc, char **argv)
         return from_log(argv[2], argv[3]);
     if (argc == 5 && !strcmp(argv[1], "cut"))
         return cut(argv[2], argv[3], atoll(argv[4]));
+    if (argc == 5 && !strcmp(argv[1], "mutate"))
+        return mutate(argv[2], argv[3], (unsigned)atoi(argv[4]));
     if (argc == 5 && !strcmp(argv[1], "send"))
         return send_file(argv[2], atoi(argv[3]), argv[4]);
     if (argc == 6 && !strcmp(argv[1], "pty"))
         return pty(argv[2], argv[3], argv[4], argv[5]);
     fprintf(stderr, "usage: ingest_tool gen DIR | verify LOG KEY T0_US [S=OFF]... | "
-            "from-log SIMLOG DIR | cut IN OUT UTIME | send HOST PORT FILE | pty FILE NAMEFILE GO DONE\n");
+            "from-log SIMLOG DIR | cut IN OUT UTIME | mutate IN OUT SEED | send HOST PORT FILE | pty FILE NAMEFILE GO DONE\n");
     return 2;
 }
