@@ -8,9 +8,10 @@
  *       with one record's data corrupted (Steim integrity) and one record
  *       of a channel not configured; XX.BRG.00.HNN (sensor 5) int32 in
  *       b.mseed with a record repeated (overlap), a record whose header is
- *       destroyed, and a last record that overlaps by 30 samples;
+ *       destroyed, and a last record (int16) that overlaps by 30 samples;
  *       XX.BRG.00.HNE (sensor 7) float32 in c1.mseed, float64 in c2.mseed
- *       (its last record at 500 Hz, not the sensor's rate).
+ *       (its last record at 500 Hz, not the sensor's rate); huge.mseed: one
+ *       float64 record whose header claims 60000 samples.
  *       Sample k of sensor s: round(1000 sin(2π k / 50 + s)) counts at
  *       T0 + k ms. DIR/expect.txt: "SENSOR INTERVALS" of the samples that
  *       must arrive (the corrupted records' missing).
@@ -221,7 +222,7 @@ static int gen(const char *dir)
      * header destroyed; then 3970 .. 4099 (30 samples overlap) */
     static recs bb;
     pack(&bb, 5, "HNN", 0, 4000, DE_INT32, 512);
-    pack(&bb, 5, "HNN", 3970, 130, DE_INT32, 512);
+    pack(&bb, 5, "HNN", 3970, 130, DE_INT16, 512); /* one record */
     const int last = bb.n - 1;
     if (bb.n < 12) {
         fprintf(stderr, "ingest_tool: too few int32 records\n");
@@ -244,6 +245,18 @@ static int gen(const char *dir)
     pack(&c2, 7, "HNE", 4000, 50, DE_FLOAT64, 512);
     pack_rate = RATE;
     kept[2][nk[2]][0] = 0, kept[2][nk[2]++][1] = 3999;
+    /* huge.mseed: a float64 record whose header claims 60000 samples (the
+     * fixed header's number of samples, bytes 30-31, big-endian) */
+    {
+        static recs h;
+        h.n = 1;
+        h.r[0].len = c2.r[0].len;
+        h.r[0].b = malloc((size_t)h.r[0].len);
+        memcpy(h.r[0].b, c2.r[0].b, (size_t)h.r[0].len);
+        h.r[0].b[30] = (char)(60000 >> 8);
+        h.r[0].b[31] = (char)(60000 & 255);
+        write_recs(dir, "huge.mseed", &h);
+    }
     write_recs(dir, "c1.mseed", &c1);
     write_recs(dir, "c2.mseed", &c2);
     char p[4096];

@@ -148,6 +148,41 @@ static void seed_id(const MSRecord *r, char *out, size_t n)
     snprintf(out, n, "%s.%s.%s.%s", r->network, r->station, r->location, r->channel);
 }
 
+/* Whether the record's header promises no more data than the record
+ * holds. libmseed 2.19 bounds its Steim decoders by the record, but not the
+ * int16, int32, float32 and float64 ones: a header claiming more samples
+ * than fit made them read past the record (a crash found by the hostile-
+ * input test). Only the encodings below are accepted; NULL when it fits,
+ * else why not. */
+static const char *data_fits(const MSRecord *r, int reclen, char *buf, size_t n)
+{
+    const int off = r->fsdh ? r->fsdh->data_offset : 0;
+    if (off < 48 || off >= reclen) {
+        snprintf(buf, n, "the data offset %d is outside the %d-byte record", off, reclen);
+        return buf;
+    }
+    const long long avail = reclen - off, cnt = r->samplecnt;
+    long long max;
+    switch (r->encoding) {
+    case DE_INT16: max = avail / 2; break;
+    case DE_INT32:
+    case DE_FLOAT32: max = avail / 4; break;
+    case DE_FLOAT64: max = avail / 8; break;
+    case DE_STEIM1: max = avail / 64 * 15 * 4; break; /* 4 differences a word at most */
+    case DE_STEIM2: max = avail / 64 * 15 * 7; break; /* 7 differences a word at most */
+    default:
+        snprintf(buf, n, "encoding %d (%s) is not int16, int32, float32, float64, Steim-1 or Steim-2",
+                 r->encoding, ms_encodingstr(r->encoding));
+        return buf;
+    }
+    if (cnt > max) {
+        snprintf(buf, n, "%lld samples cannot fit in the record's %lld data bytes (%s)", cnt, avail,
+                 ms_encodingstr(r->encoding));
+        return buf;
+    }
+    return NULL;
+}
+
 int mseed_next(mseed_src *m, ingest *g)
 {
     char where[600];
@@ -202,7 +237,18 @@ int mseed_next(mseed_src *m, ingest *g)
         diag_last[0] = '\0';
         diag_integrity = 0;
         MSRecord *r = NULL;
-        int rc = msr_unpack((char *)DATA(m), reclen, &r, 1, 0);
+        /* the header first: the data decoded only when they fit */
+        int rc = msr_unpack((char *)DATA(m), reclen, &r, 0, 0);
+        char fits[200];
+        const char *nofit = rc == MS_NOERROR && r ? data_fits(r, reclen, fits, sizeof fits) : NULL;
+        if (nofit) {
+            consume(m, (size_t)reclen);
+            ingest_note(g, BAD_RECORD, where, "data", "%s", nofit);
+            msr_free(&r);
+            continue;
+        }
+        if (rc == MS_NOERROR)
+            rc = msr_unpack((char *)DATA(m), reclen, &r, 1, 0);
         consume(m, (size_t)reclen);
         if (rc != MS_NOERROR || !r) {
             ingest_note(g, BAD_RECORD, where, "data", "cannot decode: %s%s%s", ms_errorstr(rc),
