@@ -1,16 +1,18 @@
 #!/bin/sh
 # SPDX-License-Identifier: GPL-3.0-or-later
 # amfi-ingest on MiniSEED written by libmseed (tests/ingest/ingest_tool.c
-# gen): Steim-1, Steim-2, int32, float32 and float64 records of three
-# channels in five files given out of order (and an int16 record); a 0.25 s gap; a record
-# repeated and one overlapping by 30 samples; a record with corrupted Steim
-# data and one with a destroyed header; a channel not configured; a channel
-# with a latency, a record at another rate than the sensor's. The messages go to an LCM log (LCM's file:// provider: no
-# network at all) and are verified sample by sample: signed, every value
-# the generator's, every sample once, a gap a gap (no sample invented), the
-# corrupt records' samples missing and named by file:record. Then the same
-# files as a stream (stdin and a FIFO), the configuration's refusals by
-# file:line, and a start without a key refused.
+# gen): Steim-1, Steim-2, int16, int32, float32 and float64 records of three
+# channels in five files given out of order; a 0.25 s gap; a record repeated
+# and one overlapping by 30 samples; a record with corrupted Steim data, one
+# with a destroyed header, one at another rate than the sensor's, one whose
+# header claims 60000 samples; a channel not configured; a channel with a
+# latency. The messages go to an LCM log (LCM's file:// provider: no network
+# at all) and are verified sample by sample: signed, every value the
+# generator's, every sample once, a gap a gap (no sample invented), the
+# refused records' samples missing and each named by file:record. Then the
+# same files as a stream (stdin, a FIFO, a growing file), the
+# configuration's refusals by file:line, hostile input (mutated files, random
+# bytes and lines), and a start without a key refused.
 # Usage: ingest_mseed.sh AMFI_INGEST INGEST_TOOL
 set -u
 ingest=$1 tool=$2
