@@ -46,7 +46,7 @@ static const field top_fields[] = {
     {.key = "metrics", .kind = &K_MAP, .aux = metrics_fields},
     {.key = "report", .kind = &K_MAP, .aux = report_fields},
     {.key = "detector", .kind = &K_MAP, .aux = detector_fields},
-    {.key = "ingest", .kind = &K_MAP, .aux = ingest_fields},
+    {.key = "ingest", .kind = &K_MAP, .aux = amfi_cfg_ingest_fields},
     {.key = NULL}};
 
 /* Checks that involve several keys, once the whole file is read; each finds
@@ -59,7 +59,7 @@ static int check_site(ctx *x, void *base)
 
     if (bridge_check(x, c) || sensors_check(x, c) || solver_check(x, c) ||
         daemon_check(x, c) || sim_check(x, c) || site_check(x, c) || ops_check(x, c) ||
-        ingest_check(x, c))
+        amfi_cfg_ingest_check(x, c))
         return -1;
     return model_check(x, c);
 }
@@ -131,7 +131,7 @@ void amfi_config_defaults(amfi_site_config *c)
     /* a detector in step with the accelerometers until commissioning says */
     c->detector.clock_offset_s = 0.0;
     c->detector.speed_scale = 1.0;
-    amfi_ingest_defaults(&c->ingest);
+    amfi_config_ingest_defaults(&c->ingest);
     /* The engine's defaults (docs/indicators.md has the simulation behind
      * each value); set field by field, so the padding stays zero. */
     amfi_indicator_params_default(&d->indicators);

@@ -268,11 +268,11 @@ typedef struct amfi_ingest_config {
     int max_clients;    /* ingest.line.max_clients */
 } amfi_ingest_config;
 
-void amfi_ingest_defaults(amfi_ingest_config *g);
+void amfi_config_ingest_defaults(amfi_ingest_config *g);
 /* 1 when s is a SEED channel id NET.STA.LOC.CHA, else 0. */
-int amfi_ingest_seed_valid(const char *s);
+int amfi_config_ingest_seed_valid(const char *s);
 /* "A.B.C.D:PORT" into host and *port; 0 or -1. */
-int amfi_ingest_listen_parse(const char *s, char host[64], int *port);
+int amfi_config_ingest_listen_parse(const char *s, char host[64], int *port);
 
 typedef struct amfi_site_config {
     amfi_site_identity site;   /* site.* */

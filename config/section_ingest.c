@@ -6,6 +6,11 @@
  * latency; the accel blocks it publishes; the bound on a jump of the
  * data's clock; the line protocol's TCP address or serial port. amfid
  * ignores the section. Runs on the loader's thread.
+ *
+ * Written against the loader's helpers with the amfi_cfg_ names, spans and
+ * generic lists (yaml_walk.h with F_LIVE); the block below maps them onto
+ * the earlier helpers so that the file builds on either side of that change
+ * (remove it once both are merged).
  */
 #include "sections.h"
 
@@ -15,13 +20,31 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifndef F_LIVE /* the loader before its amfi_cfg_ names */
+#define amfi_cfg_fail fail
+#define amfi_cfg_scalar scalar
+#define amfi_cfg_line_of line_of
+#define amfi_cfg_show show
+#define amfi_cfg_pathf pathf
+#define amfi_cfg_noted noted
+#define amfi_cfg_k_int K_INT
+#define amfi_cfg_k_double K_DOUBLE
+#define amfi_cfg_k_enum K_ENUM
+#define amfi_cfg_k_string K_STRING
+#define amfi_cfg_k_path K_PATH
+#define amfi_cfg_k_map K_MAP
+#define KIND(type, parse, range, dflt, nest, spans) {type, parse, range, dflt, nest}
+#else
+#define KIND(type, parse, range, dflt, nest, spans) {type, parse, range, dflt, nest, spans}
+#endif
+
 #define IG(m) offsetof(amfi_site_config, ingest.m)
 #define CH(m) offsetof(amfi_ingest_channel, m)
 #define SEED_CAP sizeof(((amfi_ingest_channel *)0)->seed)
 
 /* 1 when s is NET.STA.LOC.CHA: network 1 .. 2, station 1 .. 5, location
  * 0 .. 2, channel 3 characters of A-Z 0-9 (SEED 2.4's fixed header). */
-int amfi_ingest_seed_valid(const char *s)
+int amfi_config_ingest_seed_valid(const char *s)
 {
     const int lo[4] = {1, 1, 0, 3}, hi[4] = {2, 5, 2, 3};
     int part = 0, len = 0;
@@ -48,15 +71,15 @@ int amfi_ingest_seed_valid(const char *s)
 static int p_seed(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
     char shown[SHOW_LEN + 8];
-    const char *s = scalar(x, v, path, "a SEED channel id NET.STA.LOC.CHA", 1);
+    const char *s = amfi_cfg_scalar(x, v, path, "a SEED channel id NET.STA.LOC.CHA", 1);
 
     if (!s)
         return -1;
-    if (strlen(s) >= SEED_CAP || !amfi_ingest_seed_valid(s))
-        return fail(x, line_of(v), path,
-                    "must be NET.STA.LOC.CHA (network 1-2, station 1-5, location 0-2, "
-                    "channel 3 characters of A-Z 0-9), got '%s'",
-                    show(shown, sizeof shown, v));
+    if (strlen(s) >= SEED_CAP || !amfi_config_ingest_seed_valid(s))
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path,
+                             "must be NET.STA.LOC.CHA (network 1-2, station 1-5, location 0-2, "
+                             "channel 3 characters of A-Z 0-9), got '%s'",
+                             amfi_cfg_show(shown, sizeof shown, v));
     memset((char *)base + f->off, 0, SEED_CAP);
     memcpy((char *)base + f->off, s, strlen(s));
     return 0;
@@ -69,26 +92,80 @@ static void d_seed(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "NET.STA.LOC.CHA");
 }
 
-static const kind K_SEED = {"string", p_seed, d_seed, d_seed, NEST_NONE};
+#ifdef F_LIVE
+static const kind K_SEED = KIND("string", p_seed, d_seed, d_seed, NEST_NONE,
+                                amfi_cfg_spans_chars);
+#else
+static const kind K_SEED = KIND("string", p_seed, d_seed, d_seed, NEST_NONE, NULL);
+#endif
 
 static const field channel_fields[] = {
-    {.key = "seed", .kind = &K_SEED, .off = CH(seed), .flags = F_REQUIRED},
-    {.key = "sensor", .kind = &K_INT, .off = CH(sensor_id), .lo = 0, .hi = 255,
+    {.key = "seed", .kind = &K_SEED, .off = CH(seed), .hi = SEED_CAP, .flags = F_REQUIRED},
+    {.key = "sensor", .kind = &amfi_cfg_k_int, .off = CH(sensor_id), .lo = 0, .hi = 255,
      .flags = F_REQUIRED},
-    {.key = "gain", .kind = &K_DOUBLE, .off = CH(gain), .lo = 0, .hi = 1e6,
+    {.key = "gain", .kind = &amfi_cfg_k_double, .off = CH(gain), .lo = 0, .hi = 1e6,
      .flags = F_LO_OPEN | F_REQUIRED},
-    {.key = "offset_s", .kind = &K_DOUBLE, .off = CH(offset_s), .lo = -60, .hi = 60},
+    {.key = "offset_s", .kind = &amfi_cfg_k_double, .off = CH(offset_s), .lo = -60, .hi = 60},
     {.key = NULL}};
 
 static const amfi_ingest_channel channel_default = {.seed = "", .sensor_id = 0, .gain = 1.0,
                                                     .offset_s = 0.0};
 
-static int p_channels(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+/* Item i of ingest.channels: no channel twice, no sensor fed twice. */
+static int check_channel(ctx *x, const char *ip, const amfi_ingest_channel *ch, int i)
+{
+    char kp[PATH_LEN];
+
+    for (int j = 0; j < i; j++) {
+        if (strcmp(ch[j].seed, ch[i].seed) == 0) {
+            amfi_cfg_pathf(kp, "%s.seed", ip);
+            return amfi_cfg_fail(x, amfi_cfg_noted(x, kp), kp,
+                                 "duplicate channel %s (also ingest.channels[%d])", ch[i].seed, j);
+        }
+        if (ch[j].sensor_id == ch[i].sensor_id) {
+            amfi_cfg_pathf(kp, "%s.sensor", ip);
+            return amfi_cfg_fail(x, amfi_cfg_noted(x, kp), kp,
+                                 "sensor %d is fed by ingest.channels[%d] already: one channel "
+                                 "per sensor",
+                                 ch[i].sensor_id, j);
+        }
+    }
+    return 0;
+}
+
+static void store_channels(const void *items, int n, void *base)
 {
     amfi_site_config *c = base;
+
+    memset(c->ingest.ch, 0, sizeof c->ingest.ch);
+    memcpy(c->ingest.ch, items, sizeof c->ingest.ch[0] * (size_t)n);
+    c->ingest.n_channels = n;
+}
+
+#ifdef F_LIVE
+static int check_channel_item(ctx *x, yaml_node_t *it, const char *ip, const void *items, int i,
+                              const void *base)
+{
+    (void)it;
+    (void)base;
+    return check_channel(x, ip, items, i);
+}
+
+static int s_channels(const field *f, span *out)
+{
+    const amfi_site_config *c = NULL;
+
+    (void)f;
+    out[0] = (span){IG(ch), sizeof c->ingest.ch};
+    out[1] = (span){IG(n_channels), sizeof c->ingest.n_channels};
+    return 2;
+}
+#else
+static int p_channels(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
     amfi_ingest_channel ch[AMFI_INGEST_MAX_CHANNELS];
     yaml_node_item_t *items;
-    char ip[PATH_LEN], kp[PATH_LEN];
+    char ip[PATH_LEN];
     int n = 0;
 
     (void)f;
@@ -103,27 +180,13 @@ static int p_channels(ctx *x, yaml_node_t *v, const char *path, const field *f, 
             return fail(x, line_of(v), ip, "malformed list");
         note_line(x, ip, line_of(it));
         ch[i] = channel_default;
-        if (walk_map(x, it, ip, channel_fields, &ch[i]))
+        if (walk_map(x, it, ip, channel_fields, &ch[i]) || check_channel(x, ip, ch, i))
             return -1;
-        for (int j = 0; j < i; j++) {
-            if (strcmp(ch[j].seed, ch[i].seed) == 0) {
-                pathf(kp, "%s.seed", ip);
-                return fail(x, noted(x, kp), kp, "duplicate channel %s (also %s[%d])",
-                            ch[i].seed, path, j);
-            }
-            if (ch[j].sensor_id == ch[i].sensor_id) {
-                pathf(kp, "%s.sensor", ip);
-                return fail(x, noted(x, kp), kp,
-                            "sensor %d is fed by %s[%d] already: one channel per sensor",
-                            ch[i].sensor_id, path, j);
-            }
-        }
     }
-    memset(c->ingest.ch, 0, sizeof c->ingest.ch);
-    memcpy(c->ingest.ch, ch, sizeof ch[0] * (size_t)n);
-    c->ingest.n_channels = n;
+    store_channels(ch, n, base);
     return 0;
 }
+#endif
 
 static void d_channels(const field *f, const void *base, char *buf)
 {
@@ -139,8 +202,17 @@ static void v_channels(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "none");
 }
 
+#ifdef F_LIVE
+static const list_schema channels_list = {channel_fields,     &channel_default,
+                                          sizeof channel_default, AMFI_INGEST_MAX_CHANNELS,
+                                          "channels",         check_channel_item,
+                                          store_channels};
+static const kind K_CHANNELS = KIND("list", amfi_cfg_parse_list, d_channels, v_channels,
+                                    NEST_LIST, s_channels);
+#else
 static const list_schema channels_list = {channel_fields, &channel_default};
-static const kind K_CHANNELS = {"list", p_channels, d_channels, v_channels, NEST_LIST};
+static const kind K_CHANNELS = KIND("list", p_channels, d_channels, v_channels, NEST_LIST, NULL);
+#endif
 
 static const enum_name baud_names[] = {
     {"1200", 1200},     {"2400", 2400},     {"4800", 4800},     {"9600", 9600},
@@ -148,28 +220,29 @@ static const enum_name baud_names[] = {
     {"230400", 230400}, {"460800", 460800}, {"921600", 921600}, {NULL, 0}};
 
 static const field line_fields[] = {
-    {.key = "listen", .kind = &K_STRING, .off = IG(listen), .lo = 0,
+    {.key = "listen", .kind = &amfi_cfg_k_string, .off = IG(listen), .lo = 0,
      .hi = sizeof(((amfi_ingest_config *)0)->listen)},
-    {.key = "serial", .kind = &K_PATH, .off = IG(serial),
+    {.key = "serial", .kind = &amfi_cfg_k_path, .off = IG(serial),
      .hi = sizeof(((amfi_ingest_config *)0)->serial)},
-    {.key = "baud", .kind = &K_ENUM, .off = IG(baud), .aux = baud_names},
-    {.key = "offset_s", .kind = &K_DOUBLE, .off = IG(line_offset_s), .lo = -60, .hi = 60},
-    {.key = "source", .kind = &K_STRING, .off = IG(source), .lo = 1,
+    {.key = "baud", .kind = &amfi_cfg_k_enum, .off = IG(baud), .aux = baud_names},
+    {.key = "offset_s", .kind = &amfi_cfg_k_double, .off = IG(line_offset_s), .lo = -60,
+     .hi = 60},
+    {.key = "source", .kind = &amfi_cfg_k_string, .off = IG(source), .lo = 1,
      .hi = sizeof(((amfi_ingest_config *)0)->source)},
-    {.key = "max_clients", .kind = &K_INT, .off = IG(max_clients), .lo = 1, .hi = 64},
+    {.key = "max_clients", .kind = &amfi_cfg_k_int, .off = IG(max_clients), .lo = 1, .hi = 64},
     {.key = NULL}};
 
-const field ingest_fields[] = {
-    {.key = "producer", .kind = &K_STRING, .off = IG(producer), .lo = 1,
+const field amfi_cfg_ingest_fields[] = {
+    {.key = "producer", .kind = &amfi_cfg_k_string, .off = IG(producer), .lo = 1,
      .hi = sizeof(((amfi_ingest_config *)0)->producer)},
-    {.key = "block", .kind = &K_INT, .off = IG(block), .lo = 1, .hi = 160},
-    {.key = "max_jump_s", .kind = &K_DOUBLE, .off = IG(max_jump_s), .lo = 0, .hi = 86400,
-     .flags = F_LO_OPEN},
+    {.key = "block", .kind = &amfi_cfg_k_int, .off = IG(block), .lo = 1, .hi = 160},
+    {.key = "max_jump_s", .kind = &amfi_cfg_k_double, .off = IG(max_jump_s), .lo = 0,
+     .hi = 86400, .flags = F_LO_OPEN},
     {.key = "channels", .kind = &K_CHANNELS, .aux = &channels_list},
-    {.key = "line", .kind = &K_MAP, .aux = line_fields},
+    {.key = "line", .kind = &amfi_cfg_k_map, .aux = line_fields},
     {.key = NULL}};
 
-void amfi_ingest_defaults(amfi_ingest_config *g)
+void amfi_config_ingest_defaults(amfi_ingest_config *g)
 {
     memset(g, 0, sizeof *g);
     strcpy(g->producer, "ingest");
@@ -182,7 +255,7 @@ void amfi_ingest_defaults(amfi_ingest_config *g)
     g->max_clients = 8;
 }
 
-int amfi_ingest_listen_parse(const char *s, char host[64], int *port)
+int amfi_config_ingest_listen_parse(const char *s, char host[64], int *port)
 {
     const char *colon = s ? strrchr(s, ':') : NULL;
     struct in_addr a;
@@ -204,7 +277,7 @@ int amfi_ingest_listen_parse(const char *s, char host[64], int *port)
 
 /* Each channel feeds a sensor of sensors:; the producer id is the bus's
  * (1 .. 16 of A-Z a-z 0-9 . _ -); the address is IPv4:PORT or empty. */
-int ingest_check(ctx *x, amfi_site_config *c)
+int amfi_cfg_ingest_check(ctx *x, amfi_site_config *c)
 {
     amfi_ingest_config *g = &c->ingest;
     char kp[PATH_LEN], host[64];
@@ -215,19 +288,20 @@ int ingest_check(ctx *x, amfi_site_config *c)
         for (int s = 0; s < c->solver.n_sensors; s++)
             found |= c->sensor_id[s] == g->ch[i].sensor_id;
         if (!found) {
-            pathf(kp, "ingest.channels[%d].sensor", i);
-            return fail(x, noted(x, kp), kp, "sensor %d is not in sensors:", g->ch[i].sensor_id);
+            amfi_cfg_pathf(kp, "ingest.channels[%d].sensor", i);
+            return amfi_cfg_fail(x, amfi_cfg_noted(x, kp), kp, "sensor %d is not in sensors:",
+                                 g->ch[i].sensor_id);
         }
     }
     for (const char *p = g->producer; *p; p++)
         if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
               *p == '.' || *p == '_' || *p == '-'))
-            return fail(x, noted(x, "ingest.producer"), "ingest.producer",
-                        "must be 1 .. 16 characters of A-Z a-z 0-9 . _ -, got '%s'",
-                        g->producer);
-    if (g->listen[0] && amfi_ingest_listen_parse(g->listen, host, &port))
-        return fail(x, noted(x, "ingest.line.listen"), "ingest.line.listen",
-                    "must be IPV4-ADDRESS:PORT (port 1 .. 65535) or empty, got '%s'",
-                    g->listen);
+            return amfi_cfg_fail(x, amfi_cfg_noted(x, "ingest.producer"), "ingest.producer",
+                                 "must be 1 .. 16 characters of A-Z a-z 0-9 . _ -, got '%s'",
+                                 g->producer);
+    if (g->listen[0] && amfi_config_ingest_listen_parse(g->listen, host, &port))
+        return amfi_cfg_fail(x, amfi_cfg_noted(x, "ingest.line.listen"), "ingest.line.listen",
+                             "must be IPV4-ADDRESS:PORT (port 1 .. 65535) or empty, got '%s'",
+                             g->listen);
     return 0;
 }

@@ -46,7 +46,7 @@ extern const field alerts_fields[]; /* alerts: */
 extern const field metrics_fields[]; /* metrics: */
 extern const field report_fields[]; /* report: */
 extern const field detector_fields[]; /* detector: */
-extern const field ingest_fields[];   /* ingest: (section_ingest.c) */
+extern const field amfi_cfg_ingest_fields[]; /* ingest: (section_ingest.c) */
 extern const enum_name onoff_names[]; /* off | on (section_daemon.c) */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */
@@ -61,7 +61,7 @@ int daemon_check(ctx *x, amfi_site_config *c);
 int sim_check(ctx *x, amfi_site_config *c);
 int site_check(ctx *x, amfi_site_config *c);
 int ops_check(ctx *x, amfi_site_config *c);
-int ingest_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_ingest_check(ctx *x, amfi_site_config *c);
 
 /* The model itself: the bridge built with libamfi (its refusals reported at
  * the line of the bridge key or section that caused them) and the solver's

@@ -302,7 +302,7 @@ static int listen_on(const char *addr, char *err, size_t errlen)
 {
     char host[64];
     int port;
-    if (amfi_ingest_listen_parse(addr, host, &port)) {
+    if (amfi_config_ingest_listen_parse(addr, host, &port)) {
         snprintf(err, errlen, "listen address '%s' is not IPV4-ADDRESS:PORT", addr);
         return -1;
     }
