@@ -46,6 +46,7 @@ const field amfi_cfg_top_fields[] = {
     {.key = "metrics", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_metrics_fields},
     {.key = "report", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_report_fields},
     {.key = "detector", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_detector_fields},
+    {.key = "ingest", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_ingest_fields},
     {.key = NULL}};
 
 /* Checks that involve several keys, once the whole file is read; each finds
@@ -57,7 +58,8 @@ static int check_site(ctx *x, void *base)
     amfi_site_config *c = base;
 
     if (amfi_cfg_bridge_check(x, c) || amfi_cfg_sensors_check(x, c) || amfi_cfg_solver_check(x, c) ||
-        amfi_cfg_daemon_check(x, c) || amfi_cfg_sim_check(x, c) || amfi_cfg_site_check(x, c) || amfi_cfg_ops_check(x, c))
+        amfi_cfg_daemon_check(x, c) || amfi_cfg_sim_check(x, c) || amfi_cfg_site_check(x, c) || amfi_cfg_ops_check(x, c) ||
+        amfi_cfg_ingest_check(x, c))
         return -1;
     return amfi_cfg_model_check(x, c);
 }
@@ -129,6 +131,7 @@ void amfi_config_defaults(amfi_site_config *c)
     /* a detector in step with the accelerometers until commissioning says */
     c->detector.clock_offset_s = 0.0;
     c->detector.speed_scale = 1.0;
+    amfi_config_ingest_defaults(&c->ingest);
     /* The engine's defaults (docs/indicators.md has the simulation behind
      * each value); set field by field, so the padding stays zero. */
     amfi_indicator_params_default(&d->indicators);

@@ -245,6 +245,35 @@ typedef struct amfi_detector_config {
     double speed_scale;    /* [0.5, 2], default 1 */
 } amfi_detector_config;
 
+/* ingest.*: what amfi-ingest(1) reads (section_ingest.c, docs/ingest.md). */
+#define AMFI_INGEST_MAX_CHANNELS AMFI_MAX_SENSORS
+typedef struct amfi_ingest_channel {
+    char seed[24];   /* NET.STA.LOC.CHA */
+    int sensor_id;   /* a sensors[].id */
+    double gain;     /* m/s² per count, > 0 */
+    double offset_s; /* the logger's latency: published time = header time − offset_s */
+} amfi_ingest_channel;
+
+typedef struct amfi_ingest_config {
+    char producer[17];  /* ingest.producer: the bus producer id */
+    int block;          /* ingest.block: samples per accel block, 1 .. 160 */
+    double max_jump_s;  /* ingest.max_jump_s: a larger jump of the data's time is reported */
+    int n_channels;     /* ingest.channels[] */
+    amfi_ingest_channel ch[AMFI_INGEST_MAX_CHANNELS];
+    char listen[64];    /* ingest.line.listen: IPv4:PORT, "" none */
+    char serial[256];   /* ingest.line.serial: device, "" none */
+    int baud;           /* ingest.line.baud */
+    double line_offset_s; /* ingest.line.offset_s */
+    char source[64];    /* ingest.line.source: vehicle_t.source */
+    int max_clients;    /* ingest.line.max_clients */
+} amfi_ingest_config;
+
+void amfi_config_ingest_defaults(amfi_ingest_config *g);
+/* 1 when s is a SEED channel id NET.STA.LOC.CHA, else 0. */
+int amfi_config_ingest_seed_valid(const char *s);
+/* "A.B.C.D:PORT" into host and *port; 0 or -1. */
+int amfi_config_ingest_listen_parse(const char *s, char host[64], int *port);
+
 typedef struct amfi_site_config {
     amfi_site_identity site;   /* site.* */
     char name[64];             /* bridge.name: 1 .. 63 bytes, NUL-terminated */
@@ -267,6 +296,7 @@ typedef struct amfi_site_config {
                                         speed_coarse_rate_hz, speed_criterion,
                                         speed_pick (amfi_speed_prior_default) */
     amfi_detector_config detector;   /* detector.* */
+    amfi_ingest_config ingest;       /* ingest.* (amfi-ingest) */
 } amfi_site_config;
 
 /* Fill `c` (not NULL) with the paper-20m defaults: amfi_bridge_params_paper20,

@@ -48,6 +48,7 @@ extern const field amfi_cfg_alerts_fields[]; /* alerts: */
 extern const field amfi_cfg_metrics_fields[]; /* metrics: */
 extern const field amfi_cfg_report_fields[]; /* report: */
 extern const field amfi_cfg_detector_fields[]; /* detector: */
+extern const field amfi_cfg_ingest_fields[]; /* ingest: (section_ingest.c) */
 
 /* The rows of detector.clock_offset_s and detector.speed_scale (names,
  * meanings, ranges), for an amfi_detector_config at byte `at` of the base:
@@ -72,6 +73,7 @@ int amfi_cfg_daemon_check(ctx *x, amfi_site_config *c);
 int amfi_cfg_sim_check(ctx *x, amfi_site_config *c);
 int amfi_cfg_site_check(ctx *x, amfi_site_config *c);
 int amfi_cfg_ops_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_ingest_check(ctx *x, amfi_site_config *c);
 
 /* The model itself: the bridge built with libamfi (its refusals reported at
  * the line of the bridge key or section that caused them) and the solver's

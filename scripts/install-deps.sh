@@ -14,6 +14,7 @@ pkgs=(
   liblcm-dev                     # LCM C library: the amfi bus (messages/)
   libglib2.0-dev                 # lcm.pc requires glib-2.0; liblcm-dev does not pull it in
   libsodium-dev                  # HMAC-SHA-512-256 of the signed bus (messages/amfi_auth.c)
+  libmseed-dev                   # MiniSEED 2 records (libmseed 2.19): amfi-ingest reads data loggers (tools/ingest/)
   liblcm-bin                     # lcm-gen, lcm-logger, lcm-logplayer
   liblcm-java                    # lcm.jar: lcm-spy (tools/ops/amfi-spy)
   default-jdk-headless           # javac, jar: amfi_types.jar for lcm-spy

@@ -531,7 +531,7 @@ static const bad_case bad_cases[] = {
     {"unknown_key", "solver:\n  calc_rate_hz: 5000\n  lamda: 1e-9\n", 3, "solver.lamda",
      "unknown key"},
     {"unknown_section", "bridge: {}\nmonitor:\n  bus: udpm://\n", 2, "monitor",
-     "unknown key (known: site, bridge, sensors, solver, daemon, simulation, alerts, metrics, report, detector)"},
+     "unknown key (known: site, bridge, sensors, solver, daemon, simulation, alerts, metrics, report, detector, ingest)"},
     {"report_gvw_zero", "report:\n  limits:\n    gvw_kg: 0\n", 3, "report.limits.gvw_kg",
      "(0, 1e+06]"},
     {"report_axle_text", "report:\n  limits:\n    axle_kg: heavy\n", 3,
