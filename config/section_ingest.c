@@ -6,11 +6,6 @@
  * latency; the accel blocks it publishes; the bound on a jump of the
  * data's clock; the line protocol's TCP address or serial port. amfid
  * ignores the section. Runs on the loader's thread.
- *
- * Written against the loader's helpers with the amfi_cfg_ names, spans and
- * generic lists (yaml_walk.h with F_LIVE); the block below maps them onto
- * the earlier helpers so that the file builds on either side of that change
- * (remove it once both are merged).
  */
 #include "sections.h"
 
@@ -20,23 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifndef F_LIVE /* the loader before its amfi_cfg_ names */
-#define amfi_cfg_fail fail
-#define amfi_cfg_scalar scalar
-#define amfi_cfg_line_of line_of
-#define amfi_cfg_show show
-#define amfi_cfg_pathf pathf
-#define amfi_cfg_noted noted
-#define amfi_cfg_k_int K_INT
-#define amfi_cfg_k_double K_DOUBLE
-#define amfi_cfg_k_enum K_ENUM
-#define amfi_cfg_k_string K_STRING
-#define amfi_cfg_k_path K_PATH
-#define amfi_cfg_k_map K_MAP
-#define KIND(type, parse, range, dflt, nest, spans) {type, parse, range, dflt, nest}
-#else
 #define KIND(type, parse, range, dflt, nest, spans) {type, parse, range, dflt, nest, spans}
-#endif
 
 #define IG(m) offsetof(amfi_site_config, ingest.m)
 #define CH(m) offsetof(amfi_ingest_channel, m)
@@ -92,12 +71,8 @@ static void d_seed(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "NET.STA.LOC.CHA");
 }
 
-#ifdef F_LIVE
 static const kind K_SEED = KIND("string", p_seed, d_seed, d_seed, NEST_NONE,
                                 amfi_cfg_spans_chars);
-#else
-static const kind K_SEED = KIND("string", p_seed, d_seed, d_seed, NEST_NONE, NULL);
-#endif
 
 static const field channel_fields[] = {
     {.key = "seed", .kind = &K_SEED, .off = CH(seed), .hi = SEED_CAP, .flags = F_REQUIRED},
@@ -142,7 +117,6 @@ static void store_channels(const void *items, int n, void *base)
     c->ingest.n_channels = n;
 }
 
-#ifdef F_LIVE
 static int check_channel_item(ctx *x, yaml_node_t *it, const char *ip, const void *items, int i,
                               const void *base)
 {
@@ -160,33 +134,6 @@ static int s_channels(const field *f, span *out)
     out[1] = (span){IG(n_channels), sizeof c->ingest.n_channels};
     return 2;
 }
-#else
-static int p_channels(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
-{
-    amfi_ingest_channel ch[AMFI_INGEST_MAX_CHANNELS];
-    yaml_node_item_t *items;
-    char ip[PATH_LEN];
-    int n = 0;
-
-    (void)f;
-    items = list_items(x, v, path, "channels", AMFI_INGEST_MAX_CHANNELS, &n);
-    if (!items)
-        return -1;
-    for (int i = 0; i < n; i++) {
-        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
-
-        join_index(ip, path, (size_t)i);
-        if (!it)
-            return fail(x, line_of(v), ip, "malformed list");
-        note_line(x, ip, line_of(it));
-        ch[i] = channel_default;
-        if (walk_map(x, it, ip, channel_fields, &ch[i]) || check_channel(x, ip, ch, i))
-            return -1;
-    }
-    store_channels(ch, n, base);
-    return 0;
-}
-#endif
 
 static void d_channels(const field *f, const void *base, char *buf)
 {
@@ -202,17 +149,12 @@ static void v_channels(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "none");
 }
 
-#ifdef F_LIVE
 static const list_schema channels_list = {channel_fields,     &channel_default,
                                           sizeof channel_default, AMFI_INGEST_MAX_CHANNELS,
                                           "channels",         check_channel_item,
                                           store_channels};
 static const kind K_CHANNELS = KIND("list", amfi_cfg_parse_list, d_channels, v_channels,
                                     NEST_LIST, s_channels);
-#else
-static const list_schema channels_list = {channel_fields, &channel_default};
-static const kind K_CHANNELS = KIND("list", p_channels, d_channels, v_channels, NEST_LIST, NULL);
-#endif
 
 static const enum_name baud_names[] = {
     {"1200", 1200},     {"2400", 2400},     {"4800", 4800},     {"9600", 9600},
