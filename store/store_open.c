@@ -32,13 +32,6 @@ static const char *const stmt_sql[N_STMT] = {
     [ST_BEGIN] = "BEGIN IMMEDIATE",
     [ST_COMMIT] = "COMMIT",
     [ST_ROLLBACK] = "ROLLBACK",
-    [ST_INS_PASSAGE] =
-        "INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, "
-        "gvw_kg, status, reason, lambda, residual_rms, formulation, solve_ms, "
-        "speed_given_mps, speed_estimated, n_vehicles, quality, reference_gvw_kg, deck_c, "
-        "f1_hz, f1_comp_hz, f1_zeta, f1_r2, gvw_comp_kg) "
-        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, "
-        "?18, ?19, ?20, ?21, ?22, ?23)",
     [ST_INS_AXLE] =
         "INSERT INTO axles (passage_id, idx, spacing_m, load_kg) "
         "VALUES (?1, ?2, ?3, ?4)",
@@ -48,13 +41,6 @@ static const char *const stmt_sql[N_STMT] = {
     [ST_INS_TRUTH_AXLE] =
         "INSERT INTO truth_axles (truth_id, idx, load_kg, mean_force_N) "
         "VALUES (?1, ?2, ?3, ?4)",
-    [ST_INS_INDICATOR] =
-        "INSERT INTO indicators (utime, n, mean_kg, std_kg, baseline_mean_kg, "
-        "baseline_std_kg, std_ratio, p_value, state) "
-        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
-    [ST_INS_ALERT] =
-        "INSERT INTO alerts (utime, level, kind, message, indicator_id, raised) "
-        "VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
     [ST_GET_BASELINE] =
         "SELECT id, utime_set, n, mean_kg, std_kg, source, note "
         "FROM baseline ORDER BY id DESC LIMIT 1",
@@ -99,6 +85,14 @@ static const char *const stmt_sql[N_STMT] = {
         "FROM alerts AS b WHERE b.kind = a.kind ORDER BY b.utime DESC, b.id DESC "
         "LIMIT 1) ORDER BY a.utime",
     [ST_GVW_ERRORS] = "SELECT passage_id, status, gvw_error_pct FROM passage_errors",
+};
+
+/* The inserts of the tables written from a row: from the column table
+ * (store_rows.c). */
+static const char *const stmt_table[N_STMT] = {
+    [ST_INS_PASSAGE] = "passages",
+    [ST_INS_INDICATOR] = "indicators",
+    [ST_INS_ALERT] = "alerts",
 };
 
 /* ---- messages ------------------------------------------------------------- */
@@ -418,7 +412,16 @@ static int open_store(const char *path, int readonly, int foreign, int sync_full
     if (rc == 0 && !readonly && version < AMFI_STORE_SCHEMA_VERSION)
         rc = migrate(s, err, errlen);
     for (int k = 0; rc == 0 && k < N_STMT; k++) {
-        src = sqlite3_prepare_v3(s->db, stmt_sql[k], -1,
+        char ins[1024];
+        const char *sql = stmt_sql[k];
+        if (stmt_table[k]) {
+            if (st_insert_sql(amfi_store_tabledef_find(stmt_table[k]), ins, sizeof ins) != 0) {
+                rc = st_fail(err, errlen, AMFI_EINVAL, "%s: insert too long", stmt_table[k]);
+                break;
+            }
+            sql = ins;
+        }
+        src = sqlite3_prepare_v3(s->db, sql, -1,
                                  SQLITE_PREPARE_PERSISTENT, &s->st[k], NULL);
         if (src != SQLITE_OK)
             rc = st_db_fail(s, src, s->path, err, errlen);
