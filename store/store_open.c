@@ -295,8 +295,9 @@ static int migrate(amfi_store *s, char *err, size_t errlen)
  * file may only call functions SQLite marks innocuous, so no
  * load_extension, fts3_tokenizer or the like), no extension loading.
  * `foreign` (a store this process did not write: amfi-report's readers and
- * its --set-baseline): triggers off too, an amfi store has none. Each
- * setting is read back: an SQLite that ignores one is refused. */
+ * its --set-baseline): triggers off too, an amfi store has none; 2 (a
+ * reader of rows, amfi-sync: tables only): views off and query_only too.
+ * Each setting is read back: an SQLite that ignores one is refused. */
 static int harden(amfi_store *s, int foreign, char *err, size_t errlen)
 {
     static const struct {
@@ -307,15 +308,26 @@ static int harden(amfi_store *s, int foreign, char *err, size_t errlen)
         {SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, "SQLITE_DBCONFIG_TRUSTED_SCHEMA"},
         {SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0, "SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION"},
         {SQLITE_DBCONFIG_ENABLE_TRIGGER, 0, "SQLITE_DBCONFIG_ENABLE_TRIGGER"},
+        {SQLITE_DBCONFIG_ENABLE_VIEW, 0, "SQLITE_DBCONFIG_ENABLE_VIEW"},
     };
     for (size_t k = 0; k < sizeof set / sizeof set[0]; k++) {
-        if (set[k].op == SQLITE_DBCONFIG_ENABLE_TRIGGER && !foreign)
+        if ((set[k].op == SQLITE_DBCONFIG_ENABLE_TRIGGER && !foreign)
+            || (set[k].op == SQLITE_DBCONFIG_ENABLE_VIEW && foreign < 2))
             continue;
         int got = -1;
         int src = sqlite3_db_config(s->db, set[k].op, set[k].want, &got);
         if (src != SQLITE_OK || got != set[k].want)
             return st_fail(err, errlen, AMFI_STORE_EDB, "%s: cannot set %s to %d (SQLite %s)",
                            s->path, set[k].name, set[k].want, sqlite3_libversion());
+    }
+    if (foreign >= 2) {
+        char *emsg = NULL;
+        if (sqlite3_exec(s->db, "PRAGMA query_only = ON", NULL, NULL, &emsg) != SQLITE_OK) {
+            st_fail(err, errlen, AMFI_STORE_EDB, "%s: PRAGMA query_only: %s", s->path,
+                    emsg ? emsg : "failed");
+            sqlite3_free(emsg);
+            return AMFI_STORE_EDB;
+        }
     }
     return 0;
 }
@@ -450,4 +462,85 @@ int amfi_store_open_readonly(const char *path, amfi_store **out, char *err,
                              size_t errlen)
 {
     return open_store(path, 1, 1, 0, out, err, errlen);
+}
+
+/* ---- a reader of rows (amfi-sync) ------------------------------------------ */
+
+int amfi_store_open_reader(const char *path, int immutable_ok, amfi_store **out, int *version,
+                           int *immutable, char *err, size_t errlen)
+{
+    char wal[4200];
+    if (!out || !version || !immutable)
+        return st_fail(err, errlen, AMFI_EINVAL, "store: output is NULL");
+    *out = NULL;
+    *immutable = 0;
+    if (!path || !*path)
+        return st_fail(err, errlen, AMFI_EINVAL, "store: empty path");
+    snprintf(wal, sizeof wal, "%s-wal", path);
+    for (int pass = 0; pass < 2; pass++) {
+        char uri[3 * 4096 + 32];
+        const char *name = path;
+        if (pass == 1) {
+            /* a file: URI with the path percent-encoded */
+            size_t k = (size_t)snprintf(uri, sizeof uri, "file:");
+            for (const unsigned char *p = (const unsigned char *)path; *p && k + 4 < sizeof uri;
+                 p++) {
+                if ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9')
+                    || strchr("/._-~", *p))
+                    uri[k++] = (char)*p;
+                else
+                    k += (size_t)snprintf(uri + k, sizeof uri - k, "%%%02X", *p);
+            }
+            snprintf(uri + k, sizeof uri - k, "?immutable=1");
+            name = uri;
+        }
+        amfi_store *s = calloc(1, sizeof *s);
+        if (!s)
+            return st_fail(err, errlen, AMFI_ENOMEM, "%s: out of memory", path);
+        snprintf(s->path, sizeof s->path, "%s", path);
+        s->readonly = 1;
+        int src = sqlite3_open_v2(name, &s->db,
+                                  SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX
+                                      | (pass ? SQLITE_OPEN_URI : 0),
+                                  NULL);
+        if (src != SQLITE_OK) {
+            int rc = st_fail(err, errlen, AMFI_STORE_EDB, "%s: cannot open the store read-only: %s",
+                             path, s->db ? sqlite3_errmsg(s->db) : sqlite3_errstr(src));
+            destroy(s, 0);
+            return rc;
+        }
+        sqlite3_extended_result_codes(s->db, 1);
+        sqlite3_busy_timeout(s->db, AMFI_STORE_BUSY_TIMEOUT_MS);
+        if (harden(s, 2, err, errlen) != 0) {
+            destroy(s, 0);
+            return AMFI_STORE_ESCHEMA;
+        }
+        sqlite3_stmt *uv = NULL;
+        int ok = sqlite3_prepare_v2(s->db, "PRAGMA user_version", -1, &uv, NULL) == SQLITE_OK
+                 && sqlite3_step(uv) == SQLITE_ROW;
+        if (ok)
+            *version = sqlite3_column_int(uv, 0);
+        sqlite3_finalize(uv);
+        if (ok) {
+            /* the one prepared statement it uses (a file without meta fails
+             * its reads) */
+            if (sqlite3_prepare_v3(s->db, stmt_sql[ST_META_GET], -1, 0, &s->st[ST_META_GET], NULL)
+                != SQLITE_OK)
+                s->st[ST_META_GET] = NULL;
+            *immutable = pass;
+            *out = s;
+            return 0;
+        }
+        int code = sqlite3_errcode(s->db) & 0xff;
+        if (pass == 0 && immutable_ok && (code == SQLITE_READONLY || code == SQLITE_CANTOPEN)
+            && access(wal, F_OK) != 0 && errno == ENOENT) {
+            destroy(s, 0);
+            continue;
+        }
+        int rc = st_fail(err, errlen, code == SQLITE_NOTADB ? AMFI_STORE_ECORRUPT : AMFI_STORE_EDB,
+                         "%s: cannot read the store: %s", path, sqlite3_errmsg(s->db));
+        destroy(s, 0);
+        return rc;
+    }
+    return st_fail(err, errlen, AMFI_STORE_EDB, "%s: cannot read the store", path);
 }
