@@ -282,7 +282,7 @@ static int parse_args(int argc, char **argv, options *o)
             if (!*val)
                 return usage_error(opt, "empty value");
             *(k == 'G' ? &o->pg : &o->site) = val;
-            if (k == 'I' && !amfi_site_id_valid(val))
+            if (k == 'I' && !amfi_config_site_id_valid(val))
                 return usage_error(opt, "'%s' is not a site id (1 to 63 of A-Z a-z 0-9 _ . -)",
                                    amfi_cli_shown(val));
             break;
