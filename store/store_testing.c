@@ -155,35 +155,84 @@ int amfi_store_test_rows(amfi_store_test_db *t, const char *sql, amfi_store_test
     return rc;
 }
 
+static int record(amfi_store_test_db *t, int version, char *err, size_t errlen);
+
 int amfi_store_test_create(const char *path, int version, char *err, size_t errlen)
 {
-    char sql[160];
     if (version < 1 || version > st_n_migrations)
         return fail(err, errlen, path, "no such schema version");
     amfi_store_test_db *t = amfi_store_test_open(path, 1, err, errlen);
     if (!t)
         return -1;
     int rc = amfi_store_test_exec(t, "PRAGMA journal_mode = WAL; BEGIN IMMEDIATE", err, errlen);
-    for (int k = 0; rc == 0 && k < version; k++) {
-        const st_migration *m = &st_migrations[k];
-        sqlite3_stmt *st = NULL;
-        rc = amfi_store_test_exec(t, m->sql, err, errlen);
-        if (rc == 0
-            && (sqlite3_prepare_v2(t->db,
-                                   "INSERT INTO schema_migrations (version, description) "
-                                   "VALUES (?1, ?2)",
-                                   -1, &st, NULL) != SQLITE_OK
-                || sqlite3_bind_int(st, 1, m->version) != SQLITE_OK
-                || sqlite3_bind_text(st, 2, m->description, -1, SQLITE_STATIC) != SQLITE_OK
-                || sqlite3_step(st) != SQLITE_DONE))
-            rc = fail(err, errlen, path, sqlite3_errmsg(t->db));
-        sqlite3_finalize(st);
-        snprintf(sql, sizeof sql, "PRAGMA user_version = %d", m->version);
-        if (rc == 0)
-            rc = amfi_store_test_exec(t, sql, err, errlen);
-    }
+    for (int k = 0; rc == 0 && k < version; k++)
+        rc = amfi_store_test_exec(t, st_migrations[k].sql, err, errlen);
+    if (rc == 0)
+        rc = record(t, version, err, errlen);
     if (rc == 0)
         rc = amfi_store_test_exec(t, "COMMIT", err, errlen);
     amfi_store_test_close(t);
+    return rc;
+}
+
+static int record(amfi_store_test_db *t, int version, char *err, size_t errlen)
+{
+    char sql[160];
+    int rc = 0;
+    for (int k = 0; rc == 0 && k < version; k++) {
+        const st_migration *m = &st_migrations[k];
+        sqlite3_stmt *st = NULL;
+        if (sqlite3_prepare_v2(t->db,
+                               "INSERT INTO schema_migrations (version, description) VALUES (?1, ?2)",
+                               -1, &st, NULL) != SQLITE_OK
+            || sqlite3_bind_int(st, 1, m->version) != SQLITE_OK
+            || sqlite3_bind_text(st, 2, m->description, -1, SQLITE_STATIC) != SQLITE_OK
+            || sqlite3_step(st) != SQLITE_DONE)
+            rc = fail(err, errlen, "schema_migrations", sqlite3_errmsg(t->db));
+        sqlite3_finalize(st);
+    }
+    snprintf(sql, sizeof sql, "PRAGMA user_version = %d", version);
+    if (rc == 0)
+        rc = amfi_store_test_exec(t, sql, err, errlen);
+    return rc;
+}
+
+int amfi_store_test_stamp(amfi_store_test_db *t, int version, char *err, size_t errlen)
+{
+    if (version < 1 || version > st_n_migrations)
+        return fail(err, errlen, "stamp", "no such schema version");
+    return record(t, version, err, errlen);
+}
+
+int amfi_store_test_downgrade(amfi_store_test_db *t, int version, char *err, size_t errlen)
+{
+    char sql[256];
+    if (version < 1 || version > st_n_migrations)
+        return fail(err, errlen, "downgrade", "no such schema version");
+    int rc = 0;
+    for (int k = 0; rc == 0 && k < amfi_store_n_tabledefs; k++) {
+        const amfi_store_tabledef *tb = &amfi_store_tabledefs[k];
+        int created = tb->cols[0].since;
+        for (int j = 1; j < tb->ncols; j++)
+            if (tb->cols[j].since < created)
+                created = tb->cols[j].since;
+        if (created > version) {
+            snprintf(sql, sizeof sql, "DROP TABLE %s", tb->name);
+            rc = amfi_store_test_exec(t, sql, err, errlen);
+            continue;
+        }
+        for (int j = tb->ncols - 1; rc == 0 && j >= 0; j--) {
+            if (tb->cols[j].since <= version)
+                continue;
+            snprintf(sql, sizeof sql, "ALTER TABLE %s DROP COLUMN %s", tb->name, tb->cols[j].name);
+            rc = amfi_store_test_exec(t, sql, err, errlen);
+        }
+    }
+    snprintf(sql, sizeof sql, "DELETE FROM schema_migrations WHERE version > %d", version);
+    if (rc == 0)
+        rc = amfi_store_test_exec(t, sql, err, errlen);
+    snprintf(sql, sizeof sql, "PRAGMA user_version = %d", version);
+    if (rc == 0)
+        rc = amfi_store_test_exec(t, sql, err, errlen);
     return rc;
 }

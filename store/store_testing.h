@@ -44,4 +44,16 @@ int amfi_store_test_rows(amfi_store_test_db *db, const char *sql, amfi_store_tes
  * number written by hand. 0, or -1. */
 int amfi_store_test_create(const char *path, int version, char *err, size_t errlen);
 
+/* The store taken back to schema `version`, as that version's amfid left
+ * it, from the column table (store_columns.c): the tables a later migration
+ * created dropped, the columns a later one added dropped (their data with
+ * them), the later schema_migrations rows deleted, user_version set. 0, or
+ * -1. */
+int amfi_store_test_downgrade(amfi_store_test_db *db, int version, char *err, size_t errlen);
+
+/* user_version and the schema_migrations rows 1 .. version as the store's
+ * migrations record them, on a file built from docs/schema.md's DDL. 0, or
+ * -1. */
+int amfi_store_test_stamp(amfi_store_test_db *db, int version, char *err, size_t errlen);
+
 #endif /* AMFI_STORE_TESTING_H */
