@@ -430,7 +430,7 @@ bad foreign 1 'not an amfi store' --db "$tmp/recipes.db"
 
 cp "$tmp/pristine.db" "$tmp/newer.db"
 sqlite3 "$tmp/newer.db" "PRAGMA user_version = 99"
-bad newer 1 'schema version 99 is newer than this program.s 9' --db "$tmp/newer.db"
+bad newer 1 'schema version 99 is newer than this program.s [0-9]' --db "$tmp/newer.db"
 
 cp "$tmp/pristine.db" "$tmp/damaged.db"
 sqlite3 "$tmp/damaged.db" "PRAGMA ignore_check_constraints = ON; UPDATE passages SET gvw_kg = -1 WHERE id = 3"
