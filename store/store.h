@@ -17,8 +17,13 @@
  * store_read.c (what amfid reads back, maintenance), store_report.c (the
  * queries of reports), store_export.c (the passage listing), store_speed.c
  * (the estimated speeds), store_environment.c (the environment readings),
- * store_natfreq.c (the natural frequencies);
- * store_internal.h is shared by them only.
+ * store_natfreq.c (the natural frequencies), store_columns.c (the column
+ * table, store_columns.h: every stored column once), store_rows.c (the
+ * INSERTs, bindings and checks of the tables written from a row struct, from
+ * the column table), store_scan.c (rows as column values for amfi-sync,
+ * amfi-report --pg, amfi-fleet-bench); store_internal.h is shared by them
+ * only. store_testing.c (library amfi_store_testing) gives tests raw SQL on
+ * a file; no program links it.
  *
  * Workload: one writer thread in amfid opens one handle at start-up, adds one
  * passage per vehicle (a few per second at most, one transaction each: the

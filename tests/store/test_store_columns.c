@@ -5,8 +5,7 @@
  * migrations build: every table of a fresh store has exactly the columns of
  * its table, in order, with their SQL type and NULL rule; each column exists
  * from its `since` version on and not before (stores made at each version
- * by the store's own migrations); every row-struct column is bound by the
- * generated INSERT; the column table's CHECK-relevant ranges are the
+ * by the store's own migrations); the column table's REAL ranges are the
  * DDL's (a value just outside each range is refused by the file's CHECK and
  * reported by amfi_store_value_problem); and the column table in
  * docs/schema.md is exactly what amfi-store-schema --markdown writes.
