@@ -251,7 +251,7 @@ typedef struct amfi_environment_summary {
 } amfi_environment_summary;
 
 /* Every stored reading, by utime, into *out (malloc'd, the caller frees;
- * NULL when *n is 0); received_utime is not read (0). 0, or a status. */
+ * NULL when *n is 0). 0, or a status. */
 int amfi_store_environment_rows(amfi_store *s, amfi_environment_row **out, size_t *n, char *err,
                                 size_t errlen);
 

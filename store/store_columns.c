@@ -38,9 +38,9 @@
      .null_ok = nr != AMFI_NULL_NEVER, .open = op, .lo = lo_, .hi = hi_, .unit = u, .since = v, \
      .shipped = ship, .meaning = m}
 /* TEXT, one of the words vals */
-#define ENUM(n, f, vals, v, ship, m)                                                            \
+#define ENUM(n, f, w, v, ship, m)                                                               \
     {.name = n, .sql_type = 't', .ctype = AMFI_C_STR, .off = O(f), .text_kind = AMFI_TEXT_ENUM, \
-     .values = vals, .unit = "", .since = v, .shipped = ship, .meaning = m}
+     .words = w, .unit = "", .since = v, .shipped = ship, .meaning = m}
 /* TEXT of min .. max bytes (max 0: any), NULL rule nr, checked as kind */
 #define TEXT(n, f, nr, kind, mn, mx, v, ship, m)                                                \
     {.name = n, .sql_type = 't', .ctype = AMFI_C_STR, .off = O(f), .null_rule = nr,             \
@@ -52,7 +52,10 @@
      .shipped = ship, .meaning = m}
 #define N(a) ((int)(sizeof(a) / sizeof(a)[0]))
 
-#define STATES "baseline|normal|watch|alert"
+/* The enumerations' words (st_statuses, st_states, st_levels, st_sources
+ * in store_internal.h, and these). */
+static const char *const scale_kinds[] = {"scale_shift", "known_truck", NULL};
+static const char *const inputs[] = {"accel", "vehicle", "truth", "environment", NULL};
 
 /* ---- passages (amfi_passage_row) ------------------------------------------ */
 #define ROW amfi_passage_row
@@ -65,7 +68,7 @@ static const amfi_store_coldef passages[] = {
          "the speed weighed with; NULL unknown"),
     INT("n_axles", n_axles, 0, AMFI_MAX_AXLES, "", 1, 1, "rows in axles; 0 unknown"),
     REAL("gvw_kg", gvw_kg, AMFI_NULL_NAN, 0, -KG, KG, "kg", 1, 1, "inferred GVW; NULL not solved"),
-    ENUM("status", status, "ok|gap|late|overload|multiple|invalid|error", 1, 1,
+    ENUM("status", status, st_statuses, 1, 1,
          "ok needs gvw_kg > 0, speed_mps > 0, n_axles >= 1"),
     {.name = "reason", .sql_type = 't', .ctype = AMFI_C_STR, .off = O(reason),
      .null_rule = AMFI_NULL_EMPTY, .text_kind = AMFI_TEXT_UTF8, .wmax = AMFI_STORE_REASON_MAX,
@@ -163,7 +166,7 @@ static const amfi_store_coldef indicators[] = {
          "the baseline's STD"),
     REAL("std_ratio", std_ratio, AMFI_NULL_NAN, 0, 0, 1e6, "", 1, 1, "std_kg / baseline_std_kg"),
     REAL("p_value", p_value, AMFI_NULL_NAN, 0, 0, 1, "", 1, 1, "one-sided variance-ratio test"),
-    ENUM("state", state, STATES, 1, 1, "the indicator's state"),
+    ENUM("state", state, st_states, 1, 1, "the indicator's state"),
 };
 #undef ROW
 
@@ -172,7 +175,7 @@ static const amfi_store_coldef indicators[] = {
 static const amfi_store_coldef alerts[] = {
     ID(1, 1, "alert_id of the AMFI_ALERT message"),
     UTIME("utime", utime, 1, 1, "data time"),
-    ENUM("level", level, "info|warning", 1, 1, "info or warning"),
+    ENUM("level", level, st_levels, 1, 1, "info or warning"),
     TEXT("kind", kind, AMFI_NULL_NEVER, AMFI_TEXT_TOKEN, 1, 31, 1, 1,
          "std_increase, mean_shift, ..."),
     {.name = "message", .sql_type = 't', .ctype = AMFI_C_STR, .off = O(message),
@@ -197,7 +200,7 @@ static const amfi_store_coldef baseline[] = {
     {.name = "std_kg", .sql_type = 'r', .null_rule = AMFI_NULL_DB, .open = 1, .lo = 0, .hi = KG,
      .unit = "kg", .since = 1, .shipped = 1, .meaning = "healthy STD of GVW"},
     {.name = "source", .sql_type = 't', .null_rule = AMFI_NULL_DB, .text_kind = AMFI_TEXT_ENUM,
-     .values = "auto|manual", .unit = "", .since = 1, .shipped = 1,
+     .words = st_sources, .unit = "", .since = 1, .shipped = 1,
      .meaning = "auto (amfid) or manual (amfi-report)"},
     {.name = "note", .sql_type = 't', .null_rule = AMFI_NULL_DB, .max_len = 127, .unit = "",
      .since = 1, .shipped = 1, .meaning = "free text"},
@@ -240,7 +243,7 @@ static const amfi_store_coldef environment[] = {
 static const amfi_store_coldef scale_evals[] = {
     ID(6, 5, "one scale block or known-truck run"),
     UTIME("utime", utime, 6, 5, "data time of the block's newest passage / of the run"),
-    ENUM("kind", kind, "scale_shift|known_truck", 6, 5, "which indicator"),
+    ENUM("kind", kind, scale_kinds, 6, 5, "which indicator"),
     INT("n", n, 0, INT32_MAX, "", 6, 5, "vehicles in the block / runs so far"),
     REAL("value", value, AMFI_NULL_NAN, 1, 0, 100, "", 6, 5, "compensated scale / ratio"),
     REAL("raw", raw, AMFI_NULL_NAN, 1, 0, 100, "", 6, 5, "the same without compensation"),
@@ -249,7 +252,7 @@ static const amfi_store_coldef scale_evals[] = {
     REAL("z", z, AMFI_NULL_NAN, 0, -1e6, 1e6, "", 6, 5, "standardized increment"),
     REAL("cusum", cusum, AMFI_NULL_NAN, 0, 0, 1e6, "", 6, 5, "CUSUM statistic after it"),
     REAL("h", h, AMFI_NULL_NAN, 0, 0, 1e6, "", 6, 5, "its threshold"),
-    ENUM("state", state, STATES, 6, 5, "the indicator's state"),
+    ENUM("state", state, st_states, 6, 5, "the indicator's state"),
 };
 #undef ROW
 
@@ -260,7 +263,7 @@ static const amfi_store_coldef refusals[] = {
     UTIME("period_start", period_start, 9, 0, "wall clock: the period's start"),
     UTIME("period_end", period_end, 9, 0, "wall clock: when it was summarised (>= period_start)"),
     TEXT("channel", channel, AMFI_NULL_NEVER, AMFI_TEXT_BYTES, 1, 63, 9, 0, "the bus channel"),
-    ENUM("input", input, "accel|vehicle|truth|environment", 9, 0, "which input"),
+    ENUM("input", input, inputs, 9, 0, "which input"),
     TEXT("reason", reason, AMFI_NULL_NEVER, AMFI_TEXT_BYTES, 1, 63, 9, 0, "amfid's reason name"),
     I64("count", count, 1, INT64_MAX, "", 9, 0, "refused in the period for this reason"),
     {.name = "example", .sql_type = 't', .ctype = AMFI_C_STR, .off = O(example),
@@ -368,21 +371,29 @@ const char *amfi_store_value_problem(const amfi_store_coldef *c, const amfi_stor
         snprintf(msg, msglen, "text that is not valid UTF-8 (or holds a NUL byte)");
         return msg;
     }
-    if (c->values) {
-        size_t n = (size_t)len;
-        for (const char *w = c->values; *w;) {
-            const char *bar = strchr(w, '|');
-            size_t k = bar ? (size_t)(bar - w) : strlen(w);
-            if (k == n && memcmp(w, v->text, n) == 0) return NULL;
-            w += k + (bar != NULL);
-        }
-        snprintf(msg, msglen, "'%.40s' is not one of %s", v->text, c->values);
+    if (c->words) {
+        char all[160];
+        for (const char *const *w = c->words; *w; w++)
+            if (strlen(*w) == (size_t)len && memcmp(*w, v->text, (size_t)len) == 0) return NULL;
+        snprintf(msg, msglen, "'%.40s' is not one of %s", v->text,
+                 amfi_store_coldef_words(c, "|", all, sizeof all));
         /* the value shown may hold control characters: made '?' */
         for (char *p = msg; *p; p++)
             if ((unsigned char)*p < 0x20) *p = '?';
         return msg;
     }
     return NULL;
+}
+
+const char *amfi_store_coldef_words(const amfi_store_coldef *c, const char *sep, char *buf,
+                                    size_t len)
+{
+    size_t k = 0;
+    if (len)
+        buf[0] = '\0';
+    for (const char *const *w = c->words; w && *w && k < len; w++)
+        k += (size_t)snprintf(buf + k, len - k, "%s%s", w == c->words ? "" : sep, *w);
+    return buf;
 }
 
 const char *amfi_store_value_text(const amfi_store_value *v, char *buf, size_t len)
@@ -414,10 +425,8 @@ static void range_text(const amfi_store_coldef *c, char *buf, size_t len)
         else
             snprintf(buf, len, "%c%g, %g%c", (c->open & 1) ? '(' : '[', c->lo, c->hi,
                      (c->open & 2) ? ')' : ']');
-    } else if (c->values) {
-        snprintf(buf, len, "%s", c->values);
-        for (char *p = buf; *p; p++)
-            if (*p == '|') *p = '/';
+    } else if (c->words) {
+        amfi_store_coldef_words(c, "/", buf, len);
     } else if (c->max_len || c->min_len || c->wmax) {
         int mn = c->wmax ? c->wmin : c->min_len, mx = c->wmax ? c->wmax : c->max_len;
         snprintf(buf, len, "%d .. %d bytes", mn, mx);

@@ -60,7 +60,7 @@ enum amfi_store_null {
 /* How a text column is checked. */
 enum amfi_store_textkind {
     AMFI_TEXT_UTF8 = 0,  /* valid UTF-8 without control characters */
-    AMFI_TEXT_ENUM,      /* one of `values` */
+    AMFI_TEXT_ENUM,      /* one of `words` */
     AMFI_TEXT_TOKEN,     /* [a-z0-9_] */
     AMFI_TEXT_BYTES      /* any bytes (only the length is checked) */
 };
@@ -81,7 +81,7 @@ typedef struct amfi_store_coldef {
     int wmin, wmax;      /* TEXT: bytes the store writes, when stricter
                             (wmax 0: min_len .. max_len) */
     int cut;             /* TEXT: stored cut to this many characters (0: not) */
-    const char *values;  /* TEXT enum: "a|b|c" */
+    const char *const *words; /* TEXT enum: the words allowed, NULL-terminated */
     const char *with;    /* NULL whenever this column (of the same row) is */
     size_t flag_off;     /* AMFI_NULL_FLAG: offsetof the int flag */
     int zero_as;         /* AMFI_NULL_ZERO_AS: what 0 is stored as */
@@ -121,6 +121,10 @@ typedef struct amfi_store_value {
  * msg (at least 160 bytes) receives the explanation returned. */
 const char *amfi_store_value_problem(const amfi_store_coldef *c, const amfi_store_value *v,
                                      char *msg, size_t msglen);
+
+/* The enum's words joined by sep ("ok|gap|..."), into buf. */
+const char *amfi_store_coldef_words(const amfi_store_coldef *c, const char *sep, char *buf,
+                                    size_t len);
 
 /* The value's text as SQLite gives it (an integer in decimal, a real as
  * %.17g, text as is); buf (at least 40 bytes) holds a number's text.

@@ -142,9 +142,12 @@ int amfi_store_environment_rows(amfi_store *s, amfi_environment_row **out, size_
     int rc = st_check_handle(s, 0, err, errlen);
     if (rc == 0 && (!out || !n))
         rc = st_fail(err, errlen, AMFI_EINVAL, "environment: output is NULL");
+    const amfi_store_tabledef *t = amfi_store_tabledef_find("environment");
+    char list[256], sql[384];
+    if (rc == 0 && st_select_list(t, list, sizeof list) == 0)
+        snprintf(sql, sizeof sql, "SELECT id, %s FROM environment ORDER BY utime, id", list);
     if (rc == 0)
-        rc = st_prepare(s, "SELECT id, utime, deck_c, air_c FROM environment ORDER BY utime, id",
-                        &st, "environment: prepare rows", err, errlen);
+        rc = st_prepare(s, sql, &st, "environment: prepare rows", err, errlen);
     if (rc != 0)
         return rc;
     *out = NULL;
@@ -164,13 +167,7 @@ int amfi_store_environment_rows(amfi_store *s, amfi_environment_row **out, size_
             cap = nc;
         }
         origin o = {"environment", sqlite3_column_int64(st, 0)};
-        amfi_environment_row *r = &v[k];
-        r->received_utime = 0;
-        rc = st_read_int(st, 1, 0, AMFI_STORE_MAX_UTIME, &o, &r->utime, err, errlen);
-        if (rc == 0)
-            rc = st_read_real(st, 2, &R_TEMP_C, &o, &r->deck_c, err, errlen);
-        if (rc == 0)
-            rc = st_read_real(st, 3, &R_TEMP_C, &o, &r->air_c, err, errlen);
+        rc = st_read_row(st, 1, t, &v[k], &o, err, errlen);
         k++;
         src = SQLITE_DONE;
     }

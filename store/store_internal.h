@@ -206,4 +206,15 @@ int st_bind_row(sqlite3_stmt *st, const amfi_store_tabledef *t, const void *row)
 int st_insert_rows(amfi_store *s, const char *name, const void *rows, int n, size_t stride,
                    int batch, int64_t *id, char *err, size_t errlen);
 
+/* ", "-separated names of the row struct's columns of t (those with a C
+ * type, in the table's order), for a SELECT; 0, or -1 when it does not fit. */
+int st_select_list(const amfi_store_tabledef *t, char *buf, size_t len);
+/* Those columns read from st's columns first, first + 1, ... into the row
+ * struct, each checked by its column's rule as st_read_* do (type, range,
+ * NULL only where allowed, read back as NaN, 0 or a NULL pointer; an enum
+ * as its static word). Text other than enums is not read this way (an
+ * AMFI_EINVAL). */
+int st_read_row(sqlite3_stmt *st, int first, const amfi_store_tabledef *t, void *row,
+                const origin *o, char *err, size_t errlen);
+
 #endif /* AMFI_STORE_INTERNAL_H */

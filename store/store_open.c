@@ -70,10 +70,6 @@ static const char *const stmt_sql[N_STMT] = {
     [ST_ALL_OK_GVW] = "SELECT id, gvw_kg FROM passages WHERE status = 'ok'",
     [ST_ALL_FED_GVW] = "SELECT id, gvw_comp_kg FROM passages WHERE status = 'ok' "
                        "AND gvw_comp_kg IS NOT NULL",
-    [ST_RECENT_INDICATORS] =
-        "SELECT id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, "
-        "std_ratio, p_value, state FROM indicators ORDER BY utime DESC, id DESC "
-        "LIMIT ?1",
     /* the columns of the two alert queries are read by one function */
     [ST_RECENT_ALERTS] =
         "SELECT id, utime, level, kind, raised, indicator_id, message "
@@ -93,6 +89,12 @@ static const char *const stmt_table[N_STMT] = {
     [ST_INS_PASSAGE] = "passages",
     [ST_INS_INDICATOR] = "indicators",
     [ST_INS_ALERT] = "alerts",
+};
+/* The reads of a table's row struct: "SELECT id, <its columns> FROM ..." */
+static const struct {
+    const char *table, *tail;
+} stmt_read[N_STMT] = {
+    [ST_RECENT_INDICATORS] = {"indicators", "ORDER BY utime DESC, id DESC LIMIT ?1"},
 };
 
 /* ---- messages ------------------------------------------------------------- */
@@ -429,6 +431,16 @@ static int open_store(const char *path, int readonly, int foreign, int sync_full
         if (stmt_table[k]) {
             if (st_insert_sql(amfi_store_tabledef_find(stmt_table[k]), ins, sizeof ins) != 0) {
                 rc = st_fail(err, errlen, AMFI_EINVAL, "%s: insert too long", stmt_table[k]);
+                break;
+            }
+            sql = ins;
+        }
+        if (stmt_read[k].table) {
+            char list[768];
+            if (st_select_list(amfi_store_tabledef_find(stmt_read[k].table), list, sizeof list) != 0
+                || snprintf(ins, sizeof ins, "SELECT id, %s FROM %s %s", list, stmt_read[k].table,
+                            stmt_read[k].tail) >= (int)sizeof ins) {
+                rc = st_fail(err, errlen, AMFI_EINVAL, "%s: read too long", stmt_read[k].table);
                 break;
             }
             sql = ins;

@@ -96,40 +96,6 @@ static int is_null(const amfi_store_tabledef *t, const amfi_store_coldef *c, con
 
 /* ---- checks ---------------------------------------------------------------- */
 
-/* "a, b, c" of "a|b|c" */
-static void shown_values(const char *values, char *buf, size_t len)
-{
-    size_t k = 0;
-    for (const char *p = values; *p && k + 3 < len; p++) {
-        if (*p == '|') {
-            buf[k++] = ',';
-            buf[k++] = ' ';
-        } else {
-            buf[k++] = *p;
-        }
-    }
-    buf[k] = '\0';
-}
-
-static int check_enum(const char *name, const char *s, const char *values, char *err,
-                      size_t errlen)
-{
-    char shown[160], ex[48];
-    shown_values(values, shown, sizeof shown);
-    if (!s)
-        return st_fail(err, errlen, AMFI_EINVAL, "%s: NULL (one of %s)", name, shown);
-    size_t n = strlen(s);
-    for (const char *w = values; *w;) {
-        const char *bar = strchr(w, '|');
-        size_t k = bar ? (size_t)(bar - w) : strlen(w);
-        if (k == n && memcmp(w, s, n) == 0)
-            return 0;
-        w += k + (bar != NULL);
-    }
-    return st_fail(err, errlen, AMFI_EINVAL, "%s: '%s' is not one of %s", name, st_excerpt(s, ex),
-                   shown);
-}
-
 static int check_int(const char *name, const amfi_store_coldef *c, int64_t v, char *err,
                      size_t errlen)
 {
@@ -152,7 +118,11 @@ static int check_text(const char *name, const amfi_store_coldef *c, const char *
     size_t mn = (size_t)(c->wmax ? c->wmin : c->min_len);
     size_t mx = c->wmax ? (size_t)c->wmax : c->max_len ? (size_t)c->max_len : (size_t)-1;
     switch (c->text_kind) {
-    case AMFI_TEXT_ENUM: return check_enum(name, s, c->values, err, errlen);
+    case AMFI_TEXT_ENUM: {
+        char shown[160];
+        return st_check_enum(name, s, c->words, amfi_store_coldef_words(c, ", ", shown, sizeof shown),
+                             err, errlen);
+    }
     case AMFI_TEXT_TOKEN: return st_check_token(name, s, mx, "_", 1, err, errlen);
     case AMFI_TEXT_BYTES: {
         size_t n = s ? strlen(s) : 0;
@@ -265,5 +235,80 @@ int st_insert_rows(amfi_store *s, const char *name, const void *rows, int n, siz
     if (rc != 0 && st && n > 1)
         st_rollback(s);
     sqlite3_finalize(st);
+    return rc;
+}
+
+/* ---- reads ----------------------------------------------------------------- */
+
+int st_select_list(const amfi_store_tabledef *t, char *buf, size_t len)
+{
+    size_t k = 0;
+    int n = 0;
+    if (len)
+        buf[0] = '\0';
+    for (int j = 0; j < t->ncols && k < len; j++)
+        if (t->cols[j].ctype != AMFI_C_NONE)
+            k += (size_t)snprintf(buf + k, len - k, "%s%s", n++ ? ", " : "", t->cols[j].name);
+    return k < len ? 0 : -1;
+}
+
+static void put_int(const amfi_store_coldef *c, void *row, int64_t v)
+{
+    char *p = (char *)row + c->off;
+    if (c->ctype == AMFI_C_INT) {
+        int x = (int)v;
+        memcpy(p, &x, sizeof x);
+    } else {
+        memcpy(p, &v, sizeof v);
+    }
+}
+
+int st_read_row(sqlite3_stmt *st, int first, const amfi_store_tabledef *t, void *row,
+                const origin *o, char *err, size_t errlen)
+{
+    int col = first, rc = 0;
+    for (int j = 0; rc == 0 && j < t->ncols; j++) {
+        const amfi_store_coldef *c = &t->cols[j];
+        if (c->ctype == AMFI_C_NONE)
+            continue;
+        if (c->sql_type == AMFI_SQL_INTEGER) {
+            int64_t v = 0;
+            if (!(c->null_ok && sqlite3_column_type(st, col) == SQLITE_NULL))
+                rc = st_read_int(st, col, c->ilo, c->ihi, o, &v, err, errlen);
+            if (rc == 0)
+                put_int(c, row, v);
+        } else if (c->sql_type == AMFI_SQL_REAL) {
+            range rg = {c->lo, c->hi, c->open & 1, c->unit, (c->open & 2) != 0};
+            double x = NAN;
+            rc = c->null_ok ? st_read_real_or_null(st, col, &rg, o, &x, err, errlen)
+                            : st_read_real(st, col, &rg, o, &x, err, errlen);
+            if (rc == 0)
+                memcpy((char *)row + c->off, &x, sizeof x);
+            if (rc == 0 && c->null_rule == AMFI_NULL_FLAG) {
+                int flag = !isnan(x);
+                memcpy((char *)row + c->flag_off, &flag, sizeof flag);
+            }
+        } else if (c->text_kind == AMFI_TEXT_ENUM && c->ctype == AMFI_C_STR) {
+            char word[64];
+            const char *found = NULL;
+            rc = st_read_text(st, col, sizeof word - 1, o, word, sizeof word, NULL, 0) == 0
+                     ? 0
+                     : -1;
+            for (const char *const *w = c->words; rc == 0 && *w && !found; w++)
+                if (strcmp(*w, word) == 0)
+                    found = *w;
+            if (!found) {
+                char problem[96];
+                snprintf(problem, sizeof problem, "is not a known %s", c->name);
+                rc = st_corrupt(o, st, col, err, errlen, problem);
+            } else {
+                memcpy((char *)row + c->off, &found, sizeof found);
+            }
+        } else {
+            rc = st_fail(err, errlen, AMFI_EINVAL, "%s.%s: text is not read into a row",
+                         t->name, c->name);
+        }
+        col++;
+    }
     return rc;
 }
