@@ -4,8 +4,9 @@
  * PostgreSQL (issues 15 and 14). Every value is checked against the site
  * store's rules (fleet_col) before anything of a pass is shipped.
  *
- * Single-threaded. Reads the SQLite store read-only (SQLITE_OPEN_READONLY; in
- * WAL mode a reader never blocks amfid's writer) and writes the central
+ * Single-threaded. Reads the SQLite store read-only through the store's API
+ * (amfi_store_open_reader, rows as column values; in WAL mode a reader
+ * never blocks amfid's writer) and writes the central
  * database with libpq, as the site's own role, which row-level security
  * binds to the site's rows (central version 6), over TLS to a server not on
  * this machine (fleet_pg.c). Each batch is one PostgreSQL transaction holding
@@ -19,7 +20,6 @@
 #include <inttypes.h>
 #include <libpq-fe.h>
 #include <signal.h>
-#include <sqlite3.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,6 +34,7 @@
 #include "amfi_config.h"
 #include "fleet_pg.h"
 #include "fleet_schema.h"
+#include "store.h"
 #include "amfi_time.h"
 
 enum { BATCH_ROWS = 5000, SITE_ID_MAX = 63 };
@@ -83,26 +84,13 @@ static int buf_field(struct buf *b, const unsigned char *s, int isnull)
     return 0;
 }
 
-/* Text of the column of the current row; REAL as %.17g so the copy is exact. */
-static const unsigned char *col_text(sqlite3_stmt *st, int i, char tmp[40], int *isnull)
-{
-    int t = sqlite3_column_type(st, i);
-    *isnull = t == SQLITE_NULL;
-    if (t == SQLITE_FLOAT) {
-        snprintf(tmp, 40, "%.17g", sqlite3_column_double(st, i));
-        return (const unsigned char *)tmp;
-    }
-    return *isnull ? (const unsigned char *)"" : sqlite3_column_text(st, i);
-}
-
-static uint64_t row_hash(sqlite3_stmt *st, int ncols)
+static uint64_t row_hash(const amfi_store_value *v, int ncols)
 {
     uint64_t h = 0xcbf29ce484222325ULL;
     char tmp[40];
-    int isnull;
-    for (int i = 0; i < ncols && i < sqlite3_column_count(st); i++) {
-        const unsigned char *s = col_text(st, i, tmp, &isnull);
-        h = fnv1a(h, isnull ? "\x01N" : (const char *)s, isnull ? 2 : strlen((const char *)s));
+    for (int i = 0; i < ncols; i++) {
+        const char *s = amfi_store_value_text(&v[i], tmp, sizeof tmp);
+        h = fnv1a(h, s ? s : "\x01N", s ? strlen(s) : 2);
         h = fnv1a(h, "\x1f", 1);
     }
     return h;
@@ -221,42 +209,55 @@ static int apply_schema(PGconn *pg)
 }
 
 
-/* COPY the rows of one SELECT into table dst with the site id in front;
- * the last row's id and the hash of its first hash_cols columns go to
+/* The rows of one scan as COPY text, the site id in front. */
+struct copy_ctx {
+    struct buf b;
+    const char *site;
+    int hash_cols;
+    int64_t last_id;
+    uint64_t last_hash;
+    long n;
+};
+static int copy_row(void *ctx, const amfi_store_value *v, int n)
+{
+    struct copy_ctx *c = ctx;
+    char tmp[40];
+    if (buf_field(&c->b, (const unsigned char *)c->site, 0)) return -1;
+    for (int i = 0; i < n; i++) {
+        const char *s = amfi_store_value_text(&v[i], tmp, sizeof tmp);
+        if (buf_put(&c->b, "\t", 1) || buf_field(&c->b, (const unsigned char *)(s ? s : ""), !s))
+            return -1;
+    }
+    if (buf_put(&c->b, "\n", 1)) return -1;
+    c->last_id = v[0].i;
+    if (c->hash_cols) c->last_hash = row_hash(v, c->hash_cols < n ? c->hash_cols : n);
+    c->n++;
+    return 0;
+}
+
+/* COPY the rows of table src whose key is in (lo, hi], at most limit (0:
+ * all), into the central table of the same name with the site id in front;
+ * the last row's key and the hash of its first hash_cols columns go to
  * *last_id and *last_hash when last_id is not NULL. */
-static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst, const char *cols,
-                     int hash_cols,
-                     const char *sel, int64_t lo, int64_t hi, int64_t *last_id, uint64_t *last_hash,
+static int copy_rows(PGconn *pg, amfi_store *s, const char *site, const char *dst, int hash_cols,
+                     int64_t lo, int64_t hi, int limit, int64_t *last_id, uint64_t *last_hash,
                      long *nrows)
 {
-    sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(db, sel, -1, &st, NULL) != SQLITE_OK) {
-        fprintf(stderr, "amfi-sync: store: %s: %s\n", dst, sqlite3_errmsg(db));
+    const char *names[64];
+    char cols[1024], err[512];
+    int ncols = fleet_columns(dst, NULL, names, 64);
+    fleet_cols_text(dst, cols, sizeof cols);
+    struct copy_ctx c = {{0}, site, last_id ? hash_cols : 0, 0, 0, 0};
+    int rc = amfi_store_scan(s, dst, names, ncols, lo, hi, limit, copy_row, &c, err, sizeof err);
+    if (rc != 0) {
+        if (rc == -1) fprintf(stderr, "amfi-sync: store: %s: out of memory\n", dst);
+        else fprintf(stderr, "amfi-sync: store: %s\n", err);
+        free(c.b.p);
         return EX_RETRY;
     }
-    sqlite3_bind_int64(st, 1, lo);
-    sqlite3_bind_int64(st, 2, hi);
-    struct buf b = {0};
-    int rc, n = 0;
-    char tmp[40];
-    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
-        int isnull;
-        buf_field(&b, (const unsigned char *)site, 0);
-        for (int i = 0; i < sqlite3_column_count(st); i++) {
-            buf_put(&b, "\t", 1);
-            const unsigned char *s = col_text(st, i, tmp, &isnull);
-            if (buf_field(&b, s, isnull)) { rc = SQLITE_NOMEM; break; }
-        }
-        if (buf_put(&b, "\n", 1)) { rc = SQLITE_NOMEM; break; }
-        if (last_id) { *last_id = sqlite3_column_int64(st, 0); *last_hash = row_hash(st, hash_cols); }
-        n++;
-    }
-    if (rc != SQLITE_DONE) {
-        fprintf(stderr, "amfi-sync: store: reading %s: %s\n", dst, sqlite3_errmsg(db));
-        sqlite3_finalize(st); free(b.p);
-        return EX_RETRY;
-    }
-    sqlite3_finalize(st);
+    if (last_id && c.n > 0) { *last_id = c.last_id; *last_hash = c.last_hash; }
+    struct buf b = c.b;
+    long n = c.n;
     *nrows = n;
     if (n == 0) { free(b.p); return 0; }
     /* PostgreSQL refuses COPY FROM into a table whose row-level security
@@ -264,7 +265,7 @@ static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst,
      * by COPY into a temporary table of the same columns (this session's
      * own, emptied at every commit), then by one INSERT ... SELECT into the
      * site table, where the policies check every row. */
-    char copy[2048];
+    char copy[5120];
     snprintf(copy, sizeof copy,
              "CREATE TEMP TABLE IF NOT EXISTS amfi_in_%s (LIKE %s) ON COMMIT DELETE ROWS", dst, dst);
     if (pg_exec(pg, copy, "temporary table")) { free(b.p); return EX_RETRY; }
@@ -284,63 +285,73 @@ static int copy_rows(PGconn *pg, sqlite3 *db, const char *site, const char *dst,
     return pg_exec(pg, copy, dst) ? EX_RETRY : 0;
 }
 
-/* Every value of the rows SELECT sel gives (ids above hwm) against the
- * site store's rules (fleet_col): a store that breaks its own schema (a
- * damaged file, a row written around amfid) is refused before anything of
- * the pass is shipped, naming the table, the row and the column. */
-static int check_rows(sqlite3 *db, const char *site, const char *store, const char *table,
-                      const struct fleet_col *rules, int key_cols, const char *sel, int64_t hwm)
+/* Every value of the rows of a table with keys above hwm against the site
+ * store's rules (the store's column table): a store that breaks its own
+ * schema (a damaged file, a row written around amfid) is refused before
+ * anything of the pass is shipped, naming the table, the row and the
+ * column. */
+struct check_ctx {
+    const amfi_store_coldef *defs[64];
+    const char *site, *store, *table;
+    int key_cols;
+    long n;
+};
+static int check_row(void *ctx, const amfi_store_value *v, int n)
 {
-    sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(db, sel, -1, &st, NULL) != SQLITE_OK) {
-        fprintf(stderr, "amfi-sync: store: %s: %s\n", table, sqlite3_errmsg(db));
+    struct check_ctx *c = ctx;
+    char msg[200];
+    for (int i = 0; i < n; i++) {
+        const char *why = amfi_store_value_problem(c->defs[i], &v[i], msg, sizeof msg);
+        if (!why) continue;
+        char key[96] = "";
+        for (int k = 0; k < c->key_cols; k++)
+            snprintf(key + strlen(key), sizeof key - strlen(key), "%s%s %lld", k ? ", " : "",
+                     c->defs[k]->name, (long long)(v[k].type == AMFI_SQL_INTEGER ? v[k].i : 0));
+        fprintf(stderr,
+                "amfi-sync: refused: site '%s' store %s: table %s, %s, column %s: %s "
+                "(the site store's rules, docs/schema.md). Nothing shipped "
+                "(see docs/fleet.md, 'Bad values')\n",
+                c->site, c->store, c->table, key, c->defs[i]->name, why);
+        return EX_REFUSED;
+    }
+    if (++c->n % 4096 == 0) keepalive();
+    return 0;
+}
+
+static int check_rows(amfi_store *s, const char *site, const char *store, const char *table,
+                      int key_cols, int64_t hwm)
+{
+    const char *names[64];
+    char err[512];
+    struct check_ctx c = {.site = site, .store = store, .table = table, .key_cols = key_cols};
+    int ncols = fleet_columns(table, c.defs, names, 64);
+    int rc = amfi_store_scan(s, table, names, ncols, hwm, INT64_MAX, 0, check_row, &c, err,
+                             sizeof err);
+    if (rc == EX_REFUSED) return rc;
+    if (rc != 0) {
+        fprintf(stderr, "amfi-sync: store: %s\n", err);
         return EX_RETRY;
     }
-    int ncols = sqlite3_column_count(st);
-    for (int i = 0; i <= ncols; i++)
-        if ((i == ncols) != (rules[i].name == NULL)
-            || (i < ncols && strcmp(rules[i].name, sqlite3_column_name(st, i)) != 0)) {
-            fprintf(stderr, "amfi-sync: internal: %s: the rules do not match the columns shipped\n", table);
-            sqlite3_finalize(st);
-            return EX_USAGE;
-        }
-    sqlite3_bind_int64(st, 1, hwm);
-    int rc;
-    long n = 0;
-    char msg[200];
-    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
-        for (int i = 0; i < ncols; i++) {
-            int type = sqlite3_column_type(st, i);
-            const char *text = type == SQLITE_TEXT ? (const char *)sqlite3_column_text(st, i) : NULL;
-            const char *why = fleet_col_problem(
-                &rules[i], type, type == SQLITE_INTEGER ? sqlite3_column_int64(st, i) : 0,
-                type == SQLITE_FLOAT ? sqlite3_column_double(st, i) : 0, text,
-                text ? sqlite3_column_bytes(st, i) : 0, msg, sizeof msg);
-            if (!why) continue;
-            char key[96] = "";
-            for (int k = 0; k < key_cols; k++)
-                snprintf(key + strlen(key), sizeof key - strlen(key), "%s%s %lld", k ? ", " : "",
-                         rules[k].name, (long long)sqlite3_column_int64(st, k));
-            fprintf(stderr,
-                    "amfi-sync: refused: site '%s' store %s: table %s, %s, column %s: %s "
-                    "(the site store's rules, docs/schema.md). Nothing shipped "
-                    "(see docs/fleet.md, 'Bad values')\n",
-                    site, store, table, key, rules[i].name, why);
-            sqlite3_finalize(st);
-            return EX_REFUSED;
-        }
-        if (++n % 4096 == 0) keepalive();
-    }
-    if (rc != SQLITE_DONE) fprintf(stderr, "amfi-sync: store: reading %s: %s\n", table, sqlite3_errmsg(db));
-    sqlite3_finalize(st);
-    return rc == SQLITE_DONE ? 0 : EX_RETRY;
+    return 0;
+}
+
+/* The hash of the row at key id (*found 0: none). */
+struct mark_ctx { int hash_cols, found; uint64_t hash; };
+static int mark_row(void *ctx, const amfi_store_value *v, int n)
+{
+    struct mark_ctx *m = ctx;
+    m->found = 1;
+    m->hash = row_hash(v, m->hash_cols < n ? m->hash_cols : n);
+    return 0;
 }
 
 /* Ship one table until it has no more new rows. */
-static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const char *store,
+static int sync_table(PGconn *pg, amfi_store *db, const char *site, const char *store,
                       const struct fleet_table *t, int check_only, long *total)
 {
-    char sql[1024];
+    const char *names[64];
+    char err[512];
+    int ncols = fleet_columns(t->name, NULL, names, 64), hash_cols = fleet_hash_cols(t->name);
     const char *pv[2] = {site, t->name};
     PGresult *r = PQexecParams(pg, "SELECT hwm, last_hash FROM fleet_sync_state WHERE site_id = $1 AND tbl = $2",
                                2, NULL, pv, NULL, NULL, 0);
@@ -354,34 +365,27 @@ static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const char *sto
     PQclear(r);
     /* The row at the mark must still be the one shipped. */
     if (hwm > 0) {
-        sqlite3_stmt *st = NULL;
-        snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE id = ?1", t->cols, t->name);
-        if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK) {
-            fprintf(stderr, "amfi-sync: store: %s: %s\n", t->name, sqlite3_errmsg(db));
+        struct mark_ctx m = {hash_cols, 0, 0};
+        if (amfi_store_scan(db, t->name, names, ncols, hwm - 1, hwm, 1, mark_row, &m, err,
+                            sizeof err) != 0) {
+            fprintf(stderr, "amfi-sync: store: %s\n", err);
             return EX_RETRY;
         }
-        sqlite3_bind_int64(st, 1, hwm);
-        int rc = sqlite3_step(st);
-        uint64_t h = rc == SQLITE_ROW ? row_hash(st, t->hash_cols) : 0;
-        sqlite3_finalize(st);
-        if (rc != SQLITE_ROW || h != hash) {
+        uint64_t h = m.found ? m.hash : 0;
+        if (!m.found || h != hash) {
             fprintf(stderr,
                     "amfi-sync: refused: site '%s' table %s: the central database holds rows up to id %" PRId64
                     " but the store %s; was the store restored from an older backup? Nothing merged "
                     "(see docs/fleet.md, 'Restored stores')\n",
-                    site, t->name, hwm, rc == SQLITE_ROW ? "has a different row at that id" : "has no row at that id");
+                    site, t->name, hwm, m.found ? "has a different row at that id" : "has no row at that id");
             return EX_REFUSED;
         }
     }
     if (check_only) {
         /* the rows to ship: every value as the site store's rules say */
-        snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE id > ?1 ORDER BY id", t->cols, t->name);
-        int rc = check_rows(db, site, store, t->name, t->rules, 1, sql, hwm);
-        if (!rc && t->child) {
-            snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE %s > ?1 ORDER BY %s", t->child_cols,
-                     t->child, t->child_parent, t->child_parent);
-            rc = check_rows(db, site, store, t->child, t->child_rules, 2, sql, hwm);
-        }
+        int rc = check_rows(db, site, store, t->name, 1, hwm);
+        if (!rc && t->child)
+            rc = check_rows(db, site, store, t->child, 2, hwm);
         return rc;
     }
     for (;;) {
@@ -390,14 +394,10 @@ static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const char *sto
         int64_t last = hwm;
         uint64_t lh = hash;
         long n = 0, nc = 0;
-        snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE id > ?1 AND ?2 > 0 ORDER BY id LIMIT %d",
-                 t->cols, t->name, BATCH_ROWS);
-        int rc = copy_rows(pg, db, site, t->name, t->cols, t->hash_cols, sql, hwm, 1, &last, &lh, &n);
-        if (!rc && n > 0 && t->child) {
-            snprintf(sql, sizeof sql, "SELECT %s FROM %s WHERE %s > ?1 AND %s <= ?2 ORDER BY %s",
-                     t->child_cols, t->child, t->child_parent, t->child_parent, t->child_parent);
-            rc = copy_rows(pg, db, site, t->child, t->child_cols, 0, sql, hwm, last, NULL, NULL, &nc);
-        }
+        int rc = copy_rows(pg, db, site, t->name, hash_cols, hwm, INT64_MAX, BATCH_ROWS, &last, &lh,
+                           &n);
+        if (!rc && n > 0 && t->child)
+            rc = copy_rows(pg, db, site, t->child, 0, hwm, last, 0, NULL, NULL, &nc);
         if (!rc && n > 0) {
             char shwm[24], shash[24];
             snprintf(shwm, sizeof shwm, "%" PRId64, last);
@@ -422,7 +422,7 @@ static int sync_table(PGconn *pg, sqlite3 *db, const char *site, const char *sto
 }
 
 /* Local ids lower than the central mark: the store went backwards. */
-static int check_backwards(PGconn *pg, sqlite3 *db, const char *site)
+static int check_backwards(PGconn *pg, amfi_store *db, const char *site)
 {
     for (int i = 0; i < fleet_n_tables; i++) {
         const char *pv[2] = {site, fleet_tables[i].name};
@@ -431,16 +431,12 @@ static int check_backwards(PGconn *pg, sqlite3 *db, const char *site)
         if (pg_ok(r, "fleet_sync_state")) { PQclear(r); return EX_RETRY; }
         int64_t hwm = PQntuples(r) ? strtoll(PQgetvalue(r, 0, 0), NULL, 10) : 0;
         PQclear(r);
-        char sql[128];
-        snprintf(sql, sizeof sql, "SELECT coalesce(max(id), 0) FROM %s", fleet_tables[i].name);
-        sqlite3_stmt *st = NULL;
-        if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK || sqlite3_step(st) != SQLITE_ROW) {
-            fprintf(stderr, "amfi-sync: store: %s: %s\n", fleet_tables[i].name, sqlite3_errmsg(db));
-            sqlite3_finalize(st);
+        int64_t mx = 0;
+        char err[512];
+        if (amfi_store_max_key(db, fleet_tables[i].name, &mx, err, sizeof err) != 0) {
+            fprintf(stderr, "amfi-sync: store: %s\n", err);
             return EX_RETRY;
         }
-        int64_t mx = sqlite3_column_int64(st, 0);
-        sqlite3_finalize(st);
         if (mx < hwm) {
             fprintf(stderr,
                     "amfi-sync: refused: site '%s' table %s: the store's newest id is %" PRId64
@@ -453,86 +449,36 @@ static int check_backwards(PGconn *pg, sqlite3 *db, const char *site)
     return 0;
 }
 
-/* The store is read as a file from elsewhere: SQLite's defensive mode, an
- * untrusted schema (views and triggers may call only innocuous functions),
- * no extension loading, triggers and views off (amfi-sync reads tables
- * only), query_only; every setting read back. A store holding a trigger or
- * a view in place of a table shipped fails on the first read of it. */
-static int store_harden(sqlite3 *db, const char *store)
+/* Every table shipped (and meta) must be a table of the file, not a view
+ * or a virtual table put in its place: refused (exit 3) naming it. */
+static int store_tables_real(amfi_store *db, const char *store)
 {
-    static const struct {
-        int op, want;
-        const char *name;
-    } set[] = {
-        {SQLITE_DBCONFIG_DEFENSIVE, 1, "SQLITE_DBCONFIG_DEFENSIVE"},
-        {SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, "SQLITE_DBCONFIG_TRUSTED_SCHEMA"},
-        {SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0, "SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION"},
-        {SQLITE_DBCONFIG_ENABLE_TRIGGER, 0, "SQLITE_DBCONFIG_ENABLE_TRIGGER"},
-        {SQLITE_DBCONFIG_ENABLE_VIEW, 0, "SQLITE_DBCONFIG_ENABLE_VIEW"},
-    };
-    for (size_t k = 0; k < sizeof set / sizeof set[0]; k++) {
-        int got = -1;
-        if (sqlite3_db_config(db, set[k].op, set[k].want, &got) != SQLITE_OK || got != set[k].want) {
-            fprintf(stderr, "amfi-sync: %s: cannot set %s to %d (SQLite %s)\n", store, set[k].name,
-                    set[k].want, sqlite3_libversion());
+    for (int i = -1; i < 2 * fleet_n_tables; i++) {
+        const char *name = i < 0 ? "meta" : i % 2 ? fleet_tables[i / 2].child : fleet_tables[i / 2].name;
+        if (!name)
+            continue;
+        char type[32], err[512];
+        if (amfi_store_object_type(db, name, type, sizeof type, err, sizeof err) != 0) {
+            fprintf(stderr, "amfi-sync: %s: %s\n", store, err);
             return -1;
         }
-    }
-    char *emsg = NULL;
-    if (sqlite3_exec(db, "PRAGMA query_only = ON", NULL, NULL, &emsg) != SQLITE_OK) {
-        fprintf(stderr, "amfi-sync: %s: PRAGMA query_only: %s\n", store, emsg ? emsg : "failed");
-        sqlite3_free(emsg);
+        if (strcmp(type, "table") == 0)
+            continue;
+        fprintf(stderr, "amfi-sync: refused: store %s: '%s' is %s, not a table: not an amfi "
+                        "store (nothing shipped)\n", store, name,
+                !type[0] ? "missing" : strcmp(type, "virtual table") ? type : "a virtual table");
         return -1;
     }
     return 0;
 }
 
-/* Every table shipped (and meta) must be a table of the file, not a view
- * or a virtual table put in its place: refused (exit 3) naming it. */
-static int store_tables_real(sqlite3 *db, const char *store)
+static int store_site_id(amfi_store *db, char out[SITE_ID_MAX + 1])
 {
-    sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(db, "SELECT type, coalesce(sql, '') FROM sqlite_schema WHERE name = ?1",
-                           -1, &st, NULL) != SQLITE_OK) {
-        fprintf(stderr, "amfi-sync: %s: reading the schema: %s\n", store, sqlite3_errmsg(db));
-        return -1;
-    }
-    int bad = 0;
-    for (int i = -1; !bad && i < 2 * fleet_n_tables; i++) {
-        const char *name = i < 0 ? "meta" : i % 2 ? fleet_tables[i / 2].child : fleet_tables[i / 2].name;
-        if (!name)
-            continue;
-        sqlite3_reset(st);
-        sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
-        int src = sqlite3_step(st);
-        const char *type = src == SQLITE_ROW ? (const char *)sqlite3_column_text(st, 0) : NULL;
-        const char *sql = src == SQLITE_ROW ? (const char *)sqlite3_column_text(st, 1) : "";
-        if (src == SQLITE_ROW && type && strcmp(type, "table") == 0
-            && strncmp(sql, "CREATE VIRTUAL", 14) != 0)
-            continue;
-        if (src != SQLITE_ROW && src != SQLITE_DONE)
-            fprintf(stderr, "amfi-sync: %s: reading the schema: %s\n", store, sqlite3_errmsg(db));
-        else
-            fprintf(stderr, "amfi-sync: refused: store %s: '%s' is %s, not a table: not an amfi "
-                            "store (nothing shipped)\n", store, name,
-                    src == SQLITE_DONE ? "missing" : type && strcmp(type, "table") ? type
-                                                                                 : "a virtual table");
-        bad = 1;
-    }
-    sqlite3_finalize(st);
-    return bad ? -1 : 0;
-}
-
-static int store_site_id(sqlite3 *db, char out[SITE_ID_MAX + 1])
-{
-    sqlite3_stmt *st = NULL;
     int found = 0;
-    if (sqlite3_prepare_v2(db, "SELECT value FROM meta WHERE key = 'site.id'", -1, &st, NULL) == SQLITE_OK
-        && sqlite3_step(st) == SQLITE_ROW) {
-        const char *v = (const char *)sqlite3_column_text(st, 0);
-        if (v && strlen(v) <= SITE_ID_MAX) { strcpy(out, v); found = 1; }
-    }
-    sqlite3_finalize(st);
+    char err[256];
+    /* a value too long for a site id (an error here) is no site id */
+    if (amfi_store_meta_get(db, "site.id", out, SITE_ID_MAX + 1, &found, err, sizeof err) != 0)
+        found = 0;
     return found;
 }
 
@@ -601,60 +547,20 @@ static int check_role(PGconn *pg, const char *site)
 /* The store opened read-only; without its -wal file and unable to create a
  * -shm (amfi-sync's user only reads, amfid stopped), immutable (see
  * store_moved). */
-static int open_store(const char *store, sqlite3 **db, int *store_version)
+static int open_store(const char *store, amfi_store **db, int *store_version)
 {
-    store_immutable = 0;
+    char err[4400];
+    int immutable = 0;
     snprintf(store_wal, sizeof store_wal, "%s-wal", store);
-    for (int pass = 0; pass < 2; pass++) {
-        char uri[3 * 4096 + 32];
-        const char *name = store;
-        if (pass == 1) {
-            /* a file: URI with the path percent-encoded */
-            size_t k = (size_t)snprintf(uri, sizeof uri, "file:");
-            for (const unsigned char *p = (const unsigned char *)store; *p && k + 4 < sizeof uri; p++) {
-                if ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9')
-                    || strchr("/._-~", *p))
-                    uri[k++] = (char)*p;
-                else
-                    k += (size_t)snprintf(uri + k, sizeof uri - k, "%%%02X", *p);
-            }
-            snprintf(uri + k, sizeof uri - k, "?immutable=1");
-            name = uri;
-            if (stat(store, &store_st) != 0) break;
-            store_immutable = 1;
-        }
-        if (sqlite3_open_v2(name, db, SQLITE_OPEN_READONLY | (pass ? SQLITE_OPEN_URI : 0), NULL) != SQLITE_OK) {
-            fprintf(stderr, "amfi-sync: %s: cannot open the store read-only: %s\n", store, sqlite3_errmsg(*db));
-            sqlite3_close(*db);
-            *db = NULL;
-            return EX_RETRY;
-        }
-        sqlite3_busy_timeout(*db, 5000);
-        if (store_harden(*db, store) != 0) {
-            sqlite3_close(*db);
-            *db = NULL;
-            return EX_REFUSED;
-        }
-        sqlite3_stmt *uv = NULL;
-        int ok = sqlite3_prepare_v2(*db, "PRAGMA user_version", -1, &uv, NULL) == SQLITE_OK
-                 && sqlite3_step(uv) == SQLITE_ROW;
-        if (ok) *store_version = sqlite3_column_int(uv, 0);
-        sqlite3_finalize(uv);
-        if (ok) return 0;
-        int code = sqlite3_errcode(*db) & 0xff;
-        if (pass == 0 && (code == SQLITE_READONLY || code == SQLITE_CANTOPEN)
-            && access(store_wal, F_OK) != 0 && errno == ENOENT) {
-            sqlite3_close(*db);
-            *db = NULL;
-            continue;
-        }
-        fprintf(stderr, "amfi-sync: %s: cannot read the store: %s\n", store, sqlite3_errmsg(*db));
-        sqlite3_close(*db);
-        *db = NULL;
-        return EX_RETRY;
+    /* noted before it is opened: a change after is seen by store_moved */
+    int have_st = stat(store, &store_st) == 0;
+    int rc = amfi_store_open_reader(store, have_st, db, store_version, &immutable, err, sizeof err);
+    if (rc != 0) {
+        fprintf(stderr, "amfi-sync: %s\n", err);
+        return rc == AMFI_STORE_ESCHEMA ? EX_REFUSED : EX_RETRY;
     }
-    fprintf(stderr, "amfi-sync: %s: cannot read the store: %s\n", store, strerror(errno));
-    return EX_RETRY;
+    store_immutable = immutable;
+    return 0;
 }
 
 /* One pass: connect, create or migrate the central schema, open the store,
@@ -677,7 +583,7 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         PQfinish(pg);
         return rc;
     }
-    sqlite3 *db = NULL;
+    amfi_store *db = NULL;
     /* The columns shipped are those of the current store schema; amfid
      * migrates an older store when it starts (read-only here, amfi-sync
      * cannot). Retried: follow mode goes on once amfid has run. */
@@ -691,7 +597,7 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         fprintf(stderr, "amfi-sync: %s: store schema version %d, this amfi-sync needs %d or newer: "
                         "start the new amfid once (it migrates the store), then sync\n",
                 store, store_version, FLEET_MIN_STORE_VERSION);
-        sqlite3_close(db);
+        amfi_store_close(db);
         PQfinish(pg);
         return EX_RETRY;
     }
@@ -722,7 +628,12 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
     if (rc) goto out;
     /* One read transaction for the whole pass: a consistent snapshot while
      * amfid keeps writing (WAL). */
-    sqlite3_exec(db, "BEGIN", NULL, NULL, NULL);
+    char txerr[512];
+    if (amfi_store_transaction(db, AMFI_STORE_TX_READ, txerr, sizeof txerr) != 0) {
+        fprintf(stderr, "amfi-sync: %s\n", txerr);
+        rc = EX_RETRY;
+        goto out;
+    }
     rc = check_backwards(pg, db, site);
     long total = 0;
     /* every table checked (its mark, then its new rows' values) before any
@@ -731,14 +642,14 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         rc = sync_table(pg, db, site, store, &fleet_tables[i], 1, &total);
     for (int i = 0; !rc && i < fleet_n_tables && !stop_requested; i++)
         rc = sync_table(pg, db, site, store, &fleet_tables[i], 0, &total);
-    sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
+    amfi_store_transaction(db, AMFI_STORE_TX_COMMIT, NULL, 0);
     if (shipped) *shipped = total;
     char tls[64];
     if (!rc && !quiet && total > 0)
         fprintf(stderr, "amfi-sync: site '%s': %ld rows shipped to %s/%s %s\n", site, total, PQhost(pg),
                 PQdb(pg), tls_note(pg, tls, sizeof tls));
 out:
-    sqlite3_close(db);
+    amfi_store_close(db);
     PQfinish(pg);
     return rc;
 }

@@ -5,7 +5,6 @@
  * per-table high-water mark and the hash of the last shipped row. */
 #include "fleet_schema.h"
 
-#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -225,152 +224,48 @@ const struct fleet_migration fleet_migrations[] = {
 };
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
 
-/* The site store's rules per column (store/store_schema.c, docs/schema.md). */
-#define UT_MAX AMFI_STORE_MAX_UTIME
-#define KG AMFI_STORE_MAX_KG
-#define I_(n, lo, hi) {n, FLEET_INT, 0, 0, 0, 0, lo, hi, NULL, 0, 0}
-#define IN(n, lo, hi) {n, FLEET_INT, 1, 0, 0, 0, lo, hi, NULL, 0, 0}
-#define R_(n, open, lo, hi) {n, FLEET_REAL, 0, open, lo, hi, 0, 0, NULL, 0, 0}
-#define RN(n, open, lo, hi) {n, FLEET_REAL, 1, open, lo, hi, 0, 0, NULL, 0, 0}
-#define T_(n, values, lo, hi) {n, FLEET_TEXT, 0, 0, 0, 0, 0, 0, values, lo, hi}
-#define TN(n, values, lo, hi) {n, FLEET_TEXT, 1, 0, 0, 0, 0, 0, values, lo, hi}
-#define END_ {NULL, 0, 0, 0, 0, 0, 0, 0, NULL, 0, 0}
-#define ID_ I_("id", 1, INT64_MAX)
-#define UTIME_(n) I_(n, 0, UT_MAX)
-#define STATE_ T_("state", "baseline|normal|watch|alert", 0, 0)
-
-static const struct fleet_col passages_rules[] = {
-    ID_, I_("vehicle_id", INT64_MIN, INT64_MAX), UTIME_("utime"), I_("lane", -32768, 32767),
-    RN("speed_mps", 0, 0, AMFI_STORE_MAX_SPEED_MPS), I_("n_axles", 0, 12), RN("gvw_kg", 0, -KG, KG),
-    T_("status", "ok|gap|late|overload|multiple|invalid|error", 0, 0), T_("reason", NULL, 0, 0),
-    RN("lambda", 1, 0, INFINITY), RN("residual_rms", 0, 0, INFINITY), TN("formulation", NULL, 1, 63),
-    RN("solve_ms", 0, 0, INFINITY), T_("stored_at", NULL, 0, 0),
-    RN("speed_given_mps", 0, 0, AMFI_STORE_MAX_SPEED_MPS), I_("speed_estimated", 0, 1),
-    I_("n_vehicles", 1, 64), RN("quality", 0, 1, 1e9), RN("reference_gvw_kg", 0, 1000, 100000),
-    RN("deck_c", 0, -60, 80), RN("f1_hz", 1, 0, 1000), RN("f1_comp_hz", 1, 0, 1000),
-    RN("f1_zeta", 2, 0, 1), RN("f1_r2", 0, 0, 1), RN("gvw_comp_kg", 1, 0, KG), END_};
-static const struct fleet_col axles_rules[] = {
-    I_("passage_id", 1, INT64_MAX), I_("idx", 1, 12),
-    RN("spacing_m", 1, 0, AMFI_STORE_MAX_SPACING_M), RN("load_kg", 0, -KG, KG), END_};
-static const struct fleet_col indicators_rules[] = {
-    ID_, UTIME_("utime"), I_("n", 0, INT32_MAX), RN("mean_kg", 0, -KG, KG),
-    RN("std_kg", 0, 0, KG), RN("baseline_mean_kg", 1, 0, KG), RN("baseline_std_kg", 1, 0, KG),
-    RN("std_ratio", 0, 0, 1e6), RN("p_value", 0, 0, 1), STATE_, END_};
-static const struct fleet_col alerts_rules[] = {
-    ID_, UTIME_("utime"), T_("level", "info|warning", 0, 0), T_("kind", NULL, 1, 31),
-    T_("message", NULL, 0, 0), IN("indicator_id", INT64_MIN, INT64_MAX), I_("raised", 0, 1), END_};
-static const struct fleet_col baseline_rules[] = {
-    ID_, UTIME_("utime_set"), I_("n", 2, INT32_MAX), R_("mean_kg", 1, 0, KG), R_("std_kg", 1, 0, KG),
-    T_("source", "auto|manual", 0, 0), T_("note", NULL, 0, 127), T_("set_at", NULL, 0, 0), END_};
-static const struct fleet_col runs_rules[] = {
-    ID_, T_("started_at", NULL, 0, 0), T_("version", NULL, 1, 63), T_("config_path", NULL, 1, 4096),
-    END_};
-static const struct fleet_col environment_rules[] = {
-    ID_, UTIME_("utime"), R_("deck_c", 0, -60, 80), R_("air_c", 0, -60, 80),
-    UTIME_("received_utime"), END_};
-static const struct fleet_col scale_evals_rules[] = {
-    ID_, UTIME_("utime"), T_("kind", "scale_shift|known_truck", 0, 0), I_("n", 0, INT32_MAX),
-    RN("value", 1, 0, 100), RN("raw", 1, 0, 100), RN("deck_c", 0, -60, 80),
-    RN("z", 0, -1e6, 1e6), RN("cusum", 0, 0, 1e6), RN("h", 0, 0, 1e6), STATE_, END_};
-
 const struct fleet_table fleet_tables[] = {
-    {"passages",
-     "id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason, lambda, "
-     "residual_rms, formulation, solve_ms, stored_at, speed_given_mps, speed_estimated, "
-     "n_vehicles, quality, reference_gvw_kg, deck_c, f1_hz, f1_comp_hz, f1_zeta, f1_r2, gvw_comp_kg",
-     passages_rules, axles_rules, 14,
-     "axles", "passage_id, idx, spacing_m, load_kg", "passage_id"},
-    {"indicators",
-     "id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, std_ratio, p_value, state",
-     indicators_rules, NULL, 10, NULL, NULL, NULL},
-    {"alerts", "id, utime, level, kind, message, indicator_id, raised", alerts_rules, NULL, 7,
-     NULL, NULL, NULL},
-    {"baseline", "id, utime_set, n, mean_kg, std_kg, source, note, set_at", baseline_rules, NULL, 8,
-     NULL, NULL, NULL},
-    {"runs", "id, started_at, version, config_path", runs_rules, NULL, 4, NULL, NULL, NULL},
+    {"passages", "axles", "passage_id"},
+    {"indicators", NULL, NULL},
+    {"alerts", NULL, NULL},
+    {"baseline", NULL, NULL},
+    {"runs", NULL, NULL},
     /* central version 5 */
-    {"environment", "id, utime, deck_c, air_c, received_utime", environment_rules, NULL, 5, NULL,
-     NULL, NULL},
-    {"scale_evals", "id, utime, kind, n, value, raw, deck_c, z, cusum, h, state",
-     scale_evals_rules, NULL, 11, NULL, NULL, NULL},
+    {"environment", NULL, NULL},
+    {"scale_evals", NULL, NULL},
 };
 const int fleet_n_tables = (int)(sizeof fleet_tables / sizeof fleet_tables[0]);
 
-/* s[0..len) is valid UTF-8 without a NUL byte. */
-static int utf8_ok(const unsigned char *s, int len)
+int fleet_columns(const char *table, const amfi_store_coldef **defs, const char **names, int max)
 {
-    for (int i = 0; i < len;) {
-        unsigned c = s[i];
-        int n = c < 0x80 ? 0 : (c & 0xe0) == 0xc0 && c >= 0xc2 ? 1 : (c & 0xf0) == 0xe0 ? 2
-              : (c & 0xf8) == 0xf0 && c <= 0xf4 ? 3 : -1;
-        if (c == 0 || n < 0 || i + n >= len) return 0;
-        for (int k = 1; k <= n; k++)
-            if ((s[i + k] & 0xc0) != 0x80) return 0;
-        /* overlong 3/4-byte forms, surrogates, beyond U+10FFFF */
-        if ((n == 2 && ((c == 0xe0 && s[i + 1] < 0xa0) || (c == 0xed && s[i + 1] >= 0xa0)))
-            || (n == 3 && ((c == 0xf0 && s[i + 1] < 0x90) || (c == 0xf4 && s[i + 1] >= 0x90))))
-            return 0;
-        i += n + 1;
+    const amfi_store_tabledef *t = amfi_store_tabledef_find(table);
+    int n = 0;
+    for (int k = 0; t && k < t->ncols && n < max; k++) {
+        if (!t->cols[k].shipped)
+            continue;
+        if (defs) defs[n] = &t->cols[k];
+        if (names) names[n] = t->cols[k].name;
+        n++;
     }
-    return 1;
+    return n;
 }
 
-const char *fleet_col_problem(const struct fleet_col *c, int type, int64_t i, double r,
-                              const char *text, int len, char *msg, size_t msglen)
+void fleet_cols_text(const char *table, char *buf, size_t len)
 {
-    static const char *const names[] = {"?", "an integer", "a real", "text", "a blob", "NULL"};
-    const char *want = c->type == FLEET_INT ? "an integer" : c->type == FLEET_REAL ? "a number" : "text";
-    if (type == 5) {
-        if (c->null_ok) return NULL;
-        snprintf(msg, msglen, "NULL, but it must be %s", want);
-        return msg;
-    }
-    int ok_type = c->type == FLEET_INT ? type == 1 : c->type == FLEET_REAL ? type == 1 || type == 2
-                                                                            : type == 3;
-    if (!ok_type) {
-        snprintf(msg, msglen, "%s, but it must be %s", type >= 1 && type <= 5 ? names[type] : names[0], want);
-        return msg;
-    }
-    if (c->type == FLEET_INT) {
-        if (i < c->ilo || i > c->ihi) {
-            snprintf(msg, msglen, "%lld is not in [%lld, %lld]", (long long)i, (long long)c->ilo,
-                     (long long)c->ihi);
-            return msg;
-        }
-        return NULL;
-    }
-    if (c->type == FLEET_REAL) {
-        double x = type == 1 ? (double)i : r;
-        if (!isfinite(x) || ((c->open & 1) ? !(x > c->lo) : !(x >= c->lo))
-            || ((c->open & 2) ? !(x < c->hi) : !(x <= c->hi))) {
-            snprintf(msg, msglen, "%.17g is not in %c%.17g, %.17g%c", x, (c->open & 1) ? '(' : '[',
-                     c->lo, c->hi, (c->open & 2) ? ')' : ']');
-            return msg;
-        }
-        return NULL;
-    }
-    if (len < c->min_len || (c->max_len && len > c->max_len)) {
-        snprintf(msg, msglen, "text of %d bytes, not %d..%d", len, c->min_len,
-                 c->max_len ? c->max_len : INT32_MAX);
-        return msg;
-    }
-    if (!utf8_ok((const unsigned char *)text, len)) {
-        snprintf(msg, msglen, "text that is not valid UTF-8 (or holds a NUL byte)");
-        return msg;
-    }
-    if (c->values) {
-        size_t n = (size_t)len;
-        for (const char *v = c->values; *v;) {
-            const char *bar = strchr(v, '|');
-            size_t k = bar ? (size_t)(bar - v) : strlen(v);
-            if (k == n && memcmp(v, text, n) == 0) return NULL;
-            v += k + (bar != NULL);
-        }
-        snprintf(msg, msglen, "'%.40s' is not one of %s", text, c->values);
-        /* the value shown may hold control characters: made '?' */
-        for (char *p = msg; *p; p++)
-            if ((unsigned char)*p < 0x20) *p = '?';
-        return msg;
-    }
-    return NULL;
+    const char *names[64];
+    int n = fleet_columns(table, NULL, names, 64);
+    size_t k = 0;
+    buf[0] = '\0';
+    for (int j = 0; j < n && k < len; j++)
+        k += (size_t)snprintf(buf + k, len - k, "%s%s", j ? ", " : "", names[j]);
+}
+
+int fleet_hash_cols(const char *table)
+{
+    const amfi_store_coldef *defs[64];
+    int n = fleet_columns(table, defs, NULL, 64), first = 0, h = 0;
+    for (int j = 0; j < n; j++)
+        if (!first || defs[j]->shipped < first) first = defs[j]->shipped;
+    for (int j = 0; j < n && defs[j]->shipped == first; j++) h++;
+    return h;
 }

@@ -9,6 +9,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "store_columns.h"
+
 struct fleet_migration {
     int version;
     const char *description;
@@ -17,48 +19,30 @@ struct fleet_migration {
 extern const struct fleet_migration fleet_migrations[];
 extern const int fleet_n_migrations;
 
-/* What a shipped column may hold: the site store's rules (its types and
- * CHECK constraints, docs/schema.md), checked by amfi-sync on every value
- * it reads before anything of a pass is shipped. One per column of
- * fleet_table.cols, in that order, ended by a NULL name. */
-enum fleet_col_type { FLEET_INT = 'i', FLEET_REAL = 'r', FLEET_TEXT = 't' };
-struct fleet_col {
-    const char *name;
-    char type;            /* enum fleet_col_type */
-    char null_ok;         /* NULL allowed */
-    char open;            /* FLEET_REAL: 1 lo excluded, 2 hi excluded (bits) */
-    double lo, hi;        /* FLEET_REAL: the range (finite values only) */
-    int64_t ilo, ihi;     /* FLEET_INT: the range */
-    const char *values;   /* FLEET_TEXT: "a|b|c", the values allowed, or NULL */
-    int min_len, max_len; /* FLEET_TEXT: bytes (max 0: no limit); valid UTF-8,
-                             no NUL */
-};
-
-/* What is wrong with a value of column c, NULL if nothing. The value comes
- * as its SQLite storage class (type: 1 integer, 2 real, 3 text, 5 NULL, as
- * SQLITE_INTEGER...) with i, r or text/len set accordingly; msg (at least
- * 160 bytes) receives the explanation returned. */
-const char *fleet_col_problem(const struct fleet_col *c, int type, int64_t i, double r,
-                              const char *text, int len, char *msg, size_t msglen);
-
-/* One shipped site table: its name, the columns copied (id first; the same
- * names in the site store and the central table) with their rules, and the
- * child table shipped in the same transaction (axles for passages). */
+/* One shipped site table: its name and the child table shipped in the same
+ * transaction (axles for passages). The columns shipped are those of the
+ * store's column table (store_columns.h) that a central version added
+ * (amfi_store_coldef.shipped > 0), in the table's order, id first; the site
+ * store's rules for them (amfi_store_value_problem) are checked by
+ * amfi-sync on every value it reads before anything of a pass is shipped. */
 struct fleet_table {
     const char *name;
-    const char *cols;
-    const struct fleet_col *rules;       /* cols' rules */
-    const struct fleet_col *child_rules; /* child_cols' rules, or NULL */
-    int hash_cols;             /* leading columns in the row hash: those of
-                                  the central version that created the
-                                  table, so that marks written before a
-                                  column was added still match */
     const char *child;         /* NULL or child table */
-    const char *child_cols;    /* its columns, parent id first */
     const char *child_parent;  /* the parent id column in the child */
 };
 extern const struct fleet_table fleet_tables[];
 extern const int fleet_n_tables;
+
+/* The shipped columns of the site table `table`: up to max of their
+ * descriptions into defs and names into names (either may be NULL);
+ * returns their number (0: not a store table). */
+int fleet_columns(const char *table, const amfi_store_coldef **defs, const char **names, int max);
+/* "id, vehicle_id, ..." of the same columns into buf. */
+void fleet_cols_text(const char *table, char *buf, size_t len);
+/* Leading columns in the row hash: those of the central version that
+ * created the table, so that marks written before a column was added still
+ * match. */
+int fleet_hash_cols(const char *table);
 
 /* The oldest site store schema (PRAGMA user_version) whose columns
  * fleet_tables names: amfid migrates older stores when it starts. */

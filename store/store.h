@@ -17,8 +17,13 @@
  * store_read.c (what amfid reads back, maintenance), store_report.c (the
  * queries of reports), store_export.c (the passage listing), store_speed.c
  * (the estimated speeds), store_environment.c (the environment readings),
- * store_natfreq.c (the natural frequencies);
- * store_internal.h is shared by them only.
+ * store_natfreq.c (the natural frequencies), store_columns.c (the column
+ * table, store_columns.h: every stored column once), store_rows.c (the
+ * INSERTs, bindings and checks of the tables written from a row struct, from
+ * the column table), store_scan.c (rows as column values for amfi-sync,
+ * amfi-report --pg, amfi-fleet-bench); store_internal.h is shared by them
+ * only. store_testing.c (library amfi_store_testing) gives tests raw SQL on
+ * a file; no program links it.
  *
  * Workload: one writer thread in amfid opens one handle at start-up, adds one
  * passage per vehicle (a few per second at most, one transaction each: the
@@ -246,7 +251,7 @@ typedef struct amfi_environment_summary {
 } amfi_environment_summary;
 
 /* Every stored reading, by utime, into *out (malloc'd, the caller frees;
- * NULL when *n is 0); received_utime is not read (0). 0, or a status. */
+ * NULL when *n is 0). 0, or a status. */
 int amfi_store_environment_rows(amfi_store *s, amfi_environment_row **out, size_t *n, char *err,
                                 size_t errlen);
 
@@ -532,6 +537,70 @@ typedef struct amfi_f1_rec {
    value outside the schema's range is AMFI_STORE_ECORRUPT. */
 int amfi_store_f1_series(amfi_store *s, int64_t from, int64_t to, int max, amfi_f1_rec **out,
                          size_t *n, char *err, size_t errlen);
+
+/* ---- rows as column values, for other programs (store_scan.c) ----------- */
+/* amfi-sync ships a store's rows, amfi-report --pg and amfi-fleet-bench
+ * write rows they did not compute: they see rows as the values of the
+ * columns of store_columns.h (amfi_store_value), never the connection. Table
+ * and column names are checked against the column table (nothing else
+ * reaches SQL). */
+
+#include "store_columns.h"
+
+/* Open `path` read-only to read rows from elsewhere (amfi-sync): SQLite's
+ * defensive mode, an untrusted schema, no extension loading, triggers and
+ * views off, query_only, every setting read back; any schema version (the
+ * caller checks *version, PRAGMA user_version) and no prepared statements
+ * (only this section's functions and amfi_store_meta_get apply). When the
+ * file cannot be read because its -shm can neither be opened nor created
+ * and no -wal file exists (a reader without write access to the directory,
+ * amfid stopped), and immutable_ok, it is opened immutable (no locks: right
+ * only while nobody writes it) and *immutable is 1. Statuses: AMFI_STORE_EDB
+ * (cannot open or read it), AMFI_STORE_ECORRUPT (not SQLite),
+ * AMFI_STORE_ESCHEMA (a defence cannot be set). */
+int amfi_store_open_reader(const char *path, int immutable_ok, amfi_store **out, int *version,
+                           int *immutable, char *err, size_t errlen);
+
+/* The type of schema object `name` ("table", "view", "index", "trigger";
+ * "virtual table" for a CREATE VIRTUAL TABLE; "" when there is none) into
+ * type (len >= 16). */
+int amfi_store_object_type(amfi_store *s, const char *name, char *type, size_t len, char *err,
+                           size_t errlen);
+
+/* *max = the largest value of the table's key column
+ * (amfi_store_tabledef.key), 0 when it has no rows. */
+int amfi_store_max_key(amfi_store *s, const char *table, int64_t *max, char *err,
+                       size_t errlen);
+
+/* Called once per row with the values of the columns asked, in their order;
+ * text values are valid during the call only. Nonzero stops the scan and
+ * is returned. */
+typedef int (*amfi_store_values_fn)(void *ctx, const amfi_store_value *v, int n);
+
+/* The rows of `table` whose key column is in (lo, hi], by key, at most
+ * limit (0: all), as the values of cols[0 .. ncols − 1] as the file holds
+ * them (unchecked: amfi_store_value_problem says what is wrong). */
+int amfi_store_scan(amfi_store *s, const char *table, const char *const *cols, int ncols,
+                    int64_t lo, int64_t hi, int limit, amfi_store_values_fn fn, void *ctx,
+                    char *err, size_t errlen);
+
+/* Transactions around several calls of this section: a read snapshot
+ * (BEGIN), a write (BEGIN IMMEDIATE), their end. */
+enum { AMFI_STORE_TX_READ, AMFI_STORE_TX_WRITE, AMFI_STORE_TX_COMMIT, AMFI_STORE_TX_ROLLBACK };
+int amfi_store_transaction(amfi_store *s, int what, char *err, size_t errlen);
+
+/* Inserting rows of one table by column values (in an open write
+ * transaction for speed): cols are the columns given, in the order of the
+ * values. Every value is bound as given (text is converted by the STRICT
+ * table as it would be from SQL); the schema's constraints judge the row:
+ * a refused row gives AMFI_EINVAL with SQLite's message alone in err
+ * ("CHECK constraint failed: ..."). */
+typedef struct amfi_store_inserter amfi_store_inserter;
+int amfi_store_inserter_open(amfi_store *s, const char *table, const char *const *cols, int ncols,
+                             amfi_store_inserter **out, char *err, size_t errlen);
+int amfi_store_insert_values(amfi_store_inserter *ins, const amfi_store_value *v, char *err,
+                             size_t errlen);
+void amfi_store_inserter_close(amfi_store_inserter *ins); /* NULL-safe */
 
 /* ---- maintenance ------------------------------------------------------- */
 

@@ -15,7 +15,7 @@
 
 int st_in_range(double x, const range *rg)
 {
-    return (rg->lo_open ? x > rg->lo : x >= rg->lo) && x <= rg->hi;
+    return (rg->lo_open ? x > rg->lo : x >= rg->lo) && (rg->hi_open ? x < rg->hi : x <= rg->hi);
 }
 
 /* "NAME: X UNIT is out of range ..." (x finite, outside rg). */
@@ -27,9 +27,9 @@ int st_range_fail(const char *prefix, const char *name, double x,
         return st_fail(err, errlen, status, "%s%s: %g%s%s must be %s %g%s%s",
                     prefix, name, x, sp, rg->unit, rg->lo_open ? ">" : ">=",
                     rg->lo, sp, rg->unit);
-    return st_fail(err, errlen, status, "%s%s: %g%s%s is out of range %c%g, %g]%s%s",
+    return st_fail(err, errlen, status, "%s%s: %g%s%s is out of range %c%g, %g%c%s%s",
                 prefix, name, x, sp, rg->unit, rg->lo_open ? '(' : '[',
-                rg->lo, rg->hi, sp, rg->unit);
+                rg->lo, rg->hi, rg->hi_open ? ')' : ']', sp, rg->unit);
 }
 
 /* x is NaN (unknown, stored as NULL) or finite and within rg. */

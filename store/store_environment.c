@@ -17,61 +17,10 @@
 
 #include "store_internal.h"
 
-static int check_row(const amfi_environment_row *r, int k, char *err, size_t errlen)
-{
-    char name[64];
-    snprintf(name, sizeof name, "environment[%d].utime", k);
-    int rc = st_check_utime(name, r->utime, err, errlen);
-    if (rc == 0) {
-        snprintf(name, sizeof name, "environment[%d].received_utime", k);
-        rc = st_check_utime(name, r->received_utime, err, errlen);
-    }
-    if (rc == 0) {
-        snprintf(name, sizeof name, "environment[%d].deck_c", k);
-        rc = st_check_known(name, r->deck_c, &R_TEMP_C, err, errlen);
-    }
-    if (rc == 0) {
-        snprintf(name, sizeof name, "environment[%d].air_c", k);
-        rc = st_check_known(name, r->air_c, &R_TEMP_C, err, errlen);
-    }
-    return rc;
-}
-
 int amfi_store_add_environment(amfi_store *s, const amfi_environment_row *rows, int n,
                                char *err, size_t errlen)
 {
-    sqlite3_stmt *st = NULL;
-    int rc = st_check_handle(s, 1, err, errlen);
-    if (rc == 0 && (n < 0 || (n > 0 && !rows)))
-        rc = st_fail(err, errlen, AMFI_EINVAL, "environment: %d rows at %p", n,
-                     (const void *)rows);
-    for (int k = 0; rc == 0 && k < n; k++)
-        rc = check_row(&rows[k], k, err, errlen);
-    if (rc != 0 || n == 0)
-        return rc;
-    rc = st_prepare(s,
-                 "INSERT INTO environment (utime, deck_c, air_c, received_utime) "
-                 "VALUES (?1, ?2, ?3, ?4)",
-                 &st, "environment: prepare insert", err, errlen);
-    if (rc == 0)
-        rc = st_begin(s, err, errlen);
-    for (int k = 0; rc == 0 && k < n; k++) {
-        int b = sqlite3_bind_int64(st, 1, rows[k].utime);
-        if (b == SQLITE_OK) b = sqlite3_bind_double(st, 2, rows[k].deck_c);
-        if (b == SQLITE_OK) b = sqlite3_bind_double(st, 3, rows[k].air_c);
-        if (b == SQLITE_OK) b = sqlite3_bind_int64(st, 4, rows[k].received_utime);
-        int src = b == SQLITE_OK ? sqlite3_step(st) : b;
-        if (src != SQLITE_DONE)
-            rc = st_db_fail(s, src, "environment: insert", err, errlen);
-        sqlite3_reset(st);
-        sqlite3_clear_bindings(st);
-    }
-    if (rc == 0)
-        rc = st_commit(s, err, errlen);
-    else if (st)
-        st_rollback(s);
-    sqlite3_finalize(st);
-    return rc;
+    return st_insert_rows(s, "environment", rows, n, sizeof *rows, 1, NULL, err, errlen);
 }
 
 /* The reading nearest to utime on one side (before: utime <= t, newest;
@@ -193,9 +142,12 @@ int amfi_store_environment_rows(amfi_store *s, amfi_environment_row **out, size_
     int rc = st_check_handle(s, 0, err, errlen);
     if (rc == 0 && (!out || !n))
         rc = st_fail(err, errlen, AMFI_EINVAL, "environment: output is NULL");
+    const amfi_store_tabledef *t = amfi_store_tabledef_find("environment");
+    char list[256], sql[384];
+    if (rc == 0 && st_select_list(t, list, sizeof list) == 0)
+        snprintf(sql, sizeof sql, "SELECT id, %s FROM environment ORDER BY utime, id", list);
     if (rc == 0)
-        rc = st_prepare(s, "SELECT id, utime, deck_c, air_c FROM environment ORDER BY utime, id",
-                        &st, "environment: prepare rows", err, errlen);
+        rc = st_prepare(s, sql, &st, "environment: prepare rows", err, errlen);
     if (rc != 0)
         return rc;
     *out = NULL;
@@ -215,13 +167,7 @@ int amfi_store_environment_rows(amfi_store *s, amfi_environment_row **out, size_
             cap = nc;
         }
         origin o = {"environment", sqlite3_column_int64(st, 0)};
-        amfi_environment_row *r = &v[k];
-        r->received_utime = 0;
-        rc = st_read_int(st, 1, 0, AMFI_STORE_MAX_UTIME, &o, &r->utime, err, errlen);
-        if (rc == 0)
-            rc = st_read_real(st, 2, &R_TEMP_C, &o, &r->deck_c, err, errlen);
-        if (rc == 0)
-            rc = st_read_real(st, 3, &R_TEMP_C, &o, &r->air_c, err, errlen);
+        rc = st_read_row(st, 1, t, &v[k], &o, err, errlen);
         k++;
         src = SQLITE_DONE;
     }
@@ -240,55 +186,11 @@ int amfi_store_environment_rows(amfi_store *s, amfi_environment_row **out, size_
 int amfi_store_add_refusals(amfi_store *s, const amfi_refusal_row *rows, int n, char *err,
                             size_t errlen)
 {
-    sqlite3_stmt *st = NULL;
-    int rc = st_check_handle(s, 1, err, errlen);
-    if (rc == 0 && (n < 0 || (n > 0 && !rows)))
-        rc = st_fail(err, errlen, AMFI_EINVAL, "refusals: %d rows at %p", n, (const void *)rows);
-    for (int k = 0; rc == 0 && k < n; k++) {
-        const amfi_refusal_row *r = &rows[k];
-        char name[64];
-        snprintf(name, sizeof name, "refusals[%d].period_start", k);
-        rc = st_check_utime(name, r->period_start, err, errlen);
-        if (rc == 0) {
-            snprintf(name, sizeof name, "refusals[%d].period_end", k);
-            rc = st_check_utime(name, r->period_end, err, errlen);
-        }
-        if (rc == 0 && (r->period_end < r->period_start || r->count < 1 || !r->channel ||
-                        !r->input || !r->reason || !r->example ||
-                        strlen(r->channel) < 1 || strlen(r->channel) > 63 ||
-                        strlen(r->reason) < 1 || strlen(r->reason) > 63))
-            rc = st_fail(err, errlen, AMFI_EINVAL,
-                         "refusals[%d]: period end before start, count < 1, or a channel "
-                         "or reason not 1 .. 63 bytes",
-                         k);
-    }
-    if (rc != 0 || n == 0)
-        return rc;
-    rc = st_prepare(s,
-                    "INSERT INTO refusals (period_start, period_end, channel, input, reason, "
-                    "count, example) VALUES (?1, ?2, ?3, ?4, ?5, ?6, substr(?7, 1, 512))",
-                    &st, "refusals: prepare insert", err, errlen);
-    if (rc == 0)
-        rc = st_begin(s, err, errlen);
-    for (int k = 0; rc == 0 && k < n; k++) {
-        const amfi_refusal_row *r = &rows[k];
-        int b = sqlite3_bind_int64(st, 1, r->period_start);
-        if (b == SQLITE_OK) b = sqlite3_bind_int64(st, 2, r->period_end);
-        if (b == SQLITE_OK) b = sqlite3_bind_text(st, 3, r->channel, -1, SQLITE_STATIC);
-        if (b == SQLITE_OK) b = sqlite3_bind_text(st, 4, r->input, -1, SQLITE_STATIC);
-        if (b == SQLITE_OK) b = sqlite3_bind_text(st, 5, r->reason, -1, SQLITE_STATIC);
-        if (b == SQLITE_OK) b = sqlite3_bind_int64(st, 6, r->count);
-        if (b == SQLITE_OK) b = sqlite3_bind_text(st, 7, r->example, -1, SQLITE_STATIC);
-        int src = b == SQLITE_OK ? sqlite3_step(st) : b;
-        if (src != SQLITE_DONE)
-            rc = st_db_fail(s, src, "refusals: insert", err, errlen);
-        sqlite3_reset(st);
-        sqlite3_clear_bindings(st);
-    }
-    if (rc == 0)
-        rc = st_commit(s, err, errlen);
-    else if (st)
-        st_rollback(s);
-    sqlite3_finalize(st);
-    return rc;
+    /* what the column table cannot say: the period's order */
+    for (int k = 0; n > 0 && rows && k < n; k++)
+        if (rows[k].period_end < rows[k].period_start)
+            return st_fail(err, errlen, AMFI_EINVAL,
+                           "refusals[%d].period_end: %lld is before period_start %lld", k,
+                           (long long)rows[k].period_end, (long long)rows[k].period_start);
+    return st_insert_rows(s, "refusals", rows, n, sizeof *rows, 1, NULL, err, errlen);
 }

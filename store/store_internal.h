@@ -15,6 +15,7 @@
 #include <stdint.h>
 
 #include "store.h"
+#include "store_columns.h"
 
 /* ---- schema (store_schema.c) --------------------------------------------- */
 
@@ -90,26 +91,27 @@ typedef struct range {
     double lo, hi;   /* bounds; hi may be HUGE_VAL (no upper bound) */
     int lo_open;     /* 1: x > lo, 0: x >= lo */
     const char *unit;
+    int hi_open;     /* 1: x < hi, 0: x <= hi */
 } range;
 
-static const range R_SPEED = {0.0, AMFI_STORE_MAX_SPEED_MPS, 0, "m/s"};
-static const range R_SPEED_POS = {0.0, AMFI_STORE_MAX_SPEED_MPS, 1, "m/s"};
-static const range R_SPACING = {0.0, AMFI_STORE_MAX_SPACING_M, 1, "m"};
-static const range R_KG = {-AMFI_STORE_MAX_KG, AMFI_STORE_MAX_KG, 0, "kg"};
-static const range R_KG_POS = {0.0, AMFI_STORE_MAX_KG, 1, "kg"};
-static const range R_KG_NONNEG = {0.0, AMFI_STORE_MAX_KG, 0, "kg"};
-static const range R_FORCE = {-AMFI_STORE_MAX_FORCE_N, AMFI_STORE_MAX_FORCE_N, 0, "N"};
-static const range R_POS = {0.0, HUGE_VAL, 1, ""};
-static const range R_NONNEG = {0.0, HUGE_VAL, 0, ""};
-static const range R_MS = {0.0, HUGE_VAL, 0, "ms"};
-static const range R_RATIO = {0.0, 1e6, 0, ""};
-static const range R_PROB = {0.0, 1.0, 0, ""};
-static const range R_QUALITY = {1.0, 1e9, 0, ""};
-static const range R_REF_KG = {AMFI_STORE_MIN_REF_KG, AMFI_STORE_MAX_REF_KG, 0, "kg"};
-static const range R_TEMP_C = {AMFI_STORE_MIN_TEMP_C, AMFI_STORE_MAX_TEMP_C, 0, "°C"};
-static const range R_HZ = {0.0, 1000.0, 1, "Hz"};
-static const range R_ZETA = {0.0, 1.0 - 1e-12, 0, ""};
-static const range R_FINITE = {-HUGE_VAL, HUGE_VAL, 0, ""};
+static const range R_SPEED = {0.0, AMFI_STORE_MAX_SPEED_MPS, 0, "m/s", 0};
+static const range R_SPEED_POS = {0.0, AMFI_STORE_MAX_SPEED_MPS, 1, "m/s", 0};
+static const range R_SPACING = {0.0, AMFI_STORE_MAX_SPACING_M, 1, "m", 0};
+static const range R_KG = {-AMFI_STORE_MAX_KG, AMFI_STORE_MAX_KG, 0, "kg", 0};
+static const range R_KG_POS = {0.0, AMFI_STORE_MAX_KG, 1, "kg", 0};
+static const range R_KG_NONNEG = {0.0, AMFI_STORE_MAX_KG, 0, "kg", 0};
+static const range R_FORCE = {-AMFI_STORE_MAX_FORCE_N, AMFI_STORE_MAX_FORCE_N, 0, "N", 0};
+static const range R_POS = {0.0, HUGE_VAL, 1, "", 0};
+static const range R_NONNEG = {0.0, HUGE_VAL, 0, "", 0};
+static const range R_MS = {0.0, HUGE_VAL, 0, "ms", 0};
+static const range R_RATIO = {0.0, 1e6, 0, "", 0};
+static const range R_PROB = {0.0, 1.0, 0, "", 0};
+static const range R_QUALITY = {1.0, 1e9, 0, "", 0};
+static const range R_REF_KG = {AMFI_STORE_MIN_REF_KG, AMFI_STORE_MAX_REF_KG, 0, "kg", 0};
+static const range R_TEMP_C = {AMFI_STORE_MIN_TEMP_C, AMFI_STORE_MAX_TEMP_C, 0, "°C", 0};
+static const range R_HZ = {0.0, 1000.0, 1, "Hz", 0};
+static const range R_ZETA = {0.0, 1.0, 0, "", 1};
+static const range R_FINITE = {-HUGE_VAL, HUGE_VAL, 0, "", 0};
 
 /* NULL-terminated word lists of the schema's enumerations. */
 static const char *const st_statuses[] = {"ok", "gap", "late", "overload",
@@ -175,5 +177,44 @@ int st_read_int(sqlite3_stmt *st, int col, int64_t lo, int64_t hi,
                 const origin *o, int64_t *out, char *err, size_t errlen);
 int st_read_text(sqlite3_stmt *st, int col, size_t max, const origin *o,
                  char *buf, size_t buflen, char *err, size_t errlen);
+
+/* ---- rows from the column table (store_rows.c) --------------------------- */
+
+/* amfi_store_add_alert's arguments as a row (the alerts column table). */
+typedef struct st_alert_row {
+    int64_t utime;
+    const char *level, *kind, *message;
+    int64_t indicator_id; /* <= 0: none (NULL) */
+    int raised;
+} st_alert_row;
+
+/* "INSERT INTO t (the columns of the row struct) VALUES (?1, ...)" into
+ * buf; 0, or -1 when it does not fit. */
+int st_insert_sql(const amfi_store_tabledef *t, char *buf, size_t len);
+/* Every column of the row struct `row` checked by its rule; a message
+ * names the column as PREFIX.NAME ("passages.speed_mps",
+ * "environment[3].deck_c"). */
+int st_check_row(const amfi_store_tabledef *t, const void *row, const char *prefix, char *err,
+                 size_t errlen);
+/* Bind the row's columns to st (prepared from st_insert_sql): an SQLite
+ * status. The row's strings must live until st is reset. */
+int st_bind_row(sqlite3_stmt *st, const amfi_store_tabledef *t, const void *row);
+/* Check all n rows (stride bytes apart) of table `name`, then insert them
+ * in one transaction (all or nothing; n 0: nothing); *id (when not NULL)
+ * gets the last row's rowid. Messages name a row as TABLE[k].COLUMN when
+ * batch, else TABLE.COLUMN. */
+int st_insert_rows(amfi_store *s, const char *name, const void *rows, int n, size_t stride,
+                   int batch, int64_t *id, char *err, size_t errlen);
+
+/* ", "-separated names of the row struct's columns of t (those with a C
+ * type, in the table's order), for a SELECT; 0, or -1 when it does not fit. */
+int st_select_list(const amfi_store_tabledef *t, char *buf, size_t len);
+/* Those columns read from st's columns first, first + 1, ... into the row
+ * struct, each checked by its column's rule as st_read_* do (type, range,
+ * NULL only where allowed, read back as NaN, 0 or a NULL pointer; an enum
+ * as its static word). Text other than enums is not read this way (an
+ * AMFI_EINVAL). */
+int st_read_row(sqlite3_stmt *st, int first, const amfi_store_tabledef *t, void *row,
+                const origin *o, char *err, size_t errlen);
 
 #endif /* AMFI_STORE_INTERNAL_H */

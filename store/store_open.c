@@ -32,13 +32,6 @@ static const char *const stmt_sql[N_STMT] = {
     [ST_BEGIN] = "BEGIN IMMEDIATE",
     [ST_COMMIT] = "COMMIT",
     [ST_ROLLBACK] = "ROLLBACK",
-    [ST_INS_PASSAGE] =
-        "INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, "
-        "gvw_kg, status, reason, lambda, residual_rms, formulation, solve_ms, "
-        "speed_given_mps, speed_estimated, n_vehicles, quality, reference_gvw_kg, deck_c, "
-        "f1_hz, f1_comp_hz, f1_zeta, f1_r2, gvw_comp_kg) "
-        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, "
-        "?18, ?19, ?20, ?21, ?22, ?23)",
     [ST_INS_AXLE] =
         "INSERT INTO axles (passage_id, idx, spacing_m, load_kg) "
         "VALUES (?1, ?2, ?3, ?4)",
@@ -48,13 +41,6 @@ static const char *const stmt_sql[N_STMT] = {
     [ST_INS_TRUTH_AXLE] =
         "INSERT INTO truth_axles (truth_id, idx, load_kg, mean_force_N) "
         "VALUES (?1, ?2, ?3, ?4)",
-    [ST_INS_INDICATOR] =
-        "INSERT INTO indicators (utime, n, mean_kg, std_kg, baseline_mean_kg, "
-        "baseline_std_kg, std_ratio, p_value, state) "
-        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
-    [ST_INS_ALERT] =
-        "INSERT INTO alerts (utime, level, kind, message, indicator_id, raised) "
-        "VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
     [ST_GET_BASELINE] =
         "SELECT id, utime_set, n, mean_kg, std_kg, source, note "
         "FROM baseline ORDER BY id DESC LIMIT 1",
@@ -84,10 +70,6 @@ static const char *const stmt_sql[N_STMT] = {
     [ST_ALL_OK_GVW] = "SELECT id, gvw_kg FROM passages WHERE status = 'ok'",
     [ST_ALL_FED_GVW] = "SELECT id, gvw_comp_kg FROM passages WHERE status = 'ok' "
                        "AND gvw_comp_kg IS NOT NULL",
-    [ST_RECENT_INDICATORS] =
-        "SELECT id, utime, n, mean_kg, std_kg, baseline_mean_kg, baseline_std_kg, "
-        "std_ratio, p_value, state FROM indicators ORDER BY utime DESC, id DESC "
-        "LIMIT ?1",
     /* the columns of the two alert queries are read by one function */
     [ST_RECENT_ALERTS] =
         "SELECT id, utime, level, kind, raised, indicator_id, message "
@@ -99,6 +81,20 @@ static const char *const stmt_sql[N_STMT] = {
         "FROM alerts AS b WHERE b.kind = a.kind ORDER BY b.utime DESC, b.id DESC "
         "LIMIT 1) ORDER BY a.utime",
     [ST_GVW_ERRORS] = "SELECT passage_id, status, gvw_error_pct FROM passage_errors",
+};
+
+/* The inserts of the tables written from a row: from the column table
+ * (store_rows.c). */
+static const char *const stmt_table[N_STMT] = {
+    [ST_INS_PASSAGE] = "passages",
+    [ST_INS_INDICATOR] = "indicators",
+    [ST_INS_ALERT] = "alerts",
+};
+/* The reads of a table's row struct: "SELECT id, <its columns> FROM ..." */
+static const struct {
+    const char *table, *tail;
+} stmt_read[N_STMT] = {
+    [ST_RECENT_INDICATORS] = {"indicators", "ORDER BY utime DESC, id DESC LIMIT ?1"},
 };
 
 /* ---- messages ------------------------------------------------------------- */
@@ -301,8 +297,9 @@ static int migrate(amfi_store *s, char *err, size_t errlen)
  * file may only call functions SQLite marks innocuous, so no
  * load_extension, fts3_tokenizer or the like), no extension loading.
  * `foreign` (a store this process did not write: amfi-report's readers and
- * its --set-baseline): triggers off too, an amfi store has none. Each
- * setting is read back: an SQLite that ignores one is refused. */
+ * its --set-baseline): triggers off too, an amfi store has none; 2 (a
+ * reader of rows, amfi-sync: tables only): views off and query_only too.
+ * Each setting is read back: an SQLite that ignores one is refused. */
 static int harden(amfi_store *s, int foreign, char *err, size_t errlen)
 {
     static const struct {
@@ -313,15 +310,26 @@ static int harden(amfi_store *s, int foreign, char *err, size_t errlen)
         {SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, "SQLITE_DBCONFIG_TRUSTED_SCHEMA"},
         {SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION, 0, "SQLITE_DBCONFIG_ENABLE_LOAD_EXTENSION"},
         {SQLITE_DBCONFIG_ENABLE_TRIGGER, 0, "SQLITE_DBCONFIG_ENABLE_TRIGGER"},
+        {SQLITE_DBCONFIG_ENABLE_VIEW, 0, "SQLITE_DBCONFIG_ENABLE_VIEW"},
     };
     for (size_t k = 0; k < sizeof set / sizeof set[0]; k++) {
-        if (set[k].op == SQLITE_DBCONFIG_ENABLE_TRIGGER && !foreign)
+        if ((set[k].op == SQLITE_DBCONFIG_ENABLE_TRIGGER && !foreign)
+            || (set[k].op == SQLITE_DBCONFIG_ENABLE_VIEW && foreign < 2))
             continue;
         int got = -1;
         int src = sqlite3_db_config(s->db, set[k].op, set[k].want, &got);
         if (src != SQLITE_OK || got != set[k].want)
             return st_fail(err, errlen, AMFI_STORE_EDB, "%s: cannot set %s to %d (SQLite %s)",
                            s->path, set[k].name, set[k].want, sqlite3_libversion());
+    }
+    if (foreign >= 2) {
+        char *emsg = NULL;
+        if (sqlite3_exec(s->db, "PRAGMA query_only = ON", NULL, NULL, &emsg) != SQLITE_OK) {
+            st_fail(err, errlen, AMFI_STORE_EDB, "%s: PRAGMA query_only: %s", s->path,
+                    emsg ? emsg : "failed");
+            sqlite3_free(emsg);
+            return AMFI_STORE_EDB;
+        }
     }
     return 0;
 }
@@ -418,7 +426,26 @@ static int open_store(const char *path, int readonly, int foreign, int sync_full
     if (rc == 0 && !readonly && version < AMFI_STORE_SCHEMA_VERSION)
         rc = migrate(s, err, errlen);
     for (int k = 0; rc == 0 && k < N_STMT; k++) {
-        src = sqlite3_prepare_v3(s->db, stmt_sql[k], -1,
+        char ins[1024];
+        const char *sql = stmt_sql[k];
+        if (stmt_table[k]) {
+            if (st_insert_sql(amfi_store_tabledef_find(stmt_table[k]), ins, sizeof ins) != 0) {
+                rc = st_fail(err, errlen, AMFI_EINVAL, "%s: insert too long", stmt_table[k]);
+                break;
+            }
+            sql = ins;
+        }
+        if (stmt_read[k].table) {
+            char list[768];
+            if (st_select_list(amfi_store_tabledef_find(stmt_read[k].table), list, sizeof list) != 0
+                || snprintf(ins, sizeof ins, "SELECT id, %s FROM %s %s", list, stmt_read[k].table,
+                            stmt_read[k].tail) >= (int)sizeof ins) {
+                rc = st_fail(err, errlen, AMFI_EINVAL, "%s: read too long", stmt_read[k].table);
+                break;
+            }
+            sql = ins;
+        }
+        src = sqlite3_prepare_v3(s->db, sql, -1,
                                  SQLITE_PREPARE_PERSISTENT, &s->st[k], NULL);
         if (src != SQLITE_OK)
             rc = st_db_fail(s, src, s->path, err, errlen);
@@ -447,4 +474,85 @@ int amfi_store_open_readonly(const char *path, amfi_store **out, char *err,
                              size_t errlen)
 {
     return open_store(path, 1, 1, 0, out, err, errlen);
+}
+
+/* ---- a reader of rows (amfi-sync) ------------------------------------------ */
+
+int amfi_store_open_reader(const char *path, int immutable_ok, amfi_store **out, int *version,
+                           int *immutable, char *err, size_t errlen)
+{
+    char wal[4200];
+    if (!out || !version || !immutable)
+        return st_fail(err, errlen, AMFI_EINVAL, "store: output is NULL");
+    *out = NULL;
+    *immutable = 0;
+    if (!path || !*path)
+        return st_fail(err, errlen, AMFI_EINVAL, "store: empty path");
+    snprintf(wal, sizeof wal, "%s-wal", path);
+    for (int pass = 0; pass < 2; pass++) {
+        char uri[3 * 4096 + 32];
+        const char *name = path;
+        if (pass == 1) {
+            /* a file: URI with the path percent-encoded */
+            size_t k = (size_t)snprintf(uri, sizeof uri, "file:");
+            for (const unsigned char *p = (const unsigned char *)path; *p && k + 4 < sizeof uri;
+                 p++) {
+                if ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9')
+                    || strchr("/._-~", *p))
+                    uri[k++] = (char)*p;
+                else
+                    k += (size_t)snprintf(uri + k, sizeof uri - k, "%%%02X", *p);
+            }
+            snprintf(uri + k, sizeof uri - k, "?immutable=1");
+            name = uri;
+        }
+        amfi_store *s = calloc(1, sizeof *s);
+        if (!s)
+            return st_fail(err, errlen, AMFI_ENOMEM, "%s: out of memory", path);
+        snprintf(s->path, sizeof s->path, "%s", path);
+        s->readonly = 1;
+        int src = sqlite3_open_v2(name, &s->db,
+                                  SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX
+                                      | (pass ? SQLITE_OPEN_URI : 0),
+                                  NULL);
+        if (src != SQLITE_OK) {
+            int rc = st_fail(err, errlen, AMFI_STORE_EDB, "%s: cannot open the store read-only: %s",
+                             path, s->db ? sqlite3_errmsg(s->db) : sqlite3_errstr(src));
+            destroy(s, 0);
+            return rc;
+        }
+        sqlite3_extended_result_codes(s->db, 1);
+        sqlite3_busy_timeout(s->db, AMFI_STORE_BUSY_TIMEOUT_MS);
+        if (harden(s, 2, err, errlen) != 0) {
+            destroy(s, 0);
+            return AMFI_STORE_ESCHEMA;
+        }
+        sqlite3_stmt *uv = NULL;
+        int ok = sqlite3_prepare_v2(s->db, "PRAGMA user_version", -1, &uv, NULL) == SQLITE_OK
+                 && sqlite3_step(uv) == SQLITE_ROW;
+        if (ok)
+            *version = sqlite3_column_int(uv, 0);
+        sqlite3_finalize(uv);
+        if (ok) {
+            /* the one prepared statement it uses (a file without meta fails
+             * its reads) */
+            if (sqlite3_prepare_v3(s->db, stmt_sql[ST_META_GET], -1, 0, &s->st[ST_META_GET], NULL)
+                != SQLITE_OK)
+                s->st[ST_META_GET] = NULL;
+            *immutable = pass;
+            *out = s;
+            return 0;
+        }
+        int code = sqlite3_errcode(s->db) & 0xff;
+        if (pass == 0 && immutable_ok && (code == SQLITE_READONLY || code == SQLITE_CANTOPEN)
+            && access(wal, F_OK) != 0 && errno == ENOENT) {
+            destroy(s, 0);
+            continue;
+        }
+        int rc = st_fail(err, errlen, code == SQLITE_NOTADB ? AMFI_STORE_ECORRUPT : AMFI_STORE_EDB,
+                         "%s: cannot read the store: %s", path, sqlite3_errmsg(s->db));
+        destroy(s, 0);
+        return rc;
+    }
+    return st_fail(err, errlen, AMFI_STORE_EDB, "%s: cannot read the store", path);
 }

@@ -204,25 +204,9 @@ int amfi_store_recent_indicators(amfi_store *s, int max,
            && (src = sqlite3_step(st)) == SQLITE_ROW) {
         amfi_indicator_rec *r = &out[count];
         origin o = {"indicators", sqlite3_column_int64(st, 0)};
-        int64_t v = 0;
-        char state[16];
         memset(r, 0, sizeof *r);
         r->id = o.rowid;
-        rc = st_read_int(st, 1, 0, AMFI_STORE_MAX_UTIME, &o, &r->row.utime, err,
-                         errlen);
-        if (rc == 0) rc = st_read_int(st, 2, 0, INT32_MAX, &o, &v, err, errlen);
-        r->row.n = (int)v;
-        if (rc == 0) rc = st_read_real_or_null(st, 3, &R_KG, &o, &r->row.mean_kg, err, errlen);
-        if (rc == 0) rc = st_read_real_or_null(st, 4, &R_KG_NONNEG, &o, &r->row.std_kg, err, errlen);
-        if (rc == 0) rc = st_read_real_or_null(st, 5, &R_KG_POS, &o, &r->row.baseline_mean_kg, err, errlen);
-        if (rc == 0) rc = st_read_real_or_null(st, 6, &R_KG_POS, &o, &r->row.baseline_std_kg, err, errlen);
-        if (rc == 0) rc = st_read_real_or_null(st, 7, &R_RATIO, &o, &r->row.std_ratio, err, errlen);
-        if (rc == 0) rc = st_read_real_or_null(st, 8, &R_PROB, &o, &r->row.p_value, err, errlen);
-        if (rc == 0 && st_read_text(st, 9, sizeof state - 1, &o, state, sizeof state, NULL, 0) == 0
-            && index_of(state, st_states) >= 0)
-            r->row.state = st_states[index_of(state, st_states)];
-        else if (rc == 0)
-            rc = st_corrupt(&o, st, 9, err, errlen, "is not a known state");
+        rc = st_read_row(st, 1, amfi_store_tabledef_find("indicators"), &r->row, &o, err, errlen);
         if (rc == 0)
             count++;
         src = SQLITE_OK;

@@ -17,64 +17,16 @@
 #include "store_internal.h"
 
 static const char *const kinds[] = {"scale_shift", "known_truck", NULL};
-static const range R_SCALE = {0.0, 100.0, 1, ""};
-static const range R_Z = {-1e6, 1e6, 0, ""};
-static const range R_STAT = {0.0, 1e6, 0, ""};
+static const range R_SCALE = {0.0, 100.0, 1, "", 0};
+static const range R_Z = {-1e6, 1e6, 0, "", 0};
+static const range R_STAT = {0.0, 1e6, 0, "", 0};
 
 int amfi_store_add_scale_eval(amfi_store *s, const amfi_scale_eval_row *r, int64_t *id,
                               char *err, size_t errlen)
 {
-    int rc = st_check_handle(s, 1, err, errlen);
-    if (rc == 0 && !r)
-        rc = st_fail(err, errlen, AMFI_EINVAL, "scale_evals: row is NULL");
-    if (rc == 0)
-        rc = st_check_utime("scale_evals.utime", r->utime, err, errlen);
-    if (rc == 0)
-        rc = st_check_enum("scale_evals.kind", r->kind, kinds, "scale_shift, known_truck", err,
-                           errlen);
-    if (rc == 0 && r->n < 0)
-        rc = st_fail(err, errlen, AMFI_EINVAL, "scale_evals.n: %d must be >= 0", r->n);
-    if (rc == 0)
-        rc = st_check_num("scale_evals.value", r->value, &R_SCALE, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("scale_evals.raw", r->raw, &R_SCALE, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("scale_evals.deck_c", r->deck_c, &R_TEMP_C, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("scale_evals.z", r->z, &R_Z, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("scale_evals.cusum", r->cusum, &R_STAT, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("scale_evals.h", r->h, &R_STAT, err, errlen);
-    if (rc == 0)
-        rc = st_check_enum("scale_evals.state", r->state, st_states,
-                           "baseline, normal, watch, alert", err, errlen);
-    if (rc != 0)
-        return rc;
-    sqlite3_stmt *st = NULL;
-    rc = st_prepare(s,
-                    "INSERT INTO scale_evals (utime, kind, n, value, raw, deck_c, z, cusum, h, "
-                    "state) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
-                    &st, "scale_evals: prepare insert", err, errlen);
-    if (rc != 0)
-        return rc;
-    int b = sqlite3_bind_int64(st, 1, r->utime);
-    if (b == SQLITE_OK) b = st_bind_text(st, 2, r->kind);
-    if (b == SQLITE_OK) b = sqlite3_bind_int(st, 3, r->n);
-    if (b == SQLITE_OK) b = st_bind_real(st, 4, r->value);
-    if (b == SQLITE_OK) b = st_bind_real(st, 5, r->raw);
-    if (b == SQLITE_OK) b = st_bind_real(st, 6, r->deck_c);
-    if (b == SQLITE_OK) b = st_bind_real(st, 7, r->z);
-    if (b == SQLITE_OK) b = st_bind_real(st, 8, r->cusum);
-    if (b == SQLITE_OK) b = st_bind_real(st, 9, r->h);
-    if (b == SQLITE_OK) b = st_bind_text(st, 10, r->state);
-    int src = b == SQLITE_OK ? sqlite3_step(st) : b;
-    if (src != SQLITE_DONE)
-        rc = st_db_fail(s, src, "scale_evals: insert", err, errlen);
-    else if (id)
-        *id = sqlite3_last_insert_rowid(s->db);
-    sqlite3_finalize(st);
-    return rc;
+    if (!r)
+        return st_fail(err, errlen, AMFI_EINVAL, "scale_evals: row is NULL");
+    return st_insert_rows(s, "scale_evals", r, 1, sizeof *r, 0, id, err, errlen);
 }
 
 int amfi_store_scale_inputs(amfi_store *s, int64_t after_id, int max, amfi_scale_input **out,

@@ -12,61 +12,14 @@
 
 #include "store_internal.h"
 
+/* The columns by the column table (store_columns.c), then what it cannot
+ * say: the axle arrays and the rule of status ok. */
 static int check_passage(const amfi_passage_row *r, char *err, size_t errlen)
 {
     char name[48];
-    int rc = 0;
-    if (!r)
-        return st_fail(err, errlen, AMFI_EINVAL, "passages: row is NULL");
-    rc = st_check_enum("passages.status", r->status, st_statuses,
-                    AMFI_STORE_STATUSES, err, errlen);
-    if (rc == 0)
-        rc = st_check_utime("passages.utime", r->utime, err, errlen);
-    if (rc == 0 && (r->lane < -32768 || r->lane > 32767))
-        rc = st_fail(err, errlen, AMFI_EINVAL,
-                  "passages.lane: %d is out of range [-32768, 32767]", r->lane);
-    if (rc == 0 && (r->n_axles < 0 || r->n_axles > AMFI_MAX_AXLES))
-        rc = st_fail(err, errlen, AMFI_EINVAL,
-                  "passages.n_axles: %d is out of range [0, %d]", r->n_axles,
-                  AMFI_MAX_AXLES);
-    if (rc == 0)
-        rc = st_check_num("passages.speed_mps", r->speed_mps, &R_SPEED, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("passages.speed_given_mps", r->speed_given_mps, &R_SPEED, err,
-                          errlen);
-    if (rc == 0 && r->speed_estimated != 0 && r->speed_estimated != 1)
-        rc = st_fail(err, errlen, AMFI_EINVAL,
-                     "passages.speed_estimated: %d is not 0 or 1", r->speed_estimated);
-    if (rc == 0 && (r->n_vehicles < 0 || r->n_vehicles > 64))
-        rc = st_fail(err, errlen, AMFI_EINVAL,
-                     "passages.n_vehicles: %d is out of range [1, 64]", r->n_vehicles);
-    if (rc == 0 && r->quality != 0.0)
-        rc = st_check_num("passages.quality", r->quality, &R_QUALITY, err, errlen);
-    if (rc == 0 && r->reference_gvw_kg != 0.0)
-        rc = st_check_num("passages.reference_gvw_kg", r->reference_gvw_kg, &R_REF_KG, err,
-                          errlen);
-    if (rc == 0 && r->has_deck_c)
-        rc = st_check_known("passages.deck_c", r->deck_c, &R_TEMP_C, err, errlen);
-    if (rc == 0 && r->f1_hz != 0.0 && !isnan(r->f1_hz)) {
-        rc = st_check_num("passages.f1_hz", r->f1_hz, &R_HZ, err, errlen);
-        if (rc == 0 && r->f1_comp_hz != 0.0)
-            rc = st_check_num("passages.f1_comp_hz", r->f1_comp_hz, &R_HZ, err, errlen);
-        if (rc == 0)
-            rc = st_check_num("passages.f1_zeta", r->f1_zeta, &R_ZETA, err, errlen);
-        if (rc == 0)
-            rc = st_check_num("passages.f1_r2", r->f1_r2, &R_PROB, err, errlen);
-    }
-    if (rc == 0)
-        rc = st_check_num("passages.gvw_kg", r->gvw_kg, &R_KG, err, errlen);
-    if (rc == 0 && r->gvw_comp_kg != 0.0)
-        rc = st_check_num("passages.gvw_comp_kg", r->gvw_comp_kg, &R_KG_POS, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("passages.lambda", r->lambda, &R_POS, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("passages.residual_rms", r->residual_rms, &R_NONNEG,
-                       err, errlen);
-    if (rc == 0)
-        rc = st_check_num("passages.solve_ms", r->solve_ms, &R_MS, err, errlen);
+    int rc = st_check_row(amfi_store_tabledef_find("passages"), r, "passages", err, errlen);
+    if (rc != 0)
+        return rc;
     for (int k = 0; rc == 0 && k < r->n_axles - 1; k++) {
         snprintf(name, sizeof name, "passages: spacing_m[%d]", k);
         rc = st_check_num(name, r->spacing_m[k], &R_SPACING, err, errlen);
@@ -75,12 +28,6 @@ static int check_passage(const amfi_passage_row *r, char *err, size_t errlen)
         snprintf(name, sizeof name, "passages: axle_kg[%d]", k);
         rc = st_check_num(name, r->axle_kg[k], &R_KG, err, errlen);
     }
-    if (rc == 0 && r->reason)
-        rc = st_check_text("passages.reason", r->reason, 0, AMFI_STORE_REASON_MAX,
-                        err, errlen);
-    if (rc == 0 && r->formulation)
-        rc = st_check_text("passages.formulation", r->formulation, 1, 63, err,
-                        errlen);
     if (rc != 0 || strcmp(r->status, "ok") != 0)
         return rc;
     /* status ok: a solved passage with everything known */
@@ -115,34 +62,7 @@ int amfi_store_add_passage(amfi_store *s, const amfi_passage_row *r,
     if (rc == 0)
         rc = st_begin(s, err, errlen);
     if (rc == 0) {
-        sqlite3_stmt *st = s->st[ST_INS_PASSAGE];
-        int b = sqlite3_bind_int64(st, 1, r->vehicle_id);
-        if (b == SQLITE_OK) b = sqlite3_bind_int64(st, 2, r->utime);
-        if (b == SQLITE_OK) b = sqlite3_bind_int(st, 3, r->lane);
-        if (b == SQLITE_OK) b = st_bind_real(st, 4, r->speed_mps);
-        if (b == SQLITE_OK) b = sqlite3_bind_int(st, 5, r->n_axles);
-        if (b == SQLITE_OK) b = st_bind_real(st, 6, r->gvw_kg);
-        if (b == SQLITE_OK) b = st_bind_text(st, 7, r->status);
-        if (b == SQLITE_OK) b = st_bind_text(st, 8, r->reason ? r->reason : "");
-        if (b == SQLITE_OK) b = st_bind_real(st, 9, r->lambda);
-        if (b == SQLITE_OK) b = st_bind_real(st, 10, r->residual_rms);
-        if (b == SQLITE_OK) b = st_bind_text(st, 11, r->formulation);
-        if (b == SQLITE_OK) b = st_bind_real(st, 12, r->solve_ms);
-        if (b == SQLITE_OK) b = st_bind_real(st, 13, r->speed_given_mps);
-        if (b == SQLITE_OK) b = sqlite3_bind_int(st, 14, r->speed_estimated);
-        if (b == SQLITE_OK) b = sqlite3_bind_int(st, 15, r->n_vehicles > 0 ? r->n_vehicles : 1);
-        if (b == SQLITE_OK) b = st_bind_real(st, 16, r->quality != 0.0 ? r->quality : NAN);
-        if (b == SQLITE_OK)
-            b = st_bind_real(st, 17, r->reference_gvw_kg != 0.0 ? r->reference_gvw_kg : NAN);
-        if (b == SQLITE_OK) b = st_bind_real(st, 18, r->has_deck_c ? r->deck_c : NAN);
-        const int f1 = r->f1_hz != 0.0 && !isnan(r->f1_hz);
-        if (b == SQLITE_OK) b = st_bind_real(st, 19, f1 ? r->f1_hz : NAN);
-        if (b == SQLITE_OK)
-            b = st_bind_real(st, 20, f1 && r->f1_comp_hz != 0.0 ? r->f1_comp_hz : NAN);
-        if (b == SQLITE_OK) b = st_bind_real(st, 21, f1 ? r->f1_zeta : NAN);
-        if (b == SQLITE_OK) b = st_bind_real(st, 22, f1 ? r->f1_r2 : NAN);
-        if (b == SQLITE_OK)
-            b = st_bind_real(st, 23, r->gvw_comp_kg != 0.0 ? r->gvw_comp_kg : NAN);
+        int b = st_bind_row(s->st[ST_INS_PASSAGE], amfi_store_tabledef_find("passages"), r);
         rc = st_run(s, ST_INS_PASSAGE, b, "passages: insert", err, errlen);
         if (rc == 0)
             pid = sqlite3_last_insert_rowid(s->db);
@@ -227,45 +147,13 @@ int amfi_store_add_truth(amfi_store *s, int64_t vehicle_id, int64_t utime,
 int amfi_store_add_indicator(amfi_store *s, const amfi_indicator_row *r,
                              int64_t *id, char *err, size_t errlen)
 {
+    const amfi_store_tabledef *t = amfi_store_tabledef_find("indicators");
     int rc = st_check_handle(s, 1, err, errlen);
-    if (rc == 0 && !r)
-        rc = st_fail(err, errlen, AMFI_EINVAL, "indicators: row is NULL");
     if (rc == 0)
-        rc = st_check_utime("indicators.utime", r->utime, err, errlen);
-    if (rc == 0 && r->n < 0)
-        rc = st_fail(err, errlen, AMFI_EINVAL, "indicators.n: %d must be >= 0",
-                  r->n);
+        rc = st_check_row(t, r, "indicators", err, errlen);
     if (rc == 0)
-        rc = st_check_num("indicators.mean_kg", r->mean_kg, &R_KG, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("indicators.std_kg", r->std_kg, &R_KG_NONNEG, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("indicators.baseline_mean_kg", r->baseline_mean_kg,
-                       &R_KG_POS, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("indicators.baseline_std_kg", r->baseline_std_kg,
-                       &R_KG_POS, err, errlen);
-    if (rc == 0)
-        rc = st_check_num("indicators.std_ratio", r->std_ratio, &R_RATIO, err,
-                       errlen);
-    if (rc == 0)
-        rc = st_check_num("indicators.p_value", r->p_value, &R_PROB, err, errlen);
-    if (rc == 0)
-        rc = st_check_enum("indicators.state", r->state, st_states,
-                        "baseline, normal, watch, alert", err, errlen);
-    if (rc == 0) {
-        sqlite3_stmt *st = s->st[ST_INS_INDICATOR];
-        int b = sqlite3_bind_int64(st, 1, r->utime);
-        if (b == SQLITE_OK) b = sqlite3_bind_int(st, 2, r->n);
-        if (b == SQLITE_OK) b = st_bind_real(st, 3, r->mean_kg);
-        if (b == SQLITE_OK) b = st_bind_real(st, 4, r->std_kg);
-        if (b == SQLITE_OK) b = st_bind_real(st, 5, r->baseline_mean_kg);
-        if (b == SQLITE_OK) b = st_bind_real(st, 6, r->baseline_std_kg);
-        if (b == SQLITE_OK) b = st_bind_real(st, 7, r->std_ratio);
-        if (b == SQLITE_OK) b = st_bind_real(st, 8, r->p_value);
-        if (b == SQLITE_OK) b = st_bind_text(st, 9, r->state);
-        rc = st_run(s, ST_INS_INDICATOR, b, "indicators: insert", err, errlen);
-    }
+        rc = st_run(s, ST_INS_INDICATOR, st_bind_row(s->st[ST_INS_INDICATOR], t, r),
+                    "indicators: insert", err, errlen);
     if (rc == 0 && id)
         *id = sqlite3_last_insert_rowid(s->db);
     return rc;
@@ -277,34 +165,16 @@ int amfi_store_add_alert(amfi_store *s, int64_t utime, const char *level,
                          char *err, size_t errlen)
 {
     char what[64];
+    const amfi_store_tabledef *t = amfi_store_tabledef_find("alerts");
+    const st_alert_row r = {utime, level, kind, message, indicator_id, raised};
     int rc = st_check_handle(s, 1, err, errlen);
     if (rc == 0)
-        rc = st_check_utime("alerts.utime", utime, err, errlen);
-    if (rc == 0)
-        rc = st_check_enum("alerts.level", level, st_levels, "info, warning", err,
-                        errlen);
-    if (rc == 0)
-        rc = st_check_token("alerts.kind", kind, 31, "_", 1, err, errlen);
-    if (rc == 0)
-        rc = st_check_text("alerts.message", message, 1, AMFI_STORE_REASON_MAX,
-                        err, errlen);
-    if (rc == 0 && raised != 0 && raised != 1)
-        rc = st_fail(err, errlen, AMFI_EINVAL,
-                  "alerts.raised: %d is neither 1 (raised) nor 0 (cleared)",
-                  raised);
+        rc = st_check_row(t, &r, "alerts", err, errlen);
     if (rc == 0) {
-        sqlite3_stmt *st = s->st[ST_INS_ALERT];
-        int b = sqlite3_bind_int64(st, 1, utime);
-        if (b == SQLITE_OK) b = st_bind_text(st, 2, level);
-        if (b == SQLITE_OK) b = st_bind_text(st, 3, kind);
-        if (b == SQLITE_OK) b = st_bind_text(st, 4, message);
-        if (b == SQLITE_OK)
-            b = indicator_id > 0 ? sqlite3_bind_int64(st, 5, indicator_id)
-                                 : sqlite3_bind_null(st, 5);
-        if (b == SQLITE_OK) b = sqlite3_bind_int(st, 6, raised);
         snprintf(what, sizeof what, "alerts: insert (indicator_id %lld)",
                  (long long)indicator_id);
-        rc = st_run(s, ST_INS_ALERT, b, what, err, errlen);
+        rc = st_run(s, ST_INS_ALERT, st_bind_row(s->st[ST_INS_ALERT], t, &r), what, err,
+                    errlen);
     }
     if (rc == 0 && id)
         *id = sqlite3_last_insert_rowid(s->db);

@@ -20,9 +20,9 @@
 #include <unistd.h>
 
 #include <cmocka.h>
-#include <sqlite3.h>
 
 #include "amfid.h"
+#include "store_testing.h"
 
 #define T0 INT64_C(1767225600000000) /* 2026-01-01, µs */
 #define MIN_US INT64_C(60000000)
@@ -142,52 +142,52 @@ static void pass(daemon_s *d, int k, int damaged)
 }
 
 /* scale_evals and alerts after utime `from`, as text, malloc'd. */
+struct text { char *p; size_t len, cap; };
+static int dump_line(void *ctx, int n, const char *const *t)
+{
+    struct text *o = ctx;
+    size_t k = strlen(n > 0 && t[0] ? t[0] : "");
+    if (o->len + k + 2 > o->cap) {
+        o->cap = 2 * (o->cap + k + 2);
+        o->p = realloc(o->p, o->cap);
+        assert_non_null(o->p);
+    }
+    memcpy(o->p + o->len, n > 0 && t[0] ? t[0] : "", k);
+    o->len += k;
+    o->p[o->len++] = '\n';
+    o->p[o->len] = 0;
+    return 0;
+}
+
 static char *dump(const char *dir, const char *name, int64_t from)
 {
-    char path[128], sql[512];
-    sqlite3 *db = NULL;
-    sqlite3_stmt *st = NULL;
+    char path[128], sql[512], err[512];
     snprintf(path, sizeof path, "%s/%s.db", dir, name);
-    assert_int_equal(SQLITE_OK, sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY, NULL));
+    amfi_store_test_db *db = amfi_store_test_open(path, 0, err, sizeof err);
+    assert_non_null(db);
     snprintf(sql, sizeof sql,
              "SELECT printf('%%s %%d %%d %%.12g %%.12g %%.12g %%.12g %%.12g %%s', kind, utime, n, "
              "value, raw, deck_c, z, cusum, state) FROM scale_evals WHERE utime > %lld UNION ALL "
              "SELECT printf('alert %%s %%d %%d %%s', kind, utime, raised, message) FROM alerts "
              "WHERE utime > %lld",
              (long long)from, (long long)from);
-    assert_int_equal(SQLITE_OK, sqlite3_prepare_v2(db, sql, -1, &st, NULL));
-    size_t cap = 1 << 16, len = 0;
-    char *out = calloc(1, cap);
-    while (sqlite3_step(st) == SQLITE_ROW) {
-        const char *line = (const char *)sqlite3_column_text(st, 0);
-        size_t n = strlen(line);
-        if (len + n + 2 > cap) {
-            cap *= 2;
-            out = realloc(out, cap);
-        }
-        memcpy(out + len, line, n);
-        len += n;
-        out[len++] = '\n';
-        out[len] = 0;
-    }
-    sqlite3_finalize(st);
-    sqlite3_close(db);
-    return out;
+    struct text out = {calloc(1, 1 << 16), 0, 1 << 16};
+    assert_non_null(out.p);
+    assert_int_equal(0, amfi_store_test_rows(db, sql, dump_line, &out, err, sizeof err));
+    amfi_store_test_close(db);
+    return out.p;
 }
 
 static int count(const char *dir, const char *name, const char *sql)
 {
-    char path[128];
-    sqlite3 *db = NULL;
-    sqlite3_stmt *st = NULL;
+    char path[128], err[512];
     snprintf(path, sizeof path, "%s/%s.db", dir, name);
-    assert_int_equal(SQLITE_OK, sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY, NULL));
-    assert_int_equal(SQLITE_OK, sqlite3_prepare_v2(db, sql, -1, &st, NULL));
-    assert_int_equal(SQLITE_ROW, sqlite3_step(st));
-    int n = sqlite3_column_int(st, 0);
-    sqlite3_finalize(st);
-    sqlite3_close(db);
-    return n;
+    amfi_store_test_db *db = amfi_store_test_open(path, 0, err, sizeof err);
+    assert_non_null(db);
+    int64_t n = 0;
+    assert_int_equal(0, amfi_store_test_int(db, sql, &n, err, sizeof err));
+    amfi_store_test_close(db);
+    return (int)n;
 }
 
 static void test_restart_continues_exactly(void **state)

@@ -24,7 +24,8 @@
 set -u
 
 bin=${1:?usage: report_hostile.sh AMFI_REPORT SCHEMA_MD}
-doc=${2:?usage: report_hostile.sh AMFI_REPORT SCHEMA_MD}
+doc=${2:?usage: report_hostile.sh AMFI_REPORT SCHEMA_MD STORE_STAMP}
+stamp=${3:?usage: report_hostile.sh AMFI_REPORT SCHEMA_MD STORE_STAMP}
 [ -x "$bin" ] || { echo "report_hostile.sh: $bin: not executable" >&2; exit 1; }
 [ -r "$doc" ] || { echo "report_hostile.sh: $doc: not readable" >&2; exit 1; }
 command -v sqlite3 > /dev/null || { echo "report_hostile.sh: no sqlite3 program: skipped"; exit 77; }
@@ -48,10 +49,6 @@ awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
 {
     cat "$tmp/ddl.sql"
     cat <<'EOF'
-PRAGMA user_version = 9;
-INSERT INTO schema_migrations (version, description) VALUES (1, 'fixture'), (2, 'runs'),
-    (3, 'speed_given_mps'), (4, 'n_vehicles'), (5, 'environment'), (6, 'scale_evals'), (7, 'f1_hz'),
-    (8, 'gvw_comp_kg'), (9, 'refusals');
 WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 20)
 INSERT INTO passages (vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status,
                       reason, lambda, residual_rms, formulation, solve_ms, speed_given_mps)
@@ -87,7 +84,8 @@ INSERT INTO meta (key, value) VALUES ('intake.as_of', '=1+1'), ('intake.run', '1
   ('intake.samples_missing', '0'), ('intake.passages_lost', '0');
 EOF
 } > "$tmp/fixture.sql"
-if ! sqlite3 "$db" < "$tmp/fixture.sql" > "$tmp/fixture.log" 2>&1; then
+# the schema version and migration rows as the store's migrations record them
+if ! { sqlite3 "$db" < "$tmp/fixture.sql" && "$stamp" "$db"; } > "$tmp/fixture.log" 2>&1; then
     echo "report_hostile.sh: building the fixture failed:" >&2
     cat "$tmp/fixture.log" >&2
     exit 1

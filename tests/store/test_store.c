@@ -19,7 +19,6 @@
 #include <cmocka.h>
 
 #include <math.h>
-#include <sqlite3.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,6 +28,7 @@
 
 #include "store.h"
 #include "store_fixture.h"
+#include "store_testing.h"
 
 #ifndef AMFI_SCHEMA_DOC
 #error "AMFI_SCHEMA_DOC (path of docs/schema.md) must be defined"
@@ -47,60 +47,77 @@ static int teardown(void **state)
     return store_fixture_teardown(state, extra);
 }
 
-/* A raw connection to the fixture's file, as a user's sqlite3 would be. */
-static sqlite3 *raw_open(const char *path)
+/* A raw connection to the fixture's file, as a user's sqlite3 would be
+ * (store_testing.h). */
+typedef amfi_store_test_db raw_db;
+static raw_db *raw_open(const char *path)
 {
-    sqlite3 *db = NULL;
-    assert_int_equal(SQLITE_OK, sqlite3_open_v2(path, &db,
-                                                SQLITE_OPEN_READWRITE, NULL));
-    sqlite3_busy_timeout(db, 5000);
+    char err[512];
+    raw_db *db = amfi_store_test_open(path, 0, err, sizeof err);
+    if (!db)
+        fail_msg("%s", err);
     return db;
 }
 
-static void raw_exec(sqlite3 *db, const char *sql)
+/* The same, creating the file. */
+static raw_db *raw_create(const char *path)
 {
-    char *msg = NULL;
-    int rc = sqlite3_exec(db, sql, NULL, NULL, &msg);
-    if (rc != SQLITE_OK)
-        fail_msg("%s: %s", sql, msg ? msg : "?");
-    sqlite3_free(msg);
+    char err[512];
+    raw_db *db = amfi_store_test_open(path, 1, err, sizeof err);
+    if (!db)
+        fail_msg("%s", err);
+    return db;
+}
+
+static void raw_close(raw_db *db) { amfi_store_test_close(db); }
+
+static void raw_exec(raw_db *db, const char *sql)
+{
+    char err[1024];
+    if (amfi_store_test_exec(db, sql, err, sizeof err) != 0)
+        fail_msg("%s", err);
+}
+
+/* 0 when sql ran, -1 when SQLite refused it. */
+static int raw_try(raw_db *db, const char *sql)
+{
+    char err[1024];
+    return amfi_store_test_exec(db, sql, err, sizeof err);
+}
+
+/* The store taken back to version v, as that version's amfid left it. */
+static void raw_downgrade(raw_db *db, int v)
+{
+    char err[1024];
+    if (amfi_store_test_downgrade(db, v, err, sizeof err) != 0)
+        fail_msg("downgrade to %d: %s", v, err);
 }
 
 /* First column of the first row as integer (0 when NULL / no row). */
-static int64_t raw_int(sqlite3 *db, const char *sql)
+static int64_t raw_int(raw_db *db, const char *sql)
 {
-    sqlite3_stmt *st = NULL;
+    char err[1024];
     int64_t v = 0;
-    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK)
-        fail_msg("%s: %s", sql, sqlite3_errmsg(db));
-    if (sqlite3_step(st) == SQLITE_ROW)
-        v = sqlite3_column_int64(st, 0);
-    sqlite3_finalize(st);
+    if (amfi_store_test_int(db, sql, &v, err, sizeof err) != 0)
+        fail_msg("%s", err);
     return v;
 }
 
-static double raw_real(sqlite3 *db, const char *sql)
+static double raw_real(raw_db *db, const char *sql)
 {
-    sqlite3_stmt *st = NULL;
+    char err[1024];
     double v = NAN;
-    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK)
-        fail_msg("%s: %s", sql, sqlite3_errmsg(db));
-    if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_type(st, 0) != SQLITE_NULL)
-        v = sqlite3_column_double(st, 0);
-    sqlite3_finalize(st);
+    if (amfi_store_test_real(db, sql, &v, NULL, err, sizeof err) != 0)
+        fail_msg("%s", err);
     return v;
 }
 
 /* First column of the first row as text into buf ("" when none). */
-static const char *raw_text(sqlite3 *db, const char *sql, char *buf, size_t len)
+static const char *raw_text(raw_db *db, const char *sql, char *buf, size_t len)
 {
-    sqlite3_stmt *st = NULL;
-    buf[0] = '\0';
-    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK)
-        fail_msg("%s: %s", sql, sqlite3_errmsg(db));
-    if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0))
-        snprintf(buf, len, "%s", (const char *)sqlite3_column_text(st, 0));
-    sqlite3_finalize(st);
+    char err[1024];
+    if (amfi_store_test_text(db, sql, buf, len, err, sizeof err) != 0)
+        fail_msg("%s", err);
     return buf;
 }
 
@@ -150,7 +167,7 @@ static void test_create_and_reopen(void **state)
 {
     fixture *f = *state;
     char err[ERRLEN], buf[64];
-    sqlite3 *db = raw_open(f->path);
+    raw_db *db = raw_open(f->path);
 
     assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
     assert_int_equal(AMFI_STORE_APPLICATION_ID, raw_int(db, "PRAGMA application_id"));
@@ -161,17 +178,13 @@ static void test_create_and_reopen(void **state)
         "passage_errors", "passages_utime", "passages_status_utime", "runs",
         "environment", "environment_utime"};
     for (size_t k = 0; k < sizeof objects / sizeof objects[0]; k++) {
-        sqlite3_stmt *st = NULL;
-        assert_int_equal(SQLITE_OK, sqlite3_prepare_v2(db,
-            "SELECT count(*) FROM sqlite_schema WHERE name = ?1", -1, &st, NULL));
-        sqlite3_bind_text(st, 1, objects[k], -1, SQLITE_STATIC);
-        assert_int_equal(SQLITE_ROW, sqlite3_step(st));
-        if (sqlite3_column_int(st, 0) != 1)
+        char q[160];
+        snprintf(q, sizeof q, "SELECT count(*) FROM sqlite_schema WHERE name = '%s'", objects[k]);
+        if (raw_int(db, q) != 1)
             fail_msg("schema object %s missing", objects[k]);
-        sqlite3_finalize(st);
     }
     assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
-    sqlite3_close(db);
+    raw_close(db);
 
     /* reopen: nothing migrates again, data stays */
     add_ok(f->s, 1, DAY_US, 18000.0, NULL);
@@ -185,7 +198,7 @@ static void test_create_and_reopen(void **state)
     assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
     assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
-    sqlite3_close(db);
+    raw_close(db);
 }
 
 static void test_refuse_newer_version(void **state)
@@ -193,13 +206,13 @@ static void test_refuse_newer_version(void **state)
     fixture *f = *state;
     char err[ERRLEN];
     amfi_store *s2 = NULL;
-    sqlite3 *db;
+    raw_db *db;
 
     amfi_store_close(f->s);
     f->s = NULL;
     db = raw_open(f->path);
     raw_exec(db, "PRAGMA user_version = 99");
-    sqlite3_close(db);
+    raw_close(db);
 
     err[0] = '\0';
     assert_int_equal(AMFI_STORE_ESCHEMA,
@@ -211,7 +224,7 @@ static void test_refuse_newer_version(void **state)
                      amfi_store_open_readonly(f->path, &s2, err, sizeof err));
     db = raw_open(f->path);
     assert_int_equal(99, raw_int(db, "PRAGMA user_version")); /* untouched */
-    sqlite3_close(db);
+    raw_close(db);
 }
 
 static void test_refuse_foreign_files(void **state)
@@ -219,20 +232,20 @@ static void test_refuse_foreign_files(void **state)
     fixture *f = *state;
     char err[ERRLEN], path[128];
     amfi_store *s2 = NULL;
-    sqlite3 *db;
+    raw_db *db;
     FILE *fp;
 
     /* an SQLite database of something else */
     snprintf(path, sizeof path, "%s/other.db", f->dir);
-    assert_int_equal(SQLITE_OK, sqlite3_open(path, &db));
+    db = raw_create(path);
     raw_exec(db, "CREATE TABLE recipes (name TEXT)");
-    sqlite3_close(db);
+    raw_close(db);
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open(path, 0, &s2, err, sizeof err));
     assert_non_null(strstr(err, "not an amfi store"));
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(path, &s2, err, sizeof err));
     db = raw_open(path);
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM sqlite_schema")); /* untouched */
-    sqlite3_close(db);
+    raw_close(db);
 
     /* not SQLite at all */
     snprintf(path, sizeof path, "%s/not-sqlite.db", f->dir);
@@ -273,7 +286,7 @@ static void test_passage_with_axles(void **state)
     amfi_passage_row r;
     char err[ERRLEN], buf[64];
     int64_t id = 0;
-    sqlite3 *db;
+    raw_db *db;
 
     ok_row(&r, 42, 3 * DAY_US + 123, 25000.0);
     r.n_axles = 3;
@@ -307,7 +320,7 @@ static void test_passage_with_axles(void **state)
     /* the cascade */
     raw_exec(db, "PRAGMA foreign_keys = ON; DELETE FROM passages");
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM axles"));
-    sqlite3_close(db);
+    raw_close(db);
 }
 
 static void test_unsolved_is_null(void **state)
@@ -315,7 +328,7 @@ static void test_unsolved_is_null(void **state)
     fixture *f = *state;
     amfi_passage_row r;
     char err[ERRLEN], buf[128];
-    sqlite3 *db;
+    raw_db *db;
 
     ok_row(&r, 7, DAY_US, NAN);
     r.status = "gap";
@@ -343,7 +356,7 @@ static void test_unsolved_is_null(void **state)
     assert_string_equal("null", raw_text(db, "SELECT typeof(speed_mps) FROM passages WHERE vehicle_id = 8", buf, sizeof buf));
     assert_string_equal("", raw_text(db, "SELECT reason FROM passages WHERE vehicle_id = 8", buf, sizeof buf));
     assert_int_equal(2, raw_int(db, "SELECT count(*) FROM axles"));
-    sqlite3_close(db);
+    raw_close(db);
 }
 
 typedef struct bad_case {
@@ -398,7 +411,7 @@ static void test_invalid_rows_store_nothing(void **state)
     };
     amfi_passage_row r;
     char err[ERRLEN];
-    sqlite3 *db = raw_open(f->path);
+    raw_db *db = raw_open(f->path);
 
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         ok_row(&r, 1, DAY_US, 18000.0);
@@ -429,14 +442,14 @@ static void test_invalid_rows_store_nothing(void **state)
     assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM axles"));
-    sqlite3_close(db);
+    raw_close(db);
 }
 
 /* WAL: a reader in the middle of a read transaction does not block. */
 static void test_reader_does_not_block(void **state)
 {
     fixture *f = *state;
-    sqlite3 *db = raw_open(f->path);
+    raw_db *db = raw_open(f->path);
     char err[ERRLEN];
     amfi_passage_row r;
     add_ok(f->s, 1, DAY_US, 18000.0, NULL);
@@ -449,7 +462,7 @@ static void test_reader_does_not_block(void **state)
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages")); /* snapshot */
     raw_exec(db, "COMMIT");
     assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages"));
-    sqlite3_close(db);
+    raw_close(db);
 }
 
 /* ---- truth and passage_errors ---------------------------------------------- */
@@ -460,7 +473,7 @@ static void test_truth_and_errors_view(void **state)
     char err[ERRLEN];
     double axle[2], force[2];
     int64_t id[5];
-    sqlite3 *db;
+    raw_db *db;
     static const double inferred[5] = {18000, 20500, 9800, 31000, NAN};
     static const double truth[5] = {18200, 20000, 10000, 30000, 15000};
 
@@ -503,7 +516,7 @@ static void test_truth_and_errors_view(void **state)
             assert_true(fabs(e - want) < 1e-12 * fabs(want) + 1e-12);
         }
     }
-    sqlite3_close(db);
+    raw_close(db);
 
     /* bad truth */
     axle[0] = axle[1] = 1000;
@@ -524,7 +537,7 @@ static void test_indicators_alerts(void **state)
     char err[ERRLEN], buf[64];
     int64_t i1 = 0, i2 = 0, i3 = 0, a1 = 0;
     amfi_indicator_row r = {DAY_US, 0, NAN, NAN, NAN, NAN, NAN, NAN, "baseline"};
-    sqlite3 *db;
+    raw_db *db;
 
     assert_int_equal(0, amfi_store_add_indicator(f->s, &r, &i1, err, sizeof err));
     r = (amfi_indicator_row){DAY_US + 1000, 200, 18100, 2400, 18000, 2000, 1.2, 0.004, "watch"};
@@ -548,7 +561,7 @@ static void test_indicators_alerts(void **state)
     assert_string_equal("1970-01-02 00:00:00", raw_text(db, "SELECT time_utc FROM window_trend LIMIT 1", buf, sizeof buf));
     assert_string_equal("null", raw_text(db, "SELECT typeof(baseline_std_kg) FROM indicators ORDER BY id LIMIT 1", buf, sizeof buf));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM alerts WHERE indicator_id IS NULL"));
-    sqlite3_close(db);
+    raw_close(db);
 
     /* bad ones */
     assert_int_equal(AMFI_EINVAL, amfi_store_add_alert(f->s, 0, "warning", "std_increase", "x",
@@ -680,7 +693,7 @@ static void test_integrity_check(void **state)
 {
     fixture *f = *state;
     char err[ERRLEN], result[256];
-    sqlite3 *db;
+    raw_db *db;
 
     add_ok(f->s, 1, DAY_US, 18000.0, NULL);
     assert_int_equal(0, amfi_store_integrity_check(f->s, result, sizeof result, err, sizeof err));
@@ -689,7 +702,7 @@ static void test_integrity_check(void **state)
     db = raw_open(f->path);
     raw_exec(db, "PRAGMA foreign_keys = OFF; "
                  "INSERT INTO axles (passage_id, idx, spacing_m, load_kg) VALUES (999, 1, NULL, 10)");
-    sqlite3_close(db);
+    raw_close(db);
     assert_int_equal(0, amfi_store_integrity_check(f->s, result, sizeof result, err, sizeof err));
     assert_non_null(strstr(result, "foreign key: a axles row refers to a missing passages row"));
     assert_int_equal(AMFI_EINVAL, amfi_store_integrity_check(f->s, NULL, 0, err, sizeof err));
@@ -706,7 +719,7 @@ static void test_corrupt_rows_reported(void **state)
     int n = 0, found = 0;
     int64_t id = 0;
     amfi_baseline b = {DAY_US, 100, 18000.0, 2000.0, "auto", ""};
-    sqlite3 *db;
+    raw_db *db;
     char sql[160], expect[96];
 
     add_ok(f->s, 1, DAY_US, 18000.0, NULL);
@@ -743,11 +756,11 @@ static void test_corrupt_rows_reported(void **state)
     raw_exec(db, "PRAGMA writable_schema = ON; "
                  "UPDATE sqlite_schema SET sql = replace(sql, ') STRICT', ')') "
                  "WHERE name = 'baseline'; PRAGMA writable_schema = OFF");
-    sqlite3_close(db);
+    raw_close(db);
     db = raw_open(f->path);
     raw_exec(db, "PRAGMA ignore_check_constraints = ON; "
                  "UPDATE baseline SET std_kg = 2000, mean_kg = 'lots'");
-    sqlite3_close(db);
+    raw_close(db);
     amfi_store_close(f->s); /* the new schema is seen by a new connection */
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_get_baseline(f->s, &b, &found, err, sizeof err));
@@ -788,7 +801,7 @@ static void test_runs_and_migration_from_v1(void **state)
     char err[ERRLEN], buf[128];
     int64_t id = 0;
     amfi_store *ro = NULL;
-    sqlite3 *db;
+    raw_db *db;
 
     assert_int_equal(0, amfi_store_add_run(f->s, "0.1.0", "/etc/amfid/amfid.yaml", &id,
                                            err, sizeof err));
@@ -808,32 +821,22 @@ static void test_runs_and_migration_from_v1(void **state)
     assert_string_equal("/etc/amfid/amfid.yaml",
                         raw_text(db, "SELECT config_path FROM runs", buf, sizeof buf));
     assert_int_equal(1, raw_int(db, "SELECT started_at LIKE '____-__-__T__:__:__.___Z' FROM runs"));
-    raw_exec(db, "DROP TABLE runs; ALTER TABLE passages DROP COLUMN speed_given_mps; "
-                 "ALTER TABLE passages DROP COLUMN speed_estimated; "
-                 "ALTER TABLE passages DROP COLUMN n_vehicles; "
-                 "ALTER TABLE passages DROP COLUMN quality; "
-                 "DROP TABLE environment; "
-                 "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
-                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
-                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
-                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
-                 "DELETE FROM schema_migrations WHERE version >= 2; PRAGMA user_version = 1");
-    sqlite3_close(db);
+    raw_downgrade(db, 1);
+    raw_close(db);
 
     /* read-only openers do not migrate: they say so */
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 1 is older than this program's 9"));
+    assert_non_null(strstr(err, "schema version 1 is older than this program's"));
     assert_null(ro);
 
     /* read-write: migrated, the data kept */
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM runs"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages"));
-    sqlite3_close(db);
+    raw_close(db);
     assert_int_equal(0, amfi_store_add_run(f->s, "0.2.0", "a.yaml", &id, err, sizeof err));
     assert_int_equal(1, id);
 }
@@ -846,7 +849,7 @@ static void test_speed_given_and_migration_from_v2(void **state)
     char err[ERRLEN];
     amfi_passage_row r;
     amfi_store *ro = NULL;
-    sqlite3 *db;
+    raw_db *db;
 
     /* an estimated speed beside the detector's */
     ok_row(&r, 1, DAY_US, 18000.0);
@@ -869,31 +872,21 @@ static void test_speed_given_and_migration_from_v2(void **state)
     assert_int_equal(1, raw_int(db, "SELECT speed_given_mps = 25.0 AND speed_mps = 24.1 "
                                     "FROM passages"));
     /* make it a version-2 file: the detector's speed was the one weighed with */
-    raw_exec(db, "ALTER TABLE passages DROP COLUMN speed_given_mps; "
-                 "ALTER TABLE passages DROP COLUMN speed_estimated; "
-                 "ALTER TABLE passages DROP COLUMN n_vehicles; "
-                 "ALTER TABLE passages DROP COLUMN quality; "
-                 "UPDATE passages SET speed_mps = 25.0; "
-                 "DROP TABLE environment; "
-                 "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
-                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
-                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
-                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
-                 "DELETE FROM schema_migrations WHERE version >= 3; PRAGMA user_version = 2");
-    sqlite3_close(db);
+    raw_exec(db, "UPDATE passages SET speed_mps = 25.0");
+    raw_downgrade(db, 2);
+    raw_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 2 is older than this program's 9"));
+    assert_non_null(strstr(err, "schema version 2 is older than this program's"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE speed_given_mps = 25.0 "
                                     "AND speed_mps = 25.0 AND speed_estimated = 0"));
-    sqlite3_close(db);
+    raw_close(db);
     ok_row(&r, 2, 2 * DAY_US, 18000.0);
     assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
 }
@@ -906,7 +899,7 @@ static void test_event_columns_and_migration_from_v3(void **state)
     char err[ERRLEN];
     amfi_passage_row r;
     amfi_store *ro = NULL;
-    sqlite3 *db;
+    raw_db *db;
 
     ok_row(&r, 1, DAY_US, 18000.0); /* memset: n_vehicles 0 (taken as 1), quality 0 (NULL) */
     assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
@@ -933,28 +926,20 @@ static void test_event_columns_and_migration_from_v3(void **state)
     assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE vehicle_id = 2 AND "
                                     "n_vehicles = 3 AND quality = 1.7"));
     /* make it a version-3 file, as amfid before issue 13 left it */
-    raw_exec(db, "ALTER TABLE passages DROP COLUMN n_vehicles; "
-                 "ALTER TABLE passages DROP COLUMN quality; "
-                 "DROP TABLE environment; "
-                 "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
-                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
-                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
-                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
-                 "DELETE FROM schema_migrations WHERE version >= 4; PRAGMA user_version = 3");
-    sqlite3_close(db);
+    raw_downgrade(db, 3);
+    raw_close(db);
 
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 3 is older than this program's 9"));
+    assert_non_null(strstr(err, "schema version 3 is older than this program's"));
     assert_null(ro);
 
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages WHERE n_vehicles = 1 "
                                     "AND quality IS NULL"));
-    sqlite3_close(db);
+    raw_close(db);
     ok_row(&r, 3, 2 * DAY_US, 18000.0);
     r.n_vehicles = 2;
     r.quality = 4.0;
@@ -1033,29 +1018,22 @@ static void test_environment_and_migration_from_v4(void **state)
     f->s = NULL;
 
     /* the schema refuses what the checks refuse */
-    sqlite3 *db = raw_open(f->path);
-    assert_int_not_equal(SQLITE_OK, sqlite3_exec(db, "INSERT INTO environment (utime, deck_c, "
-                                                     "air_c, received_utime) VALUES (1, 90, 0, 1)",
-                                                 NULL, NULL, NULL));
+    raw_db *db = raw_open(f->path);
+    assert_int_not_equal(0, raw_try(db, "INSERT INTO environment (utime, deck_c, "
+                                                     "air_c, received_utime) VALUES (1, 90, 0, 1)"));
     /* make it a version-4 file, as amfid before issue 14 left it */
-    raw_exec(db, "DROP TABLE environment; "
-                 "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
-                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
-                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
-                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
-                 "DELETE FROM schema_migrations WHERE version >= 5; PRAGMA user_version = 4");
-    sqlite3_close(db);
+    raw_downgrade(db, 4);
+    raw_close(db);
     amfi_store *ro = NULL;
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 4 is older than this program's 9"));
+    assert_non_null(strstr(err, "schema version 4 is older than this program's"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM environment"));
-    sqlite3_close(db);
+    raw_close(db);
     assert_int_equal(0, amfi_store_add_environment(f->s, rows, 2, err, sizeof err));
     assert_int_equal(0, amfi_store_deck_c_at(f->s, DAY_US + H / 2, H, &t, err, sizeof err));
     assert_float_equal(12.0, t, 1e-12);
@@ -1172,31 +1150,24 @@ static void test_scale_rows_and_migration_from_v5(void **state)
     f->s = NULL;
 
     /* the schema refuses what the checks refuse */
-    sqlite3 *db = raw_open(f->path);
-    assert_int_not_equal(SQLITE_OK, sqlite3_exec(db, "UPDATE passages SET reference_gvw_kg = 500",
-                                                 NULL, NULL, NULL));
-    assert_int_not_equal(SQLITE_OK, sqlite3_exec(db, "UPDATE passages SET deck_c = -61",
-                                                 NULL, NULL, NULL));
+    raw_db *db = raw_open(f->path);
+    assert_int_not_equal(0, raw_try(db, "UPDATE passages SET reference_gvw_kg = 500"));
+    assert_int_not_equal(0, raw_try(db, "UPDATE passages SET deck_c = -61"));
     /* make it a version-5 file, as amfid before this step left it */
-    raw_exec(db, "ALTER TABLE passages DROP COLUMN reference_gvw_kg; "
-                 "ALTER TABLE passages DROP COLUMN deck_c; DROP TABLE scale_evals; "
-                 "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
-                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
-                 "DELETE FROM schema_migrations WHERE version >= 6; PRAGMA user_version = 5");
-    sqlite3_close(db);
+    raw_downgrade(db, 5);
+    raw_close(db);
     amfi_store *ro = NULL;
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 5 is older than this program's 9"));
+    assert_non_null(strstr(err, "schema version 5 is older than this program's"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE deck_c IS NULL AND "
                                     "reference_gvw_kg IS NULL"));
     assert_int_equal(0, raw_int(db, "SELECT count(*) FROM scale_evals"));
-    sqlite3_close(db);
+    raw_close(db);
     /* old rows are no inputs (no temperature); new ones are */
     assert_int_equal(0, amfi_store_scale_inputs(f->s, 0, 10, &in, &n, err, sizeof err));
     assert_int_equal(0, n);
@@ -1220,7 +1191,7 @@ static void test_f1_and_migration_from_v6(void **state)
     amfi_store *ro = NULL;
     amfi_f1_rec *a = NULL;
     size_t n = 9;
-    sqlite3 *db;
+    raw_db *db;
 
     ok_row(&r, 1, DAY_US, 18000.0); /* memset: f1_hz 0, none (NULL) */
     assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
@@ -1284,24 +1255,19 @@ static void test_f1_and_migration_from_v6(void **state)
                                     "f1_hz IS NULL AND f1_comp_hz IS NULL AND f1_zeta IS NULL "
                                     "AND f1_r2 IS NULL"));
     /* the schema refuses what the checks refuse */
-    assert_int_not_equal(SQLITE_OK,
-                         sqlite3_exec(db, "UPDATE passages SET f1_hz = 0 WHERE vehicle_id = 2",
-                                      NULL, NULL, NULL));
+    assert_int_not_equal(0, raw_try(db, "UPDATE passages SET f1_hz = 0 WHERE vehicle_id = 2"));
     /* make it a version-6 file, as amfid before the natural frequency left it */
-    raw_exec(db, "ALTER TABLE passages DROP COLUMN f1_hz; ALTER TABLE passages DROP COLUMN f1_comp_hz; "
-                 "ALTER TABLE passages DROP COLUMN f1_zeta; ALTER TABLE passages DROP COLUMN f1_r2; "
-                 "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
-                 "DELETE FROM schema_migrations WHERE version >= 7; PRAGMA user_version = 6");
-    sqlite3_close(db);
+    raw_downgrade(db, 6);
+    raw_close(db);
     assert_int_equal(AMFI_STORE_ESCHEMA, amfi_store_open_readonly(f->path, &ro, err, sizeof err));
-    assert_non_null(strstr(err, "schema version 6 is older than this program's 9"));
+    assert_non_null(strstr(err, "schema version 6 is older than this program's"));
     assert_null(ro);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
-    assert_int_equal(9, raw_int(db, "SELECT count(*) FROM schema_migrations"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "SELECT count(*) FROM schema_migrations"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE f1_hz IS NULL"));
-    sqlite3_close(db);
+    raw_close(db);
     assert_int_equal(0, amfi_store_f1_series(f->s, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err,
                                              sizeof err));
     assert_int_equal(0, n);
@@ -1325,7 +1291,7 @@ static void test_gvw_comp_and_migration_from_v7(void **state)
     amfi_passage_row r;
     double g[8];
     int n = -1;
-    sqlite3 *db;
+    raw_db *db;
 
     ok_row(&r, 1, DAY_US, 10000.0); /* memset: gvw_comp_kg 0, did not feed (NULL) */
     assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
@@ -1357,18 +1323,15 @@ static void test_gvw_comp_and_migration_from_v7(void **state)
     db = raw_open(f->path);
     assert_int_equal(2, raw_int(db, "SELECT count(*) FROM passages WHERE gvw_comp_kg IS NULL"));
     /* the schema refuses what the checks refuse */
-    assert_int_not_equal(SQLITE_OK,
-                         sqlite3_exec(db, "UPDATE passages SET gvw_comp_kg = 0 WHERE vehicle_id = 2",
-                                      NULL, NULL, NULL));
+    assert_int_not_equal(0, raw_try(db, "UPDATE passages SET gvw_comp_kg = 0 WHERE vehicle_id = 2"));
     /* make it a version-7 file, as amfid before compensated rules left it */
-    raw_exec(db, "ALTER TABLE passages DROP COLUMN gvw_comp_kg; DROP TABLE refusals; "
-                 "DELETE FROM schema_migrations WHERE version >= 8; PRAGMA user_version = 7");
-    sqlite3_close(db);
+    raw_downgrade(db, 7);
+    raw_close(db);
     assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
     db = raw_open(f->path);
-    assert_int_equal(9, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
     assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE gvw_comp_kg IS NULL"));
-    sqlite3_close(db);
+    raw_close(db);
     /* rows of before: their GVW is what the rules were fed */
     assert_int_equal(0, amfi_store_recent_ok_gvw(f->s, 8, g, &n, err, sizeof err));
     assert_int_equal(3, n);
@@ -1388,7 +1351,7 @@ static void test_alert_open_and_report_queries(void **state)
     amfi_passage_summary sum;
     double *g = NULL;
     size_t ng = 0;
-    sqlite3 *db;
+    raw_db *db;
 
     assert_int_equal(0, amfi_store_alert_open(f->s, "std_increase", &open, err, sizeof err));
     assert_int_equal(0, open);
@@ -1457,7 +1420,7 @@ static void test_alert_open_and_report_queries(void **state)
     /* a message with a control character, written by another program */
     db = raw_open(f->path);
     raw_exec(db, "UPDATE alerts SET message = 'raised' || char(9) || 'once' WHERE id = 1");
-    sqlite3_close(db);
+    raw_close(db);
     assert_int_equal(0, amfi_store_open_alerts(f->s, &open_alerts, &n, err, sizeof err));
     assert_int_equal(1, n);
     assert_string_equal("std_increase", open_alerts[0].kind);
@@ -1476,7 +1439,7 @@ static void test_alert_open_and_report_queries(void **state)
     raw_exec(db, "PRAGMA ignore_check_constraints = ON; "
                  "UPDATE passages SET gvw_kg = -1 WHERE vehicle_id = 2; "
                  "UPDATE alerts SET raised = 7 WHERE kind = 'std_increase'");
-    sqlite3_close(db);
+    raw_close(db);
     assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_all_ok_gvw(f->s, &g, &ng, err, sizeof err));
     assert_non_null(strstr(err, "passages row 2: gvw_kg is out of range for an ok passage"));
     assert_int_equal(AMFI_STORE_ECORRUPT,
@@ -1541,43 +1504,52 @@ static void squeeze(char *s)
 }
 
 /* "type name tbl_name sql" of every schema object, sorted, one per line. */
-static char *schema_dump(sqlite3 *db)
+struct dump {
+    char *out;
+    size_t len, cap;
+};
+static int dump_row(void *ctx, int n, const char *const *t)
 {
-    sqlite3_stmt *st = NULL;
-    size_t cap = 1 << 17, len = 0;
-    char *out = malloc(cap);
-    assert_non_null(out);
-    out[0] = '\0';
-    assert_int_equal(SQLITE_OK, sqlite3_prepare_v2(db,
-        "SELECT type, name, tbl_name, coalesce(sql, '') FROM sqlite_schema "
-        "ORDER BY type, name", -1, &st, NULL));
-    while (sqlite3_step(st) == SQLITE_ROW) {
-        char item[16384];
-        snprintf(item, sizeof item, "%s %s %s %s", sqlite3_column_text(st, 0),
-                 sqlite3_column_text(st, 1), sqlite3_column_text(st, 2),
-                 sqlite3_column_text(st, 3));
-        squeeze(item);
-        size_t n = strlen(item);
-        assert_true(len + n + 2 < cap);
-        memcpy(out + len, item, n);
-        len += n;
-        out[len++] = '\n';
-        out[len] = '\0';
-    }
-    sqlite3_finalize(st);
-    return out;
+    struct dump *d = ctx;
+    char item[16384];
+    assert_int_equal(4, n);
+    snprintf(item, sizeof item, "%s %s %s %s", t[0] ? t[0] : "", t[1] ? t[1] : "",
+             t[2] ? t[2] : "", t[3] ? t[3] : "");
+    squeeze(item);
+    size_t k = strlen(item);
+    assert_true(d->len + k + 2 < d->cap);
+    memcpy(d->out + d->len, item, k);
+    d->len += k;
+    d->out[d->len++] = '\n';
+    d->out[d->len] = '\0';
+    return 0;
+}
+
+/* "type name tbl_name sql" of every schema object, sorted, one per line. */
+static char *schema_dump(raw_db *db)
+{
+    char err[512];
+    struct dump d = {malloc(1 << 17), 0, 1 << 17};
+    assert_non_null(d.out);
+    d.out[0] = '\0';
+    if (amfi_store_test_rows(db,
+                             "SELECT type, name, tbl_name, coalesce(sql, '') FROM sqlite_schema "
+                             "ORDER BY type, name",
+                             dump_row, &d, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    return d.out;
 }
 
 static void test_schema_doc_matches(void **state)
 {
     fixture *f = *state;
-    char path[128], *ddl = doc_ddl(), *msg = NULL;
-    sqlite3 *doc = NULL, *db = raw_open(f->path);
+    char path[128], *ddl = doc_ddl(), msg[1024];
+    raw_db *db = raw_open(f->path);
 
     snprintf(path, sizeof path, "%s/doc.db", f->dir);
-    assert_int_equal(SQLITE_OK, sqlite3_open(path, &doc));
-    if (sqlite3_exec(doc, ddl, NULL, NULL, &msg) != SQLITE_OK)
-        fail_msg("docs/schema.md DDL: %s", msg);
+    raw_db *doc = raw_create(path);
+    if (amfi_store_test_exec(doc, ddl, msg, sizeof msg) != 0)
+        fail_msg("docs/schema.md DDL: %.300s", msg);
     char *a = schema_dump(db), *b = schema_dump(doc);
     if (strcmp(a, b) != 0) {
         /* show the first differing line */
@@ -1596,8 +1568,8 @@ static void test_schema_doc_matches(void **state)
     free(a);
     free(b);
     free(ddl);
-    sqlite3_close(doc);
-    sqlite3_close(db);
+    raw_close(doc);
+    raw_close(db);
 }
 
 /* ---- volume: 10 000 passages and the daily_trend view ---------------------- */
@@ -1611,7 +1583,7 @@ static void test_many_passages(void **state)
     static double gvw[N];
     double sum[DAYS] = {0}, mean[DAYS], ss[DAYS] = {0};
     int cnt[DAYS] = {0}, bad[DAYS] = {0};
-    sqlite3 *db;
+    raw_db *db;
     uint64_t x = 88172645463325252ULL; /* xorshift64 */
 
     double t0 = now_s();
@@ -1687,7 +1659,7 @@ static void test_many_passages(void **state)
         double sd = sqrt(ss[d] / (cnt[d] - 1));
         assert_true(fabs(raw_real(db, q) - sd) < 1e-9 * sd);
     }
-    sqlite3_close(db);
+    raw_close(db);
 }
 
 /* amfi_store_each_passage_where: 60 passages on lanes 1..3, one a minute,
@@ -1732,7 +1704,7 @@ static void test_each_passage_filtered(void **state)
         }
         assert_int_equal(0, amfi_store_add_passage(f->s, &r, &id, err, sizeof err));
     }
-    sqlite3 *db = raw_open(f->path);
+    raw_db *db = raw_open(f->path);
     const struct {
         int64_t from, to;
         const char *status;
@@ -1770,7 +1742,7 @@ static void test_each_passage_filtered(void **state)
     /* the four cases with rows are not all the table: the filter filters */
     assert_int_equal(60, raw_int(db, "SELECT count(*) FROM passages"));
     assert_int_equal(20, raw_int(db, "SELECT count(*) FROM passages WHERE lane = 2"));
-    sqlite3_close(db);
+    raw_close(db);
     /* a stop, a bad status, a bad lane, no filter */
     amfi_passage_filter all = {.from = 0, .to = AMFI_STORE_MAX_UTIME};
     each_ctx c = {.f = &all, .stop_at = 5};

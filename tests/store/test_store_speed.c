@@ -14,13 +14,13 @@
 #include <cmocka.h>
 
 #include <math.h>
-#include <sqlite3.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "store.h"
+#include "store_testing.h"
 #include "store_fixture.h"
 
 #define ERRLEN 512
@@ -146,13 +146,12 @@ static void test_bad_arguments_and_damage(void **state)
 
     add(f->s, 1, DAY_US, 1, 24.0, 25.0, 1, "ok");
     add(f->s, 2, DAY_US + 1, 1, 24.0, 25.0, 1, "ok");
-    sqlite3 *db = NULL;
-    assert_int_equal(SQLITE_OK, sqlite3_open(f->path, &db));
-    assert_int_equal(SQLITE_OK,
-                     sqlite3_exec(db, "PRAGMA ignore_check_constraints = ON; "
-                                      "UPDATE passages SET speed_given_mps = 500 WHERE id = 2",
-                                  NULL, NULL, NULL));
-    sqlite3_close(db);
+    amfi_store_test_db *db = amfi_store_test_open(f->path, 0, err, sizeof err);
+    assert_non_null(db);
+    assert_int_equal(0, amfi_store_test_exec(db, "PRAGMA ignore_check_constraints = ON; "
+                                                 "UPDATE passages SET speed_given_mps = 500 WHERE id = 2",
+                                             err, sizeof err));
+    amfi_store_test_close(db);
     amfi_passage_filter all = {.from = 0, .to = AMFI_STORE_MAX_UTIME};
     p = NULL;
     assert_int_equal(AMFI_STORE_ECORRUPT, amfi_store_speed_pairs(f->s, &all, &p, &n, err, sizeof err));

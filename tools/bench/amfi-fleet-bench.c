@@ -21,7 +21,6 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 #include <libpq-fe.h>
-#include <sqlite3.h>
 
 #include "amfi_cli.h"
 #include "store.h"
@@ -42,65 +41,45 @@ static void site_paths(int k, char *id, size_t idlen, char *path, size_t plen)
     snprintf(path, plen, "%s/%s.db", opt.dir, id);
 }
 
-static int sq(sqlite3 *db, const char *sql, const char *path)
-{
-    char *emsg = NULL;
-    if (sqlite3_exec(db, sql, NULL, NULL, &emsg) != SQLITE_OK) {
-        fprintf(stderr, "amfi-fleet-bench: %s: %s: %s\n", path, sql, emsg ? emsg : "?");
-        sqlite3_free(emsg);
-        return -1;
-    }
-    return 0;
-}
+/* Column values for the store's inserter (store.h, rows as column values). */
+static amfi_store_value vi(int64_t x) { return (amfi_store_value){.type = AMFI_SQL_INTEGER, .i = x}; }
+static amfi_store_value vr(double x) { return (amfi_store_value){.type = AMFI_SQL_REAL, .r = x}; }
+static amfi_store_value vt(const char *t) { return (amfi_store_value){.type = AMFI_SQL_TEXT, .text = t}; }
+static const amfi_store_value vnull = {0};
 
 /* One site's store: the schema from amfi_store_open (so it is the real one,
- * with the site id in meta as amfid writes it), the rows by plain SQLite in
- * large transactions (amfid's one transaction per passage would take the
- * bench hours). GVW: a loaded/empty mixture of two-axle vehicles; 2 % of the
- * passages 'multiple' (no weight). */
+ * with the site id in meta as amfid writes it), the rows by the store's
+ * inserts by column value in large transactions (amfid's one transaction
+ * per passage would take the bench hours). GVW: a loaded/empty mixture of
+ * two-axle vehicles; 2 % of the passages 'multiple' (no weight). */
 static int make_store(int k)
 {
+    static const char *const pcols[] = {"id", "vehicle_id", "utime", "lane", "speed_mps",
+                                        "n_axles", "gvw_kg", "status", "reason", "lambda",
+                                        "residual_rms", "formulation", "solve_ms"};
+    static const char *const acols[] = {"passage_id", "idx", "spacing_m", "load_kg"};
+    static const char *const icols[] = {"id", "utime", "n", "mean_kg", "std_kg",
+                                        "baseline_mean_kg", "baseline_std_kg", "std_ratio",
+                                        "p_value", "state"};
+    static const char *const lcols[] = {"utime", "level", "kind", "message", "indicator_id",
+                                        "raised"};
     char id[32], path[4096], err[512];
     site_paths(k, id, sizeof id, path, sizeof path);
     unlink(path);
     amfi_store *s = NULL;
-    if (amfi_store_open(path, 0, &s, err, sizeof err) != 0 ||
-        amfi_store_meta_set(s, "site.id", id, err, sizeof err) != 0) {
-        fprintf(stderr, "amfi-fleet-bench: %s\n", err);
-        amfi_store_close(s);
-        return -1;
-    }
-    amfi_store_close(s);
-    sqlite3 *db = NULL;
-    sqlite3_stmt *ps = NULL, *ax = NULL, *ind = NULL, *al = NULL;
+    amfi_store_inserter *ps = NULL, *ax = NULL, *ind = NULL, *al = NULL;
+    gsl_rng *r = NULL;
     int rc = -1;
-    if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READWRITE, NULL) != SQLITE_OK) {
-        fprintf(stderr, "amfi-fleet-bench: %s: %s\n", path, sqlite3_errmsg(db));
-        sqlite3_close(db);
-        return -1;
-    }
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+    if (amfi_store_open(path, 0, &s, err, sizeof err) != 0
+        || amfi_store_meta_set(s, "site.id", id, err, sizeof err) != 0
+        || amfi_store_inserter_open(s, "passages", pcols, 13, &ps, err, sizeof err) != 0
+        || amfi_store_inserter_open(s, "axles", acols, 4, &ax, err, sizeof err) != 0
+        || amfi_store_inserter_open(s, "indicators", icols, 10, &ind, err, sizeof err) != 0
+        || amfi_store_inserter_open(s, "alerts", lcols, 6, &al, err, sizeof err) != 0
+        || amfi_store_transaction(s, AMFI_STORE_TX_WRITE, err, sizeof err) != 0)
+        goto fail;
+    r = gsl_rng_alloc(gsl_rng_mt19937);
     gsl_rng_set(r, opt.seed * 1000003UL + (unsigned long)k);
-    if (sq(db, "PRAGMA synchronous = OFF", path) || sq(db, "BEGIN", path))
-        goto out;
-    if (sqlite3_prepare_v2(db,
-                           "INSERT INTO passages (id, vehicle_id, utime, lane, speed_mps, n_axles,"
-                           " gvw_kg, status, reason, lambda, residual_rms, formulation, solve_ms)"
-                           " VALUES (?1, ?2, ?3, ?4, ?5, 2, ?6, ?7, ?8, ?9, ?10, 'acceleration', ?11)",
-                           -1, &ps, NULL) != SQLITE_OK ||
-        sqlite3_prepare_v2(db, "INSERT INTO axles (passage_id, idx, spacing_m, load_kg)"
-                               " VALUES (?1, ?2, ?3, ?4)", -1, &ax, NULL) != SQLITE_OK ||
-        sqlite3_prepare_v2(db,
-                           "INSERT INTO indicators (utime, n, mean_kg, std_kg, baseline_mean_kg,"
-                           " baseline_std_kg, std_ratio, p_value, state)"
-                           " VALUES (?1, ?2, ?3, ?4, 21000, 9000, ?5, 0.5, ?6)",
-                           -1, &ind, NULL) != SQLITE_OK ||
-        sqlite3_prepare_v2(db, "INSERT INTO alerts (utime, level, kind, message, indicator_id, raised)"
-                               " VALUES (?1, 'warning', 'std_increase', 'bench alert', ?2, ?3)",
-                           -1, &al, NULL) != SQLITE_OK) {
-        fprintf(stderr, "amfi-fleet-bench: %s: %s\n", path, sqlite3_errmsg(db));
-        goto out;
-    }
     int64_t pid = 0;
     int nwin = 0, nind = 0;
     double sum = 0, sum2 = 0;
@@ -117,36 +96,24 @@ static int make_store(int k)
             double front = gvw * (0.35 + 0.05 * gsl_rng_uniform(r));
             double sp = 3.5 + 2.5 * gsl_rng_uniform(r);
             pid++;
-            sqlite3_reset(ps);
-            sqlite3_bind_int64(ps, 1, pid);
-            sqlite3_bind_int64(ps, 2, pid);
-            sqlite3_bind_int64(ps, 3, ut);
-            sqlite3_bind_int(ps, 4, 1 + (int)(pid % 2));
-            sqlite3_bind_double(ps, 5, 25 + gsl_ran_gaussian(r, 2));
-            if (multiple) {
-                sqlite3_bind_null(ps, 6);
-                sqlite3_bind_text(ps, 7, "multiple", -1, SQLITE_STATIC);
-                sqlite3_bind_text(ps, 8, "another vehicle on the span", -1, SQLITE_STATIC);
-                sqlite3_bind_null(ps, 9);
-                sqlite3_bind_null(ps, 10);
-                sqlite3_bind_null(ps, 11);
-            } else {
-                sqlite3_bind_double(ps, 6, gvw);
-                sqlite3_bind_text(ps, 7, "ok", -1, SQLITE_STATIC);
-                sqlite3_bind_text(ps, 8, "", -1, SQLITE_STATIC);
-                sqlite3_bind_double(ps, 9, 1e-3);
-                sqlite3_bind_double(ps, 10, 0.01 + 0.002 * gsl_rng_uniform(r));
-                sqlite3_bind_double(ps, 11, 5 + gsl_rng_uniform(r));
+            double speed = 25 + gsl_ran_gaussian(r, 2);
+            amfi_store_value pv[13] = {vi(pid), vi(pid), vi(ut), vi(1 + (int)(pid % 2)), vr(speed),
+                                       vi(2), vnull, vt("multiple"),
+                                       vt("another vehicle on the span"), vnull, vnull,
+                                       vt("acceleration"), vnull};
+            if (!multiple) {
+                pv[6] = vr(gvw);
+                pv[7] = vt("ok");
+                pv[8] = vt("");
+                pv[9] = vr(1e-3);
+                pv[10] = vr(0.01 + 0.002 * gsl_rng_uniform(r));
+                pv[12] = vr(5 + gsl_rng_uniform(r));
             }
-            if (sqlite3_step(ps) != SQLITE_DONE) goto sqlerr;
+            if (amfi_store_insert_values(ps, pv, err, sizeof err) != 0) goto fail;
             for (int a = 1; a <= 2; a++) {
-                sqlite3_reset(ax);
-                sqlite3_bind_int64(ax, 1, pid);
-                sqlite3_bind_int(ax, 2, a);
-                if (a == 1) sqlite3_bind_null(ax, 3); else sqlite3_bind_double(ax, 3, sp);
-                if (multiple) sqlite3_bind_null(ax, 4);
-                else sqlite3_bind_double(ax, 4, a == 1 ? front : gvw - front);
-                if (sqlite3_step(ax) != SQLITE_DONE) goto sqlerr;
+                amfi_store_value av[4] = {vi(pid), vi(a), a == 1 ? vnull : vr(sp),
+                                          multiple ? vnull : vr(a == 1 ? front : gvw - front)};
+                if (amfi_store_insert_values(ax, av, err, sizeof err) != 0) goto fail;
             }
             if (!multiple) {
                 sum += gvw;
@@ -154,49 +121,45 @@ static int make_store(int k)
                 if (++nwin == WINDOW) {
                     double mean = sum / nwin, sd = sqrt((sum2 - nwin * mean * mean) / (nwin - 1));
                     nind++;
-                    sqlite3_reset(ind);
-                    sqlite3_bind_int64(ind, 1, ut);
-                    sqlite3_bind_int(ind, 2, nwin);
-                    sqlite3_bind_double(ind, 3, mean);
-                    sqlite3_bind_double(ind, 4, sd);
-                    sqlite3_bind_double(ind, 5, sd / 9000);
-                    sqlite3_bind_text(ind, 6, nind <= 4 ? "baseline" : "normal", -1, SQLITE_STATIC);
-                    if (sqlite3_step(ind) != SQLITE_DONE) goto sqlerr;
+                    amfi_store_value iv[10] = {vi(nind), vi(ut), vi(nwin), vr(mean), vr(sd),
+                                               vr(21000), vr(9000), vr(sd / 9000), vr(0.5),
+                                               vt(nind <= 4 ? "baseline" : "normal")};
+                    if (amfi_store_insert_values(ind, iv, err, sizeof err) != 0) goto fail;
                     /* a raised and cleared alert about every 200 windows */
                     if (nind % 200 == 100 || nind % 200 == 101) {
-                        sqlite3_reset(al);
-                        sqlite3_bind_int64(al, 1, ut);
-                        sqlite3_bind_int64(al, 2, sqlite3_last_insert_rowid(db));
-                        sqlite3_bind_int(al, 3, nind % 200 == 100);
-                        if (sqlite3_step(al) != SQLITE_DONE) goto sqlerr;
+                        amfi_store_value lv[6] = {vi(ut), vt("warning"), vt("std_increase"),
+                                                  vt("bench alert"), vi(nind),
+                                                  vi(nind % 200 == 100)};
+                        if (amfi_store_insert_values(al, lv, err, sizeof err) != 0) goto fail;
                     }
                     nwin = 0;
                     sum = sum2 = 0;
                 }
             }
-            if (pid % 100000 == 0 && (sq(db, "COMMIT", path) || sq(db, "BEGIN", path)))
-                goto out;
+            if (pid % 100000 == 0
+                && (amfi_store_transaction(s, AMFI_STORE_TX_COMMIT, err, sizeof err) != 0
+                    || amfi_store_transaction(s, AMFI_STORE_TX_WRITE, err, sizeof err) != 0))
+                goto fail;
         }
     }
     /* every tenth site ends with an alert still raised */
     if (k % 10 == 0) {
-        sqlite3_reset(al);
-        sqlite3_bind_int64(al, 1, (int64_t)(opt.start_s + 86400LL * opt.days) * 1000000 - 1);
-        sqlite3_bind_null(al, 2);
-        sqlite3_bind_int(al, 3, 1);
-        if (sqlite3_step(al) != SQLITE_DONE) goto sqlerr;
+        amfi_store_value lv[6] = {vi((int64_t)(opt.start_s + 86400LL * opt.days) * 1000000 - 1),
+                                  vt("warning"), vt("std_increase"), vt("bench alert"), vnull,
+                                  vi(1)};
+        if (amfi_store_insert_values(al, lv, err, sizeof err) != 0) goto fail;
     }
-    if (sq(db, "COMMIT", path) == 0)
-        rc = 0;
+    if (amfi_store_transaction(s, AMFI_STORE_TX_COMMIT, err, sizeof err) != 0) goto fail;
+    rc = 0;
     goto out;
-sqlerr:
-    fprintf(stderr, "amfi-fleet-bench: %s: %s\n", path, sqlite3_errmsg(db));
+fail:
+    fprintf(stderr, "amfi-fleet-bench: %s: %s\n", path, err);
 out:
-    sqlite3_finalize(ps);
-    sqlite3_finalize(ax);
-    sqlite3_finalize(ind);
-    sqlite3_finalize(al);
-    sqlite3_close(db);
+    amfi_store_inserter_close(ps);
+    amfi_store_inserter_close(ax);
+    amfi_store_inserter_close(ind);
+    amfi_store_inserter_close(al);
+    amfi_store_close(s);
     gsl_rng_free(r);
     return rc;
 }

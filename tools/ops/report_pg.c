@@ -2,8 +2,8 @@
 /* report_pg.c: amfi-report --pg, the report from the central PostgreSQL
  * (docs/fleet.md). Without --site: the fleet summary, one line per site.
  * With --site: the site's central rows are fetched (COPY ... TO STDOUT, the
- * columns of fleet_tables) into a new private SQLite store with the site
- * store's own schema, which amfi-report then reads like any site's store:
+ * columns fleet_columns ships) into a new private SQLite store with the site
+ * store's own schema, written through the store's inserts by column value, which amfi-report then reads like any site's store:
  * one report, plot and export code for both sources, and every central row
  * checked by the store's constraints on the way in (a row that breaks one is
  * named by table and id). Single-threaded. */
@@ -11,7 +11,6 @@
 
 #include <errno.h>
 #include <libpq-fe.h>
-#include <sqlite3.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -205,19 +204,20 @@ static char *copy_field(char *f)
     return f;
 }
 
-/* Copies `table` (columns `cols`) of one site from the central database into
- * the store db: COPY out, one INSERT per row; *n gets the rows. */
-static int fetch_table(PGconn *pg, sqlite3 *db, const char *site_lit, const char *table,
-                       const char *cols, const char *order, long *n, char *err, size_t errlen)
+/* Copies `table` (the columns fleet_columns ships) of one site from the
+ * central database into the store s: COPY out, one insert per row (every
+ * value as text: the STRICT table converts it as from SQL, its constraints
+ * judge it); *n gets the rows. */
+static int fetch_table(PGconn *pg, amfi_store *s, const char *site_lit, const char *table,
+                       const char *order, long *n, char *err, size_t errlen)
 {
-    int ncols = 1;
-    for (const char *c = cols; *c; c++) ncols += *c == ',';
-    char sql[1024], ins[1024], marks[256] = "";
-    for (int i = 0; i < ncols; i++) strcat(marks, i ? ", ?" : "?");
-    snprintf(ins, sizeof ins, "INSERT INTO %s (%s) VALUES (%s)", table, cols, marks);
-    sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(db, ins, -1, &st, NULL) != SQLITE_OK)
-        return fail(err, errlen, 1, "%s: %s", table, sqlite3_errmsg(db));
+    const char *names[64];
+    char cols[1024], sql[2048], why[512];
+    int ncols = fleet_columns(table, NULL, names, 64);
+    fleet_cols_text(table, cols, sizeof cols);
+    amfi_store_inserter *ins = NULL;
+    if (amfi_store_inserter_open(s, table, names, ncols, &ins, why, sizeof why) != 0)
+        return fail(err, errlen, 1, "%s", why);
     snprintf(sql, sizeof sql, "COPY (SELECT %s FROM %s WHERE site_id = %s ORDER BY %s) TO STDOUT",
              cols, table, site_lit, order);
     PGresult *r = PQexec(pg, sql);
@@ -227,6 +227,7 @@ static int fetch_table(PGconn *pg, sqlite3 *db, const char *site_lit, const char
     PQclear(r);
     char *row = NULL;
     int len;
+    amfi_store_value v[64];
     while (rc == 0 && (len = PQgetCopyData(pg, &row, 0)) > 0) {
         if (row[len - 1] == '\n') row[len - 1] = 0;
         char *id = NULL;
@@ -234,22 +235,20 @@ static int fetch_table(PGconn *pg, sqlite3 *db, const char *site_lit, const char
         for (char *f = row; f && k < ncols; k++) {
             char *tab = strchr(f, '\t');
             if (tab) *tab = 0;
-            char *v = copy_field(f);
-            if (k == 0) id = v;
-            if (v) sqlite3_bind_text(st, k + 1, v, -1, SQLITE_STATIC);
+            char *val = copy_field(f);
+            if (k == 0) id = val;
+            v[k] = (amfi_store_value){.type = val ? AMFI_SQL_TEXT : 0, .text = val,
+                                      .len = val ? (int)strlen(val) : 0};
             f = tab ? tab + 1 : NULL;
         }
         if (k != ncols)
             rc = fail(err, errlen, 1, "central %s: a row with %d of %d columns", table, k, ncols);
-        else if (sqlite3_step(st) != SQLITE_DONE)
+        else if (amfi_store_insert_values(ins, v, why, sizeof why) != 0)
             rc = fail(err, errlen, 1, "central %s row (site %s, %s %s) refused by the store schema: %s",
                       table, site_lit, strcmp(table, "axles") ? "id" : "passage_id",
-                      id ? id : "NULL", sqlite3_errmsg(db));
+                      id ? id : "NULL", why);
         else
             (*n)++;
-        /* the fields are bound SQLITE_STATIC: unbind before the row goes */
-        sqlite3_reset(st);
-        sqlite3_clear_bindings(st);
         PQfreemem(row);
         row = NULL;
     }
@@ -262,7 +261,7 @@ static int fetch_table(PGconn *pg, sqlite3 *db, const char *site_lit, const char
             rc = fail(err, errlen, 1, "central %s: %s", table, PQerrorMessage(pg));
         PQclear(r);
     }
-    sqlite3_finalize(st);
+    amfi_store_inserter_close(ins);
     return rc;
 }
 
@@ -288,20 +287,17 @@ int report_pg_fetch_site(const char *conninfo, int allow_plaintext, const char *
     if (rc) { PQfinish(pg); return rc; }
 
     amfi_store *s = NULL;
-    if (amfi_store_open(path, 0, &s, err, errlen) != 0
-        || amfi_store_meta_set(s, "site.id", site, err, errlen) != 0) {
-        amfi_store_close(s);
-        PQfinish(pg);
-        return 1;
-    }
-    amfi_store_close(s);
-    sqlite3 *db = NULL;
     char *lit = PQescapeLiteral(pg, site, strlen(site));
-    if (!lit || sqlite3_open_v2(path, &db, SQLITE_OPEN_READWRITE, NULL) != SQLITE_OK) {
-        rc = fail(err, errlen, 1, "%s: %s", path, lit ? sqlite3_errmsg(db) : PQerrorMessage(pg));
+    if (!lit) {
+        rc = fail(err, errlen, 1, "%s: %s", path, PQerrorMessage(pg));
         goto out;
     }
-    sqlite3_exec(db, "PRAGMA synchronous = OFF; BEGIN", NULL, NULL, NULL);
+    if (amfi_store_open(path, 0, &s, err, errlen) != 0
+        || amfi_store_meta_set(s, "site.id", site, err, errlen) != 0
+        || amfi_store_transaction(s, AMFI_STORE_TX_WRITE, err, errlen) != 0) {
+        rc = 1;
+        goto out;
+    }
     /* one snapshot of the central tables for the whole fetch */
     r = PQexec(pg, "BEGIN ISOLATION LEVEL REPEATABLE READ READ ONLY");
     if (PQresultStatus(r) != PGRES_COMMAND_OK)
@@ -310,18 +306,20 @@ int report_pg_fetch_site(const char *conninfo, int allow_plaintext, const char *
     *rows = 0;
     for (int i = 0; rc == 0 && i < fleet_n_tables; i++) {
         const struct fleet_table *t = &fleet_tables[i];
-        rc = fetch_table(pg, db, lit, t->name, t->cols, "id", rows, err, errlen);
+        rc = fetch_table(pg, s, lit, t->name, "id", rows, err, errlen);
         if (rc == 0 && t->child) {
             char order[128];
             snprintf(order, sizeof order, "%s, idx", t->child_parent);
-            rc = fetch_table(pg, db, lit, t->child, t->child_cols, order, rows, err, errlen);
+            rc = fetch_table(pg, s, lit, t->child, order, rows, err, errlen);
         }
     }
-    if (rc == 0 && sqlite3_exec(db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK)
-        rc = fail(err, errlen, 1, "%s: %s", path, sqlite3_errmsg(db));
+    if (rc == 0 && amfi_store_transaction(s, AMFI_STORE_TX_COMMIT, err, errlen) != 0)
+        rc = 1;
+    if (rc != 0 && s)
+        amfi_store_transaction(s, AMFI_STORE_TX_ROLLBACK, NULL, 0);
 out:
     PQfreemem(lit);
-    sqlite3_close(db);
+    amfi_store_close(s);
     PQfinish(pg);
     return rc;
 }
