@@ -178,12 +178,15 @@ write_config
 "$sim" --config "$dir/amfid.yaml" --lcm-url none --log "$dir/sim.log" --vehicles 40 --headway 4 --speedup max --seed 5 \
   --damage 0.5 --damage-step-at 27 2> "$dir/sim.err" || fail "sim_publisher: $(tail -2 "$dir/sim.err")"
 t0=$("$tool" t0 "$dir/sim.log") || fail "lcm_reload t0"
+# seconds (data time after t0) and µs, in awk's doubles (exact below 2^53)
+fcalc() { awk "BEGIN { printf \"%.6f\", $1 }"; }
+icalc() { awk "BEGIN { printf \"%.0f\", $1 }"; }
 n=0 # logs written, each by its own producer (a signer's sequence is its own)
 play() { lcm-logplayer -s 20 "$1" >> "$dir/player.log" 2>&1 || fail "lcm-logplayer $1"; }
 cur=0 # seconds after t0 up to which data time was sent
 # traffic_to B: the simulator's stream up to vehicle B's window end (4 B + 5.5 s)
 traffic_to() {
-  n=$((n + 1)); end=$(echo "4 * $1 + 5.5" | bc)
+  n=$((n + 1)); end=$(fcalc "4 * $1 + 5.5")
   [ "$1" -lt 40 ] || end=166.1
   "$tool" segment "$dir/sim.log" "$dir/m$n.log" "reload.$n" "$cur" "$end" 0 0 || fail "segment"
   play "$dir/m$n.log"; cur=$end
@@ -194,14 +197,14 @@ traffic_to() {
 # (from 1.58 s before it enters) again at the current data time, its id +
 # ID_ADD; sensor 1 silent over the hole
 replay() {
-  n=$((n + 1)); from=$((4 * $1)); shift_s=$(echo "$cur - $from" | bc)
-  hole=""; [ $# -ge 4 ] && hole="$(echo "$from + 1.58 + $3" | bc) $4"
-  "$tool" segment "$dir/sim.log" "$dir/m$n.log" "reload.$n" $from "$(echo "$from + 5.5" | bc)" \
+  n=$((n + 1)); from=$((4 * $1)); shift_s=$(fcalc "$cur - $from")
+  hole=""; [ $# -ge 4 ] && hole="$(fcalc "$from + 1.58 + $3") $4"
+  "$tool" segment "$dir/sim.log" "$dir/m$n.log" "reload.$n" $from "$(fcalc "$from + 5.5")" \
     "$shift_s" "$2" $hole || fail "segment"
-  play "$dir/m$n.log"; cur=$(echo "$cur + 5.5" | bc)
+  play "$dir/m$n.log"; cur=$(fcalc "$cur + 5.5")
 }
-now_us() { echo "$t0 + $cur * 1000000" | bc | sed 's/\..*//'; }
-seq_now() { echo "$cur * 10" | bc | sed 's/\..*//'; } # 100-sample blocks at 1000 Hz
+now_us() { icalc "$t0 + $cur * 1000000"; }
+seq_now() { icalc "$cur * 10"; } # 100-sample blocks at 1000 Hz
 # (advance and the accel probe: sensor 0 only)
 probe() { # MODE ARGS...: one of lcm_reload's messages, played
   n=$((n + 1)); _m=$1; shift
@@ -209,8 +212,8 @@ probe() { # MODE ARGS...: one of lcm_reload's messages, played
   play "$dir/m$n.log"
 }
 # advance S: S seconds of (quiet) accel data of sensor 0 at the current data time
-advance() { probe accel "$(now_us)" "$(seq_now)" "$(echo "$1 * 10" | bc | sed 's/\..*//')" 1000
-  cur=$(echo "$cur + $1" | bc); }
+advance() { probe accel "$(now_us)" "$(seq_now)" "$(icalc "$1 * 10")" 1000
+  cur=$(fcalc "$cur + $1"); }
 on_channel() { # CHANNEL [AFTER_US]: messages recorded on CHANNEL (after AFTER_US)
   "$tool" list "$dir/out.log" 2>/dev/null | awk -v c="$1" -v t="${2:-0}" '$2 == c && $1 > t' | wc -l
 }
@@ -283,7 +286,7 @@ for key in $ORDER; do
     wait_for "a refusal summary within the new period" nonzero "SELECT count(*) FROM refusals" ;;
   daemon.intake.vehicle_ahead_s)
     reload $key 10
-    probe vehicles "$(echo "$(now_us) + 50000000" | bc)" 510000 1 20 4 sim_publisher 0
+    probe vehicles "$(($(now_us) + 50000000))" 510000 1 20 4 sim_publisher 0
     wait_for "vehicle 50 s ahead refused at 10 s" nonzero \
       "SELECT count(*) FROM passages WHERE vehicle_id = 510000 AND status = 'invalid' AND reason LIKE '%daemon.intake.vehicle_ahead_s 10 s%'" ;;
   daemon.intake.min_speed_mps)
@@ -316,28 +319,28 @@ for key in $ORDER; do
     # a burst of 1 s: at a margin of 4, 8000 samples at once; of 1, 2000. 3000
     # sent, dated 10 s back (the allowance also refills with the data time)
     reload $key 1
-    probe accel "$(echo "$(now_us) - 10000000" | bc)" "$(($(seq_now) - 100))" 30 1000
+    probe accel "$(($(now_us) - 10000000))" "$(($(seq_now) - 100))" 30 1000
     wait_for "accel refused at a margin of 1" refused accel "daemon.intake.accel_margin 1 "
     reload $key 4 ;; # the data time advances below
   daemon.intake.environment_min_interval_s)
     u=$(now_us)
-    probe env "$(echo "$u - 40000000" | bc)" 10.0 2 10000000 # 10.0 °C, 10 s apart: both kept
+    probe env "$(($u - 40000000))" 10.0 2 10000000 # 10.0 °C, 10 s apart: both kept
     wait_for "two readings 10 s apart stored" nonzero \
       "SELECT count(*) = 2 FROM environment WHERE deck_c = 10.0"
     reload $key 100
-    probe env "$(echo "$u - 20000000" | bc)" 10.2 2 10000000 # within 100 s of the last kept
-    probe env "$(echo "$u + 75000000" | bc)" 10.4 1 0        # 105 s after it: kept
+    probe env "$(($u - 20000000))" 10.2 2 10000000 # within 100 s of the last kept
+    probe env "$(($u + 75000000))" 10.4 1 0        # 105 s after it: kept
     wait_for "a reading 105 s after the last kept" nonzero \
       "SELECT count(*) FROM environment WHERE deck_c = 10.4"
     [ "$(q "SELECT count(*) FROM environment WHERE deck_c = 10.2")" -eq 0 ] ||
       fail "readings within 100 s of the last kept one were stored" ;;
   daemon.intake.deck_max_rate_c_per_min)
     reload $key 0.5
-    probe env "$(echo "$(now_us) + 76000000" | bc)" 11.9 1 0 # 1.5 °C in a minute
+    probe env "$(($(now_us) + 76000000))" 11.9 1 0 # 1.5 °C in a minute
     wait_for "a 1.5 °C step refused at 0.5 °C/min" refused environment "deck_max_rate_c_per_min 0.5 " ;;
   daemon.environment_max_skew_s)
     reload $key 60
-    probe env "$(echo "$(now_us) - 200000000" | bc)" 10.4 1 0
+    probe env "$(($(now_us) - 200000000))" 10.4 1 0
     wait_for "a reading 200 s old refused at 60 s" refused environment "daemon.environment_max_skew_s 60 s)" ;;
   daemon.intake.environment_per_s)
     reload $key 0.1
