@@ -14,13 +14,19 @@
  *   model_check.c                the bridge built, the solver's workspace bounded
  *
  * and holds the defaults, the order of the checks that run once the whole
- * file is read, and the list of keys for the manual (amfi_config_keys.h).
+ * file is read, the list of keys for the manual (amfi_config_keys.h), and
+ * what a reload compares and applies (amfi_config_diff,
+ * amfi_config_apply_live): both walk the same tables, each row's kind
+ * saying where its value lives (spans) and its F_LIVE flag whether SIGHUP
+ * applies it.
  *
  * Adding a section: its fields in amfi_site_config with their defaults in
  * amfi_config_defaults(), a section_*.c with its table and checks, one row
  * in amfi_cfg_top_fields[] and its check in check_site(); the key, its range and its
  * default then appear in amfi_config_keys(), which the config_man test
- * holds against man/amfid.yaml.5.scd.
+ * holds against man/amfid.yaml.5.scd. A key SIGHUP applies at once gets
+ * F_LIVE in its row (and the daemon must then read it live:
+ * tests/daemon/daemon_reload_keys.sh has a case for every live key).
  *
  * Workload: a few kB, once at start-up or reload; nothing here is fast-path.
  * No global state: distinct threads may load distinct files at once.

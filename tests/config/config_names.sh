@@ -15,8 +15,11 @@ NM=${NM:-nm}
 
 syms=$("$NM" -g --defined-only "$lib" 2>&1) ||
     { echo "config_names.sh: $NM $lib failed: $syms" >&2; exit 1; }
-# "member.o:" headers and blank lines aside, each line is "VALUE TYPE NAME"
-all=$(printf '%s\n' "$syms" | awk 'NF == 3 { print $3 }' | sort -u)
+# "member.o:" headers and blank lines aside, each line is "VALUE TYPE NAME".
+# AddressSanitizer adds "__odr_asan.NAME" beside each global NAME: NAME is
+# checked; other reserved "__" names are the compiler's, not the library's.
+all=$(printf '%s\n' "$syms" | awk 'NF == 3 { n = $3; sub(/^__odr_asan\./, "", n); print n }' |
+    grep -v '^__' | sort -u)
 n=$(printf '%s\n' "$all" | grep -c .)
 [ "$n" -gt 0 ] || { echo "config_names.sh: no defined symbols in $lib" >&2; exit 1; }
 bad=$(printf '%s\n' "$all" | grep -Ev '^amfi_(cfg|config)_')
