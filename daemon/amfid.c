@@ -43,28 +43,6 @@
 
 #include "amfid.h"
 
-FILE *amfid_log_stream;
-
-void amfid_log(const char *prefix, const char *fmt, ...)
-{
-    FILE *f = amfid_log_stream ? amfid_log_stream : stderr;
-    va_list ap;
-    va_start(ap, fmt);
-    fputs(prefix, f);
-    vfprintf(f, fmt, ap);
-    fputc('\n', f);
-    va_end(ap);
-}
-
-void set_error(daemon_s *d, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(d->last_error, sizeof d->last_error, fmt, ap);
-    va_end(ap);
-    LOG_WARN("%s", d->last_error);
-}
-
 static volatile sig_atomic_t stop_flag, reload_flag;
 static void on_stop(int sig)
 {

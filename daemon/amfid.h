@@ -44,15 +44,8 @@
 #define AMFID_DEFAULT_CONFIG "/etc/amfid/amfid.yaml"
 #endif
 
-/* ---- logging (stderr, journald reads the <N> prefixes) ----------------- */
-
-void amfid_log(const char *prefix, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-/* Where amfid_log writes: NULL (the default) is stderr; the fuzz target
- * points it at /dev/null so that only sanitizer reports reach stderr. */
-extern FILE *amfid_log_stream;
-#define LOG_INFO(...) amfid_log(SD_INFO "amfid: ", __VA_ARGS__)
-#define LOG_WARN(...) amfid_log(SD_WARNING "amfid: ", __VA_ARGS__)
-#define LOG_ERR(...) amfid_log(SD_ERR "amfid: ", __VA_ARGS__)
+/* ---- logging (log.h: stderr, journald reads the <N> prefixes) ---------- */
+#include "log.h"
 
 /* ---- command line (options.c) ------------------------------------------- */
 
@@ -253,7 +246,8 @@ typedef struct daemon_s {
     double intake_recorded;        /* amfi_mono_s() of the last record_intake */
 } daemon_s;
 
-void set_error(daemon_s *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* The error service (log.c): last_error and the log. */
+#define set_error(d, ...) amfid_error((d)->last_error, sizeof (d)->last_error, __VA_ARGS__)
 
 /* ---- life cycle (amfid.c), main thread ----------------------------------- */
 

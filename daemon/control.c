@@ -219,6 +219,7 @@ void reload(daemon_s *d)
     memcpy(d->cfg.daemon.ch_status, n.daemon.ch_status, sizeof n.daemon.ch_status);
     d->cfg.daemon.status_period_s = n.daemon.status_period_s;
     d->cfg.daemon.max_wait_s = n.daemon.max_wait_s;
+    amfi_tracker_set_max_wait(d->tracker, n.daemon.max_wait_s); /* its own copy */
     d->cfg.daemon.environment_max_skew_s = n.daemon.environment_max_skew_s;
     /* the intake's bounds (daemon.intake.*): now, the buckets kept (a
      * lower limit cuts what is left of the allowance) */
