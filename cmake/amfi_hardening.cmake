@@ -4,7 +4,7 @@
 # a sanitizer tree: _FORTIFY_SOURCE=2, the strong stack protector, stack clash
 # protection, control-flow protection (x86), position-independent executables
 # and full RELRO (-z relro -z now). scripts/package.sh adds the distribution's
-# own flags (dpkg-buildflags) on top; tests/deb.sh checks the packaged
+# own flags (dpkg-buildflags) on top; tests/package/deb.sh checks the packaged
 # programs with hardening-check (devscripts).
 #
 # Not in the ASan/UBSan, TSan or libFuzzer trees: _FORTIFY_SOURCE replaces

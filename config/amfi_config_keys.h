@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * amfi_config_keys.h: every key a site file may hold, as the loader itself
- * reads it, for the manual amfid.yaml(5) and its test (tests/test_config_man.c
+ * reads it, for the manual amfid.yaml(5) and its test (tests/config/test_config_man.c
  * holds each key's type, range and default against man/amfid.yaml.5.scd, so
  * the page cannot drift from the loader).
  *

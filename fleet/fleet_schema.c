@@ -211,7 +211,7 @@ static const char fleet_v6[] =
 /* A later version that adds a site table enables row-level security on it
  * with the two policies of version 6 (fleet_site, fleet_reader), grants
  * amfi_site SELECT, INSERT and amfi_reader SELECT on it, and revokes a new
- * view from PUBLIC and grants it to amfi_reader only (tests/fleet_security.sh
+ * view from PUBLIC and grants it to amfi_reader only (tests/fleet/fleet_security.sh
  * fails on a table with a site_id and no policy). */
 const struct fleet_migration fleet_migrations[] = {
     {1, "site tables with site_id, fleet_sync_state, fleet views", fleet_v1},

@@ -8,7 +8,7 @@
 # Deterministic: the same sources give the same files (the intake seeds,
 # simulator output, the same to the last bits on one CPU and BLAS kernel,
 # to about 1e-9 relative on another), so the fuzz_corpus test
-# (tests/fuzz_corpus.sh) can tell a committed corpus that a changed .lcm or
+# (tests/fuzz/fuzz_corpus.sh) can tell a committed corpus that a changed .lcm or
 # config/*.yaml left stale (a message seed with the old fingerprint seeds
 # nothing).
 set -eu

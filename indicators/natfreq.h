@@ -4,7 +4,7 @@
  * from a segment of free vibration (issue 14, item 4): the acceleration
  * one sensor records after the last axle has left the span.
  *
- * Method (measured in tests/test_natfreq.c, docs/indicators.md section 9):
+ * Method (measured in tests/indicators/test_natfreq.c, docs/indicators.md section 9):
  *   1. the mean is removed; a Hann-windowed periodogram, zero-padded to at
  *      least 8 times the segment, gives the strongest peak in [f_lo, f_hi]
  *      (the first mode), refined by a parabola through the log power of

@@ -3,7 +3,7 @@
 # Install what is missing, build with AddressSanitizer + UndefinedBehaviorSanitizer
 # and warnings as errors, and run the whole test suite under ctest; then a
 # ThreadSanitizer tree of only what the daemon's thread test needs (amfid,
-# sim_publisher) and that test there (tests/daemon_reload.sh). The main
+# sim_publisher) and that test there (tests/daemon/daemon_reload.sh). The main
 # suite's summary line is printed last; the exit status is non-zero when
 # either run failed.
 set -euo pipefail

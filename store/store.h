@@ -5,7 +5,7 @@
  *
  * The schema is a user interface: people query it with sqlite3, so every
  * table, column (unit, meaning) and view is documented in docs/schema.md,
- * which holds the exact DDL this file's store.c creates (tests/test_store.c
+ * which holds the exact DDL this file's store.c creates (tests/store/test_store.c
  * checks that they agree).
  *
  * The store owns every SQL statement: programs get typed rows and queries

@@ -3,7 +3,7 @@
  * store_schema.c: the store's schema as SQL, and the ordered list of
  * migrations that builds it from an empty file (store_open.c applies them).
  * A step, once released, is never edited: a change is a new step. The
- * final schema is exactly the DDL in docs/schema.md (tests/test_store.c
+ * final schema is exactly the DDL in docs/schema.md (tests/store/test_store.c
  * compares the two). No state, no threads.
  */
 #include "store_internal.h"
@@ -16,7 +16,7 @@ _Static_assert(AMFI_STORE_APPLICATION_ID == 1095583305,
 
 /* ---- schema --------------------------------------------------------------- */
 
-/* Version 1, exactly as docs/schema.md shows it (tests/test_store.c compares
+/* Version 1, exactly as docs/schema.md shows it (tests/store/test_store.c compares
  * the two). The comments inside CREATE statements are kept by SQLite, so
  * `sqlite3 DB .schema passages` shows units and meanings. */
 static const char schema_v1[] =
