@@ -189,10 +189,7 @@ static int start_runtime(daemon_s *d)
                               amfi_speed_slowest_frac(&d->cfg.speed_prior),
                               d->cfg.daemon.natfreq_free_s};
     d->tracker = amfi_tracker_create(&tp);
-    d->pend_cap = d->cfg.daemon.queue_size + AMFI_TRACKER_MAX_PENDING + 16;
-    d->pending = calloc((size_t)d->pend_cap, sizeof *d->pending);
-    d->next_seq = 1;
-    if (!d->tracker || !d->pending) {
+    if (!d->tracker || pipeline_start(d)) {
         LOG_ERR("out of memory at start-up");
         return 1;
     }
@@ -264,7 +261,7 @@ int amfid_run(daemon_s *d)
         }
         release_windows(d, 0);
         pipeline_drain_results(d);
-        if (d->held_n > 0)
+        if (pipeline_held(d) > 0)
             pipeline_retry(d, 0);
         if (reload_flag) {
             reload_flag = 0;
@@ -278,7 +275,7 @@ int amfid_run(daemon_s *d)
         }
         notify_tick(d);
         metrics_tick(d, 0);
-        if (!d->degraded)
+        if (!pipeline_degraded(d))
             record_intake(d, 0);
         if (wd && now - last_wd >= 0.5e-6 * (double)wd_usec) {
             sd_notify(0, "WATCHDOG=1");
@@ -297,8 +294,9 @@ int amfid_drain(daemon_s *d)
     release_windows(d, 1);
     pool_join(&d->pool);
     pipeline_drain_results(d);
-    if (d->held_n > 0) { /* the store still refuses: keep trying a while */
-        LOG_WARN("store: %d passages held at shutdown; retrying for up to 20 s", d->held_n);
+    if (pipeline_held(d) > 0) { /* the store still refuses: keep trying a while */
+        LOG_WARN("store: %d passages held at shutdown; retrying for up to 20 s",
+                 pipeline_held(d));
         pipeline_retry(d, 20.0);
     }
     heartbeat(d);
@@ -307,9 +305,9 @@ int amfid_drain(daemon_s *d)
     freevib_final(d);
     notify_finish(d);
     metrics_tick(d, 1);
-    if (!d->degraded)
+    if (!pipeline_degraded(d))
         record_intake(d, 1);
-    if (d->passages_lost > 0)
+    if (pipeline_lost(d) > 0)
         rc = 1; /* acknowledged passages are safe; these never were */
     if (d->env.received + d->env.rejected > 0)
         LOG_INFO("environment: %lld readings decoded, %lld refused, %lld stored%s",
@@ -334,7 +332,7 @@ int amfid_drain(daemon_s *d)
              "%lld blocks, %lld vehicles, %lld rejected messages, %lld refused by the bus "
              "authentication",
              (long long)d->passages_stored, (long long)d->passages_ok,
-             (long long)d->passages_lost, (long long)d->messages_in,
+             (long long)pipeline_lost(d), (long long)d->messages_in,
              (long long)d->blocks_received, (long long)d->vehicles_received,
              (long long)(d->blocks_rejected + d->vehicles_rejected + d->messages_malformed),
              (long long)d->auth_refused);
@@ -345,20 +343,11 @@ int amfid_drain(daemon_s *d)
 void amfid_stop(daemon_s *d)
 {
     notify_free(d);
-    for (; d->held && d->held_n > 0; d->held_n--) { /* only left on an early error */
-        job_free(d->held[d->held_head]);
-        d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;
-    }
-    free(d->held);
-    d->held = NULL;
     pool_stop(&d->pool);
     if (d->lcm)
         lcm_destroy(d->lcm);
     bus_auth_stop(d);
-    if (d->pending)
-        for (int i = 0; i < d->pend_cap; i++)
-            job_free(d->pending[i]);
-    free(d->pending);
+    pipeline_stop(d);
     for (int i = 0; i < AMFI_MAX_SENSORS; i++)
         amfi_ring_destroy(d->rings[i]);
     amfi_tracker_destroy(d->tracker);

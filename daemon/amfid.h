@@ -197,10 +197,10 @@ typedef struct daemon_s {
     amfi_tracker *tracker;
     amfi_ring *rings[AMFI_MAX_SENSORS];
     pool pool;
-    /* reorder: results stored in seq order */
-    job **pending;                 /* ring of size pend_cap indexed by seq */
-    int pend_cap;
-    int64_t next_seq;              /* next seq to store */
+    /* the pipeline (pipeline.c): results in seq order (reorder.c), then the
+     * store sink (sink.c: held in order while the store cannot write) */
+    struct reorder *reorder;
+    struct sink *sink;
     int64_t released;              /* windows released by the tracker */
     /* counters (status_t) */
     int64_t blocks_received, blocks_rejected, vehicles_received, vehicles_rejected;
@@ -228,13 +228,7 @@ typedef struct daemon_s {
     env_state env;                 /* environment readings (environment.c) */
     scale_state sc;                /* scale indicator, known truck (scaleind.c) */
     freevib_state fv;              /* the natural frequency (freevib.c) */
-    /* passages the store could not take (disk full, I/O error, read-only):
-     * held in order and retried (pipeline.c); nothing acknowledged is lost */
-    job **held;
-    int held_n, held_head, held_peak;
-    int64_t passages_lost;         /* held queue overflowed (each logged) */
-    double retry_at, retry_wait;   /* amfi_mono_s() of the next try; backoff */
-    int degraded;
+    /* the store_degraded alert while the sink holds passages (pipeline.c) */
     int64_t degraded_utime;        /* data time the store_degraded alert was raised */
     char degraded_msg[1024];       /* its message, stored once the store writes again */
     char last_error[256];
@@ -359,8 +353,14 @@ void pipeline_drain_results(daemon_s *d);
 /* Retry the held passages when their time has come (the loop); with
  * final != 0 (stopping) keep trying for up to final seconds. */
 void pipeline_retry(daemon_s *d, double final);
-/* The held-queue bound: passages kept while the store cannot write. */
-#define STORE_HOLD_MAX 20000
+/* The reorder buffer and the sink (daemon.store.held_max_bytes): 0, or −1
+ * out of memory; stop frees whatever they still hold. */
+int pipeline_start(daemon_s *d);
+void pipeline_stop(daemon_s *d);
+/* Passages held now, not stored since start (all causes), degraded. */
+int pipeline_held(const daemon_s *d);
+int64_t pipeline_lost(const daemon_s *d);
+int pipeline_degraded(const daemon_s *d);
 
 /* ---- alert notices (notify.c), main thread -------------------------------- */
 

@@ -107,7 +107,7 @@ void record_intake(daemon_s *d, int force)
               {"intake.messages_refused", (long long)d->rej.total},
               {"intake.datagrams_dropped", (long long)(d->udp_drops > 0 ? d->udp_drops : 0)},
               {"intake.samples_missing", (long long)d->samples_missing},
-              {"intake.passages_lost", (long long)d->passages_lost},
+              {"intake.passages_lost", (long long)pipeline_lost(d)},
               {"intake.environment_received", (long long)d->env.received},
               {"intake.environment_refused", (long long)d->env.rejected},
               {"intake.environment_stored", (long long)d->env.stored},
@@ -163,7 +163,7 @@ void heartbeat(daemon_s *d)
     }
     m.messages_refused = d->rej.total;
     m.datagrams_dropped = d->udp_drops;
-    m.passages_held = d->held_n;
+    m.passages_held = pipeline_held(d);
     m.state = (char *)d->state;
     m.last_error = d->last_error;
     m.site_id = d->cfg.site.id;

@@ -138,9 +138,9 @@ static void write_all(daemon_s *d, FILE *f)
                 (long long)m->by_status[k]);
     head(f, "amfi_passages_lost_total", "counter",
          "Passages not stored (held queue full, or the store refused at shutdown).");
-    fprintf(f, "amfi_passages_lost_total %lld\n", (long long)d->passages_lost);
+    fprintf(f, "amfi_passages_lost_total %lld\n", (long long)pipeline_lost(d));
     head(f, "amfi_passages_held", "gauge", "Passages held because the store cannot write.");
-    fprintf(f, "amfi_passages_held %d\n", d->held_n);
+    fprintf(f, "amfi_passages_held %d\n", pipeline_held(d));
     head(f, "amfi_queue_depth", "gauge", "Passages waiting for a solver thread.");
     fprintf(f, "amfi_queue_depth %d\n", queue_depth(&d->pool.jobs));
 

@@ -12,17 +12,21 @@
  * daemon.indicators.single_presence_only the indicators take only the
  * passages weighed alone (the one filter here, not in the engine).
  *
- * A passage is acknowledged when its transaction has committed; only then
- * is it published and fed to the indicators. When the store cannot write
- * (disk full, I/O error, read-only, locked) the passage is held, in order,
- * in a bounded queue (STORE_HOLD_MAX) and retried with a backoff (1 s
- * doubling to 30 s); amfid is then degraded (status message state,
+ * The pipeline is three parts: the reorder buffer (reorder.c: results parked
+ * by their release order, handed on consecutively), the store sink (sink.c)
+ * and, here, the fan-out of a stored passage. A passage is acknowledged
+ * when its transaction has committed; only then is it published and fed to
+ * the indicators. When the store cannot write (disk full, I/O error,
+ * read-only, locked) the sink holds the passage, in order, in a queue
+ * bounded in bytes (daemon.store.held_max_bytes) and retries with a backoff
+ * (1 s doubling to 30 s); amfid is then degraded (status message state,
  * sd_notify STATUS, a `store_degraded` alert on the bus and in the log,
- * cleared when the queue has drained). What overflows the queue is counted
- * and each such vehicle logged with its id and time.
+ * raised and cleared here, cleared when the queue has drained). What
+ * overflows the queue is counted and each such vehicle logged with its id
+ * and time.
  *
- * Thread: the main thread only. Owns the reorder buffer (d->pending), the
- * held queue, the store handle's writes and the indicator engine; it takes jobs back from
+ * Thread: the main thread only. Owns the reorder buffer and the sink, the
+ * store handle's writes and the indicator engine; it takes jobs back from
  * the solver pool's result queue (pool.h), after which they are its own.
  */
 #include <errno.h>
@@ -37,6 +41,8 @@
 #include "amfi_indicator_t.h"
 #include "amfi_passage_t.h"
 #include "amfid.h"
+#include "reorder.h"
+#include "sink.h"
 
 /* The speed the passage was weighed with: the estimate when the solver
  * estimated it (solver.speed: estimate), else the detector's. */
@@ -244,69 +250,35 @@ static void publish_store_alert(daemon_s *d, int raised, const char *msg)
         LOG_INFO("alert cleared store_degraded: %s", msg);
 }
 
-static void set_degraded(daemon_s *d, int on)
+/* The sink became degraded, or is not any more (sink.h). */
+static void on_degraded(void *arg, int on)
 {
+    daemon_s *d = arg;
     char msg[1000];
-    if (on && !d->degraded) {
-        d->degraded = 1;
+    sink_stats st;
+    sink_stats_of(d->sink, &st);
+    if (on) {
         d->state = "degraded";
         snprintf(msg, sizeof msg,
                  "the store %.300s cannot be written (%.300s); passages are held in memory (up to %d) "
                  "and retried",
-                 d->cfg.daemon.db_path, d->last_error, STORE_HOLD_MAX);
+                 d->cfg.daemon.db_path, d->last_error, sink_capacity(d->sink));
         publish_store_alert(d, 1, msg);
-        sd_notifyf(0, "STATUS=degraded: store cannot be written, %d passages held", d->held_n);
-    } else if (!on && d->degraded) {
-        d->degraded = 0;
+        sd_notifyf(0, "STATUS=degraded: store cannot be written, %d passages held", st.held);
+    } else {
         if (strcmp(d->state, "degraded") == 0)
             d->state = "running";
         snprintf(msg, sizeof msg,
                  "the store %.300s takes writes again; every held passage is stored (%d at most "
                  "were held, %lld lost to overflow)",
-                 d->cfg.daemon.db_path, d->held_peak, (long long)d->passages_lost);
+                 d->cfg.daemon.db_path, st.peak, (long long)st.lost);
         publish_store_alert(d, 0, msg);
     }
 }
 
-/* Hold a passage the store refused, in order (the job keeps only what the
- * row needs: its samples are freed). */
-static void hold(daemon_s *d, job *j)
+static int write_passage(void *arg, job *j)
 {
-    if (!d->held) {
-        d->held = calloc(STORE_HOLD_MAX, sizeof *d->held);
-        d->held_n = d->held_head = 0;
-    }
-    if (!d->held || d->held_n >= STORE_HOLD_MAX) {
-        d->passages_lost++;
-        LOG_ERR("store: passage of vehicle %lld at utime %lld LOST: the held queue is full "
-                "(%d passages; %lld lost in all)",
-                (long long)j->w.v.vehicle_id, (long long)j->w.v.utime, STORE_HOLD_MAX,
-                (long long)d->passages_lost);
-        job_free(j);
-        return;
-    }
-    free(j->accel);
-    j->accel = NULL;
-    d->held[(d->held_head + d->held_n) % STORE_HOLD_MAX] = j;
-    d->held_n++;
-    if (d->held_n > d->held_peak)
-        d->held_peak = d->held_n;
-    if (!d->degraded) {
-        d->retry_wait = 1.0;
-        d->retry_at = amfi_mono_s() + d->retry_wait;
-    }
-    set_degraded(d, 1);
-}
-
-/* Store in order: behind any held passage, or now. Takes the job. */
-static int store_one(daemon_s *d, job *j)
-{
-    if (d->held_n > 0 || store_now(d, j) != 0) {
-        hold(d, j);
-        return -1;
-    }
-    job_free(j);
-    return 0;
+    return store_now(arg, j);
 }
 
 /* The job of vehicle i of an event: its own vehicle, result and status
@@ -418,7 +390,7 @@ static int store_job(daemon_s *d, job *e)
 {
     if (e->w.n_vehicles <= 1) {
         mark_inseparable(d, e, 0, e);
-        return store_one(d, e);
+        return sink_put(d->sink, e);
     }
     int rc = 0;
     for (int i = 0; i < e->w.n_vehicles; i++) {
@@ -426,98 +398,81 @@ static int store_job(daemon_s *d, job *e)
         if (j)
             mark_inseparable(d, e, i, j);
         if (!j) {
-            d->passages_lost++;
+            sink_lost(d->sink, 1);
             set_error(d, "out of memory: passage of vehicle %lld at utime %lld LOST",
                       (long long)e->w.ev[i].vehicle_id, (long long)e->w.ev[i].utime);
             rc = -1;
             continue;
         }
-        if (store_one(d, j))
+        if (sink_put(d->sink, j))
             rc = -1;
     }
     job_free(e);
     return rc;
 }
 
-void pipeline_retry(daemon_s *d, double final)
+int pipeline_start(daemon_s *d)
 {
-    double until = amfi_mono_s() + final;
-    while (d->held_n > 0) {
-        double now = amfi_mono_s();
-        if (now < d->retry_at) {
-            if (final <= 0)
-                return;
-            if (now >= until)
-                break; /* stopping, and out of time: counted below */
-            double w = fmin(d->retry_at - now, until - now);
-            struct timespec ts = {(time_t)w, (long)(1e9 * (w - floor(w)))};
-            nanosleep(&ts, NULL);
-            continue;
-        }
-        while (d->held_n > 0 && store_now(d, d->held[d->held_head]) == 0) {
-            job_free(d->held[d->held_head]);
-            d->held[d->held_head] = NULL;
-            d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;
-            d->held_n--;
-        }
-        if (d->held_n == 0) {
-            LOG_INFO("store: the held passages are stored (peak %d)", d->held_peak);
-            set_degraded(d, 0);
-            return;
-        }
-        d->retry_wait = fmin(2.0 * d->retry_wait, 30.0);
-        d->retry_at = amfi_mono_s() + d->retry_wait;
-        sd_notifyf(0, "STATUS=degraded: store cannot be written, %d passages held", d->held_n);
-        if (final <= 0 || amfi_mono_s() >= until) {
-            if (final > 0)
-                break;
-            return;
-        }
-    }
-    for (; d->held_n > 0; d->held_n--) { /* stopping, and the store still refuses */
-        job *j = d->held[d->held_head];
-        LOG_ERR("store: passage of vehicle %lld at utime %lld NOT STORED: the store still "
-                "refuses writes at shutdown (%s)",
-                (long long)j->w.v.vehicle_id, (long long)j->w.v.utime, d->last_error);
-        d->passages_lost++;
-        job_free(j);
-        d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;
-    }
+    sink_params sp = {(size_t)d->cfg.daemon.held_max_bytes, 1.0, 30.0};
+    sink_ops ops = {write_passage, on_degraded, d, d->last_error};
+    d->reorder = reorder_create(d->cfg.daemon.queue_size + AMFI_TRACKER_MAX_PENDING + 16, 1);
+    d->sink = sink_create(&sp, &ops);
+    return d->reorder && d->sink ? 0 : -1;
 }
 
-/* Park a finished job by seq; store every consecutive one from next_seq.
- * The parking ring grows when the solvers fall far behind (windows that
- * bypass them keep arriving): a passage is never dropped for lack of room. */
+void pipeline_stop(daemon_s *d)
+{
+    sink_destroy(d->sink);
+    d->sink = NULL;
+    reorder_destroy(d->reorder);
+    d->reorder = NULL;
+}
+
+void pipeline_retry(daemon_s *d, double final)
+{
+    sink_retry(d->sink, final);
+}
+
+int pipeline_held(const daemon_s *d)
+{
+    sink_stats st;
+    if (!d->sink)
+        return 0;
+    sink_stats_of(d->sink, &st);
+    return st.held;
+}
+
+int64_t pipeline_lost(const daemon_s *d)
+{
+    sink_stats st;
+    if (!d->sink)
+        return 0;
+    sink_stats_of(d->sink, &st);
+    return st.lost;
+}
+
+int pipeline_degraded(const daemon_s *d)
+{
+    sink_stats st;
+    if (!d->sink)
+        return 0;
+    sink_stats_of(d->sink, &st);
+    return st.degraded;
+}
+
+/* Park a finished job by seq (reorder.c); store every consecutive one. */
 int pipeline_complete(daemon_s *d, job *j)
 {
-    int64_t seq = j->w.seq;
-    if (seq - d->next_seq >= d->pend_cap) {
-        int cap = d->pend_cap;
-        while (seq - d->next_seq >= cap)
-            cap *= 2;
-        job **np = calloc((size_t)cap, sizeof *np);
-        if (!np) { /* out of memory: store it now, out of order, rather than lose it */
-            set_error(d, "out of memory for the reorder buffer: passage %lld stored out of order",
-                      (long long)seq);
-            return store_job(d, j);
-        }
-        for (int i = 0; i < d->pend_cap; i++)
-            if (d->pending[i])
-                np[d->pending[i]->w.seq % cap] = d->pending[i];
-        free(d->pending);
-        d->pending = np;
-        d->pend_cap = cap;
+    if (reorder_park(d->reorder, j)) { /* out of memory: stored now, out of order, not lost */
+        set_error(d, "out of memory for the reorder buffer: passage %lld stored out of order",
+                  (long long)j->w.seq);
+        return store_job(d, j);
     }
-    d->pending[seq % d->pend_cap] = j;
     int rc = 0;
-    while (d->pending[d->next_seq % d->pend_cap] &&
-           d->pending[d->next_seq % d->pend_cap]->w.seq == d->next_seq) {
-        job *k = d->pending[d->next_seq % d->pend_cap];
-        d->pending[d->next_seq % d->pend_cap] = NULL;
+    job *k;
+    while ((k = reorder_next(d->reorder)) != NULL)
         if (store_job(d, k))
             rc = -1;
-        d->next_seq++;
-    }
     return rc;
 }
 

@@ -144,11 +144,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             ;
         release_windows(&d, 0);
         pipeline_drain_results(&d);
-        if (d.held_n > 0)
+        if (pipeline_held(&d) > 0)
             pipeline_retry(&d, 0);
     }
     if (amfid_drain(&d) != 0)
-        finding("amfid_drain failed: passages lost", d.passages_lost, 0);
+        finding("amfid_drain failed: passages lost", pipeline_lost(&d), 0);
     int64_t rows = -1, truth = -1;
     char err[256];
     if (amfi_store_count(d.store, AMFI_STORE_PASSAGES, &rows, err, sizeof err) ||
