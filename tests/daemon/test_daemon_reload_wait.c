@@ -73,7 +73,7 @@ static void publish(lcm_t *lcm, const char *ch, const void *buf, int len)
 static const int64_t T0 = 1700000000000000LL; /* µs */
 
 /* Sensor 0's samples from `from` to `to` s after T0, 1000 Hz, blocks of 100. */
-static void accel(daemon_s *d, double from, double to)
+static void accel(amfid *d, double from, double to)
 {
     static double a[100];
     static unsigned char buf[4096];
@@ -81,19 +81,16 @@ static void accel(daemon_s *d, double from, double to)
     for (double t = from; t < to - 1e-9; t += 0.1) {
         amfi_accel_block_t m = {T0 + (int64_t)llround(t * 1e6), 0, ++seq, 1000.0, 100, a};
         int n = amfi_accel_block_t_encode(buf, 0, sizeof buf, &m);
-        publish(d->lcm, d->cfg.daemon.ch_accel, buf, n);
-        while (lcm_handle_timeout(d->lcm, 0) > 0)
-            ;
-        release_windows(d, 0);
-        pipeline_drain_results(d);
+        publish(amfid_lcm(d), amfid_config(d)->daemon.ch_accel, buf, n);
+        amfid_turn(d); /* handled, windows released, results stored */
     }
 }
 
-static int64_t passages(daemon_s *d)
+static int64_t passages(amfid *d)
 {
     int64_t n = -1;
     char err[256];
-    if (amfi_store_count(d->store, AMFI_STORE_PASSAGES, &n, err, sizeof err))
+    if (amfi_store_count(amfid_store(d), AMFI_STORE_PASSAGES, &n, err, sizeof err))
         fail(err);
     return n;
 }
@@ -107,32 +104,33 @@ int main(int argc, char **argv)
     snprintf(cfg_path, sizeof cfg_path, "%s/amfid.yaml", dir);
     snprintf(db_path, sizeof db_path, "%s/amfi.db", dir);
     write_config(argv[1], "300");
-    static daemon_s d;
+    amfid *d = NULL;
     amfid_options o = {.config = cfg_path, .db = db_path, .lcm_url = "memq://"};
     if (amfid_start(&d, &o) != 0)
         fail("amfid_start");
-    accel(&d, 0.0, 6.0);
+    accel(d, 0.0, 6.0);
     double sp[1] = {4.0};
     amfi_vehicle_t v = {T0 + 5000000, 1, 1, 20.0, 2, 1, sp, (char *)"", 0.0};
     unsigned char buf[512];
-    publish(d.lcm, d.cfg.daemon.ch_vehicle, buf, amfi_vehicle_t_encode(buf, 0, sizeof buf, &v));
-    accel(&d, 6.0, 40.0); /* 30 s of data past the window's end */
-    if (passages(&d) != 0 || amfi_tracker_pending(d.tracker) != 1)
+    publish(amfid_lcm(d), amfid_config(d)->daemon.ch_vehicle, buf,
+            amfi_vehicle_t_encode(buf, 0, sizeof buf, &v));
+    accel(d, 6.0, 40.0); /* 30 s of data past the window's end */
+    amfid_stats st;
+    amfid_counts(d, &st);
+    if (passages(d) != 0 || st.vehicles_received != 1)
         fail("with max_wait_s 300 the window should still wait for sensor 1");
     write_config(argv[1], "2");
-    reload(&d); /* the SIGHUP path */
-    if (d.cfg.daemon.max_wait_s != 2.0)
+    amfid_reload(d); /* the SIGHUP path */
+    if (amfid_config(d)->daemon.max_wait_s != 2.0)
         fail("the reload did not apply max_wait_s");
-    release_windows(&d, 0);
-    pipeline_drain_results(&d);
-    int64_t n = passages(&d);
-    printf("test_daemon_reload_wait: %lld passage(s) stored after the reload, %d pending\n",
-           (long long)n, amfi_tracker_pending(d.tracker));
+    amfid_turn(d);
+    int64_t n = passages(d);
+    printf("test_daemon_reload_wait: %lld passage(s) stored after the reload\n", (long long)n);
     if (n != 1)
         fail("after the reload to max_wait_s 2 the window was not released: the tracker "
              "still waits with the old max_wait_s");
-    int rc = amfid_drain(&d);
-    amfid_stop(&d);
+    int rc = amfid_drain(d);
+    amfid_stop(d);
     char cmd[400];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     if (system(cmd) != 0)
