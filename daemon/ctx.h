@@ -18,6 +18,28 @@
  * environment.c, freevib.c, drift.c, stdmean.c, scaleind.c (the
  * indicators), notify.c, metrics.c, status.c (heartbeat, intake record).
  *
+ * Who calls whom (from the built objects; tests/daemon/daemon_calls.sh
+ * fails when this list differs from the library, or when it has a circle):
+ *   admit.c -> reject.c
+ *   alert.c -> log.c metrics.c notify.c
+ *   amfid.c -> alert.c bus.c drift.c environment.c freevib.c intake.c log.c metrics.c notify.c pipeline.c pool.c reject.c scaleind.c status.c stdmean.c timer.c
+ *   bus.c -> admit.c log.c reject.c
+ *   drift.c -> log.c metrics.c
+ *   environment.c -> admit.c bus.c log.c reject.c
+ *   freevib.c -> environment.c log.c pipeline.c timer.c
+ *   intake.c -> admit.c bus.c freevib.c log.c pipeline.c pool.c reject.c
+ *   metrics.c -> log.c reject.c timer.c
+ *   notify.c -> log.c
+ *   pipeline.c -> log.c metrics.c notify.c pool.c reorder.c sink.c
+ *   reject.c -> log.c timer.c
+ *   reorder.c -> pool.c
+ *   scaleind.c -> environment.c log.c metrics.c
+ *   sink.c -> log.c pool.c
+ *   status.c -> bus.c environment.c log.c pipeline.c timer.c
+ *   stdmean.c -> log.c metrics.c
+ * log.c and timer.c call nothing of amfid's; a module reaches the core only
+ * through the context.
+ *
  * Threads: everything here is the main thread's; the solver threads see
  * only the jobs they are handed (pool.h).
  */
