@@ -145,9 +145,10 @@ struct amfid_module {
     void (*stop)(amfid_ctx *c);
 };
 
-extern const amfid_module intake_module, environment_module, environment_lost_module, record_module, metrics_module,
-    notify_module, freevib_module, pipeline_module, drift_module, stdmean_module,
-    scaleind_module, reject_module, status_module;
+/* The modules (amfid.c's table holds them, in order). */
+extern const amfid_module environment_lost_module, intake_module, environment_module,
+    record_module, metrics_module, notify_module, freevib_module, pipeline_module, drift_module,
+    stdmean_module, scaleind_module, reject_module, status_module;
 
 /* ---- timers (timer.c) ------------------------------------------------------- */
 
