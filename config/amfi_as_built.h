@@ -64,11 +64,11 @@ typedef struct amfi_as_built {
 } amfi_as_built;
 
 /* The identity: the design's bridge and sensors, an exact detector (0, 1, 1). */
-void amfi_as_built_from_design(const amfi_site_config *design, amfi_as_built *out);
+void amfi_config_as_built_from_design(const amfi_site_config *design, amfi_as_built *out);
 
-/* Load `path` over amfi_as_built_from_design(design). 0 and *out filled, or
+/* Load `path` over amfi_config_as_built_from_design(design). 0 and *out filled, or
  * −1, *out untouched and one line in err ("FILE:LINE: key.path: problem"). */
-int amfi_as_built_load(const char *path, const amfi_site_config *design, amfi_as_built *out,
+int amfi_config_as_built_load(const char *path, const amfi_site_config *design, amfi_as_built *out,
                        char *err, size_t errlen);
 
 /* The keys of an as-built file (for sim_publisher(1) and its test): visit
@@ -76,7 +76,7 @@ int amfi_as_built_load(const char *path, const amfi_site_config *design, amfi_as
  * "sensors[].at_m"), its type, range, default and whether an item must
  * give it; the first non-zero return
  * stops the walk and is returned. */
-int amfi_as_built_keys(int (*visit)(const char *path, const char *type, const char *range,
+int amfi_config_as_built_keys(int (*visit)(const char *path, const char *type, const char *range,
                                     const char *dflt, int required, void *arg),
                        void *arg);
 

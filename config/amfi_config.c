@@ -18,7 +18,7 @@
  *
  * Adding a section: its fields in amfi_site_config with their defaults in
  * amfi_config_defaults(), a section_*.c with its table and checks, one row
- * in top_fields[] and its check in check_site(); the key, its range and its
+ * in amfi_cfg_top_fields[] and its check in check_site(); the key, its range and its
  * default then appear in amfi_config_keys(), which the config_man test
  * holds against man/amfid.yaml.5.scd.
  *
@@ -35,17 +35,17 @@
 #include <string.h>
 
 /* The top level of a site file. */
-static const field top_fields[] = {
-    {.key = "site", .kind = &K_MAP, .aux = site_fields},
-    {.key = "bridge", .kind = &K_MAP, .aux = bridge_fields},
-    {.key = "sensors", .kind = &K_SENSORS, .aux = &sensors_list},
-    {.key = "solver", .kind = &K_MAP, .aux = solver_fields},
-    {.key = "daemon", .kind = &K_MAP, .aux = daemon_fields},
-    {.key = "simulation", .kind = &K_MAP, .aux = sim_fields},
-    {.key = "alerts", .kind = &K_MAP, .aux = alerts_fields},
-    {.key = "metrics", .kind = &K_MAP, .aux = metrics_fields},
-    {.key = "report", .kind = &K_MAP, .aux = report_fields},
-    {.key = "detector", .kind = &K_MAP, .aux = detector_fields},
+const field amfi_cfg_top_fields[] = {
+    {.key = "site", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_site_fields},
+    {.key = "bridge", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_bridge_fields},
+    {.key = "sensors", .kind = &amfi_cfg_k_sensors, .aux = &amfi_cfg_sensors_list},
+    {.key = "solver", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_solver_fields},
+    {.key = "daemon", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_daemon_fields},
+    {.key = "simulation", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_sim_fields},
+    {.key = "alerts", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_alerts_fields},
+    {.key = "metrics", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_metrics_fields},
+    {.key = "report", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_report_fields},
+    {.key = "detector", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_detector_fields},
     {.key = NULL}};
 
 /* Checks that involve several keys, once the whole file is read; each finds
@@ -56,10 +56,10 @@ static int check_site(ctx *x, void *base)
 {
     amfi_site_config *c = base;
 
-    if (bridge_check(x, c) || sensors_check(x, c) || solver_check(x, c) ||
-        daemon_check(x, c) || sim_check(x, c) || site_check(x, c) || ops_check(x, c))
+    if (amfi_cfg_bridge_check(x, c) || amfi_cfg_sensors_check(x, c) || amfi_cfg_solver_check(x, c) ||
+        amfi_cfg_daemon_check(x, c) || amfi_cfg_sim_check(x, c) || amfi_cfg_site_check(x, c) || amfi_cfg_ops_check(x, c))
         return -1;
-    return model_check(x, c);
+    return amfi_cfg_model_check(x, c);
 }
 
 void amfi_config_defaults(amfi_site_config *c)
@@ -214,7 +214,7 @@ int amfi_config_load(const char *path, amfi_site_config *c, char *err, size_t er
     x->err = err;
     x->errlen = errlen;
     amfi_config_defaults(&tmp);
-    rc = walk_file(x, top_fields, &tmp, check_site);
+    rc = amfi_cfg_walk_file(x, amfi_cfg_top_fields, &tmp, check_site);
     if (rc == 0)
         memcpy(c, &tmp, sizeof tmp);
     free(x);
@@ -224,22 +224,100 @@ int amfi_config_load(const char *path, amfi_site_config *c, char *err, size_t er
 typedef struct visit_arg {
     int (*visit)(const amfi_config_key *k, void *arg);
     void *arg;
+    const amfi_site_config *dflt; /* the defaults, for the manual's strings */
+    const amfi_site_config *a, *b; /* amfi_config_diff: the two compared */
+    amfi_site_config *run;         /* amfi_config_apply_live: copied into */
+    const amfi_site_config *n;     /* amfi_config_apply_live: copied from */
 } visit_arg;
 
-static int visit_one(const char *path, const char *type, const char *range,
-                     const char *dflt, int required, void *arg)
+static int visit_key(const char *path, const field *f, const void *item_default, int live,
+                     const visit_arg *va)
 {
-    const visit_arg *va = arg;
-    amfi_config_key k = {path, type, range, dflt, required};
+    char range[DOC_LEN], dflt[DOC_LEN];
+    amfi_config_key k;
 
+    amfi_cfg_describe_row(f, item_default ? item_default : (const void *)va->dflt, range,
+                          dflt);
+    k = (amfi_config_key){path, f->kind->type, range, dflt, (f->flags & F_REQUIRED) != 0,
+                          live};
     return va->visit(&k, va->arg);
+}
+
+static int visit_one(const char *path, const field *f, const void *item_default, int live,
+                     void *arg)
+{
+    return visit_key(path, f, item_default, live, arg);
 }
 
 int amfi_config_keys(int (*visit)(const amfi_config_key *k, void *arg), void *arg)
 {
     amfi_site_config d;
-    visit_arg va = {visit, arg};
+    visit_arg va = {.visit = visit, .arg = arg, .dflt = &d};
 
     amfi_config_defaults(&d);
-    return describe_table(top_fields, "", &d, visit_one, &va);
+    return amfi_cfg_walk_rows(amfi_cfg_top_fields, "", 1, visit_one, &va);
+}
+
+/* The spans of row f of the top table (the site config's offsets). */
+static int row_spans(const field *f, span out[MAX_SPANS])
+{
+    int n = f->kind->spans(f, out);
+
+    for (int i = 0; i < n; i++) /* a row's spans lie in the struct */
+        if (out[i].off + out[i].len > sizeof(amfi_site_config) || out[i].len == 0)
+            abort();
+    return n;
+}
+
+static int diff_one(const char *path, const field *f, const void *item_default, int live,
+                    void *arg)
+{
+    const visit_arg *va = arg;
+    span sp[MAX_SPANS];
+    const int n = row_spans(f, sp);
+
+    (void)item_default; /* walked without items: lists compare as one key */
+    for (int i = 0; i < n; i++)
+        if (memcmp((const char *)va->a + sp[i].off, (const char *)va->b + sp[i].off,
+                   sp[i].len) != 0)
+            return visit_key(path, f, NULL, live, va);
+    return 0;
+}
+
+int amfi_config_diff(const amfi_site_config *a, const amfi_site_config *b,
+                     int (*visit)(const amfi_config_key *k, void *arg), void *arg)
+{
+    amfi_site_config d;
+    visit_arg va = {.visit = visit, .arg = arg, .dflt = &d, .a = a, .b = b};
+
+    if (!a || !b || !visit)
+        return 0;
+    amfi_config_defaults(&d);
+    return amfi_cfg_walk_rows(amfi_cfg_top_fields, "", 0, diff_one, &va);
+}
+
+static int apply_one(const char *path, const field *f, const void *item_default, int live,
+                     void *arg)
+{
+    const visit_arg *va = arg;
+    span sp[MAX_SPANS];
+    int n;
+
+    (void)path;
+    (void)item_default;
+    if (!live)
+        return 0;
+    n = row_spans(f, sp);
+    for (int i = 0; i < n; i++)
+        memcpy((char *)va->run + sp[i].off, (const char *)va->n + sp[i].off, sp[i].len);
+    return 0;
+}
+
+void amfi_config_apply_live(amfi_site_config *run, const amfi_site_config *n)
+{
+    visit_arg va = {.run = run, .n = n};
+
+    if (!run || !n || run == n)
+        return;
+    amfi_cfg_walk_rows(amfi_cfg_top_fields, "", 0, apply_one, &va);
 }

@@ -228,7 +228,7 @@ typedef struct amfi_site_identity {
 } amfi_site_identity;
 
 /* 1 when s is a valid site.id ([A-Za-z0-9_.-], 1 .. 63 bytes), else 0. */
-int amfi_site_id_valid(const char *s);
+int amfi_config_site_id_valid(const char *s);
 
 /* report.*: what amfi-report holds passages against (section_report.c). */
 typedef struct amfi_report_config {

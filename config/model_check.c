@@ -32,7 +32,7 @@
 static const char *given(const ctx *x, const char *const *keys, const char *fallback)
 {
     for (; *keys; keys++)
-        if (noted(x, *keys))
+        if (amfi_cfg_noted(x, *keys))
             return *keys;
     return fallback;
 }
@@ -101,7 +101,7 @@ static int workspace_check(ctx *x, const amfi_site_config *c, const amfi_bridge 
 
     if (steps > AMFI_CONFIG_MAX_STEPS) {
         k = given(x, step_keys, "solver");
-        return fail(x, noted(x, k), k,
+        return amfi_cfg_fail(x, amfi_cfg_noted(x, k), k,
                     "%g Hz over (max_duration_s %g + pre_roll_s %g + post_roll_s %g) s "
                     "is %.0f solver steps, above the limit of %.0f steps; lower "
                     "solver.calc_rate_hz or solver.max_duration_s",
@@ -111,7 +111,7 @@ static int workspace_check(ctx *x, const amfi_site_config *c, const amfi_bridge 
     if (p->coords == AMFI_COORDS_MODAL) {
         int m = modes_kept(b, p);
         if (m < 0)
-            return fail(x, 0, NULL, "out of memory while counting the modes");
+            return amfi_cfg_fail(x, 0, NULL, "out of memory while counting the modes");
         gstride = 2.0 * m + na;
     } else {
         gstride = 4.0 * n + na;
@@ -120,7 +120,7 @@ static int workspace_check(ctx *x, const amfi_site_config *c, const amfi_bridge 
     bytes = steps * sizeof(double) * (2.0 * ns + 2.0 * na + na * gstride) + fixed;
     if (bytes > AMFI_CONFIG_MAX_WORKSPACE_BYTES) {
         k = given(x, space_keys, "solver");
-        return fail(x, noted(x, k), k,
+        return amfi_cfg_fail(x, amfi_cfg_noted(x, k), k,
                     "the solver's workspace would be %.2f GiB (%.0f steps of %.0f axles "
                     "over %.0f states), above the limit of %.0f GiB per solver; lower "
                     "solver.calc_rate_hz, max_duration_s, max_axles or modes",
@@ -130,7 +130,7 @@ static int workspace_check(ctx *x, const amfi_site_config *c, const amfi_bridge 
     return 0;
 }
 
-int model_check(ctx *x, amfi_site_config *c)
+int amfi_cfg_model_check(ctx *x, amfi_site_config *c)
 {
     amfi_bridge *b = NULL;
     char why[256] = "";
@@ -139,7 +139,7 @@ int model_check(ctx *x, amfi_site_config *c)
 
     if (amfi_bridge_create(&c->bridge, &b, why, sizeof why)) {
         k = bridge_blame(x, why);
-        return fail(x, noted(x, k), k, "the bridge model is refused: %s", why);
+        return amfi_cfg_fail(x, amfi_cfg_noted(x, k), k, "the bridge model is refused: %s", why);
     }
     rc = workspace_check(x, c, b);
     amfi_bridge_destroy(b);

@@ -22,7 +22,7 @@ static int p_name(ctx *x, yaml_node_t *v, const char *path, const field *f, void
     amfi_site_config *c = base;
 
     (void)f;
-    return get_name(x, v, path, c->name, sizeof c->name);
+    return amfi_cfg_get_name(x, v, path, c->name, sizeof c->name);
 }
 
 /* bridge.damping.modes: [a, b], two distinct 1-based mode numbers */
@@ -35,24 +35,24 @@ static int p_rayleigh_modes(ctx *x, yaml_node_t *v, const char *path, const fiel
 
     (void)f;
     if (v->type != YAML_SEQUENCE_NODE)
-        return fail(x, line_of(v), path, "expected a list of two mode numbers such "
-                    "as [1, 2], got %s", what(v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected a list of two mode numbers such "
+                    "as [1, 2], got %s", amfi_cfg_what(v));
     if (v->data.sequence.items.top - v->data.sequence.items.start != 2)
-        return fail(x, line_of(v), path, "expected two mode numbers, got %d",
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected two mode numbers, got %d",
                     (int)(v->data.sequence.items.top - v->data.sequence.items.start));
     for (int i = 0; i < 2; i++) {
         yaml_node_t *it = yaml_document_get_node(x->doc, v->data.sequence.items.start[i]);
-        join_index(ip, path, (size_t)i);
+        amfi_cfg_join_index(ip, path, (size_t)i);
         if (!it)
-            return fail(x, line_of(v), ip, "malformed list");
-        if (get_long(x, it, ip, &m[i]))
+            return amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
+        if (amfi_cfg_get_long(x, it, ip, &m[i]))
             return -1;
         if (m[i] < 1 || m[i] > MAX_MODE_NO)
-            return fail(x, line_of(it), ip, "must be a mode number 1 .. %d, got %ld",
+            return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "must be a mode number 1 .. %d, got %ld",
                         MAX_MODE_NO, m[i]);
     }
     if (m[0] == m[1])
-        return fail(x, line_of(v), path, "the two modes must differ, got %ld twice",
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "the two modes must differ, got %ld twice",
                     m[0]);
     c->bridge.rayleigh_mode_a = (int)m[0];
     c->bridge.rayleigh_mode_b = (int)m[1];
@@ -88,9 +88,24 @@ static void v_modes_pair(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "[%d, %d]", b->rayleigh_mode_a, b->rayleigh_mode_b);
 }
 
-static const kind K_NAME = {"string", p_name, d_name, v_name, NEST_NONE};
+static int s_name(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(name), sizeof(((amfi_site_config *)0)->name)};
+    return 1;
+}
+
+static int s_modes_pair(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(bridge.rayleigh_mode_a), sizeof(int)};
+    out[1] = (span){SC(bridge.rayleigh_mode_b), sizeof(int)};
+    return 2;
+}
+
+static const kind K_NAME = {"string", p_name, d_name, v_name, NEST_NONE, s_name};
 static const kind K_RAYLEIGH = {"list", p_rayleigh_modes, d_modes_pair, v_modes_pair,
-                                NEST_NONE};
+                                NEST_NONE, s_modes_pair};
 
 /* bridge.supports: a list of {at_m, type, k_w_npm, k_theta_nmprad} */
 typedef struct support_item {
@@ -107,61 +122,54 @@ static const enum_name support_types[] = {
     {"elastic", SUPPORT_ELASTIC}, {NULL, 0}};
 
 static const field support_fields[] = {
-    {.key = "at_m", .kind = &K_DOUBLE, .off = offsetof(support_item, at_m), .lo = 0,
+    {.key = "at_m", .kind = &amfi_cfg_k_double, .off = offsetof(support_item, at_m), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN | F_REQUIRED},
-    {.key = "type", .kind = &K_ENUM, .off = offsetof(support_item, type),
+    {.key = "type", .kind = &amfi_cfg_k_enum, .off = offsetof(support_item, type),
      .aux = support_types, .flags = F_REQUIRED},
-    {.key = "k_w_npm", .kind = &K_DOUBLE, .off = offsetof(support_item, k_w_npm), .lo = 0,
+    {.key = "k_w_npm", .kind = &amfi_cfg_k_double, .off = offsetof(support_item, k_w_npm), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN},
-    {.key = "k_theta_nmprad", .kind = &K_DOUBLE, .off = offsetof(support_item, k_theta_nmprad),
+    {.key = "k_theta_nmprad", .kind = &amfi_cfg_k_double, .off = offsetof(support_item, k_theta_nmprad),
      .lo = 0, .hi = HUGE_VAL, .flags = F_HI_OPEN},
     {.key = NULL}};
 
-static int p_supports(ctx *x, yaml_node_t *v, const char *path, const field *f,
-                      void *base)
+/* Item i of bridge.supports: the springs its type allows. */
+static int check_support(ctx *x, yaml_node_t *it, const char *ip, const void *items, int i,
+                         const void *base)
+{
+    const support_item *si = (const support_item *)items + i;
+
+    (void)base;
+    if (si->type == SUPPORT_ELASTIC && !(si->k_w_npm > 0))
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "an elastic support needs k_w_npm > 0 "
+                    "(its vertical stiffness, N/m)");
+    if (si->type != SUPPORT_ELASTIC && si->k_w_npm > 0)
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "k_w_npm is the spring of an elastic support; "
+                    "a %s support holds the vertical displacement",
+                    si->type == SUPPORT_FIXED ? "fixed" : si->type == SUPPORT_ROLLER ? "roller"
+                                                                                : "pinned");
+    if (si->type == SUPPORT_FIXED && si->k_theta_nmprad > 0)
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "a fixed support holds the rotation: no "
+                    "k_theta_nmprad (use pinned with k_theta_nmprad for a partly "
+                    "fixed bearing)");
+    return 0;
+}
+
+/* The supports read, as libamfi's amfi_support. */
+static void store_supports(const void *items, int n, void *base)
 {
     amfi_bridge_params *b = &((amfi_site_config *)base)->bridge;
-    amfi_support s[AMFI_MAX_SUPPORTS];
-    yaml_node_item_t *items;
-    char ip[PATH_LEN];
-    int n = 0;
+    const support_item *si = items;
 
-    (void)f;
-    items = list_items(x, v, path, "supports", AMFI_MAX_SUPPORTS, &n);
-    if (!items)
-        return -1;
-    memset(s, 0, sizeof s);
+    memset(b->supports, 0, sizeof b->supports);
     for (int i = 0; i < n; i++) {
-        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
-        support_item si = {0.0, SUPPORT_PINNED, 0.0, 0.0};
-
-        join_index(ip, path, (size_t)i);
-        if (!it)
-            return fail(x, line_of(v), ip, "malformed list");
-        note_line(x, ip, line_of(it));
-        if (walk_map(x, it, ip, support_fields, &si))
-            return -1;
-        if (si.type == SUPPORT_ELASTIC && !(si.k_w_npm > 0))
-            return fail(x, line_of(it), ip, "an elastic support needs k_w_npm > 0 "
-                        "(its vertical stiffness, N/m)");
-        if (si.type != SUPPORT_ELASTIC && si.k_w_npm > 0)
-            return fail(x, line_of(it), ip, "k_w_npm is the spring of an elastic support; "
-                        "a %s support holds the vertical displacement",
-                        si.type == SUPPORT_FIXED ? "fixed" : si.type == SUPPORT_ROLLER ? "roller"
-                                                                                   : "pinned");
-        if (si.type == SUPPORT_FIXED && si.k_theta_nmprad > 0)
-            return fail(x, line_of(it), ip, "a fixed support holds the rotation: no "
-                        "k_theta_nmprad (use pinned with k_theta_nmprad for a partly "
-                        "fixed bearing)");
-        s[i].x_m = si.at_m;
-        s[i].restrain_w = si.type != SUPPORT_ELASTIC;
-        s[i].restrain_theta = si.type == SUPPORT_FIXED;
-        s[i].k_w_npm = si.type == SUPPORT_ELASTIC ? si.k_w_npm : 0.0;
-        s[i].k_theta_nmprad = si.k_theta_nmprad;
+        amfi_support *s = &b->supports[i];
+        s->x_m = si[i].at_m;
+        s->restrain_w = si[i].type != SUPPORT_ELASTIC;
+        s->restrain_theta = si[i].type == SUPPORT_FIXED;
+        s->k_w_npm = si[i].type == SUPPORT_ELASTIC ? si[i].k_w_npm : 0.0;
+        s->k_theta_nmprad = si[i].k_theta_nmprad;
     }
-    memcpy(b->supports, s, sizeof s);
     b->n_supports = n;
-    return 0;
 }
 
 static void d_supports(const field *f, const void *base, char *buf)
@@ -179,52 +187,54 @@ static void v_supports(const field *f, const void *base, char *buf)
 }
 
 static const support_item support_default = {0.0, SUPPORT_PINNED, 0.0, 0.0};
-static const list_schema support_list = {support_fields, &support_default};
-static const kind K_SUPPORTS = {"list", p_supports, d_supports, v_supports, NEST_LIST};
+static const list_schema support_list = {support_fields, &support_default, sizeof(support_item),
+                                         AMFI_MAX_SUPPORTS, "supports", check_support,
+                                         store_supports};
+static int s_supports(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(bridge.supports), sizeof(((amfi_bridge_params *)0)->supports)};
+    out[1] = (span){SC(bridge.n_supports), sizeof(int)};
+    return 2;
+}
+
+static const kind K_SUPPORTS = {"list", amfi_cfg_parse_list, d_supports, v_supports, NEST_LIST,
+                                s_supports};
 
 /* bridge.segments: a list of {from_m, to_m, EI_nm2, mass_kgpm} */
 static const field segment_fields[] = {
-    {.key = "from_m", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, x0_m), .lo = 0,
+    {.key = "from_m", .kind = &amfi_cfg_k_double, .off = offsetof(amfi_segment, x0_m), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN | F_REQUIRED},
-    {.key = "to_m", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, x1_m), .lo = 0,
+    {.key = "to_m", .kind = &amfi_cfg_k_double, .off = offsetof(amfi_segment, x1_m), .lo = 0,
      .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN | F_REQUIRED},
-    {.key = "EI_nm2", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, EI_nm2), .lo = 0,
+    {.key = "EI_nm2", .kind = &amfi_cfg_k_double, .off = offsetof(amfi_segment, EI_nm2), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN},
-    {.key = "mass_kgpm", .kind = &K_DOUBLE, .off = offsetof(amfi_segment, mass_kgpm), .lo = 0,
+    {.key = "mass_kgpm", .kind = &amfi_cfg_k_double, .off = offsetof(amfi_segment, mass_kgpm), .lo = 0,
      .hi = HUGE_VAL, .flags = F_HI_OPEN},
     {.key = NULL}};
 
-static int p_segments(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+/* Item i of bridge.segments: a length and something on it. */
+static int check_segment(ctx *x, yaml_node_t *it, const char *ip, const void *items, int i,
+                         const void *base)
+{
+    const amfi_segment *g = (const amfi_segment *)items + i;
+
+    (void)base;
+    if (!(g->x1_m > g->x0_m))
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "to_m (%g) must be beyond from_m (%g)",
+                             g->x1_m, g->x0_m);
+    if (g->EI_nm2 == 0 && g->mass_kgpm == 0)
+        return amfi_cfg_fail(x, amfi_cfg_line_of(it), ip, "gives neither EI_nm2 nor mass_kgpm");
+    return 0;
+}
+
+static void store_segments(const void *items, int n, void *base)
 {
     amfi_bridge_params *b = &((amfi_site_config *)base)->bridge;
-    amfi_segment g[AMFI_MAX_SEGMENTS];
-    yaml_node_item_t *items;
-    char ip[PATH_LEN];
-    int n = 0;
 
-    (void)f;
-    items = list_items(x, v, path, "segments", AMFI_MAX_SEGMENTS, &n);
-    if (!items)
-        return -1;
-    memset(g, 0, sizeof g);
-    for (int i = 0; i < n; i++) {
-        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
-
-        join_index(ip, path, (size_t)i);
-        if (!it)
-            return fail(x, line_of(v), ip, "malformed list");
-        note_line(x, ip, line_of(it));
-        if (walk_map(x, it, ip, segment_fields, &g[i]))
-            return -1;
-        if (!(g[i].x1_m > g[i].x0_m))
-            return fail(x, line_of(it), ip, "to_m (%g) must be beyond from_m (%g)", g[i].x1_m,
-                        g[i].x0_m);
-        if (g[i].EI_nm2 == 0 && g[i].mass_kgpm == 0)
-            return fail(x, line_of(it), ip, "gives neither EI_nm2 nor mass_kgpm");
-    }
-    memcpy(b->segments, g, sizeof g);
+    memset(b->segments, 0, sizeof b->segments);
+    memcpy(b->segments, items, (size_t)n * sizeof b->segments[0]);
     b->n_segments = n;
-    return 0;
 }
 
 static void d_segments(const field *f, const void *base, char *buf)
@@ -242,37 +252,48 @@ static void v_segments(const field *f, const void *base, char *buf)
 }
 
 static const amfi_segment segment_default = {0.0, 0.0, 0.0, 0.0};
-static const list_schema segment_list = {segment_fields, &segment_default};
-static const kind K_SEGMENTS = {"list", p_segments, d_segments, v_segments, NEST_LIST};
+static const list_schema segment_list = {segment_fields, &segment_default, sizeof(amfi_segment),
+                                         AMFI_MAX_SEGMENTS, "segments", check_segment,
+                                         store_segments};
+static int s_segments(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(bridge.segments), sizeof(((amfi_bridge_params *)0)->segments)};
+    out[1] = (span){SC(bridge.n_segments), sizeof(int)};
+    return 2;
+}
+
+static const kind K_SEGMENTS = {"list", amfi_cfg_parse_list, d_segments, v_segments, NEST_LIST,
+                                s_segments};
 
 static const field damping_fields[] = {
-    {.key = "ratio", .kind = &K_DOUBLE, .off = SC(bridge.damping_ratio), .lo = 0,
+    {.key = "ratio", .kind = &amfi_cfg_k_double, .off = SC(bridge.damping_ratio), .lo = 0,
      .hi = 1, .flags = F_HI_OPEN},
     {.key = "modes", .kind = &K_RAYLEIGH},
     {.key = NULL}};
 
-const field bridge_fields[] = {
+const field amfi_cfg_bridge_fields[] = {
     {.key = "name", .kind = &K_NAME},
-    {.key = "span_m", .kind = &K_DOUBLE, .off = SC(bridge.span_m), .lo = 0,
+    {.key = "span_m", .kind = &amfi_cfg_k_double, .off = SC(bridge.span_m), .lo = 0,
      .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "elements", .kind = &K_INT, .off = SC(bridge.n_elements), .lo = 1,
+    {.key = "elements", .kind = &amfi_cfg_k_int, .off = SC(bridge.n_elements), .lo = 1,
      .hi = 1000},
-    {.key = "E_pa", .kind = &K_DOUBLE, .off = SC(bridge.E_pa), .lo = 0, .hi = HUGE_VAL,
+    {.key = "E_pa", .kind = &amfi_cfg_k_double, .off = SC(bridge.E_pa), .lo = 0, .hi = HUGE_VAL,
      .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "A_m2", .kind = &K_DOUBLE, .off = SC(bridge.A_m2), .lo = 0, .hi = HUGE_VAL,
+    {.key = "A_m2", .kind = &amfi_cfg_k_double, .off = SC(bridge.A_m2), .lo = 0, .hi = HUGE_VAL,
      .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "I_m4", .kind = &K_DOUBLE, .off = SC(bridge.I_m4), .lo = 0, .hi = HUGE_VAL,
+    {.key = "I_m4", .kind = &amfi_cfg_k_double, .off = SC(bridge.I_m4), .lo = 0, .hi = HUGE_VAL,
      .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "density_kgm3", .kind = &K_DOUBLE, .off = SC(bridge.density_kgm3), .lo = 0,
+    {.key = "density_kgm3", .kind = &amfi_cfg_k_double, .off = SC(bridge.density_kgm3), .lo = 0,
      .hi = HUGE_VAL, .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "damping", .kind = &K_MAP, .aux = damping_fields},
+    {.key = "damping", .kind = &amfi_cfg_k_map, .aux = damping_fields},
     {.key = "supports", .kind = &K_SUPPORTS, .aux = &support_list},
     {.key = "segments", .kind = &K_SEGMENTS, .aux = &segment_list},
-    {.key = "damage", .kind = &K_DOUBLE, .off = SC(bridge.damage), .lo = 0, .hi = 1,
+    {.key = "damage", .kind = &amfi_cfg_k_double, .off = SC(bridge.damage), .lo = 0, .hi = 1,
      .flags = F_HI_OPEN},
     {.key = NULL}};
 
-int bridge_free_dofs(const amfi_bridge_params *b)
+int amfi_cfg_bridge_free_dofs(const amfi_bridge_params *b)
 {
     int restrained = 0;
 
@@ -282,54 +303,54 @@ int bridge_free_dofs(const amfi_bridge_params *b)
 }
 
 /* Without `supports` in the file, the roller follows bridge.span_m. */
-int bridge_check(ctx *x, amfi_site_config *c)
+int amfi_cfg_bridge_check(ctx *x, amfi_site_config *c)
 {
     amfi_bridge_params *b = &c->bridge;
     int node[AMFI_MAX_SUPPORTS];
     int ndof;
     char p[PATH_LEN];
 
-    if (!noted(x, "bridge.supports"))
+    if (!amfi_cfg_noted(x, "bridge.supports"))
         b->supports[b->n_supports - 1].x_m = b->span_m;
 
     /* Supports: on the beam, one per node, and the beam not a mechanism. */
     for (int i = 0; i < b->n_supports; i++) {
-        pathf(p, "bridge.supports[%d].at_m", i);
+        amfi_cfg_pathf(p, "bridge.supports[%d].at_m", i);
         if (b->supports[i].x_m > b->span_m)
-            return fail(x, first_noted(x, p, "bridge.span_m", NULL), p,
+            return amfi_cfg_fail(x, amfi_cfg_first_noted(x, p, "bridge.span_m", NULL), p,
                         "%g m is beyond the span (bridge.span_m = %g m)",
                         b->supports[i].x_m, b->span_m);
         node[i] = (int)lround(b->supports[i].x_m / b->span_m * b->n_elements);
         for (int j = 0; j < i; j++)
             if (node[j] == node[i])
-                return fail(x, first_noted(x, p, "bridge.elements", NULL), p,
+                return amfi_cfg_fail(x, amfi_cfg_first_noted(x, p, "bridge.elements", NULL), p,
                             "falls on node %d (of %d elements), like "
                             "bridge.supports[%d]", node[i], b->n_elements, j);
     }
     if (b->n_supports == 1 && !b->supports[0].restrain_theta &&
         !(b->supports[0].k_theta_nmprad > 0))
-        return fail(x, noted(x, "bridge.supports"), "bridge.supports",
+        return amfi_cfg_fail(x, amfi_cfg_noted(x, "bridge.supports"), "bridge.supports",
                     "a single support without a held or sprung rotation leaves the beam "
                     "free to rotate; make it fixed or add a support");
 
     /* Segments: on the beam, apart. */
     for (int i = 0; i < b->n_segments; i++) {
-        pathf(p, "bridge.segments[%d]", i);
+        amfi_cfg_pathf(p, "bridge.segments[%d]", i);
         if (b->segments[i].x1_m > b->span_m)
-            return fail(x, first_noted(x, p, "bridge.span_m", NULL), p,
+            return amfi_cfg_fail(x, amfi_cfg_first_noted(x, p, "bridge.span_m", NULL), p,
                         "to_m %g m is beyond the span (bridge.span_m = %g m)",
                         b->segments[i].x1_m, b->span_m);
         for (int j = 0; j < i; j++)
             if (b->segments[i].x0_m < b->segments[j].x1_m &&
                 b->segments[j].x0_m < b->segments[i].x1_m)
-                return fail(x, noted(x, p), p, "overlaps bridge.segments[%d] ([%g, %g) m)", j,
+                return amfi_cfg_fail(x, amfi_cfg_noted(x, p), p, "overlaps bridge.segments[%d] ([%g, %g) m)", j,
                             b->segments[j].x0_m, b->segments[j].x1_m);
     }
 
     /* Mode numbers within the model's free DOFs. */
-    ndof = bridge_free_dofs(b);
+    ndof = amfi_cfg_bridge_free_dofs(b);
     if (b->rayleigh_mode_a > ndof || b->rayleigh_mode_b > ndof)
-        return fail(x, first_noted(x, "bridge.damping.modes", "bridge.elements", NULL),
+        return amfi_cfg_fail(x, amfi_cfg_first_noted(x, "bridge.damping.modes", "bridge.elements", NULL),
                     "bridge.damping.modes", "the model has only %d modes (free DOFs)",
                     ndof);
     return 0;

@@ -15,64 +15,65 @@
 #include <string.h>
 
 #define DC(m) offsetof(amfi_site_config, daemon.m)
-#define STR(k, m, minlen) \
-    {.key = k, .kind = &K_STRING, .off = DC(m), .lo = minlen, \
-     .hi = sizeof(((amfi_daemon_config *)0)->m)}
+#define STRF(k, m, minlen, fl) \
+    {.key = k, .kind = &amfi_cfg_k_string, .off = DC(m), .lo = minlen, \
+     .hi = sizeof(((amfi_daemon_config *)0)->m), .flags = fl}
+#define STR(k, m, minlen) STRF(k, m, minlen, 0)
 
 static const field channel_fields[] = {
     STR("accel", ch_accel, 1),     STR("vehicle", ch_vehicle, 1),
-    STR("truth", ch_truth, 1),     STR("passage", ch_passage, 1),
-    STR("indicator", ch_indicator, 1), STR("alert", ch_alert, 1),
-    STR("status", ch_status, 1),   STR("environment", ch_environment, 1),
+    STR("truth", ch_truth, 1),     STRF("passage", ch_passage, 1, F_LIVE),
+    STRF("indicator", ch_indicator, 1, F_LIVE), STRF("alert", ch_alert, 1, F_LIVE),
+    STRF("status", ch_status, 1, F_LIVE),   STR("environment", ch_environment, 1),
     {.key = NULL}};
 
 static const enum_name auth_names[] = {{"off", 0}, {"required", 1}, {NULL, 0}};
 
 static const field bus_fields[] = {
-    {.key = "auth", .kind = &K_ENUM, .off = DC(bus_auth), .aux = auth_names},
+    {.key = "auth", .kind = &amfi_cfg_k_enum, .off = DC(bus_auth), .aux = auth_names},
     STR("key_file", bus_key_file, 1),
-    {.key = "max_skew_s", .kind = &K_DOUBLE, .off = DC(bus_max_skew_s), .lo = 1, .hi = 86400},
+    {.key = "max_skew_s", .kind = &amfi_cfg_k_double, .off = DC(bus_max_skew_s), .lo = 1, .hi = 86400},
     {.key = NULL}};
 
 static const enum_name sync_names[] = {{"normal", 0}, {"full", 1}, {NULL, 0}};
 
 static const field store_fields[] = {
     STR("path", db_path, 1),
-    {.key = "sync", .kind = &K_ENUM, .off = DC(sync_full), .aux = sync_names},
-    {.key = "held_max_bytes", .kind = &K_LLONG, .off = DC(held_max_bytes), .lo = 1048576,
-     .hi = 68719476736.0},
+    {.key = "sync", .kind = &amfi_cfg_k_enum, .off = DC(sync_full), .aux = sync_names},
+    {.key = "held_max_bytes", .kind = &amfi_cfg_k_llong, .off = DC(held_max_bytes),
+     .lo = 1048576, .hi = 68719476736.0},
     {.key = NULL}};
 
 /* Offsets of the engine's amfi_indicator_params inside the site config. */
 #define IND(m) DC(indicators.m)
 
-const enum_name onoff_names[] = {{"off", 0}, {"on", 1}, {NULL, 0}};
+const enum_name amfi_cfg_onoff_names[] = {{"off", 0}, {"on", 1}, {NULL, 0}};
 static const enum_name bool_names[] = {{"false", 0}, {"true", 1}, {NULL, 0}};
 static const enum_name temperature_names[] = {{"raw", 0}, {"compensated", 1}, {NULL, 0}};
 
 static const field indicator_fields[] = {
-    {.key = "window", .kind = &K_INT, .off = IND(window), .lo = 10, .hi = 1000000},
-    {.key = "every", .kind = &K_INT, .off = IND(every), .lo = 1, .hi = 1000000},
-    {.key = "baseline_n", .kind = &K_INT, .off = IND(baseline_n), .lo = 10, .hi = 1000000},
-    {.key = "std_alert_ratio", .kind = &K_DOUBLE, .off = IND(std_alert_ratio), .lo = 1,
+    {.key = "window", .kind = &amfi_cfg_k_int, .off = IND(window), .lo = 10, .hi = 1000000},
+    {.key = "every", .kind = &amfi_cfg_k_int, .off = IND(every), .lo = 1, .hi = 1000000},
+    {.key = "baseline_n", .kind = &amfi_cfg_k_int, .off = IND(baseline_n), .lo = 10, .hi = 1000000},
+    {.key = "std_alert_ratio", .kind = &amfi_cfg_k_double, .off = IND(std_alert_ratio), .lo = 1,
      .hi = 10},
-    {.key = "std_alert_p", .kind = &K_DOUBLE, .off = IND(std_alert_p), .lo = 0, .hi = 1,
+    {.key = "std_alert_p", .kind = &amfi_cfg_k_double, .off = IND(std_alert_p), .lo = 0, .hi = 1,
      .flags = F_LO_OPEN},
-    {.key = "std_clear_ratio", .kind = &K_DOUBLE, .off = IND(std_clear_ratio), .lo = 0.5,
+    {.key = "std_clear_ratio", .kind = &amfi_cfg_k_double, .off = IND(std_clear_ratio), .lo = 0.5,
      .hi = 10},
-    {.key = "raise_after", .kind = &K_INT, .off = IND(raise_after), .lo = 1, .hi = 1000},
-    {.key = "clear_after", .kind = &K_INT, .off = IND(clear_after), .lo = 1, .hi = 1000},
-    {.key = "mean_shift", .kind = &K_ENUM, .off = IND(mean_shift), .aux = onoff_names},
-    {.key = "mean_alert_ratio", .kind = &K_DOUBLE, .off = IND(mean_alert_ratio), .lo = 1,
+    {.key = "raise_after", .kind = &amfi_cfg_k_int, .off = IND(raise_after), .lo = 1, .hi = 1000},
+    {.key = "clear_after", .kind = &amfi_cfg_k_int, .off = IND(clear_after), .lo = 1, .hi = 1000},
+    {.key = "mean_shift", .kind = &amfi_cfg_k_enum, .off = IND(mean_shift), .aux = amfi_cfg_onoff_names},
+    {.key = "mean_alert_ratio", .kind = &amfi_cfg_k_double, .off = IND(mean_alert_ratio), .lo = 1,
      .hi = 10},
-    {.key = "mean_alert_p", .kind = &K_DOUBLE, .off = IND(mean_alert_p), .lo = 0, .hi = 1,
+    {.key = "mean_alert_p", .kind = &amfi_cfg_k_double, .off = IND(mean_alert_p), .lo = 0, .hi = 1,
      .flags = F_LO_OPEN},
-    {.key = "mean_clear_ratio", .kind = &K_DOUBLE, .off = IND(mean_clear_ratio), .lo = 0.5,
+    {.key = "mean_clear_ratio", .kind = &amfi_cfg_k_double, .off = IND(mean_clear_ratio), .lo = 0.5,
      .hi = 10},
     /* amfid's filter in front of the engine (pipeline.c), not an engine parameter */
-    {.key = "single_presence_only", .kind = &K_ENUM, .off = DC(single_presence_only),
-     .aux = onoff_names},
-    {.key = "temperature", .kind = &K_ENUM, .off = DC(ind_temp_compensated),
+    {.key = "single_presence_only", .kind = &amfi_cfg_k_enum, .off = DC(single_presence_only),
+     .aux = amfi_cfg_onoff_names},
+    {.key = "temperature", .kind = &amfi_cfg_k_enum, .off = DC(ind_temp_compensated),
      .aux = temperature_names},
     {.key = NULL}};
 
@@ -80,85 +81,85 @@ static const field indicator_fields[] = {
 #define NF(m) DC(natfreq.m)
 
 static const field natfreq_fields[] = {
-    {.key = "free_s", .kind = &K_DOUBLE, .off = DC(natfreq_free_s), .lo = 0, .hi = 30},
-    {.key = "f_lo_hz", .kind = &K_DOUBLE, .off = NF(f_lo_hz), .lo = 0, .hi = 1000,
+    {.key = "free_s", .kind = &amfi_cfg_k_double, .off = DC(natfreq_free_s), .lo = 0, .hi = 30},
+    {.key = "f_lo_hz", .kind = &amfi_cfg_k_double, .off = NF(f_lo_hz), .lo = 0, .hi = 1000,
      .flags = F_LO_OPEN},
-    {.key = "f_hi_hz", .kind = &K_DOUBLE, .off = NF(f_hi_hz), .lo = 0, .hi = 1000,
+    {.key = "f_hi_hz", .kind = &amfi_cfg_k_double, .off = NF(f_hi_hz), .lo = 0, .hi = 1000,
      .flags = F_LO_OPEN},
-    {.key = "modes", .kind = &K_INT, .off = NF(n_modes), .lo = 1, .hi = AMFI_NATFREQ_MAX_MODES},
-    {.key = "min_periods", .kind = &K_DOUBLE, .off = NF(min_periods), .lo = 1, .hi = 1000},
-    {.key = "min_r2", .kind = &K_DOUBLE, .off = NF(min_r2), .lo = 0, .hi = 1,
+    {.key = "modes", .kind = &amfi_cfg_k_int, .off = NF(n_modes), .lo = 1, .hi = AMFI_NATFREQ_MAX_MODES},
+    {.key = "min_periods", .kind = &amfi_cfg_k_double, .off = NF(min_periods), .lo = 1, .hi = 1000},
+    {.key = "min_r2", .kind = &amfi_cfg_k_double, .off = NF(min_r2), .lo = 0, .hi = 1,
      .flags = F_HI_OPEN},
-    {.key = "max_zeta", .kind = &K_DOUBLE, .off = NF(max_zeta), .lo = 0, .hi = 1,
+    {.key = "max_zeta", .kind = &amfi_cfg_k_double, .off = NF(max_zeta), .lo = 0, .hi = 1,
      .flags = F_LO_OPEN | F_HI_OPEN},
-    {.key = "max_se_frac", .kind = &K_DOUBLE, .off = NF(max_se_frac), .lo = 0, .hi = 1,
+    {.key = "max_se_frac", .kind = &amfi_cfg_k_double, .off = NF(max_se_frac), .lo = 0, .hi = 1,
      .flags = F_LO_OPEN},
-    {.key = "baseline_n", .kind = &K_INT, .off = DC(natfreq_baseline_n), .lo = 10,
+    {.key = "baseline_n", .kind = &amfi_cfg_k_int, .off = DC(natfreq_baseline_n), .lo = 10,
      .hi = 100000},
     {.key = NULL}};
 
 static const field intake_fields[] = {
-    {.key = "vehicle_ahead_s", .kind = &K_DOUBLE, .off = DC(vehicle_ahead_s), .lo = 1,
-     .hi = 3600},
-    {.key = "min_speed_mps", .kind = &K_DOUBLE, .off = DC(min_speed_mps), .lo = 1, .hi = 60,
-     .flags = F_HI_OPEN},
-    {.key = "max_length_m", .kind = &K_DOUBLE, .off = DC(max_length_m), .lo = 1, .hi = 360},
-    {.key = "accel_margin", .kind = &K_DOUBLE, .off = DC(accel_margin), .lo = 1, .hi = 1000},
-    {.key = "vehicles_per_s", .kind = &K_DOUBLE, .off = DC(vehicles_per_s), .lo = 0.1,
-     .hi = 1e5},
-    {.key = "environment_per_s", .kind = &K_DOUBLE, .off = DC(environment_per_s), .lo = 0.1,
-     .hi = 1e5},
-    {.key = "truth_per_s", .kind = &K_DOUBLE, .off = DC(truth_per_s), .lo = 0.1, .hi = 1e5},
-    {.key = "burst_s", .kind = &K_DOUBLE, .off = DC(burst_s), .lo = 1, .hi = 3600},
-    {.key = "summary_period_s", .kind = &K_DOUBLE, .off = DC(summary_period_s), .lo = 1,
-     .hi = 86400},
-    {.key = "environment_min_interval_s", .kind = &K_DOUBLE, .off = DC(env_min_interval_s),
-     .lo = 0, .hi = 86400},
-    {.key = "deck_max_rate_c_per_min", .kind = &K_DOUBLE, .off = DC(deck_max_rate_c_min),
-     .lo = 0, .hi = 1e6, .flags = F_LO_OPEN},
-    STR("calibration_sources", calibration_sources, 0),
-    {.key = "calibration_min_kg", .kind = &K_DOUBLE, .off = DC(calibration_min_kg),
-     .lo = 1000, .hi = 100000},
-    {.key = "calibration_max_kg", .kind = &K_DOUBLE, .off = DC(calibration_max_kg),
-     .lo = 1000, .hi = 100000},
+    {.key = "vehicle_ahead_s", .kind = &amfi_cfg_k_double, .off = DC(vehicle_ahead_s), .lo = 1,
+     .hi = 3600, .flags = F_LIVE},
+    {.key = "min_speed_mps", .kind = &amfi_cfg_k_double, .off = DC(min_speed_mps), .lo = 1, .hi = 60,
+     .flags = F_HI_OPEN | F_LIVE},
+    {.key = "max_length_m", .kind = &amfi_cfg_k_double, .off = DC(max_length_m), .lo = 1, .hi = 360, .flags = F_LIVE},
+    {.key = "accel_margin", .kind = &amfi_cfg_k_double, .off = DC(accel_margin), .lo = 1, .hi = 1000, .flags = F_LIVE},
+    {.key = "vehicles_per_s", .kind = &amfi_cfg_k_double, .off = DC(vehicles_per_s), .lo = 0.1,
+     .hi = 1e5, .flags = F_LIVE},
+    {.key = "environment_per_s", .kind = &amfi_cfg_k_double, .off = DC(environment_per_s), .lo = 0.1,
+     .hi = 1e5, .flags = F_LIVE},
+    {.key = "truth_per_s", .kind = &amfi_cfg_k_double, .off = DC(truth_per_s), .lo = 0.1, .hi = 1e5, .flags = F_LIVE},
+    {.key = "burst_s", .kind = &amfi_cfg_k_double, .off = DC(burst_s), .lo = 1, .hi = 3600, .flags = F_LIVE},
+    {.key = "summary_period_s", .kind = &amfi_cfg_k_double, .off = DC(summary_period_s), .lo = 1,
+     .hi = 86400, .flags = F_LIVE},
+    {.key = "environment_min_interval_s", .kind = &amfi_cfg_k_double, .off = DC(env_min_interval_s),
+     .lo = 0, .hi = 86400, .flags = F_LIVE},
+    {.key = "deck_max_rate_c_per_min", .kind = &amfi_cfg_k_double, .off = DC(deck_max_rate_c_min),
+     .lo = 0, .hi = 1e6, .flags = F_LO_OPEN | F_LIVE},
+    STRF("calibration_sources", calibration_sources, 0, F_LIVE),
+    {.key = "calibration_min_kg", .kind = &amfi_cfg_k_double, .off = DC(calibration_min_kg),
+     .lo = 1000, .hi = 100000, .flags = F_LIVE},
+    {.key = "calibration_max_kg", .kind = &amfi_cfg_k_double, .off = DC(calibration_max_kg),
+     .lo = 1000, .hi = 100000, .flags = F_LIVE},
     {.key = NULL}};
 
-const field daemon_fields[] = {
+const field amfi_cfg_daemon_fields[] = {
     STR("lcm_url", lcm_url, 0),
-    {.key = "channels", .kind = &K_MAP, .aux = channel_fields},
-    {.key = "bus", .kind = &K_MAP, .aux = bus_fields},
-    {.key = "simulation", .kind = &K_ENUM, .off = DC(simulation), .aux = bool_names},
-    {.key = "store", .kind = &K_MAP, .aux = store_fields},
-    {.key = "workers", .kind = &K_INT, .off = DC(workers), .lo = 1, .hi = 64},
-    {.key = "queue_size", .kind = &K_INT, .off = DC(queue_size), .lo = 1, .hi = 100000},
-    {.key = "recv_buf_bytes", .kind = &K_INT, .off = DC(recv_buf_bytes), .lo = 0,
+    {.key = "channels", .kind = &amfi_cfg_k_map, .aux = channel_fields},
+    {.key = "bus", .kind = &amfi_cfg_k_map, .aux = bus_fields},
+    {.key = "simulation", .kind = &amfi_cfg_k_enum, .off = DC(simulation), .aux = bool_names},
+    {.key = "store", .kind = &amfi_cfg_k_map, .aux = store_fields},
+    {.key = "workers", .kind = &amfi_cfg_k_int, .off = DC(workers), .lo = 1, .hi = 64},
+    {.key = "queue_size", .kind = &amfi_cfg_k_int, .off = DC(queue_size), .lo = 1, .hi = 100000},
+    {.key = "recv_buf_bytes", .kind = &amfi_cfg_k_int, .off = DC(recv_buf_bytes), .lo = 0,
      .hi = 1073741824},
-    {.key = "bus_queue", .kind = &K_INT, .off = DC(bus_queue), .lo = 30, .hi = 1000000},
-    {.key = "ring_s", .kind = &K_DOUBLE, .off = DC(ring_s), .lo = 5, .hi = 3600},
-    {.key = "environment_max_skew_s", .kind = &K_DOUBLE, .off = DC(environment_max_skew_s),
-     .lo = 1, .hi = 864000},
-    {.key = "window_margin_s", .kind = &K_DOUBLE, .off = DC(margin_s), .lo = 0, .hi = 5},
-    {.key = "max_wait_s", .kind = &K_DOUBLE, .off = DC(max_wait_s), .lo = 0, .hi = 3600,
-     .flags = F_LO_OPEN},
-    {.key = "max_event_s", .kind = &K_DOUBLE, .off = DC(max_event_s), .lo = 0, .hi = 600},
-    {.key = "max_event_axles", .kind = &K_INT, .off = DC(max_event_axles), .lo = 2,
+    {.key = "bus_queue", .kind = &amfi_cfg_k_int, .off = DC(bus_queue), .lo = 30, .hi = 1000000},
+    {.key = "ring_s", .kind = &amfi_cfg_k_double, .off = DC(ring_s), .lo = 5, .hi = 3600},
+    {.key = "environment_max_skew_s", .kind = &amfi_cfg_k_double, .off = DC(environment_max_skew_s),
+     .lo = 1, .hi = 864000, .flags = F_LIVE},
+    {.key = "window_margin_s", .kind = &amfi_cfg_k_double, .off = DC(margin_s), .lo = 0, .hi = 5},
+    {.key = "max_wait_s", .kind = &amfi_cfg_k_double, .off = DC(max_wait_s), .lo = 0, .hi = 3600,
+     .flags = F_LO_OPEN | F_LIVE},
+    {.key = "max_event_s", .kind = &amfi_cfg_k_double, .off = DC(max_event_s), .lo = 0, .hi = 600},
+    {.key = "max_event_axles", .kind = &amfi_cfg_k_int, .off = DC(max_event_axles), .lo = 2,
      .hi = AMFI_MAX_AXLES},
-    {.key = "inseparable_gap_m", .kind = &K_DOUBLE, .off = DC(inseparable_gap_m), .lo = 0,
+    {.key = "inseparable_gap_m", .kind = &amfi_cfg_k_double, .off = DC(inseparable_gap_m), .lo = 0,
      .hi = 10},
-    {.key = "inseparable_share", .kind = &K_DOUBLE, .off = DC(inseparable_share), .lo = 0,
+    {.key = "inseparable_share", .kind = &amfi_cfg_k_double, .off = DC(inseparable_share), .lo = 0,
      .hi = 1, .flags = F_LO_OPEN},
-    {.key = "inseparable_quality", .kind = &K_DOUBLE, .off = DC(inseparable_quality), .lo = 1,
+    {.key = "inseparable_quality", .kind = &amfi_cfg_k_double, .off = DC(inseparable_quality), .lo = 1,
      .hi = 1e9},
-    {.key = "inseparable_quality_lanes", .kind = &K_DOUBLE,
+    {.key = "inseparable_quality_lanes", .kind = &amfi_cfg_k_double,
      .off = DC(inseparable_quality_lanes), .lo = 1, .hi = 1e9},
-    {.key = "status_period_s", .kind = &K_DOUBLE, .off = DC(status_period_s), .lo = 0.1,
-     .hi = 3600},
-    {.key = "indicators", .kind = &K_MAP, .aux = indicator_fields},
-    {.key = "natural_frequency", .kind = &K_MAP, .aux = natfreq_fields},
-    {.key = "intake", .kind = &K_MAP, .aux = intake_fields},
+    {.key = "status_period_s", .kind = &amfi_cfg_k_double, .off = DC(status_period_s), .lo = 0.1,
+     .hi = 3600, .flags = F_LIVE},
+    {.key = "indicators", .kind = &amfi_cfg_k_map, .aux = indicator_fields},
+    {.key = "natural_frequency", .kind = &amfi_cfg_k_map, .aux = natfreq_fields},
+    {.key = "intake", .kind = &amfi_cfg_k_map, .aux = intake_fields},
     {.key = NULL}};
 
-int daemon_check(ctx *x, amfi_site_config *c)
+int amfi_cfg_daemon_check(ctx *x, amfi_site_config *c)
 {
     const char *blamed = NULL;
     char why[256], path[PATH_LEN];
@@ -167,7 +168,7 @@ int daemon_check(ctx *x, amfi_site_config *c)
     /* an event's samples must still be in the ring when its last vehicle
      * has left (tracker.h): the ring holds more than the longest event */
     if (c->daemon.max_event_s >= c->daemon.ring_s)
-        return fail(x, first_noted(x, "daemon.max_event_s", "daemon.ring_s", "daemon"),
+        return amfi_cfg_fail(x, amfi_cfg_first_noted(x, "daemon.max_event_s", "daemon.ring_s", "daemon"),
                     "daemon.max_event_s",
                     "%g s is not below daemon.ring_s (%g s): an event's samples would leave "
                     "the ring before it ends",
@@ -175,8 +176,8 @@ int daemon_check(ctx *x, amfi_site_config *c)
 
     /* and the free vibration after it (the natural frequency) */
     if (c->daemon.max_event_s + c->daemon.natfreq_free_s >= c->daemon.ring_s)
-        return fail(x,
-                    first_noted(x, "daemon.natural_frequency.free_s", "daemon.ring_s", "daemon"),
+        return amfi_cfg_fail(x,
+                    amfi_cfg_first_noted(x, "daemon.natural_frequency.free_s", "daemon.ring_s", "daemon"),
                     "daemon.natural_frequency.free_s",
                     "%g s after an event of up to daemon.max_event_s (%g s) is not below "
                     "daemon.ring_s (%g s): the free vibration would leave the ring first",
@@ -185,8 +186,8 @@ int daemon_check(ctx *x, amfi_site_config *c)
     /* the calibration trucks' range, and their sources: names separated by
      * commas, each 1 .. 63 bytes of A-Z a-z 0-9 _ . - (vehicle_t.source) */
     if (c->daemon.calibration_min_kg > c->daemon.calibration_max_kg)
-        return fail(x,
-                    first_noted(x, "daemon.intake.calibration_max_kg",
+        return amfi_cfg_fail(x,
+                    amfi_cfg_first_noted(x, "daemon.intake.calibration_max_kg",
                                 "daemon.intake.calibration_min_kg", "daemon"),
                     "daemon.intake.calibration_max_kg", "%g kg is below calibration_min_kg (%g kg)",
                     c->daemon.calibration_max_kg, c->daemon.calibration_min_kg);
@@ -196,11 +197,11 @@ int daemon_check(ctx *x, amfi_site_config *c)
         for (const char *p = s;; p++) {
             if (*p == ',' || *p == '\0') {
                 if (len == 0 && (*p == ',' || p != s))
-                    return fail(x, first_noted(x, "daemon.intake.calibration_sources", "daemon", NULL),
+                    return amfi_cfg_fail(x, amfi_cfg_first_noted(x, "daemon.intake.calibration_sources", "daemon", NULL),
                                 "daemon.intake.calibration_sources",
                                 "an empty name in '%s' (names separated by single commas)", s);
                 if (len > 63)
-                    return fail(x, first_noted(x, "daemon.intake.calibration_sources", "daemon", NULL),
+                    return amfi_cfg_fail(x, amfi_cfg_first_noted(x, "daemon.intake.calibration_sources", "daemon", NULL),
                                 "daemon.intake.calibration_sources",
                                 "a name longer than 63 bytes in '%s'", s);
                 if (*p == '\0')
@@ -210,7 +211,7 @@ int daemon_check(ctx *x, amfi_site_config *c)
                        (*p >= '0' && *p <= '9') || *p == '_' || *p == '.' || *p == '-') {
                 len++;
             } else {
-                return fail(x, first_noted(x, "daemon.intake.calibration_sources", "daemon", NULL),
+                return amfi_cfg_fail(x, amfi_cfg_first_noted(x, "daemon.intake.calibration_sources", "daemon", NULL),
                             "daemon.intake.calibration_sources",
                             "'%c' in '%s': names are A-Z a-z 0-9 _ . - separated by commas", *p,
                             s);
@@ -220,20 +221,20 @@ int daemon_check(ctx *x, amfi_site_config *c)
 
     /* the band's two ends (each key's own range is the table's) */
     if (amfi_natfreq_params_check(&c->daemon.natfreq, why, sizeof why) != 0)
-        return fail(x,
-                    first_noted(x, "daemon.natural_frequency.f_hi_hz",
+        return amfi_cfg_fail(x,
+                    amfi_cfg_first_noted(x, "daemon.natural_frequency.f_hi_hz",
                                 "daemon.natural_frequency.f_lo_hz", "daemon"),
                     "daemon.natural_frequency.f_hi_hz", "%s", why);
 
     if (amfi_indicator_params_check(&c->daemon.indicators, &blamed, why, sizeof why) == 0)
         return 0;
-    pathf(path, "daemon.indicators.%s", blamed ? blamed : "");
+    amfi_cfg_pathf(path, "daemon.indicators.%s", blamed ? blamed : "");
     /* The key blamed, else the latest indicator key given (the one that
      * moved a limit past the blamed key's default), else the section. */
-    line = noted(x, path);
+    line = amfi_cfg_noted(x, path);
     if (!line)
-        line = noted_under(x, "daemon.indicators.");
+        line = amfi_cfg_noted_under(x, "daemon.indicators.");
     if (!line)
-        line = first_noted(x, "daemon.indicators", "daemon", NULL);
-    return fail(x, line, path, "%s", why);
+        line = amfi_cfg_first_noted(x, "daemon.indicators", "daemon", NULL);
+    return amfi_cfg_fail(x, line, path, "%s", why);
 }

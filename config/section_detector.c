@@ -9,9 +9,6 @@
  */
 #include "sections.h"
 
-#define DET(m) offsetof(amfi_site_config, detector.m)
-
-const field detector_fields[] = {
-    {.key = "clock_offset_s", .kind = &K_DOUBLE, .off = DET(clock_offset_s), .lo = -1, .hi = 1},
-    {.key = "speed_scale", .kind = &K_DOUBLE, .off = DET(speed_scale), .lo = 0.5, .hi = 2},
+const field amfi_cfg_detector_fields[] = {
+    AMFI_CFG_DETECTOR_ROWS(offsetof(amfi_site_config, detector)),
     {.key = NULL}};

@@ -22,10 +22,10 @@
 #define DRIFT(m) OPS(speed_drift.m)
 
 static const field speed_drift_fields[] = {
-    {.key = "enabled", .kind = &K_ENUM, .off = DRIFT(enabled), .aux = onoff_names},
-    {.key = "window", .kind = &K_INT, .off = DRIFT(window), .lo = 2,
+    {.key = "enabled", .kind = &amfi_cfg_k_enum, .off = DRIFT(enabled), .aux = amfi_cfg_onoff_names},
+    {.key = "window", .kind = &amfi_cfg_k_int, .off = DRIFT(window), .lo = 2,
      .hi = AMFI_SPEED_DRIFT_MAX_WINDOW},
-    {.key = "threshold", .kind = &K_DOUBLE, .off = DRIFT(threshold), .lo = 0,
+    {.key = "threshold", .kind = &amfi_cfg_k_double, .off = DRIFT(threshold), .lo = 0,
      .hi = AMFI_SPEED_DRIFT_MAX_THRESHOLD, .flags = F_LO_OPEN},
     {.key = NULL}};
 
@@ -35,62 +35,62 @@ static const field speed_drift_fields[] = {
  * too, for the cross-field rules: floor_c below knee_c, block times
  * baseline_blocks). */
 static const field scale_fields[] = {
-    {.key = "enabled", .kind = &K_ENUM, .off = OPS(scale_enabled), .aux = onoff_names},
-    {.key = "max_temp_gap_s", .kind = &K_DOUBLE, .off = OPS(scale_max_temp_gap_s), .lo = 1,
+    {.key = "enabled", .kind = &amfi_cfg_k_enum, .off = OPS(scale_enabled), .aux = amfi_cfg_onoff_names},
+    {.key = "max_temp_gap_s", .kind = &amfi_cfg_k_double, .off = OPS(scale_max_temp_gap_s), .lo = 1,
      .hi = 86400},
-    {.key = "block", .kind = &K_INT, .off = SCALE(block), .lo = 50, .hi = 1000000},
-    {.key = "baseline_blocks", .kind = &K_INT, .off = SCALE(baseline_blocks), .lo = 4,
+    {.key = "block", .kind = &amfi_cfg_k_int, .off = SCALE(block), .lo = 50, .hi = 1000000},
+    {.key = "baseline_blocks", .kind = &amfi_cfg_k_int, .off = SCALE(baseline_blocks), .lo = 4,
      .hi = 10000},
-    {.key = "class_split_kg", .kind = &K_DOUBLE, .off = SCALE(class_split_kg), .lo = 100,
+    {.key = "class_split_kg", .kind = &amfi_cfg_k_double, .off = SCALE(class_split_kg), .lo = 100,
      .hi = AMFI_IND_MAX_GVW_KG},
-    {.key = "share_range", .kind = &K_DOUBLE, .off = SCALE(share_range), .lo = 0.01, .hi = 1},
-    {.key = "ref_c", .kind = &K_DOUBLE, .off = SCALE(ref_c), .lo = -30, .hi = 40},
-    {.key = "knee_c", .kind = &K_DOUBLE, .off = SCALE(knee_c), .lo = -30, .hi = 30},
-    {.key = "floor_c", .kind = &K_DOUBLE, .off = SCALE(floor_c), .lo = -60, .hi = 29.5},
-    {.key = "warm_slope", .kind = &K_DOUBLE, .off = SCALE(warm_slope), .lo = -0.1, .hi = 0.1},
-    {.key = "frost_slope", .kind = &K_DOUBLE, .off = SCALE(frost_slope), .lo = -0.1, .hi = 0.1},
-    {.key = "slope_prior_sd", .kind = &K_DOUBLE, .off = SCALE(slope_prior_sd), .lo = 0,
+    {.key = "share_range", .kind = &amfi_cfg_k_double, .off = SCALE(share_range), .lo = 0.01, .hi = 1},
+    {.key = "ref_c", .kind = &amfi_cfg_k_double, .off = SCALE(ref_c), .lo = -30, .hi = 40},
+    {.key = "knee_c", .kind = &amfi_cfg_k_double, .off = SCALE(knee_c), .lo = -30, .hi = 30},
+    {.key = "floor_c", .kind = &amfi_cfg_k_double, .off = SCALE(floor_c), .lo = -60, .hi = 29.5},
+    {.key = "warm_slope", .kind = &amfi_cfg_k_double, .off = SCALE(warm_slope), .lo = -0.1, .hi = 0.1},
+    {.key = "frost_slope", .kind = &amfi_cfg_k_double, .off = SCALE(frost_slope), .lo = -0.1, .hi = 0.1},
+    {.key = "slope_prior_sd", .kind = &amfi_cfg_k_double, .off = SCALE(slope_prior_sd), .lo = 0,
      .hi = 0.1},
-    {.key = "design_shift", .kind = &K_DOUBLE, .off = SCALE(design_shift), .lo = 1e-4,
+    {.key = "design_shift", .kind = &amfi_cfg_k_double, .off = SCALE(design_shift), .lo = 1e-4,
      .hi = 0.5, .flags = F_HI_OPEN},
-    {.key = "false_alarms_per_year", .kind = &K_DOUBLE, .off = SCALE(false_alarms_per_year),
+    {.key = "false_alarms_per_year", .kind = &amfi_cfg_k_double, .off = SCALE(false_alarms_per_year),
      .lo = 1e-4, .hi = 1000},
-    {.key = "vehicles_per_day", .kind = &K_DOUBLE, .off = SCALE(vehicles_per_day), .lo = 1,
+    {.key = "vehicles_per_day", .kind = &amfi_cfg_k_double, .off = SCALE(vehicles_per_day), .lo = 1,
      .hi = 1e7},
-    {.key = "clear_after", .kind = &K_INT, .off = SCALE(clear_after), .lo = 1, .hi = 1000000},
+    {.key = "clear_after", .kind = &amfi_cfg_k_int, .off = SCALE(clear_after), .lo = 1, .hi = 1000000},
     {.key = NULL}};
 
 #define TRUCK(m) OPS(known_truck.m)
 
 static const field known_truck_fields[] = {
-    {.key = "enabled", .kind = &K_ENUM, .off = OPS(known_truck_enabled), .aux = onoff_names},
-    {.key = "baseline_runs", .kind = &K_INT, .off = TRUCK(baseline_runs), .lo = 2, .hi = 1000},
-    {.key = "run_sd", .kind = &K_DOUBLE, .off = TRUCK(run_sd), .lo = 1e-4, .hi = 1},
-    {.key = "design_shift", .kind = &K_DOUBLE, .off = TRUCK(design_shift), .lo = 1e-4,
+    {.key = "enabled", .kind = &amfi_cfg_k_enum, .off = OPS(known_truck_enabled), .aux = amfi_cfg_onoff_names},
+    {.key = "baseline_runs", .kind = &amfi_cfg_k_int, .off = TRUCK(baseline_runs), .lo = 2, .hi = 1000},
+    {.key = "run_sd", .kind = &amfi_cfg_k_double, .off = TRUCK(run_sd), .lo = 1e-4, .hi = 1},
+    {.key = "design_shift", .kind = &amfi_cfg_k_double, .off = TRUCK(design_shift), .lo = 1e-4,
      .hi = 0.5, .flags = F_HI_OPEN},
-    {.key = "false_alarms_per_year", .kind = &K_DOUBLE, .off = TRUCK(false_alarms_per_year),
+    {.key = "false_alarms_per_year", .kind = &amfi_cfg_k_double, .off = TRUCK(false_alarms_per_year),
      .lo = 1e-4, .hi = 1000},
-    {.key = "runs_per_year", .kind = &K_DOUBLE, .off = TRUCK(runs_per_year), .lo = 1,
+    {.key = "runs_per_year", .kind = &amfi_cfg_k_double, .off = TRUCK(runs_per_year), .lo = 1,
      .hi = 1e5},
-    {.key = "clear_after", .kind = &K_INT, .off = TRUCK(clear_after), .lo = 1, .hi = 1000000},
+    {.key = "clear_after", .kind = &amfi_cfg_k_int, .off = TRUCK(clear_after), .lo = 1, .hi = 1000000},
     {.key = NULL}};
 
-const field alerts_fields[] = {
-    {.key = "command", .kind = &K_PATH, .off = OPS(alert_command), .hi = OPS_CAP(alert_command)},
-    {.key = "command_timeout_s", .kind = &K_DOUBLE, .off = OPS(alert_timeout_s), .lo = 0,
+const field amfi_cfg_alerts_fields[] = {
+    {.key = "command", .kind = &amfi_cfg_k_path, .off = OPS(alert_command), .hi = OPS_CAP(alert_command)},
+    {.key = "command_timeout_s", .kind = &amfi_cfg_k_double, .off = OPS(alert_timeout_s), .lo = 0,
      .hi = 3600, .flags = F_LO_OPEN},
-    {.key = "command_max_running", .kind = &K_INT, .off = OPS(alert_max_running), .lo = 1,
+    {.key = "command_max_running", .kind = &amfi_cfg_k_int, .off = OPS(alert_max_running), .lo = 1,
      .hi = 64},
-    {.key = "command_stop_wait_s", .kind = &K_DOUBLE, .off = OPS(alert_stop_wait_s), .lo = 0,
+    {.key = "command_stop_wait_s", .kind = &amfi_cfg_k_double, .off = OPS(alert_stop_wait_s), .lo = 0,
      .hi = 30},
-    {.key = "speed_drift", .kind = &K_MAP, .aux = speed_drift_fields},
-    {.key = "scale", .kind = &K_MAP, .aux = scale_fields},
-    {.key = "known_truck", .kind = &K_MAP, .aux = known_truck_fields},
+    {.key = "speed_drift", .kind = &amfi_cfg_k_map, .aux = speed_drift_fields},
+    {.key = "scale", .kind = &amfi_cfg_k_map, .aux = scale_fields},
+    {.key = "known_truck", .kind = &amfi_cfg_k_map, .aux = known_truck_fields},
     {.key = NULL}};
 
-const field metrics_fields[] = {
-    {.key = "textfile", .kind = &K_PATH, .off = OPS(metrics_path), .hi = OPS_CAP(metrics_path)},
-    {.key = "interval_s", .kind = &K_DOUBLE, .off = OPS(metrics_interval_s), .lo = 1,
+const field amfi_cfg_metrics_fields[] = {
+    {.key = "textfile", .kind = &amfi_cfg_k_path, .off = OPS(metrics_path), .hi = OPS_CAP(metrics_path)},
+    {.key = "interval_s", .kind = &amfi_cfg_k_double, .off = OPS(metrics_interval_s), .lo = 1,
      .hi = 3600},
     {.key = NULL}};
 
@@ -99,16 +99,16 @@ const field metrics_fields[] = {
 static int blame(ctx *x, const char *section, const char *blamed, const char *why)
 {
     char path[PATH_LEN], sec[PATH_LEN];
-    pathf(path, "alerts.%s.%s", section, blamed ? blamed : "");
-    pathf(sec, "alerts.%s", section);
-    int line = noted(x, path);
-    return fail(x, line ? line : first_noted(x, sec, "alerts", NULL), path, "%s", why);
+    amfi_cfg_pathf(path, "alerts.%s.%s", section, blamed ? blamed : "");
+    amfi_cfg_pathf(sec, "alerts.%s", section);
+    int line = amfi_cfg_noted(x, path);
+    return amfi_cfg_fail(x, line ? line : amfi_cfg_first_noted(x, sec, "alerts", NULL), path, "%s", why);
 }
 
 /* The command must be a program amfid can run now (absolute: amfid runs
  * from / under systemd); the metrics file must be an absolute path whose
  * folder exists (node-exporter reads *.prom files there). */
-int ops_check(ctx *x, amfi_site_config *c)
+int amfi_cfg_ops_check(ctx *x, amfi_site_config *c)
 {
     const char *cmd = c->daemon.alert_command;
     const char *prom = c->daemon.metrics_path;
@@ -123,27 +123,27 @@ int ops_check(ctx *x, amfi_site_config *c)
     if (amfi_known_truck_params_check(&c->daemon.known_truck, &blamed, why, sizeof why) != 0)
         return blame(x, "known_truck", blamed, why);
     if (cmd[0]) {
-        int line = noted(x, "alerts.command");
+        int line = amfi_cfg_noted(x, "alerts.command");
         if (cmd[0] != '/')
-            return fail(x, line, "alerts.command", "must be an absolute path, got '%s'", cmd);
+            return amfi_cfg_fail(x, line, "alerts.command", "must be an absolute path, got '%s'", cmd);
         if (stat(cmd, &st) != 0 || !S_ISREG(st.st_mode))
-            return fail(x, line, "alerts.command", "'%s' is not a file", cmd);
+            return amfi_cfg_fail(x, line, "alerts.command", "'%s' is not a file", cmd);
         if (access(cmd, X_OK) != 0)
-            return fail(x, line, "alerts.command", "'%s' is not executable", cmd);
+            return amfi_cfg_fail(x, line, "alerts.command", "'%s' is not executable", cmd);
     }
     if (prom[0]) {
-        int line = noted(x, "metrics.textfile");
+        int line = amfi_cfg_noted(x, "metrics.textfile");
         const char *slash = strrchr(prom, '/');
         char dir[sizeof c->daemon.metrics_path];
         if (prom[0] != '/')
-            return fail(x, line, "metrics.textfile", "must be an absolute path, got '%s'", prom);
+            return amfi_cfg_fail(x, line, "metrics.textfile", "must be an absolute path, got '%s'", prom);
         size_t n = (size_t)(slash - prom);
         memcpy(dir, prom, n ? n : 1);
         dir[n ? n : 1] = '\0';
         if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
-            return fail(x, line, "metrics.textfile", "the folder '%s' does not exist", dir);
+            return amfi_cfg_fail(x, line, "metrics.textfile", "the folder '%s' does not exist", dir);
         if (!slash[1])
-            return fail(x, line, "metrics.textfile", "'%s' names a folder, not a file", prom);
+            return amfi_cfg_fail(x, line, "metrics.textfile", "'%s' names a folder, not a file", prom);
     }
     return 0;
 }

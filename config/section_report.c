@@ -13,13 +13,13 @@
 #define REP(m) offsetof(amfi_site_config, report.m)
 
 static const field limit_fields[] = {
-    {.key = "gvw_kg", .kind = &K_DOUBLE, .off = REP(gvw_limit_kg), .lo = 0, .hi = 1e6,
+    {.key = "gvw_kg", .kind = &amfi_cfg_k_double, .off = REP(gvw_limit_kg), .lo = 0, .hi = 1e6,
      .flags = F_LO_OPEN},
-    {.key = "axle_kg", .kind = &K_DOUBLE, .off = REP(axle_limit_kg), .lo = 0, .hi = 1e6,
+    {.key = "axle_kg", .kind = &amfi_cfg_k_double, .off = REP(axle_limit_kg), .lo = 0, .hi = 1e6,
      .flags = F_LO_OPEN},
     {.key = NULL}};
 
-const field report_fields[] = {
-    {.key = "limits", .kind = &K_MAP, .aux = limit_fields},
-    {.key = "histogram_bin_kg", .kind = &K_DOUBLE, .off = REP(bin_kg), .lo = 100, .hi = 1e5},
+const field amfi_cfg_report_fields[] = {
+    {.key = "limits", .kind = &amfi_cfg_k_map, .aux = limit_fields},
+    {.key = "histogram_bin_kg", .kind = &amfi_cfg_k_double, .off = REP(bin_kg), .lo = 100, .hi = 1e5},
     {.key = NULL}};

@@ -16,7 +16,7 @@
 #define ID_CAP sizeof(((amfi_site_identity *)0)->id)
 #define NAME_CAP sizeof(((amfi_site_identity *)0)->name)
 
-int amfi_site_id_valid(const char *s)
+int amfi_config_site_id_valid(const char *s)
 {
     size_t n = s ? strlen(s) : 0;
 
@@ -35,16 +35,16 @@ int amfi_site_id_valid(const char *s)
 static int p_id(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
     amfi_site_config *c = base;
-    const char *s = scalar(x, v, path, "a site id", 1);
+    const char *s = amfi_cfg_scalar(x, v, path, "a site id", 1);
 
     (void)f;
     if (!s)
         return -1;
-    if (!amfi_site_id_valid(s)) {
+    if (!amfi_config_site_id_valid(s)) {
         char shown[SHOW_LEN + 8];
-        return fail(x, line_of(v), path,
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path,
                     "must be 1 .. %zu bytes of A-Z a-z 0-9 _ . -, got '%s'", ID_CAP - 1,
-                    show(shown, sizeof shown, v));
+                    amfi_cfg_show(shown, sizeof shown, v));
     }
     memset(c->site.id, 0, ID_CAP);
     memcpy(c->site.id, s, strlen(s));
@@ -70,7 +70,7 @@ static int p_sname(ctx *x, yaml_node_t *v, const char *path, const field *f, voi
     amfi_site_config *c = base;
 
     (void)f;
-    return get_name(x, v, path, c->site.name, NAME_CAP);
+    return amfi_cfg_get_name(x, v, path, c->site.name, NAME_CAP);
 }
 
 static void d_sname(const field *f, const void *base, char *buf)
@@ -90,13 +90,13 @@ static void v_sname(const field *f, const void *base, char *buf)
 /* site.latitude / site.longitude: degrees (WGS 84); absent: unknown (NaN) */
 static int p_coord(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
-    return K_DOUBLE.parse(x, v, path, f, base);
+    return amfi_cfg_k_double.parse(x, v, path, f, base);
 }
 
 static void d_coord(const field *f, const void *base, char *buf)
 {
     (void)base;
-    describe_interval(f, buf);
+    amfi_cfg_describe_interval(f, buf);
 }
 
 static void v_coord(const field *f, const void *base, char *buf)
@@ -110,11 +110,26 @@ static void v_coord(const field *f, const void *base, char *buf)
         snprintf(buf, DOC_LEN, "%g", d);
 }
 
-static const kind K_SITE_ID = {"string", p_id, d_id, v_id, NEST_NONE};
-static const kind K_SITE_NAME = {"string", p_sname, d_sname, v_sname, NEST_NONE};
-static const kind K_COORD = {"number", p_coord, d_coord, v_coord, NEST_NONE};
+static int s_id(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(site.id), ID_CAP};
+    return 1;
+}
 
-const field site_fields[] = {
+static int s_sname(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(site.name), NAME_CAP};
+    return 1;
+}
+
+static const kind K_SITE_ID = {"string", p_id, d_id, v_id, NEST_NONE, s_id};
+static const kind K_SITE_NAME = {"string", p_sname, d_sname, v_sname, NEST_NONE, s_sname};
+static const kind K_COORD = {"number", p_coord, d_coord, v_coord, NEST_NONE,
+                             amfi_cfg_spans_double};
+
+const field amfi_cfg_site_fields[] = {
     {.key = "id", .kind = &K_SITE_ID},
     {.key = "name", .kind = &K_SITE_NAME},
     {.key = "latitude", .kind = &K_COORD, .off = SC(site.latitude), .lo = -90, .hi = 90},
@@ -124,15 +139,15 @@ const field site_fields[] = {
 
 /* site.name follows bridge.name when not given (bridge_check runs first);
  * a latitude without a longitude (or the reverse) is half a position. */
-int site_check(ctx *x, amfi_site_config *c)
+int amfi_cfg_site_check(ctx *x, amfi_site_config *c)
 {
-    if (!noted(x, "site.name")) {
+    if (!amfi_cfg_noted(x, "site.name")) {
         memset(c->site.name, 0, NAME_CAP);
         memcpy(c->site.name, c->name, sizeof c->name);
     }
     if (isnan(c->site.latitude) != isnan(c->site.longitude)) {
-        int line = first_noted(x, "site.latitude", "site.longitude", NULL);
-        return fail(x, line, isnan(c->site.latitude) ? "site.longitude" : "site.latitude",
+        int line = amfi_cfg_first_noted(x, "site.latitude", "site.longitude", NULL);
+        return amfi_cfg_fail(x, line, isnan(c->site.latitude) ? "site.longitude" : "site.latitude",
                     "give both site.latitude and site.longitude, or neither");
     }
     return 0;

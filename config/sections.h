@@ -35,35 +35,47 @@
 #define AMFI_CONFIG_MAX_STEPS 10000000.0
 #define AMFI_CONFIG_MAX_WORKSPACE_BYTES (1024.0 * 1024.0 * 1024.0)
 
-extern const field bridge_fields[]; /* bridge: */
-extern const kind K_SENSORS;        /* sensors: (a list of sensors_list) */
-extern const list_schema sensors_list;
-extern const field solver_fields[]; /* solver: */
-extern const field daemon_fields[]; /* daemon: */
-extern const field sim_fields[];    /* simulation: */
-extern const field site_fields[];   /* site: */
-extern const field alerts_fields[]; /* alerts: */
-extern const field metrics_fields[]; /* metrics: */
-extern const field report_fields[]; /* report: */
-extern const field detector_fields[]; /* detector: */
-extern const enum_name onoff_names[]; /* off | on (section_daemon.c) */
+/* The top level of a site file (amfi_config.c): the sections under it. */
+extern const field amfi_cfg_top_fields[];
+extern const field amfi_cfg_bridge_fields[]; /* bridge: */
+extern const kind amfi_cfg_k_sensors;        /* sensors: (a list of amfi_cfg_sensors_list) */
+extern const list_schema amfi_cfg_sensors_list;
+extern const field amfi_cfg_solver_fields[]; /* solver: */
+extern const field amfi_cfg_daemon_fields[]; /* daemon: */
+extern const field amfi_cfg_sim_fields[];    /* simulation: */
+extern const field amfi_cfg_site_fields[];   /* site: */
+extern const field amfi_cfg_alerts_fields[]; /* alerts: */
+extern const field amfi_cfg_metrics_fields[]; /* metrics: */
+extern const field amfi_cfg_report_fields[]; /* report: */
+extern const field amfi_cfg_detector_fields[]; /* detector: */
+
+/* The rows of detector.clock_offset_s and detector.speed_scale (names,
+ * meanings, ranges), for an amfi_detector_config at byte `at` of the base:
+ * the site file's detector: section and the as-built file's (whose
+ * amfi_detector_error starts alike, checked in as_built.c). */
+#define AMFI_CFG_DETECTOR_ROWS(at)                                                   \
+    {.key = "clock_offset_s", .kind = &amfi_cfg_k_double,                            \
+     .off = (at) + offsetof(amfi_detector_config, clock_offset_s), .lo = -1, .hi = 1}, \
+    {.key = "speed_scale", .kind = &amfi_cfg_k_double,                               \
+     .off = (at) + offsetof(amfi_detector_config, speed_scale), .lo = 0.5, .hi = 2}
+extern const enum_name amfi_cfg_onoff_names[]; /* off | on (section_daemon.c) */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */
-int bridge_free_dofs(const amfi_bridge_params *b);
+int amfi_cfg_bridge_free_dofs(const amfi_bridge_params *b);
 
 /* The checks of one section that involve several of its keys (or that
- * follow defaults of another, noted in each); 0 or −1 after fail(). */
-int bridge_check(ctx *x, amfi_site_config *c);
-int sensors_check(ctx *x, amfi_site_config *c);
-int solver_check(ctx *x, amfi_site_config *c);
-int daemon_check(ctx *x, amfi_site_config *c);
-int sim_check(ctx *x, amfi_site_config *c);
-int site_check(ctx *x, amfi_site_config *c);
-int ops_check(ctx *x, amfi_site_config *c);
+ * follow defaults of another, noted in each); 0 or −1 after amfi_cfg_fail(). */
+int amfi_cfg_bridge_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_sensors_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_solver_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_daemon_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_sim_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_site_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_ops_check(ctx *x, amfi_site_config *c);
 
 /* The model itself: the bridge built with libamfi (its refusals reported at
  * the line of the bridge key or section that caused them) and the solver's
  * workspace counted against the bounds above (section_solver.c). */
-int model_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_model_check(ctx *x, amfi_site_config *c);
 
 #endif /* AMFI_CONFIG_SECTIONS_H */

@@ -26,53 +26,53 @@ static int is_null(const char *s)
            !strcmp(s, "NULL");
 }
 
-int is_plain(const yaml_node_t *v)
+int amfi_cfg_is_plain(const yaml_node_t *v)
 {
     return v->data.scalar.style == YAML_PLAIN_SCALAR_STYLE;
 }
 
 /* The text of scalar node v, or NULL after an error saying what was `want`ed.
  * Numbers must be plain (unquoted) scalars: allow_quoted = 0. */
-int get_name(ctx *x, const yaml_node_t *v, const char *path, char *dst, size_t cap)
+int amfi_cfg_get_name(ctx *x, const yaml_node_t *v, const char *path, char *dst, size_t cap)
 {
-    const char *s = scalar(x, v, path, "a name", 1);
+    const char *s = amfi_cfg_scalar(x, v, path, "a name", 1);
     size_t n;
 
     if (!s)
         return -1;
     n = strlen(s);
     if (n == 0 || n >= cap)
-        return fail(x, line_of(v), path, "must be 1 .. %zu bytes long, got %zu", cap - 1, n);
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "must be 1 .. %zu bytes long, got %zu", cap - 1, n);
     for (size_t i = 0; i < n; i++)
         if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
-            return fail(x, line_of(v), path, "must not contain control characters");
+            return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "must not contain control characters");
     memset(dst, 0, cap);
     memcpy(dst, s, n);
     return 0;
 }
 
-const char *scalar(ctx *x, const yaml_node_t *v, const char *path,
+const char *amfi_cfg_scalar(ctx *x, const yaml_node_t *v, const char *path,
                           const char *want, int allow_quoted)
 {
     const char *s;
     char buf[SHOW_LEN];
 
     if (v->type != YAML_SCALAR_NODE) {
-        fail(x, line_of(v), path, "expected %s, got %s", want, what(v));
+        amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected %s, got %s", want, amfi_cfg_what(v));
         return NULL;
     }
     s = (const char *)v->data.scalar.value;
     if (strlen(s) != v->data.scalar.length) {
-        fail(x, line_of(v), path, "expected %s, got a value with a NUL byte", want);
+        amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected %s, got a value with a NUL byte", want);
         return NULL;
     }
-    if (is_plain(v) && is_null(s)) {
-        fail(x, line_of(v), path, "expected %s, got no value", want);
+    if (amfi_cfg_is_plain(v) && is_null(s)) {
+        amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected %s, got no value", want);
         return NULL;
     }
-    if (!is_plain(v) && !allow_quoted) {
-        fail(x, line_of(v), path, "expected %s, got the quoted string '%s'", want,
-             show(buf, sizeof buf, v));
+    if (!amfi_cfg_is_plain(v) && !allow_quoted) {
+        amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected %s, got the quoted string '%s'", want,
+             amfi_cfg_show(buf, sizeof buf, v));
         return NULL;
     }
     return s;
@@ -80,7 +80,7 @@ const char *scalar(ctx *x, const yaml_node_t *v, const char *path,
 
 /* Strict decimal floating point: digits, sign, point, exponent; no hex, no
  * inf/nan, no trailing characters. 0 ok, −1 not a number, −2 out of range. */
-int to_double(const char *s, double *out)
+int amfi_cfg_to_double(const char *s, double *out)
 {
     char *end;
     double d;
@@ -101,7 +101,7 @@ int to_double(const char *s, double *out)
 }
 
 /* Strict decimal integer: optional sign, digits. 0 ok, −1 not, −2 range. */
-int to_llong(const char *s, long long *out)
+int amfi_cfg_to_llong(const char *s, long long *out)
 {
     const char *p = s;
     char *end;
@@ -122,10 +122,10 @@ int to_llong(const char *s, long long *out)
     return 0;
 }
 
-int to_long(const char *s, long *out)
+int amfi_cfg_to_long(const char *s, long *out)
 {
     long long l;
-    int rc = to_llong(s, &l);
+    int rc = amfi_cfg_to_llong(s, &l);
 
     if (rc)
         return rc;
@@ -135,75 +135,75 @@ int to_long(const char *s, long *out)
     return 0;
 }
 
-int get_double(ctx *x, const yaml_node_t *v, const char *path, double *out)
+int amfi_cfg_get_double(ctx *x, const yaml_node_t *v, const char *path, double *out)
 {
     char buf[SHOW_LEN];
-    const char *s = scalar(x, v, path, "a number", 0);
+    const char *s = amfi_cfg_scalar(x, v, path, "a number", 0);
     int rc;
 
     if (!s)
         return -1;
-    rc = to_double(s, out);
+    rc = amfi_cfg_to_double(s, out);
     if (rc == -1)
-        return fail(x, line_of(v), path, "expected a finite number, got '%s'",
-                    show(buf, sizeof buf, v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected a finite number, got '%s'",
+                    amfi_cfg_show(buf, sizeof buf, v));
     if (rc == -2)
-        return fail(x, line_of(v), path, "number out of range: '%s'",
-                    show(buf, sizeof buf, v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "number out of range: '%s'",
+                    amfi_cfg_show(buf, sizeof buf, v));
     return 0;
 }
 
-int get_number(ctx *x, const yaml_node_t *v, const char *path, const char *want,
+int amfi_cfg_get_number(ctx *x, const yaml_node_t *v, const char *path, const char *want,
                double *out)
 {
     char buf[SHOW_LEN];
-    int rc = is_plain(v) ? to_double((const char *)v->data.scalar.value, out) : -1;
+    int rc = amfi_cfg_is_plain(v) ? amfi_cfg_to_double((const char *)v->data.scalar.value, out) : -1;
 
     if (rc == -1)
-        return fail(x, line_of(v), path, "expected %s, got '%s'", want,
-                    show(buf, sizeof buf, v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected %s, got '%s'", want,
+                    amfi_cfg_show(buf, sizeof buf, v));
     if (rc == -2)
-        return fail(x, line_of(v), path, "number out of range: '%s'",
-                    show(buf, sizeof buf, v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "number out of range: '%s'",
+                    amfi_cfg_show(buf, sizeof buf, v));
     return 0;
 }
 
-int get_long(ctx *x, const yaml_node_t *v, const char *path, long *out)
+int amfi_cfg_get_long(ctx *x, const yaml_node_t *v, const char *path, long *out)
 {
     char buf[SHOW_LEN];
-    const char *s = scalar(x, v, path, "an integer", 0);
+    const char *s = amfi_cfg_scalar(x, v, path, "an integer", 0);
     int rc;
 
     if (!s)
         return -1;
-    rc = to_long(s, out);
+    rc = amfi_cfg_to_long(s, out);
     if (rc == -1)
-        return fail(x, line_of(v), path, "expected an integer, got '%s'",
-                    show(buf, sizeof buf, v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected an integer, got '%s'",
+                    amfi_cfg_show(buf, sizeof buf, v));
     if (rc == -2)
-        return fail(x, line_of(v), path, "integer out of range: '%s'",
-                    show(buf, sizeof buf, v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "integer out of range: '%s'",
+                    amfi_cfg_show(buf, sizeof buf, v));
     return 0;
 }
 
-int out_of_range(double d, const field *f)
+int amfi_cfg_out_of_range(double d, const field *f)
 {
     return d < f->lo || d > f->hi || ((f->flags & F_LO_OPEN) && d == f->lo) ||
            ((f->flags & F_HI_OPEN) && d == f->hi);
 }
 
 /* The message for d outside row f's range; returns −1. */
-int range_fail(ctx *x, const yaml_node_t *v, const char *path, const field *f,
+int amfi_cfg_range_fail(ctx *x, const yaml_node_t *v, const char *path, const field *f,
                       double d)
 {
     char range[DOC_LEN];
 
-    describe_interval(f, range);
-    return fail(x, line_of(v), path, "must be %s%s, got %g", isinf(f->hi) ? "" : "in ",
+    amfi_cfg_describe_interval(f, range);
+    return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "must be %s%s, got %g", isinf(f->hi) ? "" : "in ",
                 range, d);
 }
 
-void describe_interval(const field *f, char *buf)
+void amfi_cfg_describe_interval(const field *f, char *buf)
 {
     if (isinf(f->hi))
         snprintf(buf, DOC_LEN, "%s %g", (f->flags & F_LO_OPEN) ? ">" : ">=", f->lo);
@@ -212,7 +212,7 @@ void describe_interval(const field *f, char *buf)
                  f->hi, (f->flags & F_HI_OPEN) ? ')' : ']');
 }
 
-void describe_count(const field *f, char *buf)
+void amfi_cfg_describe_count(const field *f, char *buf)
 {
     snprintf(buf, DOC_LEN, "%.0f .. %.0f", f->lo, f->hi);
 }
@@ -222,10 +222,10 @@ static int p_double(ctx *x, yaml_node_t *v, const char *path, const field *f,
 {
     double d = 0.0;
 
-    if (get_double(x, v, path, &d))
+    if (amfi_cfg_get_double(x, v, path, &d))
         return -1;
-    if (out_of_range(d, f))
-        return range_fail(x, v, path, f, d);
+    if (amfi_cfg_out_of_range(d, f))
+        return amfi_cfg_range_fail(x, v, path, f, d);
     memcpy((char *)base + f->off, &d, sizeof d);
     return 0;
 }
@@ -235,10 +235,10 @@ static int p_int(ctx *x, yaml_node_t *v, const char *path, const field *f, void 
     long l = 0;
     int i;
 
-    if (get_long(x, v, path, &l))
+    if (amfi_cfg_get_long(x, v, path, &l))
         return -1;
     if ((double)l < f->lo || (double)l > f->hi)
-        return fail(x, line_of(v), path, "must be %.0f .. %.0f, got %ld", f->lo, f->hi,
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "must be %.0f .. %.0f, got %ld", f->lo, f->hi,
                     l);
     i = (int)l;
     memcpy((char *)base + f->off, &i, sizeof i);
@@ -249,19 +249,19 @@ static int p_int(ctx *x, yaml_node_t *v, const char *path, const field *f, void 
 static int p_llong(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
     char buf[SHOW_LEN];
-    const char *s = scalar(x, v, path, "an integer", 0);
+    const char *s = amfi_cfg_scalar(x, v, path, "an integer", 0);
     long long l = 0;
     int rc;
 
     if (!s)
         return -1;
-    rc = to_llong(s, &l);
+    rc = amfi_cfg_to_llong(s, &l);
     if (rc == -1)
-        return fail(x, line_of(v), path, "expected an integer, got '%s'",
-                    show(buf, sizeof buf, v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected an integer, got '%s'",
+                    amfi_cfg_show(buf, sizeof buf, v));
     if (rc == -2 || (double)l < f->lo || (double)l > f->hi)
-        return fail(x, line_of(v), path, "must be %.0f .. %.0f, got '%s'", f->lo, f->hi,
-                    show(buf, sizeof buf, v));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "must be %.0f .. %.0f, got '%s'", f->lo, f->hi,
+                    amfi_cfg_show(buf, sizeof buf, v));
     memcpy((char *)base + f->off, &l, sizeof l);
     return 0;
 }
@@ -272,15 +272,15 @@ static void list_names(char *buf, size_t len, const enum_name *names)
 
     buf[0] = '\0';
     for (const enum_name *e = names; e->name; e++)
-        used = append_name(buf, len, used, e->name);
+        used = amfi_cfg_append_name(buf, len, used, e->name);
 }
 
-void describe_names(const enum_name *names, char *buf)
+void amfi_cfg_describe_names(const enum_name *names, char *buf)
 {
     list_names(buf, DOC_LEN, names);
 }
 
-const char *enum_label(const enum_name *names, int value)
+const char *amfi_cfg_enum_label(const enum_name *names, int value)
 {
     for (const enum_name *e = names; e->name; e++)
         if (e->value == value)
@@ -293,7 +293,7 @@ static int p_enum(ctx *x, yaml_node_t *v, const char *path, const field *f, void
 {
     const enum_name *names = f->aux;
     char known[128], buf[SHOW_LEN];
-    const char *s = scalar(x, v, path, "a name", 1);
+    const char *s = amfi_cfg_scalar(x, v, path, "a name", 1);
 
     if (!s)
         return -1;
@@ -303,40 +303,40 @@ static int p_enum(ctx *x, yaml_node_t *v, const char *path, const field *f, void
             return 0;
         }
     list_names(known, sizeof known, names);
-    return fail(x, line_of(v), path, "expected one of %s; got '%s'", known,
-                show(buf, sizeof buf, v));
+    return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected one of %s; got '%s'", known,
+                amfi_cfg_show(buf, sizeof buf, v));
 }
 
 static int p_map(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
-    return walk_map(x, v, path, f->aux, base);
+    return amfi_cfg_walk_map(x, v, path, f->aux, base);
 }
 
 /* A string of printable characters, stored in char[f->hi] at f->off; lo is
  * the minimum length. */
 static int p_string(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
-    const char *s = scalar(x, v, path, "a string", 1);
+    const char *s = amfi_cfg_scalar(x, v, path, "a string", 1);
     size_t n, cap = (size_t)f->hi;
 
     if (!s)
         return -1;
     n = strlen(s);
     if ((double)n < f->lo || n >= cap)
-        return fail(x, line_of(v), path, "must be %.0f .. %zu characters long, got %zu",
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "must be %.0f .. %zu characters long, got %zu",
                     f->lo, cap - 1, n);
     for (size_t i = 0; i < n; i++)
         if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
-            return fail(x, line_of(v), path, "must not contain control characters");
+            return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "must not contain control characters");
     memset((char *)base + f->off, 0, cap);
     memcpy((char *)base + f->off, s, n);
     return 0;
 }
 
 /* A plain null (`key:`, `~`, `null`): "no value" for the keys that allow it. */
-int is_null_node(const yaml_node_t *v)
+int amfi_cfg_is_null_node(const yaml_node_t *v)
 {
-    return v->type == YAML_SCALAR_NODE && is_plain(v) &&
+    return v->type == YAML_SCALAR_NODE && amfi_cfg_is_plain(v) &&
            strlen((const char *)v->data.scalar.value) == v->data.scalar.length &&
            is_null((const char *)v->data.scalar.value);
 }
@@ -350,21 +350,21 @@ static int p_path(ctx *x, yaml_node_t *v, const char *path, const field *f, void
     size_t cap = (size_t)f->hi, n, dir = 0;
     const char *s, *slash;
 
-    if (is_null_node(v)) {
+    if (amfi_cfg_is_null_node(v)) {
         memset(dst, 0, cap);
         return 0;
     }
-    s = scalar(x, v, path, "a file path", 1);
+    s = amfi_cfg_scalar(x, v, path, "a file path", 1);
     if (!s)
         return -1;
     n = strlen(s);
     for (size_t i = 0; i < n; i++)
         if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
-            return fail(x, line_of(v), path, "must not contain control characters");
+            return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "must not contain control characters");
     if (n && s[0] != '/' && (f->flags & F_FILE_DIR) && (slash = strrchr(x->file, '/')))
         dir = (size_t)(slash - x->file) + 1;
     if (dir + n >= cap)
-        return fail(x, line_of(v), path, "too long: %zu characters%s, at most %zu",
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "too long: %zu characters%s, at most %zu",
                     dir + n, dir ? " with the file's folder" : "", cap - 1);
     memset(dst, 0, cap);
     memcpy(dst, x->file, dir);
@@ -378,19 +378,19 @@ static int p_path(ctx *x, yaml_node_t *v, const char *path, const field *f, void
 static void d_interval(const field *f, const void *base, char *buf)
 {
     (void)base;
-    describe_interval(f, buf);
+    amfi_cfg_describe_interval(f, buf);
 }
 
 static void d_count(const field *f, const void *base, char *buf)
 {
     (void)base;
-    describe_count(f, buf);
+    amfi_cfg_describe_count(f, buf);
 }
 
 static void d_names(const field *f, const void *base, char *buf)
 {
     (void)base;
-    describe_names(f->aux, buf);
+    amfi_cfg_describe_names(f->aux, buf);
 }
 
 static void d_length(const field *f, const void *base, char *buf)
@@ -442,7 +442,7 @@ static void v_enum(const field *f, const void *base, char *buf)
     const char *s;
 
     memcpy(&i, (const char *)base + f->off, sizeof i);
-    s = enum_label(f->aux, i);
+    s = amfi_cfg_enum_label(f->aux, i);
     snprintf(buf, DOC_LEN, "%s", s ? s : "?");
 }
 
@@ -460,10 +460,42 @@ static void v_path(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "%s", *s ? s : "none");
 }
 
-const kind K_DOUBLE = {"number", p_double, d_interval, v_double, NEST_NONE};
-const kind K_INT = {"integer", p_int, d_count, v_int, NEST_NONE};
-const kind K_LLONG = {"integer", p_llong, d_count, v_llong, NEST_NONE};
-const kind K_ENUM = {"name", p_enum, d_names, v_enum, NEST_NONE};
-const kind K_STRING = {"string", p_string, d_length, v_string, NEST_NONE};
-const kind K_PATH = {"file path", p_path, d_path_length, v_path, NEST_NONE};
-const kind K_MAP = {"mapping", p_map, d_none, d_none, NEST_MAP};
+/* ---- where the values live ---------------------------------------------- */
+
+static int one_span(size_t off, size_t len, span *out)
+{
+    out[0] = (span){off, len};
+    return 1;
+}
+
+int amfi_cfg_spans_double(const field *f, span *out)
+{
+    return one_span(f->off, sizeof(double), out);
+}
+
+int amfi_cfg_spans_int(const field *f, span *out)
+{
+    return one_span(f->off, sizeof(int), out);
+}
+
+int amfi_cfg_spans_llong(const field *f, span *out)
+{
+    return one_span(f->off, sizeof(long long), out);
+}
+
+int amfi_cfg_spans_chars(const field *f, span *out)
+{
+    return one_span(f->off, (size_t)f->hi, out);
+}
+
+const kind amfi_cfg_k_double = {"number", p_double, d_interval, v_double, NEST_NONE,
+                                amfi_cfg_spans_double};
+const kind amfi_cfg_k_int = {"integer", p_int, d_count, v_int, NEST_NONE, amfi_cfg_spans_int};
+const kind amfi_cfg_k_llong = {"integer", p_llong, d_count, v_llong, NEST_NONE,
+                               amfi_cfg_spans_llong};
+const kind amfi_cfg_k_enum = {"name", p_enum, d_names, v_enum, NEST_NONE, amfi_cfg_spans_int};
+const kind amfi_cfg_k_string = {"string", p_string, d_length, v_string, NEST_NONE,
+                                amfi_cfg_spans_chars};
+const kind amfi_cfg_k_path = {"file path", p_path, d_path_length, v_path, NEST_NONE,
+                              amfi_cfg_spans_chars};
+const kind amfi_cfg_k_map = {"mapping", p_map, d_none, d_none, NEST_MAP, NULL};

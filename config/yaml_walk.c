@@ -6,7 +6,7 @@
  * The file (at most 1 MiB) is read into memory, checked once with libyaml's
  * event API (syntax, nesting depth, a single document), then loaded with the
  * document API (yaml_parser_load); every node keeps its start mark, so an
- * error names the line of the offending key or value. walk_map() does what
+ * error names the line of the offending key or value. amfi_cfg_walk_map() does what
  * every mapping needs (type check, unknown, duplicate and required keys) and
  * records the line of every key path it sees, so that checks which involve
  * several keys, run once the whole file is read, can name the line they
@@ -27,7 +27,7 @@
 
 /* ---- messages and key paths ---------------------------------------------- */
 
-size_t advance(size_t used, int n, size_t len)
+size_t amfi_cfg_advance(size_t used, int n, size_t len)
 {
     if (n < 0)
         return used;
@@ -36,7 +36,7 @@ size_t advance(size_t used, int n, size_t len)
     return used + (size_t)n;
 }
 
-int fail(ctx *x, int line, const char *path, const char *fmt, ...)
+int amfi_cfg_fail(ctx *x, int line, const char *path, const char *fmt, ...)
 {
     va_list ap;
     size_t used = 0;
@@ -44,12 +44,12 @@ int fail(ctx *x, int line, const char *path, const char *fmt, ...)
     if (!x->err || x->errlen == 0)
         return -1;
     if (line > 0)
-        used = advance(used, snprintf(x->err, x->errlen, "%s:%d: ", x->file, line),
+        used = amfi_cfg_advance(used, snprintf(x->err, x->errlen, "%s:%d: ", x->file, line),
                        x->errlen);
     else
-        used = advance(used, snprintf(x->err, x->errlen, "%s: ", x->file), x->errlen);
+        used = amfi_cfg_advance(used, snprintf(x->err, x->errlen, "%s: ", x->file), x->errlen);
     if (path && *path)
-        used = advance(used, snprintf(x->err + used, x->errlen - used, "%s: ", path),
+        used = amfi_cfg_advance(used, snprintf(x->err + used, x->errlen - used, "%s: ", path),
                        x->errlen);
     va_start(ap, fmt);
     vsnprintf(x->err + used, x->errlen - used, fmt, ap);
@@ -57,7 +57,7 @@ int fail(ctx *x, int line, const char *path, const char *fmt, ...)
     return -1;
 }
 
-int line_of(const yaml_node_t *n)
+int amfi_cfg_line_of(const yaml_node_t *n)
 {
     return (int)n->start_mark.line + 1; /* the file is < 1 MiB: fits an int */
 }
@@ -76,7 +76,7 @@ static void sanitise(char *buf, size_t len, const char *s, size_t n)
 }
 
 /* A scalar's value for a message: sanitised, cut at SHOW_LEN bytes. */
-const char *show(char *buf, size_t len, const yaml_node_t *v)
+const char *amfi_cfg_show(char *buf, size_t len, const yaml_node_t *v)
 {
     size_t n = v->data.scalar.length;
 
@@ -86,7 +86,7 @@ const char *show(char *buf, size_t len, const yaml_node_t *v)
     return buf;
 }
 
-const char *what(const yaml_node_t *v)
+const char *amfi_cfg_what(const yaml_node_t *v)
 {
     switch (v->type) {
     case YAML_MAPPING_NODE: return "a mapping";
@@ -97,7 +97,7 @@ const char *what(const yaml_node_t *v)
 }
 
 /* A path that does not fit PATH_LEN is cut. */
-void pathf(char *out, const char *fmt, ...)
+void amfi_cfg_pathf(char *out, const char *fmt, ...)
 {
     va_list ap;
 
@@ -112,28 +112,28 @@ static void join_key(char *out, const char *path, const yaml_node_t *k)
 
     sanitise(key, sizeof key, (const char *)k->data.scalar.value, k->data.scalar.length);
     if (*path)
-        pathf(out, "%s.%s", path, key);
+        amfi_cfg_pathf(out, "%s.%s", path, key);
     else
-        pathf(out, "%s", key);
+        amfi_cfg_pathf(out, "%s", key);
 }
 
-void join_index(char *out, const char *path, size_t i)
+void amfi_cfg_join_index(char *out, const char *path, size_t i)
 {
-    pathf(out, "%s[%zu]", path, i);
+    amfi_cfg_pathf(out, "%s[%zu]", path, i);
 }
 
-void note_line(ctx *x, const char *path, int line)
+void amfi_cfg_note_line(ctx *x, const char *path, int line)
 {
     /* A full record only loses the line number of a later cross-check error. */
     if (x->n_notes >= MAX_NOTES)
         return;
-    pathf(x->notes[x->n_notes].path, "%s", path);
+    amfi_cfg_pathf(x->notes[x->n_notes].path, "%s", path);
     x->notes[x->n_notes].line = line;
     x->n_notes++;
 }
 
 /* Line where key path `path` was given in the file, 0 when it was not. */
-int noted(const ctx *x, const char *path)
+int amfi_cfg_noted(const ctx *x, const char *path)
 {
     for (int i = 0; i < x->n_notes; i++)
         if (strcmp(x->notes[i].path, path) == 0)
@@ -142,19 +142,19 @@ int noted(const ctx *x, const char *path)
 }
 
 /* The first of the key paths that was given in the file, for a message. */
-int first_noted(const ctx *x, const char *a, const char *b, const char *c)
+int amfi_cfg_first_noted(const ctx *x, const char *a, const char *b, const char *c)
 {
-    int line = noted(x, a);
+    int line = amfi_cfg_noted(x, a);
 
     if (!line && b)
-        line = noted(x, b);
+        line = amfi_cfg_noted(x, b);
     if (!line && c)
-        line = noted(x, c);
+        line = amfi_cfg_noted(x, c);
     return line;
 }
 
 /* The latest line of any key given under `prefix`. */
-int noted_under(const ctx *x, const char *prefix)
+int amfi_cfg_noted_under(const ctx *x, const char *prefix)
 {
     size_t n = strlen(prefix);
     int line = 0;
@@ -167,9 +167,9 @@ int noted_under(const ctx *x, const char *prefix)
 
 /* ---- the walk ------------------------------------------------------------ */
 
-size_t append_name(char *buf, size_t len, size_t used, const char *name)
+size_t amfi_cfg_append_name(char *buf, size_t len, size_t used, const char *name)
 {
-    return advance(used, snprintf(buf + used, len - used, "%s%s", used ? ", " : "", name),
+    return amfi_cfg_advance(used, snprintf(buf + used, len - used, "%s%s", used ? ", " : "", name),
                    len);
 }
 
@@ -179,11 +179,11 @@ static void list_keys(char *buf, size_t len, const field *table)
 
     buf[0] = '\0';
     for (const field *f = table; f->key; f++)
-        used = append_name(buf, len, used, f->key);
+        used = amfi_cfg_append_name(buf, len, used, f->key);
 }
 
 /* Parse mapping m (key path `path`, "" at the top) with `table` into base. */
-int walk_map(ctx *x, yaml_node_t *m, const char *path, const field *table,
+int amfi_cfg_walk_map(ctx *x, yaml_node_t *m, const char *path, const field *table,
                     void *base)
 {
     int seen[MAX_FIELDS] = {0}; /* line of each row's key, 0: not given */
@@ -193,10 +193,10 @@ int walk_map(ctx *x, yaml_node_t *m, const char *path, const field *table,
     while (table[nf].key)
         nf++;
     if (nf > MAX_FIELDS)
-        return fail(x, line_of(m), path, "internal: schema table too large");
+        return amfi_cfg_fail(x, amfi_cfg_line_of(m), path, "internal: schema table too large");
     if (m->type != YAML_MAPPING_NODE)
-        return fail(x, line_of(m), path, "expected a mapping (key: value), got %s",
-                    what(m));
+        return amfi_cfg_fail(x, amfi_cfg_line_of(m), path, "expected a mapping (key: value), got %s",
+                    amfi_cfg_what(m));
     for (yaml_node_pair_t *pr = m->data.mapping.pairs.start;
          pr < m->data.mapping.pairs.top; pr++) {
         yaml_node_t *k = yaml_document_get_node(x->doc, pr->key);
@@ -204,10 +204,10 @@ int walk_map(ctx *x, yaml_node_t *m, const char *path, const field *table,
         int i;
 
         if (!k || !v)
-            return fail(x, line_of(m), path, "malformed mapping");
+            return amfi_cfg_fail(x, amfi_cfg_line_of(m), path, "malformed mapping");
         if (k->type != YAML_SCALAR_NODE)
-            return fail(x, line_of(k), path, "a key must be a plain name, got %s",
-                        what(k));
+            return amfi_cfg_fail(x, amfi_cfg_line_of(k), path, "a key must be a plain name, got %s",
+                        amfi_cfg_what(k));
         join_key(sub, path, k);
         for (i = 0; i < nf; i++)
             if (strlen(table[i].key) == k->data.scalar.length &&
@@ -215,71 +215,143 @@ int walk_map(ctx *x, yaml_node_t *m, const char *path, const field *table,
                 break;
         if (i == nf) {
             list_keys(known, sizeof known, table);
-            return fail(x, line_of(k), sub, "unknown key (known: %s)", known);
+            return amfi_cfg_fail(x, amfi_cfg_line_of(k), sub, "unknown key (known: %s)", known);
         }
         if (seen[i])
-            return fail(x, line_of(k), sub, "duplicate key (first at line %d)", seen[i]);
-        seen[i] = line_of(k);
-        note_line(x, sub, line_of(k));
+            return amfi_cfg_fail(x, amfi_cfg_line_of(k), sub, "duplicate key (first at line %d)", seen[i]);
+        seen[i] = amfi_cfg_line_of(k);
+        amfi_cfg_note_line(x, sub, amfi_cfg_line_of(k));
         if (table[i].kind->parse(x, v, sub, &table[i], base))
             return -1;
     }
     for (int i = 0; i < nf; i++)
         if ((table[i].flags & F_REQUIRED) && !seen[i]) {
-            pathf(sub, "%s%s%s", path, *path ? "." : "", table[i].key);
-            return fail(x, line_of(m), sub, "missing (required)");
+            amfi_cfg_pathf(sub, "%s%s%s", path, *path ? "." : "", table[i].key);
+            return amfi_cfg_fail(x, amfi_cfg_line_of(m), sub, "missing (required)");
         }
     return 0;
 }
 
-/* The items of list node v, checked to be 1 .. max long; NULL after fail(). */
-yaml_node_item_t *list_items(ctx *x, yaml_node_t *v, const char *path,
+/* The items of list node v, checked to be 1 .. max long; NULL after amfi_cfg_fail(). */
+static yaml_node_item_t *list_items(ctx *x, yaml_node_t *v, const char *path,
                                     const char *what_items, int max, int *n)
 {
     ptrdiff_t len;
 
     if (v->type != YAML_SEQUENCE_NODE) {
-        fail(x, line_of(v), path, "expected a list of %s, got %s", what_items, what(v));
+        amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected a list of %s, got %s", what_items, amfi_cfg_what(v));
         return NULL;
     }
     len = v->data.sequence.items.top - v->data.sequence.items.start;
     if (len < 1 || len > max) {
-        fail(x, line_of(v), path, "expected 1 .. %d %s, got %td", max, what_items, len);
+        amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "expected 1 .. %d %s, got %td", max, what_items, len);
         return NULL;
     }
     *n = (int)len;
     return v->data.sequence.items.start;
 }
 
-int describe_table(const field *table, const char *prefix, const void *base,
-                   key_visit visit, void *arg)
+int amfi_cfg_parse_list(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
-    char path[PATH_LEN], range[DOC_LEN], dflt[DOC_LEN];
+    const list_schema *ls = f->aux;
+    yaml_node_item_t *items;
+    unsigned char *buf;
+    char ip[PATH_LEN];
+    int n = 0, rc = 0;
+
+    items = list_items(x, v, path, ls->what, ls->max, &n);
+    if (!items)
+        return -1;
+    buf = calloc((size_t)ls->max, ls->item_size);
+    if (!buf)
+        return amfi_cfg_fail(x, amfi_cfg_line_of(v), path, "out of memory");
+    for (int i = 0; i < n && rc == 0; i++) {
+        yaml_node_t *it = yaml_document_get_node(x->doc, items[i]);
+        void *item = buf + (size_t)i * ls->item_size;
+
+        amfi_cfg_join_index(ip, path, (size_t)i);
+        if (!it) {
+            rc = amfi_cfg_fail(x, amfi_cfg_line_of(v), ip, "malformed list");
+            break;
+        }
+        amfi_cfg_note_line(x, ip, amfi_cfg_line_of(it));
+        memcpy(item, ls->item_default, ls->item_size);
+        rc = amfi_cfg_walk_map(x, it, ip, ls->items, item);
+        if (rc == 0 && ls->check)
+            rc = ls->check(x, it, ip, buf, i, base);
+    }
+    if (rc == 0)
+        ls->store(buf, n, base);
+    free(buf);
+    return rc;
+}
+
+static int walk_rows(const field *table, const char *prefix, int items,
+                     const void *item_default, int parent_live, row_visit visit, void *arg)
+{
+    char path[PATH_LEN];
     int rc;
 
     for (const field *f = table; f->key; f++) {
-        pathf(path, "%s%s%s", prefix, *prefix ? "." : "", f->key);
+        const int live = item_default ? parent_live : (f->flags & F_LIVE) != 0;
+
+        amfi_cfg_pathf(path, "%s%s%s", prefix, *prefix ? "." : "", f->key);
         if (f->kind->nest == NEST_MAP) {
-            rc = describe_table(f->aux, path, base, visit, arg);
+            rc = walk_rows(f->aux, path, items, item_default, live, visit, arg);
         } else {
-            f->kind->range(f, base, range);
-            if (base)
-                f->kind->dflt(f, base, dflt);
-            else
-                snprintf(dflt, sizeof dflt, "%s", (f->flags & F_REQUIRED) ? "required" : "");
-            if ((f->flags & F_REQUIRED))
-                snprintf(dflt, sizeof dflt, "required");
-            rc = visit(path, f->kind->type, range, dflt, (f->flags & F_REQUIRED) != 0, arg);
-            if (!rc && f->kind->nest == NEST_LIST) {
+            rc = visit(path, f, item_default, live, arg);
+            if (!rc && items && f->kind->nest == NEST_LIST) {
                 const list_schema *ls = f->aux;
-                pathf(path, "%s%s%s[]", prefix, *prefix ? "." : "", f->key);
-                rc = describe_table(ls->items, path, ls->item_default, visit, arg);
+                amfi_cfg_pathf(path, "%s%s%s[]", prefix, *prefix ? "." : "", f->key);
+                rc = walk_rows(ls->items, path, items, ls->item_default, live, visit, arg);
             }
         }
         if (rc)
             return rc;
     }
     return 0;
+}
+
+int amfi_cfg_walk_rows(const field *table, const char *prefix, int items, row_visit visit,
+                       void *arg)
+{
+    return walk_rows(table, prefix, items, NULL, 0, visit, arg);
+}
+
+void amfi_cfg_describe_row(const field *f, const void *base, char *range, char *dflt)
+{
+    f->kind->range(f, base, range);
+    if (base)
+        f->kind->dflt(f, base, dflt);
+    else
+        dflt[0] = '\0';
+    if ((f->flags & F_REQUIRED))
+        snprintf(dflt, DOC_LEN, "required");
+}
+
+typedef struct describe_arg {
+    const void *base;
+    key_visit visit;
+    void *arg;
+} describe_arg;
+
+static int describe_one(const char *path, const field *f, const void *item_default, int live,
+                        void *arg)
+{
+    const describe_arg *da = arg;
+    char range[DOC_LEN], dflt[DOC_LEN];
+
+    (void)live;
+    amfi_cfg_describe_row(f, item_default ? item_default : da->base, range, dflt);
+    return da->visit(path, f->kind->type, range, dflt, (f->flags & F_REQUIRED) != 0, da->arg);
+}
+
+int amfi_cfg_describe_table(const field *table, const char *prefix, const void *base,
+                            key_visit visit, void *arg)
+{
+    describe_arg da = {base, visit, arg};
+
+    return amfi_cfg_walk_rows(table, prefix, 1, describe_one, &da);
 }
 
 /* ---- the file ------------------------------------------------------------ */
@@ -301,19 +373,19 @@ static void yaml_error(ctx *x, const yaml_parser_t *p, const unsigned char *buf,
 
     switch (p->error) {
     case YAML_MEMORY_ERROR:
-        fail(x, 0, NULL, "out of memory while reading YAML");
+        amfi_cfg_fail(x, 0, NULL, "out of memory while reading YAML");
         break;
     case YAML_READER_ERROR: /* bad encoding: libyaml gives a byte offset */
-        fail(x, line_at_offset(buf, len, p->problem_offset), NULL,
+        amfi_cfg_fail(x, line_at_offset(buf, len, p->problem_offset), NULL,
              "cannot read: %s (byte %zu)", problem, p->problem_offset);
         break;
     default: /* scanner, parser, composer */
         if (p->context)
-            fail(x, (int)p->problem_mark.line + 1, NULL,
+            amfi_cfg_fail(x, (int)p->problem_mark.line + 1, NULL,
                  "YAML syntax error: %s (%s at line %d)", problem, p->context,
                  (int)p->context_mark.line + 1);
         else
-            fail(x, (int)p->problem_mark.line + 1, NULL, "YAML syntax error: %s",
+            amfi_cfg_fail(x, (int)p->problem_mark.line + 1, NULL, "YAML syntax error: %s",
                  problem);
         break;
     }
@@ -331,7 +403,7 @@ static int check_stream(ctx *x, const unsigned char *buf, size_t len)
     int depth = 0, docs = 0, rc = -1, done = 0;
 
     if (!yaml_parser_initialize(&p))
-        return fail(x, 0, NULL, "out of memory");
+        return amfi_cfg_fail(x, 0, NULL, "out of memory");
     yaml_parser_set_input_string(&p, buf, len);
     while (!done) {
         int line;
@@ -361,11 +433,11 @@ static int check_stream(ctx *x, const unsigned char *buf, size_t len)
         }
         yaml_event_delete(&ev);
         if (docs > 1) {
-            fail(x, line, NULL, "a second YAML document; a site file holds one");
+            amfi_cfg_fail(x, line, NULL, "a second YAML document; a site file holds one");
             goto fail;
         }
         if (depth > MAX_DEPTH) {
-            fail(x, line, NULL, "nested deeper than %d levels", MAX_DEPTH);
+            amfi_cfg_fail(x, line, NULL, "nested deeper than %d levels", MAX_DEPTH);
             goto fail;
         }
     }
@@ -375,7 +447,7 @@ fail:
     return rc;
 }
 
-int walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *base))
+int amfi_cfg_walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *base))
 {
     FILE *fp = NULL;
     unsigned char *buf = NULL;
@@ -391,30 +463,30 @@ int walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *b
     /* The whole file in memory (at most MAX_FILE_BYTES), read by two passes. */
     fp = fopen(x->file, "rb");
     if (!fp) {
-        fail(x, 0, NULL, "cannot open: %s", strerror(errno));
+        amfi_cfg_fail(x, 0, NULL, "cannot open: %s", strerror(errno));
         goto fail;
     }
     if (fstat(fileno(fp), &st) != 0) {
-        fail(x, 0, NULL, "cannot stat: %s", strerror(errno));
+        amfi_cfg_fail(x, 0, NULL, "cannot stat: %s", strerror(errno));
         goto fail;
     }
     if (!S_ISREG(st.st_mode)) {
-        fail(x, 0, NULL, "not a regular file");
+        amfi_cfg_fail(x, 0, NULL, "not a regular file");
         goto fail;
     }
     if (st.st_size > MAX_FILE_BYTES) {
-        fail(x, 0, NULL, "too large (%lld bytes, a site file is at most %ld)",
+        amfi_cfg_fail(x, 0, NULL, "too large (%lld bytes, a site file is at most %ld)",
              (long long)st.st_size, MAX_FILE_BYTES);
         goto fail;
     }
     buf = malloc((size_t)st.st_size + 1);
     if (!buf) {
-        fail(x, 0, NULL, "out of memory");
+        amfi_cfg_fail(x, 0, NULL, "out of memory");
         goto fail;
     }
     len = fread(buf, 1, (size_t)st.st_size, fp);
     if (ferror(fp)) {
-        fail(x, 0, NULL, "cannot read: %s", strerror(errno));
+        amfi_cfg_fail(x, 0, NULL, "cannot read: %s", strerror(errno));
         goto fail;
     }
     fclose(fp);
@@ -423,7 +495,7 @@ int walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *b
     if (check_stream(x, buf, len))
         goto fail;
     if (!yaml_parser_initialize(&parser)) {
-        fail(x, 0, NULL, "out of memory");
+        amfi_cfg_fail(x, 0, NULL, "out of memory");
         goto fail;
     }
     have_parser = 1;
@@ -436,7 +508,7 @@ int walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *b
     root = yaml_document_get_root_node(&doc);
     if (!root) {
         list_keys(known, sizeof known, top);
-        fail(x, 1, NULL, "empty file: expected the sections %s", known);
+        amfi_cfg_fail(x, 1, NULL, "empty file: expected the sections %s", known);
         goto fail;
     }
 
@@ -444,7 +516,7 @@ int walk_file(ctx *x, const field *top, void *base, int (*check)(ctx *x, void *b
     /* Parse numbers with a decimal point whatever the process locale. */
     cloc = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
     old = cloc ? uselocale(cloc) : (locale_t)0;
-    walk = walk_map(x, root, "", top, base);
+    walk = amfi_cfg_walk_map(x, root, "", top, base);
     if (cloc) {
         uselocale(old);
         freelocale(cloc);

@@ -45,6 +45,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "amfi_config_keys.h"
 #include "ctx.h"
 
 /* ---- the table of modules ------------------------------------------------------
@@ -305,70 +306,24 @@ int amfid_start(amfid **out, const amfid_options *o)
 
 /* ---- reload ---------------------------------------------------------------------------- */
 
-/* The keys that apply at once (amfid.yaml(5)): the λ policy, the output
- * channels, the heartbeat period, max_wait_s, the environment's skew and
- * the intake's bounds (daemon.intake.*). Everything else is reported below
- * (and by the modules' reload) and applies at the next start. */
-static void apply_live(amfi_site_config *run, const amfi_site_config *n)
+/* A key that differs between the running configuration and the file: a
+ * restart-only one (the key table's live flag 0) is reported by name. */
+static int report_restart_only(const amfi_config_key *k, void *arg)
 {
-    /* The λ policy is copied into each job at release (intake.c): passages
-     * released from now on are solved with the new one, those already
-     * queued with theirs. */
-    run->lambda = n->lambda;
-    amfi_daemon_config *c = &run->daemon;
-    const amfi_daemon_config *m = &n->daemon;
-    memcpy(c->ch_passage, m->ch_passage, sizeof c->ch_passage);
-    memcpy(c->ch_indicator, m->ch_indicator, sizeof c->ch_indicator);
-    memcpy(c->ch_alert, m->ch_alert, sizeof c->ch_alert);
-    memcpy(c->ch_status, m->ch_status, sizeof c->ch_status);
-    c->status_period_s = m->status_period_s;
-    c->max_wait_s = m->max_wait_s;
-    c->environment_max_skew_s = m->environment_max_skew_s;
-    c->vehicle_ahead_s = m->vehicle_ahead_s;
-    c->min_speed_mps = m->min_speed_mps;
-    c->max_length_m = m->max_length_m;
-    c->accel_margin = m->accel_margin;
-    c->vehicles_per_s = m->vehicles_per_s;
-    c->environment_per_s = m->environment_per_s;
-    c->truth_per_s = m->truth_per_s;
-    c->burst_s = m->burst_s;
-    c->summary_period_s = m->summary_period_s;
-    c->env_min_interval_s = m->env_min_interval_s;
-    c->deck_max_rate_c_min = m->deck_max_rate_c_min;
-    memcpy(c->calibration_sources, m->calibration_sources, sizeof c->calibration_sources);
-    c->calibration_min_kg = m->calibration_min_kg;
-    c->calibration_max_kg = m->calibration_max_kg;
+    (void)arg;
+    if (!k->live)
+        LOG_WARN("reload: %s changed; takes effect at the next start", k->path);
+    return 0;
 }
 
-/* The core's restart-only keys that changed, reported. */
-static void report_restart_only(const amfi_site_config *run, const amfi_site_config *n)
-{
-    if (memcmp(&n->bridge, &run->bridge, sizeof n->bridge) ||
-        memcmp(&n->solver, &run->solver, sizeof n->solver) ||
-        memcmp(n->sensor_id, run->sensor_id, sizeof n->sensor_id) ||
-        memcmp(n->sensor_rate_hz, run->sensor_rate_hz, sizeof n->sensor_rate_hz))
-        LOG_WARN("reload: bridge, sensors and solver changes take effect at the next start");
-    if (strcmp(n->site.id, run->site.id) || strcmp(n->site.name, run->site.name))
-        LOG_WARN("reload: site.id and site.name take effect at the next start (a store "
-                 "that holds another site.id is then refused)");
-    const amfi_daemon_config *a = &run->daemon, *b = &n->daemon;
-    if (strcmp(b->ch_accel, a->ch_accel) || strcmp(b->ch_vehicle, a->ch_vehicle) ||
-        strcmp(b->ch_truth, a->ch_truth) || strcmp(b->ch_environment, a->ch_environment) ||
-        b->workers != a->workers || b->queue_size != a->queue_size || b->ring_s != a->ring_s ||
-        b->sync_full != a->sync_full || b->held_max_bytes != a->held_max_bytes ||
-        b->max_event_s != a->max_event_s || b->max_event_axles != a->max_event_axles)
-        LOG_WARN("reload: channels, workers, queue, ring, event limits and store changes take "
-                 "effect at the next start");
-    if (b->bus_auth != a->bus_auth || strcmp(b->bus_key_file, a->bus_key_file) ||
-        b->bus_max_skew_s != a->bus_max_skew_s || b->simulation != a->simulation)
-        LOG_WARN("reload: daemon.bus (authentication, key, skew) and daemon.simulation take "
-                 "effect at the next start");
-}
-
-/* SIGHUP: the file read again; the running configuration takes the new
- * file's live keys; then each module's reload in table order, with the
- * configuration that ran until now and the file as read (to apply its own
- * live keys, already in c->cfg, and report its restart-only ones). */
+/* SIGHUP: the file read again (refused: the running configuration is kept);
+ * every restart-only key that changed reported by name; the running
+ * configuration takes the file's live keys (the key table's live flag:
+ * the λ policy, the output channels, status_period_s, max_wait_s,
+ * environment_max_skew_s, daemon.intake.*), then each module's reload in
+ * table order with the configuration that ran until now and the new
+ * running one (the intake gives the tracker the new max_wait_s and re-reads
+ * its rate limits). */
 void amfid_reload(amfid *h)
 {
     static amfi_site_config n, old; /* large */
@@ -379,12 +334,12 @@ void amfid_reload(amfid *h)
     /* keep the command-line overrides */
     memcpy(n.daemon.db_path, h->cfg.daemon.db_path, sizeof n.daemon.db_path);
     memcpy(n.daemon.lcm_url, h->cfg.daemon.lcm_url, sizeof n.daemon.lcm_url);
-    report_restart_only(&h->cfg, &n);
+    amfi_config_diff(&h->cfg, &n, report_restart_only, NULL);
     old = h->cfg;
-    apply_live(&h->cfg, &n);
+    amfi_config_apply_live(&h->cfg, &n);
     for (int i = 0; i < N_MODULES; i++)
         if (modules[i]->reload)
-            modules[i]->reload(&h->c, &old, &n);
+            modules[i]->reload(&h->c, &old, &h->cfg);
     LOG_INFO("reload: configuration %s applied", h->c.config_path);
 }
 

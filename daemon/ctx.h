@@ -126,10 +126,9 @@ struct amfid_module {
     /* The store is open: what the store keeps (baselines, open alerts),
      * subscriptions (bus_want), timers (timer_add). 0, or 1 (logged). */
     int (*restore)(amfid_ctx *c);
-    /* SIGHUP: c->cfg already holds the new live keys (amfid.c); old is the
-     * configuration that ran until now, n the file as read: a module applies
-     * its live keys (from c->cfg) and reports its restart-only ones that
-     * differ in n (they take effect at the next start). */
+    /* SIGHUP: old is the configuration that ran until now, n the new running
+     * one (old with the file's live keys, the key table's live flag; the core
+     * has logged every restart-only key that changed): apply what changed. */
     void (*reload)(amfid_ctx *c, const amfi_site_config *old, const amfi_site_config *n);
     /* A passage about to be stored: its columns (r is the row). */
     void (*row)(amfid_ctx *c, const amfid_passage *p, amfi_passage_row *r);

@@ -87,12 +87,6 @@ static void drift_feed(amfid_ctx *c, const amfid_passage *ps)
         c->emit_alert(c, ps->j->w.v.utime, &al, 0);
 }
 
-static void drift_reload(amfid_ctx *c, const amfi_site_config *old, const amfi_site_config *n)
-{
-    (void)c, (void)old;
-    if (!amfi_speed_drift_params_equal(&n->daemon.speed_drift, &D.params))
-        LOG_WARN("reload: alerts.speed_drift takes effect at the next start");
-}
 
 static void drift_stop(amfid_ctx *c)
 {
@@ -106,7 +100,6 @@ const amfid_module drift_module = {
     .section = "alerts.speed_drift",
     .start = drift_start,
     .restore = drift_restore,
-    .reload = drift_reload,
     .on_passage = drift_feed,
     .stop = drift_stop,
 };

@@ -94,17 +94,6 @@ static int freevib_restore(amfid_ctx *d)
     return timer_add(d->timers, &record_period_s, freevib_tick) ? 1 : 0;
 }
 
-static void freevib_reload(amfid_ctx *c, const amfi_site_config *old, const amfi_site_config *n)
-{
-    (void)c;
-    const amfi_daemon_config *a = &old->daemon, *b = &n->daemon;
-    const amfi_natfreq_params *p = &a->natfreq, *q = &b->natfreq;
-    if (a->natfreq_free_s != b->natfreq_free_s || a->natfreq_baseline_n != b->natfreq_baseline_n ||
-        p->f_lo_hz != q->f_lo_hz || p->f_hi_hz != q->f_hi_hz || p->n_modes != q->n_modes ||
-        p->min_periods != q->min_periods || p->min_r2 != q->min_r2 ||
-        p->max_zeta != q->max_zeta || p->max_se_frac != q->max_se_frac)
-        LOG_WARN("reload: daemon.natural_frequency takes effect at the next start");
-}
 
 static void freevib_stop(amfid_ctx *c)
 {
@@ -296,7 +285,6 @@ const amfid_module freevib_module = {
     .name = "freevib",
     .start = freevib_start,
     .restore = freevib_restore,
-    .reload = freevib_reload,
     .row = freevib_row,
     .on_passage = freevib_stored,
     .final = freevib_final,

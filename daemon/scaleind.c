@@ -287,36 +287,8 @@ static void scaleind_feed(amfid_ctx *d, const amfid_passage *p)
          r->reference_gvw_kg != 0.0 ? r->reference_gvw_kg : NAN, 1);
 }
 
-static int scale_params_equal(const amfi_scale_params *a, const amfi_scale_params *b)
-{
-    return a->block == b->block && a->baseline_blocks == b->baseline_blocks &&
-           a->class_split_kg == b->class_split_kg && a->share_range == b->share_range &&
-           a->ref_c == b->ref_c && a->knee_c == b->knee_c && a->floor_c == b->floor_c &&
-           a->warm_slope == b->warm_slope && a->frost_slope == b->frost_slope &&
-           a->slope_prior_sd == b->slope_prior_sd && a->design_shift == b->design_shift &&
-           a->false_alarms_per_year == b->false_alarms_per_year &&
-           a->vehicles_per_day == b->vehicles_per_day && a->clear_after == b->clear_after;
-}
 
-static int truck_params_equal(const amfi_known_truck_params *a, const amfi_known_truck_params *b)
-{
-    return a->baseline_runs == b->baseline_runs && a->run_sd == b->run_sd &&
-           a->design_shift == b->design_shift &&
-           a->false_alarms_per_year == b->false_alarms_per_year &&
-           a->runs_per_year == b->runs_per_year && a->clear_after == b->clear_after;
-}
 
-static void scaleind_reload(amfid_ctx *d, const amfi_site_config *old, const amfi_site_config *n)
-{
-    (void)d, (void)old;
-    const amfi_daemon_config *a = &n->daemon;
-    if (a->scale_enabled != S.enabled || a->scale_max_temp_gap_s != S.max_gap_s ||
-        !scale_params_equal(&a->scale, &S.params))
-        LOG_WARN("reload: alerts.scale takes effect at the next start");
-    if (a->known_truck_enabled != S.truck_enabled ||
-        !truck_params_equal(&a->known_truck, &S.truck_params))
-        LOG_WARN("reload: alerts.known_truck takes effect at the next start");
-}
 
 static void scaleind_final(amfid_ctx *d)
 {
@@ -382,7 +354,6 @@ const amfid_module scaleind_module = {
     .section = "alerts.scale / alerts.known_truck",
     .start = scaleind_start,
     .restore = scaleind_restore,
-    .reload = scaleind_reload,
     .row = scaleind_row,
     .on_passage = scaleind_feed,
     .metrics = scaleind_metrics,

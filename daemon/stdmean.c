@@ -128,14 +128,6 @@ static void stdmean_feed(amfid_ctx *c, const amfid_passage *p)
         c->emit_alert(c, j->w.v.utime, &al[i], ind_id);
 }
 
-static void stdmean_reload(amfid_ctx *c, const amfi_site_config *old, const amfi_site_config *n)
-{
-    (void)c;
-    if (!amfi_indicator_params_equal(&n->daemon.indicators, &M.params) ||
-        n->daemon.single_presence_only != old->daemon.single_presence_only ||
-        n->daemon.ind_temp_compensated != old->daemon.ind_temp_compensated)
-        LOG_WARN("reload: indicator settings take effect at the next start");
-}
 
 static void stdmean_stop(amfid_ctx *c)
 {
@@ -149,7 +141,6 @@ const amfid_module stdmean_module = {
     .section = "daemon.indicators",
     .start = stdmean_start,
     .restore = stdmean_restore,
-    .reload = stdmean_reload,
     .on_passage = stdmean_feed,
     .stop = stdmean_stop,
 };

@@ -713,7 +713,7 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         rc = EX_USAGE;
         goto out;
     }
-    if (!amfi_site_id_valid(site)) {
+    if (!amfi_config_site_id_valid(site)) {
         fprintf(stderr, "amfi-sync: site id '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n", site);
         rc = EX_USAGE;
         goto out;
@@ -901,12 +901,12 @@ int main(int argc, char **argv)
                                      : "takes --pg, --role, --passfile, --allow-plaintext and --quiet only");
             return EX_USAGE;
         }
-        if (!amfi_site_id_valid(init_role_site)) {
+        if (!amfi_config_site_id_valid(init_role_site)) {
             fprintf(stderr, "amfi-sync: --init-site-role: '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n",
                     init_role_site);
             return EX_USAGE;
         }
-        if (role && !amfi_site_id_valid(role)) {
+        if (role && !amfi_config_site_id_valid(role)) {
             fprintf(stderr, "amfi-sync: --role: '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n", role);
             return EX_USAGE;
         }
@@ -931,7 +931,7 @@ int main(int argc, char **argv)
         usage(stderr);
         return EX_USAGE;
     }
-    if (site && !amfi_site_id_valid(site)) {
+    if (site && !amfi_config_site_id_valid(site)) {
         fprintf(stderr, "amfi-sync: --site: '%s' is not 1..63 bytes of [A-Za-z0-9_.-]\n", site);
         return EX_USAGE;
     }

@@ -1097,7 +1097,7 @@ int main(int argc, char **argv)
     char err[512];
     cfg.bridge.damage = o.damage;
     static amfi_as_built ab; /* --as-built: large */
-    if (o.as_built && amfi_as_built_load(o.as_built, &cfg, &ab, err, sizeof err)) {
+    if (o.as_built && amfi_config_as_built_load(o.as_built, &cfg, &ab, err, sizeof err)) {
         fprintf(stderr, "%s\n", err);
         return 1;
     }

@@ -18,6 +18,7 @@ pids=""
 cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
 trap cleanup EXIT
 . "$(dirname "$0")/../common/bus_key.sh"
+. "$(dirname "$0")/../common/proc.sh"
 # amfid_start AMFID CONFIG: amfid on the bus in the background, store
 # $dir/s.db, log $dir/amfid.log, pid $apid (killed at exit); returns once it
 # runs. amfid_stop: SIGTERM, wait for its drain (up to 300 s: minutes under
@@ -28,12 +29,8 @@ amfid_start() {
   : > "$dir/amfid.log"
   "$1" --config "$2" --db "$dir/s.db" 2> "$dir/amfid.log" &
   apid=$!; pids="$pids $apid"
-  _i=0; until grep -q "running" "$dir/amfid.log"; do
-    _i=$((_i + 1)); [ $_i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+  wait_for running "$dir/amfid.log" $apid || fail "amfid did not start"
 }
 amfid_stop() {
-  kill -TERM $apid
-  _i=0; while kill -0 $apid 2>/dev/null; do
-    _i=$((_i + 1)); [ $_i -lt 3000 ] || fail "amfid did not stop on SIGTERM"; sleep 0.1; done
-  wait $apid || fail "amfid exit status $?"
+  stop_pid $apid || fail "amfid exit status $? (or no stop on SIGTERM)"
 }

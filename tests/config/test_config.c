@@ -122,10 +122,10 @@ static void test_site_section(void **state)
                                   "  latitude: 46.05\n  longitude: -14.5\n", &c, err));
     assert_string_equal("Most čez Savo, km 42", c.site.name);
     assert_true(c.site.latitude == 46.05 && c.site.longitude == -14.5);
-    assert_true(amfi_site_id_valid("a-b.c_9"));
-    assert_false(amfi_site_id_valid(""));
-    assert_false(amfi_site_id_valid("a b"));
-    assert_false(amfi_site_id_valid(NULL));
+    assert_true(amfi_config_site_id_valid("a-b.c_9"));
+    assert_false(amfi_config_site_id_valid(""));
+    assert_false(amfi_config_site_id_valid("a b"));
+    assert_false(amfi_config_site_id_valid(NULL));
 }
 
 static void test_shipped_file_is_the_defaults(void **state)

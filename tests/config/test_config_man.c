@@ -31,12 +31,17 @@ typedef struct page {
     int keys; /* keys the loader reads */
 } page;
 
+/* "*path* (type; range; default D; applies ...)": when a change applies,
+ * from the key's live flag (amfi_config_apply_live is what SIGHUP copies). */
 static void entry(const amfi_config_key *k, char *buf, size_t len)
 {
+    const char *when = k->live ? "applies at once on SIGHUP" : "applies at the next start";
+
     if (k->required)
-        snprintf(buf, len, "*%s* (%s; %s; required)", k->path, k->type, k->range);
+        snprintf(buf, len, "*%s* (%s; %s; required; %s)", k->path, k->type, k->range, when);
     else
-        snprintf(buf, len, "*%s* (%s; %s; default %s)", k->path, k->type, k->range, k->dflt);
+        snprintf(buf, len, "*%s* (%s; %s; default %s; %s)", k->path, k->type, k->range,
+                 k->dflt, when);
 }
 
 static int print_key(const amfi_config_key *k, void *arg)
@@ -50,7 +55,7 @@ static int print_key(const amfi_config_key *k, void *arg)
 }
 
 /* An entry line: "*" a path (no blanks) "* (" ... "; default ...)" or
- * "; required)". */
+ * "; required; ...)". */
 static int is_entry(const char *l)
 {
     size_t n = strlen(l), p;
@@ -59,7 +64,7 @@ static int is_entry(const char *l)
         return 0;
     p = strcspn(l + 1, "* \t") + 1;
     return p > 1 && strncmp(l + p, "* (", 3) == 0 && n && l[n - 1] == ')' &&
-           (strstr(l, "; default ") || strstr(l, "; required)"));
+           (strstr(l, "; default ") || strstr(l, "; required"));
 }
 
 /* The page states the bounds the loader applies (sections.h). */

@@ -6,6 +6,7 @@
 # stderr naming the option by its long name, and nothing on stdout.
 # Usage: amfid_cli.sh AMFID CONFIG
 set -u
+. "$(dirname "$0")/../common/proc.sh"
 amfid=$1 config=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -99,8 +100,7 @@ od -An -tx1 -v "$tmp/k1" | tr -d ' \n' > "$tmp/khex" && echo >> "$tmp/khex" && c
 : > "$tmp/err"
 "$amfid" -c "$config" -d "$tmp/h.db" -u memq:// --bus-key "$tmp/khex" 2> "$tmp/err" &
 hpid=$!
-i=0; until grep -q running "$tmp/err"; do
-    i=$((i + 1)); [ $i -lt 300 ] && kill -0 $hpid 2>/dev/null || break; sleep 0.1; done
+wait_for running "$tmp/err" $hpid 60 || true
 grep -q "bus authentication required, key $tmp/khex (from the option)" "$tmp/err" ||
     problem "hex key not taken: $(head -5 "$tmp/err")"
 kill -TERM $hpid 2>/dev/null; wait $hpid || problem "amfid with a hex key exited $?"
@@ -112,8 +112,7 @@ grep -q "^    auth: off$" "$tmp/off.yaml" || problem "the test's daemon.bus.auth
 : > "$tmp/err"
 "$amfid" -c "$tmp/off.yaml" -d "$tmp/o.db" -u memq:// 2> "$tmp/err" &
 opid=$!
-i=0; until grep -q running "$tmp/err"; do
-    i=$((i + 1)); [ $i -lt 300 ] && kill -0 $opid 2>/dev/null || break; sleep 0.1; done
+wait_for running "$tmp/err" $opid 60 || true
 grep -q "daemon.bus.auth is off: every message on the bus is accepted unchecked" "$tmp/err" ||
     problem "no warning: $(head -5 "$tmp/err")"
 kill -TERM $opid 2>/dev/null; wait $opid || problem "amfid with auth off exited $?"

@@ -59,8 +59,7 @@ N=$((HEALTHY + p99))
 apid=$!; pids="$pids $apid"
 lcm-logger -c 'AMFI_ALERT' -f "$dir/alerts.lcmlog" > "$dir/logger.log" 2>&1 &
 lpid=$!; pids="$pids $lpid"
-i=0; until grep -q "running" "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+wait_for running "$dir/amfid.log" $lpid 60 || fail "amfid did not start"
 "$sim" --vehicles $N --headway 2 --speedup 40 --damage 0.1 --damage-step-at $HEALTHY \
   --seed $SEED 2> "$dir/sim.log" &
 spid=$!; pids="$pids $spid"

@@ -22,6 +22,7 @@ pids=""
 cleanup() { for p in $pids; do kill -9 "$p" 2>/dev/null; done; rm -rf "$dir"; }
 trap cleanup EXIT
 . "$(dirname "$0")/../common/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
+. "$(dirname "$0")/../common/proc.sh"
 # The fuzz is aimed at the decoders and the authentication: every real
 # vehicle must get its row. The mutated vehicles that pass both are signed
 # and, like a broken detector's, can exceed the vehicle channel's rate
@@ -39,7 +40,7 @@ t0=$(date +%s.%N)
 if [ "$mode" = live ]; then
   "$amfid" --config "$config" --db "$dir/a.db" 2> "$dir/amfid.log" &
   apid=$!; pids="$pids $apid"
-  i=0; until grep -q running "$dir/amfid.log"; do i=$((i + 1)); [ $i -lt 100 ] || fail "no start"; sleep 0.1; done
+  wait_for running "$dir/amfid.log" $apid 60 || fail "no start"
   lcm-logplayer -s 1 "$dir/fuzz.log" > "$dir/player.log" 2>&1 || fail "lcm-logplayer"
   sleep 3
   kill -0 $apid 2>/dev/null || fail "amfid died"

@@ -23,7 +23,7 @@ cap=$(cat /proc/sys/net/core/rmem_max)
 sed "s/^  recv_buf_bytes: .*/  recv_buf_bytes: $((cap + 4096))/" "$config" > "$dir/big.yaml"
 "$amfid" --config "$dir/big.yaml" --db "$dir/big.db" 2> "$dir/big.log" &
 pid=$!; pids="$pids $pid"
-i=0; until grep -q running "$dir/big.log"; do i=$((i + 1)); [ $i -lt 100 ] || fail "no start"; sleep 0.1; done
+wait_for running "$dir/big.log" $pid 60 || fail "no start"
 kill -TERM $pid; wait $pid
 grep -q "net.core.rmem_max=$((cap + 4096))" "$dir/big.log" || fail "no warning naming the sysctl to set"
 echo "receive buffer above net.core.rmem_max ($cap): warned with the sysctl"
@@ -31,7 +31,7 @@ echo "receive buffer above net.core.rmem_max ($cap): warned with the sysctl"
 sed "s/^  recv_buf_bytes: .*/  recv_buf_bytes: 4096/" "$config" > "$dir/small.yaml"
 "$amfid" --config "$dir/small.yaml" --db "$dir/a.db" 2> "$dir/amfid.log" &
 apid=$!; pids="$pids $apid"
-i=0; until grep -q running "$dir/amfid.log"; do i=$((i + 1)); [ $i -lt 100 ] || fail "no start"; sleep 0.1; done
+wait_for running "$dir/amfid.log" $apid 60 || fail "no start"
 lcm-logger -c AMFI_STATUS -f "$dir/status.lcmlog" > /dev/null 2>&1 &
 lpid=$!; pids="$pids $lpid"
 kill -STOP $apid
@@ -57,7 +57,7 @@ sed "s/^  simulation: false .*/  simulation: true/" "$config" > "$dir/sim.yaml"
 grep -q "^  simulation: true$" "$dir/sim.yaml" || fail "daemon.simulation did not apply"
 "$amfid" --config "$dir/sim.yaml" --db "$dir/c.db" 2> "$dir/burst.log" &
 bpid=$!; pids="$pids $bpid"
-i=0; until grep -q running "$dir/burst.log"; do i=$((i + 1)); [ $i -lt 100 ] || fail "no start"; sleep 0.1; done
+wait_for running "$dir/burst.log" $bpid 60 || fail "no start"
 kill -STOP $bpid
 timeout 60 "$sim" --vehicles 4 --headway 2 --speedup 50 --seed 6 2> "$dir/sim3.log" || fail "sim_publisher (3)"
 kill -CONT $bpid

@@ -29,8 +29,7 @@ grep -q "^    baseline_n: 10 " "$dir/amfid.yaml" || fail "the test's indicator s
 # 1. Live: amfid listening, sim_publisher publishing at 20x real time.
 "$amfid" --config "$dir/amfid.yaml" --db "$dir/live.db" 2> "$dir/amfid.log" &
 apid=$!; pids="$pids $apid"
-i=0; until grep -q "running" "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
 lcm-logger -f "$dir/recorded.lcmlog" > "$dir/logger.log" 2>&1 &  # every channel
 lpid=$!; pids="$pids $lpid"
 timeout 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 3 2> "$dir/sim.log" &
@@ -65,8 +64,7 @@ awk -v e="$err" 'BEGIN { exit !(e < 0.08) }' || fail "GVW error $err over 8 %"
 #    whose data never came as gap), the database is intact.
 "$amfid" --config "$dir/amfid.yaml" --db "$dir/term.db" 2> "$dir/term.log" &
 apid=$!; pids="$pids $apid"
-i=0; until grep -q "running" "$dir/term.log"; do
-  i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start"; sleep 0.1; done
+wait_for running "$dir/term.log" $apid 60 || fail "amfid did not start"
 # -k 10: sim_publisher once did not exit after its SIGTERM summary under
 # ASan and the test hung at the wait below until ctest's 600 s (not
 # diagnosed); amfid is what this section tests

@@ -24,8 +24,7 @@ sed -e "s|^  # textfile: .*|  textfile: $dir/amfid.prom|" \
 "$amfid" --config "$dir/amfid.yaml" --check-config > /dev/null || fail "check-config"
 "$amfid" --config "$dir/amfid.yaml" --db "$dir/a.db" 2> "$dir/amfid.log" &
 apid=$!; pids="$pids $apid"
-i=0; until grep -q "running" "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 200 ] || fail "amfid did not start"; sleep 0.05; done
+wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
 
 # 1. live traffic with the site's climate; sim_publisher logs what it sends
 timeout 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 3 --dt 2.5e-4 \

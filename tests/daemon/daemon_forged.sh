@@ -25,6 +25,7 @@
 # same attack unsigned, to show what it stores.
 # Usage: daemon_forged.sh AMFID SIM_PUBLISHER LCM_FORGE CONFIG [NFT_EXAMPLE]
 set -u
+. "$(dirname "$0")/../common/proc.sh"
 if [ "${AMFI_IN_NETNS:-}" != 1 ]; then
   exec unshare --net sh -c 'ip link set lo up && AMFI_IN_NETNS=1 exec sh "$0" "$@"' "$0" "$@"
 fi
@@ -67,9 +68,7 @@ grep -q "path: $dir/forged.db" "$dir/amfid.yaml" || fail "the store path did not
 diff "$config" "$dir/amfid.yaml" | grep '^>' | sed 's/^/  config: /'
 "$amfid" --config "$dir/amfid.yaml" 2> "$dir/amfid.log" &
 apid=$!; pids="$pids $apid"
-i=0; until grep -q running "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 300 ] || fail "amfid did not start"
-  kill -0 $apid 2>/dev/null || fail "amfid exited at start"; sleep 0.1; done
+wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
 lcm-logger "$dir/capture.lcmlog" > "$dir/logger.log" 2>&1 &
 lpid=$!; pids="$pids $lpid"
 sleep 0.5

@@ -17,8 +17,7 @@ grep -q "^  interval_s: 1 " "$dir/a.yaml" || fail "the test's metrics settings d
 mkdir "$dir/m"
 "$amfid" --config "$dir/a.yaml" --db "$dir/a.db" 2> "$dir/amfid.log" &
 apid=$!; pids="$pids $apid"
-i=0; until grep -q running "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 200 ] || fail "amfid did not start"; sleep 0.05; done
+wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
 timeout 120 "$sim" --vehicles 30 --headway 2 --speedup 15 --seed 9 2> "$dir/sim.log" &
 spid=$!; pids="$pids $spid"
 copies=0 seen=""

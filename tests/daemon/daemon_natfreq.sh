@@ -30,8 +30,7 @@ start_amfid() {
   : > "$dir/amfid.log"
   "$amfid" --config "$dir/amfid.yaml" --db "$dir/a.db" 2> "$dir/amfid.log" &
   apid=$!; pids="$pids $apid"
-  i=0; until grep -q "running" "$dir/amfid.log"; do
-    i=$((i + 1)); [ $i -lt 200 ] || fail "amfid did not start"; sleep 0.05; done
+  wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
 }
 stop_amfid() {
   kill -TERM $apid
@@ -89,9 +88,8 @@ grep -q "natural frequency: baseline from the store: 10 estimates, f1 $base Hz" 
 # a reload reports a changed free_s, which applies at the next start
 sed -i 's/^    free_s: 2 .*/    free_s: 3/' "$dir/amfid.yaml"
 kill -HUP $apid
-i=0; until grep -q "reload: configuration .* applied" "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 200 ] || fail "no reload"; sleep 0.05; done
-grep -q "reload: daemon.natural_frequency takes effect at the next start" "$dir/amfid.log" ||
+wait_for "reload: configuration .* applied" "$dir/amfid.log" "" 60 || fail "no reload"
+grep -q "reload: daemon.natural_frequency.free_s changed; takes effect at the next start" "$dir/amfid.log" ||
   fail "reload: $(grep reload "$dir/amfid.log")"
 # 3. vehicles 1.5 s apart: 0.5 s of free vibration each, refused as short
 timeout 120 "$sim" --vehicles 4 --headway 1.5 --speedup 20 --seed 6 --dt 2.5e-4 \

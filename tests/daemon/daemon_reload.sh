@@ -22,6 +22,7 @@ apid=""
 cleanup() { [ -n "$apid" ] && kill -9 "$apid" 2>/dev/null; rm -rf "$dir"; }
 trap cleanup EXIT
 . "$(dirname "$0")/../common/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
+. "$(dirname "$0")/../common/proc.sh"
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -30 "$f"; done; exit 1; }
 N=${AMFI_RELOAD_VEHICLES:-120}
 L1=7.94e-9 L2=2.5e-8
@@ -40,9 +41,7 @@ cp "$dir/base.yaml" "$dir/amfid.yaml"
 "$amfid" --config "$dir/amfid.yaml" --db "$dir/reload.db" \
   --lcm-url "file://$dir/traffic.lcmlog?speed=0" 2> "$dir/amfid.log" &
 apid=$!
-i=0; until grep -q "running" "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 600 ] || fail "amfid did not start"
-  kill -0 $apid 2>/dev/null || fail "amfid exited at start-up"; sleep 0.1; done
+wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
 k=0
 while kill -0 $apid 2>/dev/null; do
   sleep 0.1

@@ -51,8 +51,7 @@ start() { # NAME: amfid on a.db, logging to NAME.log
   : > "$dir/$1.log"
   "$amfid" --config "$dir/amfid.yaml" --db "$dir/a.db" 2>> "$dir/$1.log" &
   apid=$!; pids="$pids $apid"
-  i=0; until grep -q "running" "$dir/$1.log"; do
-    i=$((i + 1)); [ $i -lt 300 ] || fail "amfid did not start ($1)"; sleep 0.1; done
+  wait_for running "$dir/$1.log" $apid 60 || fail "amfid did not start ($1)"
 }
 stop() {
   kill -TERM $apid

@@ -35,8 +35,7 @@ lcm-logger -f "$dir/out.lcmlog" > "$dir/logger.log" 2>&1 &
 pids="$pids $!"
 "$amfid" --config "$dir/a.yaml" --db "$dir/a.db" 2> "$dir/amfid.log" &
 apid=$!
-i=0; until grep -q running "$dir/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 200 ] || fail "amfid did not start"; sleep 0.05; done
+wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
 lcm-logplayer -s 8 "$dir/traffic.log" > "$dir/player.log" 2>&1 || fail "lcm-logplayer"
 sleep 1.5
 kill -TERM $apid; wait $apid; rc=$?
@@ -75,8 +74,7 @@ grep -q "belongs to site 'north-42', but .*b.yaml configures site.id 'south-7'" 
 # 3. The same site renamed: the new name is stored.
 site north-42 "Sava bridge km 42 (north)" > "$dir/c.yaml"
 "$amfid" --config "$dir/c.yaml" --db "$dir/a.db" 2> "$dir/c.log" & cpid=$!
-i=0; until grep -q running "$dir/c.log"; do
-  i=$((i + 1)); [ $i -lt 200 ] || fail "amfid did not start (renamed)"; sleep 0.05; done
+wait_for running "$dir/c.log" $cpid 60 || fail "amfid did not start (renamed)"
 kill -TERM $cpid; wait $cpid || fail "renamed run exited non-zero"
 [ "$(meta site.name)" = "Sava bridge km 42 (north)" ] || fail "meta site.name is '$(meta site.name)'"
 grep -q "site.name changed from 'Bridge over the Sava, km 42' to 'Sava bridge km 42 (north)'" \

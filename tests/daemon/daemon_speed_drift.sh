@@ -30,8 +30,7 @@ start() {
   : > "$dir/$1.log"
   "$amfid" --config "$dir/amfid.yaml" --db "$dir/$1.db" 2>> "$dir/$1.log" &
   apid=$!; pids="$pids $apid"
-  i=0; until grep -q "running" "$dir/$1.log"; do
-    i=$((i + 1)); [ $i -lt 100 ] || fail "amfid did not start ($1)"; sleep 0.1; done
+  wait_for running "$dir/$1.log" $apid 60 || fail "amfid did not start ($1)"
 }
 stop() {
   kill -TERM $apid

@@ -8,7 +8,8 @@
  * after the configuration is rewritten with max_wait_s 2 and reloaded (the
  * SIGHUP path), the same data releases it at once, stored as "gap". Before
  * the fix the tracker kept the wait it was created with and the window
- * stayed pending.
+ * stayed pending. The same reload changes daemon.workers, a restart-only
+ * key: reported by name (the key table's live flag), not applied.
  *
  * usage: test_daemon_reload_wait CONFIG (the shipped config/amfid.yaml)
  */
@@ -32,8 +33,8 @@ static void fail(const char *what)
 }
 
 /* The shipped file with two sensors, the bus unauthenticated (memq:// is
- * this process's own) and the given max_wait_s. */
-static void write_config(const char *shipped, const char *max_wait)
+ * this process's own) and the given max_wait_s and workers. */
+static void write_config(const char *shipped, const char *max_wait, const char *workers)
 {
     FILE *in = fopen(shipped, "r");
     char tmp[320];
@@ -42,7 +43,7 @@ static void write_config(const char *shipped, const char *max_wait)
     if (!in || !out)
         fail("cannot copy the configuration");
     char line[1024];
-    int sensors = 0, auth = 0, wait = 0;
+    int sensors = 0, auth = 0, wait = 0, work = 0;
     while (fgets(line, sizeof line, in)) {
         if (strncmp(line, "  - {id: 0, at_m: 10, weight: 1}", 32) == 0) {
             fputs("  - {id: 0, at_m: 10, weight: 1}\n  - {id: 1, at_m: 5, weight: 1}\n", out);
@@ -53,12 +54,15 @@ static void write_config(const char *shipped, const char *max_wait)
         } else if (strncmp(line, "  max_wait_s: 10 ", 17) == 0) {
             fprintf(out, "  max_wait_s: %s\n", max_wait);
             wait = 1;
+        } else if (strncmp(line, "  workers: 2 ", 13) == 0) {
+            fprintf(out, "  workers: %s\n", workers);
+            work = 1;
         } else {
             fputs(line, out);
         }
     }
     fclose(in);
-    if (fclose(out) != 0 || !sensors || !auth || !wait)
+    if (fclose(out) != 0 || !sensors || !auth || !wait || !work)
         fail("the shipped configuration lacks a line this test rewrites");
     if (rename(tmp, cfg_path) != 0)
         fail("rename");
@@ -103,7 +107,12 @@ int main(int argc, char **argv)
         fail("mkdtemp");
     snprintf(cfg_path, sizeof cfg_path, "%s/amfid.yaml", dir);
     snprintf(db_path, sizeof db_path, "%s/amfi.db", dir);
-    write_config(argv[1], "300");
+    write_config(argv[1], "300", "2");
+    char log_path[320];
+    snprintf(log_path, sizeof log_path, "%s/amfid.log", dir);
+    amfid_log_stream = fopen(log_path, "w+");
+    if (!amfid_log_stream)
+        fail("the log file");
     amfid *d = NULL;
     amfid_options o = {.config = cfg_path, .db = db_path, .lcm_url = "memq://"};
     if (amfid_start(&d, &o) != 0)
@@ -119,10 +128,21 @@ int main(int argc, char **argv)
     amfid_counts(d, &st);
     if (passages(d) != 0 || st.vehicles_received != 1)
         fail("with max_wait_s 300 the window should still wait for sensor 1");
-    write_config(argv[1], "2");
+    write_config(argv[1], "2", "3");
     amfid_reload(d); /* the SIGHUP path */
     if (amfid_config(d)->daemon.max_wait_s != 2.0)
         fail("the reload did not apply max_wait_s");
+    if (amfid_config(d)->daemon.workers != 2)
+        fail("the reload applied daemon.workers, a restart-only key");
+    fflush(amfid_log_stream);
+    rewind(amfid_log_stream);
+    char line[1024];
+    int reported = 0;
+    while (fgets(line, sizeof line, amfid_log_stream))
+        reported |= strstr(line, "reload: daemon.workers changed; takes effect at the next "
+                                 "start") != NULL;
+    if (!reported)
+        fail("the reload did not report daemon.workers by name");
     amfid_turn(d);
     int64_t n = passages(d);
     printf("test_daemon_reload_wait: %lld passage(s) stored after the reload\n", (long long)n);
@@ -131,6 +151,8 @@ int main(int argc, char **argv)
              "still waits with the old max_wait_s");
     int rc = amfid_drain(d);
     amfid_stop(d);
+    fclose(amfid_log_stream);
+    amfid_log_stream = NULL;
     char cmd[400];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     if (system(cmd) != 0)

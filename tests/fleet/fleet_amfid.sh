@@ -22,6 +22,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 . "$here/../common/pg_server.sh"
 pg_tmp fleet_amfid
 dir=$tmp; . "$here/../common/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
+. "$(dirname "$0")/../common/proc.sh"
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 die() { echo "FAIL: $*"; tail -n 5 "$tmp/amfid.log" "$tmp/sync.log" "$tmp/sim.log"; exit 1; }
@@ -35,8 +36,7 @@ grep -q "^  id: live-1$" "$tmp/live.yaml" && grep -q "path: $tmp/live.db" "$tmp/
     die "the test's site and store did not apply"
 "$amfid" --config "$tmp/live.yaml" 2> "$tmp/amfid.log" &
 apid=$!
-i=0; until grep -q running "$tmp/amfid.log"; do
-  i=$((i + 1)); [ $i -lt 200 ] || die "amfid did not start"; sleep 0.05; done
+wait_for running "$tmp/amfid.log" $apid 60 || die "amfid did not start"
 "$sync" --config "$tmp/live.yaml" --pg "$PG_CONNINFO" --interval 0.2 2> "$tmp/sync.log" &
 spid=$!
 # 120 vehicles 2 s apart, 12 times faster than real time: about 20 s; the

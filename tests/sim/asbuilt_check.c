@@ -14,7 +14,7 @@
  *       the same peak of Welch's average of the Hann-windowed transforms of
  *       SEG_S-long pieces overlapping by half (an ambient record)
  *   asbuilt_check keys
- *       every key of an as-built file, one path a line (amfi_as_built_keys)
+ *       every key of an as-built file, one path a line (amfi_config_as_built_keys)
  *   asbuilt_check log LOG
  *       the vehicle_t and truth_t of an LCM log, one line each:
  *       "V ID UTIME SPEED SPACING1" and "T ID UTIME SPEED"
@@ -42,8 +42,8 @@ static int f1(const char *design, const char *as_built)
         fprintf(stderr, "%s\n", err);
         return 1;
     }
-    amfi_as_built_from_design(&c, &a);
-    if (as_built && amfi_as_built_load(as_built, &c, &a, err, sizeof err)) {
+    amfi_config_as_built_from_design(&c, &a);
+    if (as_built && amfi_config_as_built_load(as_built, &c, &a, err, sizeof err)) {
         fprintf(stderr, "%s\n", err);
         return 1;
     }
@@ -224,7 +224,7 @@ static int print_key(const char *path, const char *type, const char *range,
 int main(int argc, char **argv)
 {
     if (argc == 2 && !strcmp(argv[1], "keys"))
-        return amfi_as_built_keys(print_key, NULL) != 0;
+        return amfi_config_as_built_keys(print_key, NULL) != 0;
     if (argc >= 3 && argc <= 4 && !strcmp(argv[1], "f1"))
         return f1(argv[2], argc == 4 ? argv[3] : NULL);
     if (argc == 7 && !strcmp(argv[1], "freq"))

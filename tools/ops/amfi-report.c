@@ -15,11 +15,13 @@
  * inferred GVW against the truth (simulations); sets a manual baseline from
  * the last N ok passages or from explicit values; checks the file's
  * integrity; lists passages (filtered by time, status, lane), the GVW
- * histogram per lane and the overloads against legal limits (report_export.c);
- * shows the speed corrections of the passages whose speed amfid estimated
- * (report_speed.c).
+ * histogram per lane and the overloads against legal limits; shows the
+ * speed corrections of the passages whose speed amfid estimated; draws the
+ * store with gnuplot (--plot).
  * Every section prints as a table, CSV (one section at a time) or one JSON
- * document. With no option: summary, trend and alerts, and the speed
+ * document. The sections are the rows of one table below (sections[]);
+ * each lives in its subject's file (report.h lists them and who calls
+ * whom). With no option: summary, trend and alerts, and the speed
  * corrections when the store holds estimated speeds. The table format ends
  * with the sqlite3 queries one would type next. Schema: docs/schema.md.
  *
@@ -48,27 +50,179 @@
 #include "amfi_cli.h"
 #include "amfi_config.h"
 #include "amfi_json.h"
-#include "report_export.h"
+#include "report.h"
+#include "report_indicators.h"
+#include "report_natfreq.h"
+#include "report_passages.h"
 #include "report_pg.h"
 #include "report_plot.h"
-#include "report_natfreq.h"
 #include "report_scale.h"
 #include "report_speed.h"
+#include "report_summary.h"
 #include "store.h"
 
 #define PROG "amfi-report"
 #define EXIT_DATA 1
 #define EXIT_USAGE 2
-#define TREND_ROWS 20  /* indicators shown by --trend */
-#define ALERT_ROWS 20  /* alerts shown by --alerts */
 #define MAX_BASELINE_N 10000000
+#define STR_(x) #x
+#define STR(x) STR_(x)
+#define HELP_INDENT "                               " /* where --help's texts start */
+
+/* ---- the table of sections ---------------------------------------------------
+ *
+ * One row per section: its flag, its table, its CSV and JSON, its plots,
+ * which filters it honours. parse_args, --help, the default selection, the
+ * CSV and JSON document and the table output all come from it: a new
+ * section is one row here (and its functions in its subject's file). */
+
+/* A plot of --plot: its place in the gnuplot script (the plots share the
+ * script's settings, so they are drawn in this order whatever the section
+ * order), its PNG, what it shows, and the function that writes it. */
+typedef struct plot_def {
+    int place; /* > 0; 0 ends a row's list */
+    const char *png, *what;
+    report_plot_fn draw;
+} plot_def;
+
+/* The filters a section honours; the others see every passage. */
+#define F_RANGE 1u  /* --from, --to, --lane */
+#define F_STATUS 2u /* --status */
+
+typedef struct section {
+    const char *name;                /* --name */
+    int key;                         /* -k */
+    const char *help;                /* --help's text; "\n" continues it indented */
+    int (*table)(report_ctx *);      /* --format table */
+    int (*export)(report_ctx *);     /* --format csv (to c->out) and json (into c->root) */
+    plot_def plots[4];               /* what it draws with --plot */
+    unsigned filters;                /* F_* */
+    /* with no section asked for: 1 shown; and then only when default_if
+     * says yes, when that is set */
+    int by_default;
+    int (*default_if)(amfi_store *s, int *yes, char *err, size_t errlen);
+    const char *default_when; /* what default_if asks, for --help */
+    /* written as it is read, never held whole: not rendered in memory
+     * first (a damaged row cuts the table short) and, in JSON, streamed
+     * last into the document */
+    int streamed;
+} section;
+
+enum { SEC_SUMMARY, SEC_TREND, SEC_ALERTS, SEC_ERRORS, SEC_PASSAGES, SEC_HISTOGRAM, SEC_OVERLOADS,
+       SEC_SPEED, N_SECTIONS };
+
+static const section sections[N_SECTIONS] = {
+    [SEC_SUMMARY] = {
+        .name = "summary", .key = 's',
+        .help = "passages by status, GVW of the ok ones, time span, baseline",
+        .table = summary_table, .export = summary_export,
+        .plots = {{7, "scale.png", "scale indicator: raw and temperature-compensated scale, "
+                   "CUSUM and threshold", scale_plot_scale},
+                  {8, "known_truck.png", "known-truck runs: ratio inferred / reference, raw and "
+                   "compensated", scale_plot_known_truck},
+                  {9, "temperature.png", "deck and air temperature", scale_plot_temperature},
+                  {10, "natfreq.png", "natural frequency per passage, raw and "
+                   "temperature-compensated", natfreq_plot}},
+        .by_default = 1},
+    [SEC_TREND] = {
+        .name = "trend", .key = 't', .help = "the last " STR(REPORT_TREND_ROWS) " indicators",
+        .table = trend_table, .export = trend_export,
+        .plots = {{2, "trend.png", "indicator trend, thresholds, alerts raised and cleared",
+                   indicators_plot_trend}},
+        .by_default = 1},
+    [SEC_ALERTS] = {
+        .name = "alerts", .key = 'a',
+        .help = "the last " STR(REPORT_ALERT_ROWS) " alerts and those open now",
+        .table = alerts_table, .export = alerts_export, .by_default = 1},
+    [SEC_ERRORS] = {
+        .name = "errors", .key = 'e', .help = "inferred GVW against the truth (simulations)",
+        .table = errors_table, .export = errors_export},
+    [SEC_PASSAGES] = {
+        .name = "passages", .key = 'P',
+        .help = "one line per passage: time, lane, speed, axles, GVW,\n"
+                "axle loads, status, reason",
+        .table = passages_table, .export = passages_export,
+        .plots = {{1, "gvw.png", "inferred GVW per passage over time, baseline band",
+                   passages_plot_gvw},
+                  {4, "passages_per_hour.png", "passages per hour by status",
+                   passages_plot_per_hour},
+                  {5, "speed.png", "speed distribution", passages_plot_speed}},
+        .filters = F_RANGE | F_STATUS, .streamed = 1},
+    [SEC_HISTOGRAM] = {
+        .name = "histogram", .key = 'H', .help = "GVW histogram of the ok passages per lane",
+        .table = histogram_table, .export = histogram_export,
+        .plots = {{3, "gvw_histogram.png", "GVW histogram, baseline against the latest window",
+                   passages_plot_histogram}},
+        .filters = F_RANGE},
+    [SEC_OVERLOADS] = {
+        .name = "overloads", .key = 'O',
+        .help = "ok passages over the legal GVW or axle limit (--config)",
+        .table = overloads_table, .export = overloads_export, .filters = F_RANGE},
+    [SEC_SPEED] = {
+        .name = "speed", .key = 'C',
+        .help = "speed corrections of the estimated passages (speed used /\n"
+                "detector's - 1): distribution, one line per day",
+        .table = speed_table, .export = speed_export,
+        .plots = {{6, "speed_correction.png", "daily median speed correction, p5 .. p95",
+                   speed_plot_correction}},
+        .filters = F_RANGE, .by_default = 1, .default_if = amfi_store_has_estimated,
+        .default_when = "when the store has estimated speeds"},
+};
+
+/* ---- the other options ------------------------------------------------------- */
+
+/* --help lists these in this order; a row with sections = N stands for the
+ * sections from the table whose index is in [N's first, its last]. */
+typedef struct option_row {
+    const char *name;
+    int has_arg;
+    int key;          /* getopt's value; shown as -k when show_short */
+    int show_short;
+    const char *arg;  /* the value's name in --help, or NULL */
+    const char *help; /* NULL: not listed (shown with another row) */
+    int first, last;  /* a row of sections: first .. last in the table (last > 0) */
+    int builtin;      /* --help and --version: amfi_cli's own */
+} option_row;
+
+#define OPT(name_, arg_, key_, shown_, what_, help_, ...)                                       \
+    {.name = (name_), .has_arg = (arg_), .key = (key_), .show_short = (shown_), .arg = (what_),   \
+     .help = (help_), __VA_ARGS__}
+static const option_row option_rows[] = {
+    OPT("db", 1, 'd', 1, "PATH", "the store (must exist)"),
+    OPT("pg", 1, 'G', 0, "CONNINFO", "the central PostgreSQL instead (docs/fleet.md): the fleet\n"
+                                  "summary, or with --site the report of one site"),
+    OPT("site", 1, 'I', 0, "ID", "the site, with --pg"),
+    OPT("allow-plaintext", 0, 'X', 0, NULL, "with --pg: no TLS to a server not on this machine"),
+    {.first = SEC_SUMMARY, .last = SEC_ERRORS},
+    OPT("set-baseline-last", 1, 'B', 1, "N", "baseline (source manual) from the last N ok passages, "
+                                          "N >= 2"),
+    OPT("set-baseline", 1, 'b', 1, "M,S,N", "baseline mean M kg, STD S kg, from N passages"),
+    OPT("note", 1, 'n', 1, "TEXT", "note stored with the baseline (<= 127 bytes)"),
+    OPT("check", 0, 'k', 1, NULL, "PRAGMA integrity_check and foreign_key_check"),
+    {.first = SEC_PASSAGES, .last = SEC_SPEED},
+    OPT("from", 1, 'f', 1, "T, -T, --to T", "only passages in [T, T]: YYYY-MM-DD or "
+                                         "YYYY-MM-DDTHH:MM[:SS], UTC"),
+    OPT("to", 1, 'T', 1, NULL, NULL),
+    OPT("status", 1, 'S', 1, "S", "only passages of status S (--passages)"),
+    OPT("lane", 1, 'l', 1, "N", "only lane N (--passages, --histogram, --overloads, --speed)"),
+    OPT("bin-kg", 1, 'w', 1, "W", "histogram bin width, kg (default report.histogram_bin_kg)"),
+    OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document)"),
+    OPT("plot", 1, 'p', 1, "DIR", "draw PNGs into DIR (gnuplot): GVW, trend, histogram, per hour, "
+                               "speed"),
+    OPT("config", 1, 'c', 1, "FILE", "the site's amfid.yaml: alert thresholds, site name, legal "
+                                  "limits"),
+    OPT("help", 0, 'h', 1, NULL, "this help", .builtin = 1),
+    OPT("version", 0, 'V', 1, NULL, "print the version", .builtin = 1),
+};
+#define N_OPTION_ROWS (sizeof option_rows / sizeof option_rows[0])
 
 typedef struct options {
     const char *db;
     const char *pg;         /* --pg CONNINFO: the central database, NULL: none */
     const char *site;       /* --site ID (with --pg) */
     int allow_plaintext;    /* --allow-plaintext: no TLS to a remote --pg server */
-    int summary, trend, alerts, errors, check;
+    int sel[N_SECTIONS];    /* 1: asked for; 2: by default, if its default_if says yes */
+    int check;
     int baseline_last;   /* N of --set-baseline-last, 0: not given */
     int baseline_given;  /* --set-baseline MEAN,STD,N given */
     double mean_kg, std_kg;
@@ -76,24 +230,26 @@ typedef struct options {
     const char *note;    /* NULL: empty */
     const char *plot_dir;   /* --plot DIR, NULL: none */
     const char *config;     /* --config FILE, NULL: none */
-    int passages, histogram, overloads;
-    int speed;              /* --speed; 2: by default, when the store has estimated speeds */
     int format;             /* FMT_* */
     export_opts ex;         /* --from --to --status --lane --bin-kg, limits */
     int bin_given;
 } options;
 
-static const char *g_db = "?"; /* for messages */
-static FILE *g_out;             /* where a section is rendered */
-
-static void out(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-
-static void out(const char *fmt, ...)
+/* --help: "  -k, --name ARG" in 31 columns, then its text */
+static void help_line(FILE *f, int key, int show_short, const char *name, const char *arg,
+                      const char *help)
 {
-    va_list ap;
-    va_start(ap, fmt);
-    vfprintf(g_out, fmt, ap);
-    va_end(ap);
+    char left[64], shrt[8] = "    ";
+    if (show_short)
+        snprintf(shrt, sizeof shrt, "-%c, ", key);
+    snprintf(left, sizeof left, "%s%s%s", name, arg ? " " : "", arg ? arg : "");
+    fprintf(f, "  %s--%-23s", shrt, left);
+    for (const char *p = help; *p; p++) {
+        fputc(*p, f);
+        if (*p == '\n')
+            fputs(HELP_INDENT, f);
+    }
+    fputc('\n', f);
 }
 
 static void usage(FILE *f)
@@ -108,71 +264,37 @@ static void usage(FILE *f)
             "       [--speed] [--lane N] [--bin-kg W] [--format table|csv|json] [--plot DIR] "
             "[--config FILE]\n"
             "\n"
-            "Reports on amfid's SQLite store (schema: docs/schema.md).\n"
-            "  -d, --db PATH                the store (must exist)\n"
-            "      --pg CONNINFO            the central PostgreSQL instead (docs/fleet.md): "
-            "the fleet\n"
-            "                               summary, or with --site the report of one "
-            "site\n"
-            "      --site ID                the site, with --pg\n"
-            "      --allow-plaintext        with --pg: no TLS to a server not on this machine\n"
-            "  -s, --summary                passages by status, GVW of the ok "
-            "ones, time span, baseline\n"
-            "  -t, --trend                  the last %d indicators\n"
-            "  -a, --alerts                 the last %d alerts and those open "
-            "now\n"
-            "  -e, --errors                 inferred GVW against the truth "
-            "(simulations)\n"
-            "  -B, --set-baseline-last N    baseline (source manual) from the "
-            "last N ok passages, N >= 2\n"
-            "  -b, --set-baseline M,S,N     baseline mean M kg, STD S kg, from "
-            "N passages\n"
-            "  -n, --note TEXT              note stored with the baseline "
-            "(<= 127 bytes)\n"
-            "  -k, --check                  PRAGMA integrity_check and "
-            "foreign_key_check\n"
-            "  -P, --passages               one line per passage: time, lane, speed, "
-            "axles, GVW,\n"
-            "                               axle loads, status, reason\n"
-            "  -H, --histogram              GVW histogram of the ok passages per lane\n"
-            "  -O, --overloads              ok passages over the legal GVW or axle "
-            "limit (--config)\n"
-            "  -C, --speed                  speed corrections of the estimated passages "
-            "(speed used /\n"
-            "                               detector's - 1): distribution, one line per "
-            "day\n"
-            "  -f, --from T, -T, --to T     only passages in [T, T]: YYYY-MM-DD or "
-            "YYYY-MM-DDTHH:MM[:SS], UTC\n"
-            "  -S, --status S               only passages of status S (--passages)\n"
-            "  -l, --lane N                 only lane N (--passages, --histogram, "
-            "--overloads, --speed)\n"
-            "  -w, --bin-kg W               histogram bin width, kg (default "
-            "report.histogram_bin_kg)\n"
-            "  -F, --format F               table (default), csv (one section) or "
-            "json (one document)\n"
-            "  -p, --plot DIR               draw PNGs into DIR (gnuplot): GVW, "
-            "trend, histogram, per hour, speed\n"
-            "  -c, --config FILE            the site's amfid.yaml: alert "
-            "thresholds, site name, legal limits\n"
-            "  -h, --help                   this help\n"
-            "  -V, --version                print the version\n"
-            "With no option: --summary --trend --alerts (and --speed when the store "
-            "has estimated speeds).\n"
-            "Exit status: 0 ok, 1 database error or check failed, 2 usage "
-            "error.\n",
-            TREND_ROWS, ALERT_ROWS);
+            "Reports on amfid's SQLite store (schema: docs/schema.md).\n");
+    for (size_t i = 0; i < N_OPTION_ROWS; i++) {
+        const option_row *r = &option_rows[i];
+        if (r->last > 0) {
+            for (int k = r->first; k <= r->last; k++)
+                help_line(f, sections[k].key, 1, sections[k].name, NULL, sections[k].help);
+        } else if (r->help) {
+            help_line(f, r->key, r->show_short, r->name, r->arg, r->help);
+        }
+    }
+    fputs("With no option:", f);
+    for (int k = 0; k < N_SECTIONS; k++)
+        if (sections[k].by_default && !sections[k].default_if)
+            fprintf(f, " --%s", sections[k].name);
+    for (int k = 0; k < N_SECTIONS; k++)
+        if (sections[k].by_default && sections[k].default_if)
+            fprintf(f, " (and --%s %s)", sections[k].name, sections[k].default_when);
+    fputs(".\nExit status: 0 ok, 1 database error or check failed, 2 usage error.\n", f);
 }
 
 /* "amfi-report: OPT: problem" on stderr; returns −1 */
 #define usage_error(opt, ...) (amfi_cli_error(PROG, opt, __VA_ARGS__), -1)
 
-static int data_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int data_error(const report_ctx *c, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
 
-/* "amfi-report: PATH: problem" on stderr; returns −1 */
-static int data_error(const char *fmt, ...)
+/* "amfi-report: PATH: problem" (the site with --pg) on stderr; returns −1 */
+static int data_error(const report_ctx *c, const char *fmt, ...)
 {
     va_list ap;
-    fprintf(stderr, PROG ": %s: ", g_db);
+    fprintf(stderr, PROG ": %s: ", c->name);
     va_start(ap, fmt);
     vfprintf(stderr, fmt, ap);
     va_end(ap);
@@ -225,46 +347,40 @@ static int parse_baseline(const char *arg, options *o)
     return 0;
 }
 
+static int check_args(options *o);
+
 static int parse_args(int argc, char **argv, options *o)
 {
-    static const struct option longopts[] = {
-        {"db", required_argument, NULL, 'd'},
-        {"summary", no_argument, NULL, 's'},
-        {"trend", no_argument, NULL, 't'},
-        {"alerts", no_argument, NULL, 'a'},
-        {"errors", no_argument, NULL, 'e'},
-        {"set-baseline-last", required_argument, NULL, 'B'},
-        {"set-baseline", required_argument, NULL, 'b'},
-        {"note", required_argument, NULL, 'n'},
-        {"check", no_argument, NULL, 'k'},
-        {"plot", required_argument, NULL, 'p'},
-        {"config", required_argument, NULL, 'c'},
-        {"passages", no_argument, NULL, 'P'},
-        {"histogram", no_argument, NULL, 'H'},
-        {"overloads", no_argument, NULL, 'O'},
-        {"speed", no_argument, NULL, 'C'},
-        {"from", required_argument, NULL, 'f'},
-        {"to", required_argument, NULL, 'T'},
-        {"status", required_argument, NULL, 'S'},
-        {"lane", required_argument, NULL, 'l'},
-        {"bin-kg", required_argument, NULL, 'w'},
-        {"format", required_argument, NULL, 'F'},
-        {"pg", required_argument, NULL, 'G'},
-        {"site", required_argument, NULL, 'I'},
-        {"allow-plaintext", no_argument, NULL, 'X'},
-        AMFI_CLI_END};
+    struct option longopts[N_OPTION_ROWS + N_SECTIONS + 1];
+    size_t nl = 0;
+    for (size_t i = 0; i < N_OPTION_ROWS; i++)
+        if (option_rows[i].name && !option_rows[i].builtin)
+            longopts[nl++] = (struct option){option_rows[i].name,
+                                             option_rows[i].has_arg ? required_argument
+                                                                    : no_argument,
+                                             NULL, option_rows[i].key};
+    for (int k = 0; k < N_SECTIONS; k++)
+        longopts[nl++] = (struct option){sections[k].name, no_argument, NULL, sections[k].key};
+    const struct option tail[] = {AMFI_CLI_END};
+    struct option all[sizeof longopts / sizeof longopts[0] + sizeof tail / sizeof tail[0]];
+    memcpy(all, longopts, nl * sizeof *all);
+    memcpy(all + nl, tail, sizeof tail);
     memset(o, 0, sizeof *o);
     o->ex.from = 0;
     o->ex.to = AMFI_STORE_MAX_UTIME;
     amfi_cli c;
-    amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
+    amfi_cli_init(&c, PROG, argc, argv, all, usage);
     for (int k; (k = amfi_cli_next(&c)) != -1;) {
         const char *opt = c.opt, *val = optarg;
+        int sec = -1;
+        for (int i = 0; i < N_SECTIONS; i++)
+            if (sections[i].key == k)
+                sec = i;
+        if (sec >= 0) {
+            o->sel[sec] = 1;
+            continue;
+        }
         switch (k) {
-        case 's': o->summary = 1; break;
-        case 't': o->trend = 1; break;
-        case 'a': o->alerts = 1; break;
-        case 'e': o->errors = 1; break;
         case 'k': o->check = 1; break;
         case 'd':
             if (!*val)
@@ -282,20 +398,16 @@ static int parse_args(int argc, char **argv, options *o)
             if (!*val)
                 return usage_error(opt, "empty value");
             *(k == 'G' ? &o->pg : &o->site) = val;
-            if (k == 'I' && !amfi_site_id_valid(val))
+            if (k == 'I' && !amfi_config_site_id_valid(val))
                 return usage_error(opt, "'%s' is not a site id (1 to 63 of A-Z a-z 0-9 _ . -)",
                                    amfi_cli_shown(val));
             break;
         case 'X': o->allow_plaintext = 1; break;
-        case 'P': o->passages = 1; break;
-        case 'H': o->histogram = 1; break;
-        case 'O': o->overloads = 1; break;
-        case 'C': o->speed = 1; break;
         case 'f':
         case 'T':
             {
                 char why[128];
-                if (export_parse_time(val, k == 'T', k == 'f' ? &o->ex.from : &o->ex.to,
+                if (report_parse_time(val, k == 'T', k == 'f' ? &o->ex.from : &o->ex.to,
                                       why, sizeof why) != 0)
                     return usage_error(opt, "'%s' is not a UTC time (%s): use YYYY-MM-DD, "
                                        "YYYY-MM-DDTHH:MM[:SS[.ffffff]][Z]",
@@ -356,6 +468,16 @@ static int parse_args(int argc, char **argv, options *o)
             break;
         }
     }
+    return check_args(o);
+}
+
+/* The rules between options, in the order they are checked; then the
+ * default sections when none was asked for. */
+static int check_args(options *o)
+{
+    int asked = 0, n_status = 0; /* sections asked for; of them, those --status filters */
+    for (int k = 0; k < N_SECTIONS; k++)
+        asked += o->sel[k];
     if (o->db && o->pg)
         return usage_error("--pg", "give --db or --pg, not both");
     if (!o->db && !o->pg)
@@ -368,8 +490,7 @@ static int parse_args(int argc, char **argv, options *o)
         return usage_error("--pg", "the central database is read only here: --set-baseline* and "
                            "--check work on a site's store (--db)");
     if (o->pg && !o->site) {
-        if (o->summary || o->trend || o->alerts || o->errors || o->passages || o->histogram
-            || o->overloads || o->speed || o->plot_dir || o->format != FMT_TABLE)
+        if (asked || o->plot_dir || o->format != FMT_TABLE)
             return usage_error("--site", "the report sections need one site: without --site, "
                                "--pg prints the fleet summary only");
         return 0;
@@ -382,17 +503,24 @@ static int parse_args(int argc, char **argv, options *o)
                            "--set-baseline");
     if (o->ex.from > o->ex.to)
         return usage_error("--from", "after --to");
-    if (!o->summary && !o->trend && !o->alerts && !o->errors && !o->check
-        && !o->plot_dir && !o->baseline_last && !o->baseline_given && !o->passages
-        && !o->histogram && !o->overloads && !o->speed) {
-        o->summary = o->trend = o->alerts = 1;
-        o->speed = 2; /* when the store has estimated speeds (report_main) */
+    if (!asked && !o->check && !o->plot_dir && !o->baseline_last && !o->baseline_given)
+        for (int k = 0; k < N_SECTIONS; k++)
+            o->sel[k] = sections[k].by_default ? (sections[k].default_if ? 2 : 1) : 0;
+    for (int k = 0; k < N_SECTIONS; k++)
+        n_status += o->sel[k] && (sections[k].filters & F_STATUS);
+    if (o->ex.status && !n_status) {
+        char with[256] = "";
+        size_t at = 0;
+        for (int k = 0; k < N_SECTIONS; k++)
+            if ((sections[k].filters & F_STATUS) && at < sizeof with)
+                at += (size_t)snprintf(with + at, sizeof with - at, "%s--%s", at ? " or " : "",
+                                       sections[k].name);
+        return usage_error("--status", "only with %s", with);
     }
-    if (o->ex.status && !o->passages)
-        return usage_error("--status", "only with --passages");
     if (o->format != FMT_TABLE) {
-        int n = o->summary + o->trend + o->alerts + o->errors + o->passages + o->histogram
-                + o->overloads + (o->speed == 1);
+        int n = 0;
+        for (int k = 0; k < N_SECTIONS; k++)
+            n += o->sel[k] == 1;
         if (o->check || o->plot_dir || o->baseline_last || o->baseline_given)
             return usage_error("--format", "csv and json are for the report sections, not "
                                "--check, --plot or --set-baseline*");
@@ -402,243 +530,7 @@ static int parse_args(int argc, char **argv, options *o)
     return 0;
 }
 
-/* µs since 1970 → "YYYY-MM-DD HH:MM:SS" (UTC). */
-static const char *utc(long long utime, char buf[32])
-{
-    time_t t = (time_t)(utime / 1000000);
-    struct tm tm;
-    if (!gmtime_r(&t, &tm) || strftime(buf, 32, "%Y-%m-%d %H:%M:%S", &tm) == 0)
-        snprintf(buf, 32, "%lld us", utime);
-    return buf;
-}
-
-static const char *duration(double s, char buf[32])
-{
-    if (s < 120)
-        snprintf(buf, 32, "%.0f s", s);
-    else if (s < 7200)
-        snprintf(buf, 32, "%.1f min", s / 60);
-    else if (s < 172800)
-        snprintf(buf, 32, "%.1f h", s / 3600);
-    else
-        snprintf(buf, 32, "%.1f days", s / 86400);
-    return buf;
-}
-
-/* "-" for NaN, else printf of fmt into buf. */
-static const char *num(double x, const char *fmt, char buf[32])
-{
-    if (isnan(x))
-        return "-";
-    snprintf(buf, 32, fmt, x);
-    return buf;
-}
-
-/* ---- sections ------------------------------------------------------------ */
-
-static int print_baseline(amfi_store *s)
-{
-    amfi_baseline b;
-    int found = 0;
-    char err[256], t[32];
-    if (amfi_store_get_baseline(s, &b, &found, err, sizeof err) != 0)
-        return data_error("%s", err);
-    if (!found) {
-        out("baseline     none yet (amfid sets it from the first ok "
-               "passages, or --set-baseline*)\n");
-        return 0;
-    }
-    out("baseline     mean %.0f kg, STD %.0f kg, n %d, %s, from %s UTC%s%s%s\n",
-           b.mean_kg, b.std_kg, b.n, b.source, utc(b.utime_set, t),
-           b.note[0] ? " \"" : "", b.note, b.note[0] ? "\"" : "");
-    return 0;
-}
-
-static int section_summary(amfi_store *s)
-{
-    amfi_passage_summary sum;
-    double *g = NULL;
-    size_t ng = 0;
-    char a[32], b[32], c[32], err[512];
-    if (amfi_store_passage_summary(s, &sum, err, sizeof err) != 0)
-        return data_error("%s", err);
-    out("== passages\n");
-    if (sum.total == 0)
-        out("time span    (no passages yet)\n");
-    else
-        out("time span    %s .. %s UTC (%s)\n", utc(sum.utime_first, a),
-               utc(sum.utime_last, b),
-               duration((double)(sum.utime_last - sum.utime_first) / 1e6, c));
-    out("passages     %lld\n", (long long)sum.total);
-    for (int k = 0; k < AMFI_STORE_N_STATUS; k++)
-        out("  %-10s %8lld  %5.1f %%\n", amfi_store_status_name(k),
-               (long long)sum.by_status[k],
-               sum.total ? 100.0 * (double)sum.by_status[k] / (double)sum.total : 0.0);
-    if (amfi_store_all_ok_gvw(s, &g, &ng, err, sizeof err) != 0)
-        return data_error("%s", err);
-    double mean = 0, std = 0;
-    const size_t n_ok = ng;
-    if (ng == 0) {
-        out("GVW, ok      (no ok passages)\n");
-    } else {
-        report_mean_std(g, ng, &mean, &std);
-        report_sort(g, ng);
-        out("GVW, ok      n %zu, mean %.0f kg, STD %s kg, min %.0f, "
-               "median %.0f, max %.0f kg\n",
-               ng, mean, num(std, "%.0f", a), g[0],
-               report_percentile(g, ng, 50), g[ng - 1]);
-    }
-    free(g);
-    /* what the STD and mean rules were fed (at the calibration temperature
-     * with daemon.indicators.temperature: compensated), when it is not the
-     * raw GVW itself (no deck temperature, or raw) */
-    const double raw_mean = mean, raw_std = std;
-    if (amfi_store_all_fed_gvw(s, &g, &ng, err, sizeof err) != 0)
-        return data_error("%s", err);
-    if (ng > 0)
-        report_mean_std(g, ng, &mean, &std);
-    if (ng > 0 && (ng != n_ok || mean != raw_mean || !(std == raw_std || isnan(std)))) {
-        report_sort(g, ng);
-        out("GVW, fed     n %zu, mean %.0f kg, STD %s kg, min %.0f, median %.0f, max %.0f kg "
-            "(the STD and mean rules' input: compensated to the calibration temperature)\n",
-            ng, mean, num(std, "%.0f", a), g[0], report_percentile(g, ng, 50), g[ng - 1]);
-    }
-    free(g);
-    report_intake in;
-    if (export_read_intake(s, &in, err, sizeof err) != 0)
-        return data_error("%s", err);
-    if (in.found)
-        out("bus          run %lld (as of %s): %lld messages received, %lld refused, "
-            "%lld kernel drops, %lld samples missing, %lld passages not stored\n",
-            in.run, in.as_of, in.received, in.refused, in.dropped, in.missing, in.lost);
-    amfi_environment_summary env;
-    if (amfi_store_environment_summary(s, &env, err, sizeof err) != 0)
-        return data_error("%s", err);
-    if (env.n > 0)
-        out("temperature  deck %.1f .. %.1f °C, air %.1f .. %.1f °C, %lld readings, "
-            "%s .. %s UTC\n",
-            env.deck_min_c, env.deck_max_c, env.air_min_c, env.air_max_c, (long long)env.n,
-            utc(env.utime_first, a), utc(env.utime_last, b));
-    if (report_scale_summary(s, g_out, err, sizeof err) != 0)
-        return data_error("%s", err);
-    char f1line[1024];
-    if (natfreq_summary(s, f1line, sizeof f1line, err, sizeof err) != 0)
-        return data_error("%s", err);
-    out("%s", f1line);
-    return print_baseline(s);
-}
-
-static int section_trend(amfi_store *s)
-{
-    int64_t total = 0;
-    amfi_indicator_rec rec[TREND_ROWS];
-    int nl = 0;
-    char err[512];
-    if (amfi_store_count(s, AMFI_STORE_INDICATORS, &total, err, sizeof err) != 0)
-        return data_error("%s", err);
-    out("== indicators (last %lld of %lld)\n",
-           total < TREND_ROWS ? (long long)total : (long long)TREND_ROWS,
-           (long long)total);
-    if (total == 0) {
-        out("(none yet: amfid writes one every few ok passages once its "
-               "window is full)\n");
-        return 0;
-    }
-    if (amfi_store_recent_indicators(s, TREND_ROWS, rec, &nl, err, sizeof err) != 0)
-        return data_error("%s", err);
-    out("%-19s  %6s  %9s  %8s  %6s  %8s  %s\n", "time (UTC)", "n",
-           "mean kg", "STD kg", "ratio", "p", "state");
-    for (int k = nl - 1; k >= 0; k--) { /* oldest first */
-        const amfi_indicator_row *r = &rec[k].row;
-        char t[32], b1[32], b2[32], b3[32], b4[32];
-        out("%-19.19s  %6lld  %9.31s  %8.31s  %6.31s  %8.31s  %.8s\n",
-            utc(r->utime, t), (long long)r->n, num(r->mean_kg, "%.0f", b1),
-            num(r->std_kg, "%.0f", b2), num(r->std_ratio, "%.3f", b3),
-            num(r->p_value, "%.2e", b4), r->state);
-    }
-    return 0;
-}
-
-static int section_alerts(amfi_store *s)
-{
-    int64_t total = 0;
-    amfi_alert_rec rec[ALERT_ROWS], *open = NULL;
-    int nl = 0, n_open = 0;
-    char err[512];
-    if (amfi_store_count(s, AMFI_STORE_ALERTS, &total, err, sizeof err) != 0)
-        return data_error("%s", err);
-    out("== alerts (last %lld of %lld)\n",
-           total < ALERT_ROWS ? (long long)total : (long long)ALERT_ROWS,
-           (long long)total);
-    if (total == 0) {
-        out("(none)\n");
-        return 0;
-    }
-    if (amfi_store_open_alerts(s, &open, &n_open, err, sizeof err) != 0)
-        return data_error("%s", err);
-    for (int k = 0; k < n_open; k++) {
-        char t[32];
-        out("OPEN NOW     %s %s since %s UTC\n", amfi_cli_shown(open[k].level),
-               amfi_cli_shown(open[k].kind), utc(open[k].utime, t));
-    }
-    free(open);
-    if (n_open == 0)
-        out("open now     none\n");
-    if (amfi_store_recent_alerts(s, ALERT_ROWS, rec, &nl, err, sizeof err) != 0)
-        return data_error("%s", err);
-    out("%-19s  %-7s  %-14s  %-7s  %9s  %s\n", "time (UTC)", "level",
-           "kind", "event", "indicator", "message");
-    for (int k = nl - 1; k >= 0; k--) {
-        const amfi_alert_rec *a = &rec[k];
-        char t[32], is[32];
-        if (a->indicator_id > 0)
-            snprintf(is, sizeof is, "%lld", (long long)a->indicator_id);
-        else
-            snprintf(is, sizeof is, "-");
-        /* one line per alert: the store shows control characters as '?' */
-        out("%-19.19s  %-7.7s  %-14.40s  %-7s  %9.20s  %.300s\n",
-            utc(a->utime, t), amfi_cli_shown(a->level), amfi_cli_shown(a->kind),
-            a->raised ? "raised" : "cleared", is, a->message);
-    }
-    return 0;
-}
-
-static int section_errors(amfi_store *s)
-{
-    int64_t n_truth = 0, not_ok = 0;
-    double *e = NULL;
-    size_t ne = 0;
-    char b[4][32], err[512];
-    if (amfi_store_count(s, AMFI_STORE_TRUTH, &n_truth, err, sizeof err) != 0)
-        return data_error("%s", err);
-    out("== errors against the truth\n");
-    if (n_truth == 0) {
-        out("(no truth rows: the truth is recorded in simulations only)\n");
-        return 0;
-    }
-    if (amfi_store_gvw_errors(s, &e, &ne, &not_ok, err, sizeof err) != 0)
-        return data_error("%s", err);
-    out("truth rows   %lld; ok passages matched %zu; other passages "
-           "matched %lld\n", (long long)n_truth, ne, (long long)not_ok);
-    if (ne > 0) {
-        double mean, std;
-        report_mean_std(e, ne, &mean, &std);
-        out("GVW error    mean %+.2f %%, STD %s %%\n", mean,
-               num(std, "%.2f", b[0]));
-        for (size_t k = 0; k < ne; k++)
-            e[k] = fabs(e[k]);
-        report_sort(e, ne);
-        out("|GVW error|  median %.2f %%, 90 %% %.2f %%, 95 %% %.2f %%, "
-               "99 %% %.2f %%, max %.2f %%\n",
-               report_percentile(e, ne, 50), report_percentile(e, ne, 90),
-               report_percentile(e, ne, 95), report_percentile(e, ne, 99),
-               e[ne - 1]);
-    }
-    free(e);
-    return 0;
-}
-
-static int set_baseline(const options *o)
+static int set_baseline(const options *o, const report_ctx *c)
 {
     amfi_store *s = NULL;
     amfi_baseline b;
@@ -653,13 +545,13 @@ static int set_baseline(const options *o)
     if (o->baseline_last) {
         g = malloc((size_t)o->baseline_last * sizeof *g);
         if (!g)
-            rc = data_error("out of memory");
+            rc = data_error(c, "out of memory");
         if (rc == 0
             && amfi_store_recent_ok_gvw(s, o->baseline_last, g, &n, err,
                                         sizeof err) != 0)
-            rc = data_error("%s", err);
+            rc = data_error(c, "%s", err);
         if (rc == 0 && n < o->baseline_last)
-            rc = data_error("only %d ok passages stored, --set-baseline-last "
+            rc = data_error(c, "only %d ok passages stored, --set-baseline-last "
                             "asked for %d", n, o->baseline_last);
         if (rc == 0) {
             report_mean_std(g, (size_t)n, &b.mean_kg, &b.std_kg);
@@ -674,7 +566,7 @@ static int set_baseline(const options *o)
     if (rc == 0) {
         amfi_passage_summary sum;
         if (amfi_store_passage_summary(s, &sum, err, sizeof err) != 0)
-            rc = data_error("%s", err);
+            rc = data_error(c, "%s", err);
         else
             b.utime_set = sum.utime_last;
     }
@@ -682,12 +574,12 @@ static int set_baseline(const options *o)
         snprintf(b.source, sizeof b.source, "manual");
         snprintf(b.note, sizeof b.note, "%s", o->note ? o->note : "");
         if (amfi_store_set_baseline(s, &b, err, sizeof err) != 0)
-            rc = data_error("%s", err);
+            rc = data_error(c, "%s", err);
     }
     if (rc == 0) {
         char t[32];
         printf("baseline set: mean %.0f kg, STD %.0f kg, n %d, manual, from "
-               "%s UTC\n", b.mean_kg, b.std_kg, b.n, utc(b.utime_set, t));
+               "%s UTC\n", b.mean_kg, b.std_kg, b.n, report_utc(b.utime_set, t));
         printf("(amfid reads the newest baseline row when it starts: restart "
                "it to use this one)\n");
     }
@@ -729,16 +621,17 @@ static void shell_word(const char *s, char *out, size_t len)
 static void print_next(const options *o)
 {
     char w[1100];
+    const int *sel = o->sel;
     if (o->pg) {
         /* the central database; the connection as given to --pg, not
          * echoed (it may hold a password) */
         printf("\nNext, with psql on the central database (docs/fleet.md lists the views):\n");
         printf("  psql -c \"SELECT * FROM fleet_daily_trend WHERE site_id = '%s' ORDER BY day\"\n",
                o->site);
-        if (o->trend || o->alerts)
+        if (sel[SEC_TREND] || sel[SEC_ALERTS])
             printf("  psql -c \"SELECT * FROM indicators WHERE site_id = '%s' "
                    "ORDER BY utime DESC LIMIT 50\"\n", o->site);
-        if (o->summary)
+        if (sel[SEC_SUMMARY])
             printf("  psql -c \"SELECT * FROM fleet_passages_daily WHERE site_id = '%s' "
                    "AND status <> 'ok'\"\n", o->site);
         return;
@@ -746,14 +639,14 @@ static void print_next(const options *o)
     shell_word(o->db, w, sizeof w);
     printf("\nNext, with sqlite3 (docs/schema.md lists every table and view):\n");
     printf("  sqlite3 -header -column %s \"SELECT * FROM daily_trend\"\n", w);
-    if (o->trend || o->alerts)
+    if (sel[SEC_TREND] || sel[SEC_ALERTS])
         printf("  sqlite3 -header -column %s \"SELECT * FROM window_trend "
                "ORDER BY utime DESC LIMIT 50\"\n", w);
-    if (o->summary)
+    if (sel[SEC_SUMMARY])
         printf("  sqlite3 -header -column %s \"SELECT status, reason, "
                "count(*) FROM passages WHERE status <> 'ok' GROUP BY 1, 2\"\n",
                w);
-    if (o->errors)
+    if (sel[SEC_ERRORS])
         printf("  sqlite3 -header -column %s \"SELECT * FROM passage_errors "
                "ORDER BY abs(gvw_error_pct) DESC LIMIT 20\"\n", w);
     if (o->baseline_last || o->baseline_given)
@@ -761,131 +654,119 @@ static void print_next(const options *o)
                "id DESC LIMIT 5\"\n", w);
 }
 
-/* The export sections (report_export.c) in the table format, through
- * run_section: they read the options from here. */
-static const options *g_opt;
-static int section_passages(amfi_store *s)
+/* ---- dispatch ---------------------------------------------------------------- */
+
+/* The context of section k: the filters it honours, the others open. */
+static void context_for(report_ctx *c, const options *o, int k)
 {
-    char err[512];
-    return export_passages(s, &g_opt->ex, FMT_TABLE, g_out, NULL, err, sizeof err)
-               ? data_error("%s", err) : 0;
-}
-static int section_histogram(amfi_store *s)
-{
-    char err[512];
-    return export_histogram(s, &g_opt->ex, FMT_TABLE, g_out, NULL, err, sizeof err)
-               ? data_error("%s", err) : 0;
-}
-static int section_overloads(amfi_store *s)
-{
-    char err[512];
-    return export_overloads(s, &g_opt->ex, FMT_TABLE, g_out, NULL, err, sizeof err)
-               ? data_error("%s", err) : 0;
-}
-static int section_speed(amfi_store *s)
-{
-    char err[512];
-    return export_speed(s, &g_opt->ex, FMT_TABLE, g_out, NULL, err, sizeof err)
-               ? data_error("%s", err) : 0;
+    c->ex = o->ex;
+    if (!(sections[k].filters & F_RANGE)) {
+        c->ex.from = 0;
+        c->ex.to = AMFI_STORE_MAX_UTIME;
+        c->ex.lane_given = 0;
+        c->ex.lane = 0;
+    }
+    if (!(sections[k].filters & F_STATUS))
+        c->ex.status = NULL;
 }
 
 /* --format csv|json: the chosen sections as one CSV table or one JSON
  * document ({"site_id": ..., "summary": {...}, ..., "passages": [...]}).
- * CSV (one section) goes straight to stdout. In JSON, the sections other
- * than --passages are built first (small: counts, bins, the indicator and
- * alert rows) and the passage array is streamed last, element by element:
- * a year of passages is never held in memory. A store error part-way ends
- * the output short, with the message on stderr and exit 1. */
-static int export_all(const options *o, amfi_store *s)
+ * CSV (one section) goes straight to stdout. In JSON, the sections that are
+ * not streamed are built first (small: counts, bins, the indicator and
+ * alert rows) and the streamed ones (the passage array) written last,
+ * element by element: a year of passages is never held in memory. A store
+ * error part-way ends the output short, with the message on stderr and
+ * exit 1. */
+static int export_all(const options *o, report_ctx *c)
 {
-    char err[512];
-    const int fmt = o->format;
-    const export_opts *x = &o->ex;
-    if (fmt == FMT_CSV) {
-        int rc = 0;
-        if (o->summary)
-            rc = export_summary(s, fmt, stdout, NULL, err, sizeof err);
-        else if (o->trend)
-            rc = export_trend(s, fmt, stdout, NULL, err, sizeof err);
-        else if (o->alerts)
-            rc = export_alerts(s, fmt, stdout, NULL, err, sizeof err);
-        else if (o->errors)
-            rc = export_errors(s, fmt, stdout, NULL, err, sizeof err);
-        else if (o->passages)
-            rc = export_passages(s, x, fmt, stdout, NULL, err, sizeof err);
-        else if (o->histogram)
-            rc = export_histogram(s, x, fmt, stdout, NULL, err, sizeof err);
-        else if (o->overloads)
-            rc = export_overloads(s, x, fmt, stdout, NULL, err, sizeof err);
-        else if (o->speed)
-            rc = export_speed(s, x, fmt, stdout, NULL, err, sizeof err);
-        return rc ? data_error("%s", err) : 0;
+    c->out = stdout;
+    if (o->format == FMT_CSV) {
+        for (int k = 0; k < N_SECTIONS; k++)
+            if (o->sel[k]) {
+                context_for(c, o, k);
+                return sections[k].export(c) ? data_error(c, "%s", c->err) : 0;
+            }
+        return 0;
     }
     json_t *root = json_object();
     if (!root)
-        return data_error("out of memory");
+        return data_error(c, "out of memory");
+    c->root = root;
     char site[256] = "";
-    int found = 0;
-    int rc = amfi_store_meta_get(s, "site.id", site, sizeof site, &found, err, sizeof err);
+    int found = 0, rc = 0, streamed = 0;
+    rc = amfi_store_meta_get(c->s, "site.id", site, sizeof site, &found, c->err, sizeof c->err);
     json_object_set_new(root, "site_id", found ? json_string(site) : json_null());
-    if (rc == 0 && o->summary)
-        rc = export_summary(s, fmt, NULL, root, err, sizeof err);
-    if (rc == 0 && o->trend)
-        rc = export_trend(s, fmt, NULL, root, err, sizeof err);
-    if (rc == 0 && o->alerts)
-        rc = export_alerts(s, fmt, NULL, root, err, sizeof err);
-    if (rc == 0 && o->errors)
-        rc = export_errors(s, fmt, NULL, root, err, sizeof err);
-    if (rc == 0 && o->histogram)
-        rc = export_histogram(s, x, fmt, NULL, root, err, sizeof err);
-    if (rc == 0 && o->overloads)
-        rc = export_overloads(s, x, fmt, NULL, root, err, sizeof err);
-    if (rc == 0 && o->speed)
-        rc = export_speed(s, x, fmt, NULL, root, err, sizeof err);
+    for (int k = 0; rc == 0 && k < N_SECTIONS; k++) {
+        if (!o->sel[k] || sections[k].streamed) {
+            streamed += o->sel[k] != 0;
+            continue;
+        }
+        context_for(c, o, k);
+        rc = sections[k].export(c);
+    }
     if (rc != 0) {
         json_decref(root);
-        return data_error("%s", err);
+        return data_error(c, "%s", c->err);
     }
-    if (!o->passages)
+    if (!streamed)
         return amfi_json_print(stdout, root) != 0
-                   ? data_error("cannot write the JSON document") : 0;
-    /* the document without its closing brace, then "passages" streamed */
+                   ? data_error(c, "cannot write the JSON document") : 0;
+    /* the document without its closing brace, then each streamed section */
     char *head = json_dumps(root, JSON_COMPACT | JSON_PRESERVE_ORDER
                                       | JSON_REAL_PRECISION(10));
     json_decref(root);
+    c->root = NULL;
     size_t hl = head ? strlen(head) : 0;
     if (hl < 2 || head[hl - 1] != '}') {
         free(head);
-        return data_error("cannot write the JSON document");
+        return data_error(c, "cannot write the JSON document");
     }
     fwrite(head, 1, hl - 1, stdout);
     free(head);
-    fputs(",\"passages\":", stdout);
-    if (export_passages(s, x, fmt, stdout, NULL, err, sizeof err) != 0)
-        return data_error("%s", err);
+    for (int k = 0; k < N_SECTIONS; k++) {
+        if (!o->sel[k] || !sections[k].streamed)
+            continue;
+        printf(",\"%s\":", sections[k].name);
+        context_for(c, o, k);
+        if (sections[k].export(c) != 0)
+            return data_error(c, "%s", c->err);
+    }
     if (fputs("}\n", stdout) == EOF || ferror(stdout))
-        return data_error("cannot write the JSON document");
+        return data_error(c, "cannot write the JSON document");
     return 0;
 }
 
-/* Render one section in memory and print it only when it is complete: a
- * damaged row gives its error line, not half a table. Sections are
- * separated by a blank line. */
-static int run_section(int (*fn)(amfi_store *), amfi_store *s, int *printed)
+/* One section as a table. Rendered in memory and printed only when it is
+ * complete (a damaged row gives its error line, not half a table), unless
+ * it is streamed (a year of passages is not rendered in memory first: a
+ * damaged row ends the list with its error line). Sections are separated by
+ * a blank line. */
+static int run_section(const options *o, report_ctx *c, int k, int *printed)
 {
+    context_for(c, o, k);
+    if (sections[k].streamed) {
+        if (*printed)
+            putchar('\n');
+        c->out = stdout;
+        *printed = 1;
+        return sections[k].table(c) ? data_error(c, "%s", c->err) : 0;
+    }
     char *buf = NULL;
     size_t len = 0;
-    g_out = open_memstream(&buf, &len);
-    if (!g_out)
-        return data_error("out of memory");
-    int rc = fn(s);
-    fclose(g_out);
-    g_out = stdout;
+    c->out = open_memstream(&buf, &len);
+    if (!c->out)
+        return data_error(c, "out of memory");
+    int rc = sections[k].table(c);
+    fclose(c->out);
+    c->out = stdout;
     if (rc == 0) {
         if (*printed)
             putchar('\n');
         fwrite(buf, 1, len, stdout);
         *printed = 1;
+    } else {
+        data_error(c, "%s", c->err);
     }
     free(buf);
     return rc;
@@ -893,20 +774,21 @@ static int run_section(int (*fn)(amfi_store *), amfi_store *s, int *printed)
 
 /* --plot: site name from the store's meta (site.name), else the config's
  * bridge.name, else the database's file name; thresholds from --config or
- * the indicator defaults. */
-static int plot(const options *o, const amfi_site_config *c, amfi_store *s)
+ * the indicator defaults. Every section's plots, in their places. */
+static int plot(const options *o, const amfi_site_config *cfg, const report_ctx *c)
 {
+    amfi_store *s = c->s;
     char site[4097], err[1024]; /* meta values hold at most 4096 bytes */
     int found = 0;
     amfi_indicator_params ip;
     amfi_indicator_params_default(&ip);
     if (amfi_store_meta_get(s, "site.name", site, sizeof site, &found, err,
                             sizeof err) != 0)
-        return data_error("%s", err);
-    if (c) {
-        ip = c->daemon.indicators;
+        return data_error(c, "%s", err);
+    if (cfg) {
+        ip = cfg->daemon.indicators;
         if (!found) {
-            snprintf(site, sizeof site, "%s", c->site.name);
+            snprintf(site, sizeof site, "%s", cfg->site.name);
             found = 1;
         }
     }
@@ -914,7 +796,31 @@ static int plot(const options *o, const amfi_site_config *c, amfi_store *s)
         const char *b = strrchr(o->db, '/');
         snprintf(site, sizeof site, "%s", b ? b + 1 : o->db);
     }
-    if (report_plot(s, o->plot_dir, site, &ip, err, sizeof err) != 0) {
+    /* every section's plots in their places */
+    enum { MAX_PLOTS = N_SECTIONS * 4 };
+    const plot_def *order[MAX_PLOTS], *made[MAX_PLOTS];
+    int n_plots = 0, n_made = 0, rc = 0;
+    for (int k = 0; k < N_SECTIONS; k++)
+        for (int j = 0; j < 4 && sections[k].plots[j].place > 0; j++) {
+            int i = n_plots++;
+            for (; i > 0 && order[i - 1]->place > sections[k].plots[j].place; i--)
+                order[i] = order[i - 1];
+            order[i] = &sections[k].plots[j];
+        }
+    report_plot_frame p;
+    rc = report_plot_begin(&p, s, o->plot_dir, site, &ip, err, sizeof err);
+    for (int i = 0; rc == 0 && i < n_plots; i++) {
+        int drawn = 0;
+        rc = order[i]->draw(&p, &drawn, err, sizeof err);
+        if (rc == 0 && drawn)
+            made[n_made++] = order[i];
+    }
+    if (rc == 0)
+        rc = report_plot_run(&p, err, sizeof err);
+    for (int i = 0; rc == 0 && i < n_made; i++)
+        rc = report_plot_listed(&p, made[i]->png, made[i]->what, err, sizeof err);
+    report_plot_free(&p);
+    if (rc != 0) {
         fprintf(stderr, PROG ": --plot: %s\n", err);
         return -1;
     }
@@ -974,11 +880,11 @@ static void remove_tmp(const char *dir, const char *db)
 static int report_main(options *op)
 {
     options o = *op;
-    amfi_store *s = NULL;
+    report_ctx c;
     char err[512];
     int rc = 0, printed = 0;
-    g_db = o.pg ? o.site : o.db;
-    g_opt = &o;
+    memset(&c, 0, sizeof c);
+    c.name = o.pg ? o.site : o.db;
     /* --config: thresholds, names, legal limits; else the defaults */
     amfi_site_config *cfg = malloc(sizeof *cfg);
     if (!cfg) {
@@ -997,77 +903,63 @@ static int report_main(options *op)
         o.ex.bin_kg = cfg->report.bin_kg;
     /* read-only first: refuses a missing file, a non-SQLite file, a foreign
      * or newer database, before anything could write to it */
-    if (amfi_store_open_readonly(o.db, &s, err, sizeof err) != 0) {
+    if (amfi_store_open_readonly(o.db, &c.s, err, sizeof err) != 0) {
         /* the store's message starts with the path already */
         fprintf(stderr, PROG ": %s\n", err);
         free(cfg);
         return EXIT_DATA;
     }
-    g_out = stdout;
-    if (o.speed == 2) {
-        /* by default: only when the store has estimated speeds */
+    c.db = o.db;
+    c.site = o.site;
+    c.format = o.format;
+    c.cfg = o.config ? cfg : NULL;
+    c.out = stdout;
+    /* the sections shown by default only when the store has their data */
+    for (int k = 0; k < N_SECTIONS; k++) {
+        if (o.sel[k] != 2)
+            continue;
         int yes = 0;
-        if (amfi_store_has_estimated(s, &yes, err, sizeof err) != 0) {
-            data_error("%s", err);
-            amfi_store_close(s);
+        if (sections[k].default_if(c.s, &yes, err, sizeof err) != 0) {
+            data_error(&c, "%s", err);
+            amfi_store_close(c.s);
             free(cfg);
             return EXIT_DATA;
         }
-        o.speed = yes;
+        o.sel[k] = yes;
     }
     if (o.format != FMT_TABLE) {
-        rc = export_all(&o, s);
-        amfi_store_close(s);
+        rc = export_all(&o, &c);
+        amfi_store_close(c.s);
         free(cfg);
         fflush(stdout);
         return rc == 0 ? 0 : EXIT_DATA;
     }
     if (o.baseline_last || o.baseline_given) {
-        rc = set_baseline(&o);
+        rc = set_baseline(&o, &c);
         printed = rc == 0;
     }
-    if (rc == 0 && o.summary)
-        rc = run_section(section_summary, s, &printed);
-    if (rc == 0 && o.trend)
-        rc = run_section(section_trend, s, &printed);
-    if (rc == 0 && o.alerts)
-        rc = run_section(section_alerts, s, &printed);
-    if (rc == 0 && o.errors)
-        rc = run_section(section_errors, s, &printed);
-    if (rc == 0 && o.passages) {
-        /* streamed (a year of passages is not rendered in memory first): a
-         * damaged row ends the list with its error line */
-        if (printed)
-            putchar('\n');
-        rc = section_passages(s);
-        printed = 1;
-    }
-    if (rc == 0 && o.histogram)
-        rc = run_section(section_histogram, s, &printed);
-    if (rc == 0 && o.overloads)
-        rc = run_section(section_overloads, s, &printed);
-    if (rc == 0 && o.speed)
-        rc = run_section(section_speed, s, &printed);
+    for (int k = 0; rc == 0 && k < N_SECTIONS; k++)
+        if (o.sel[k])
+            rc = run_section(&o, &c, k, &printed);
     if (rc == 0 && o.plot_dir) {
         if (printed)
             printf("\n");
-        rc = plot(&o, o.config ? cfg : NULL, s);
+        rc = plot(&o, o.config ? cfg : NULL, &c);
         printed = 1;
     }
     if (rc == 0 && o.check) {
         char result[1024];
-        int st = amfi_store_integrity_check(s, result, sizeof result, err,
-                                            sizeof err);
+        int st = amfi_store_integrity_check(c.s, result, sizeof result, err, sizeof err);
         if (printed)
             printf("\n");
         printf("integrity    %s\n", result);
         if (st != 0 || strcmp(result, "ok") != 0)
-            rc = data_error("integrity check failed: %s", result);
+            rc = data_error(&c, "integrity check failed: %s", result);
     }
-    if (rc == 0 && (o.summary || o.trend || o.alerts || o.errors
-                    || o.baseline_last || o.baseline_given))
+    if (rc == 0 && (o.sel[SEC_SUMMARY] || o.sel[SEC_TREND] || o.sel[SEC_ALERTS]
+                    || o.sel[SEC_ERRORS] || o.baseline_last || o.baseline_given))
         print_next(&o);
-    amfi_store_close(s);
+    amfi_store_close(c.s);
     free(cfg);
     fflush(stdout);
     return rc == 0 ? 0 : EXIT_DATA;

@@ -4,7 +4,6 @@
  * (report_natfreq.h). Single-threaded, the caller's thread.
  */
 #include "report_natfreq.h"
-#include "report_plot.h" /* report_data_open, report_data_close */
 
 #include <math.h>
 #include <stdlib.h>
@@ -96,16 +95,19 @@ int natfreq_summary(amfi_store *s, char *line, size_t len, char *err, size_t err
     return 0;
 }
 
-int natfreq_plot(amfi_store *s, const char *dir, FILE *gp, const char *sub, int *made,
-                 char *err, size_t errlen)
+int natfreq_plot(report_plot_frame *p, int *made, char *err, size_t errlen)
 {
+    amfi_store *s = p->s;
+    const char *dir = p->dir, *sub = p->sub;
+    FILE *gp = p->gp;
     amfi_f1_rec *a = NULL;
     size_t n = 0;
-    *made = 0;
     if (amfi_store_f1_series(s, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err, errlen) != 0)
         return -1;
-    if (n == 0)
+    if (n == 0) {
+        free(a);
         return 0;
+    }
     FILE *f = report_data_open(dir, "natfreq.dat", err, errlen);
     if (!f) {
         free(a);

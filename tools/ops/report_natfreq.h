@@ -15,6 +15,7 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "report_plot.h"
 #include "store.h"
 
 /* The figures of the summary: every passage with an f1, raw and
@@ -32,11 +33,9 @@ int natfreq_read_stats(amfi_store *s, natfreq_stats *st, char *err, size_t errle
  * −1 with the store's message in err. */
 int natfreq_summary(amfi_store *s, char *line, size_t len, char *err, size_t errlen);
 
-/* --plot: write dir/data/natfreq.dat (time, raw, compensated, damping) and
- * append natfreq.png's commands to the gnuplot script gp (sub: the plots'
- * subtitle). *made = 1 when the store holds an f1 (else nothing is written).
- * 0, or −1 with a message in err. */
-int natfreq_plot(amfi_store *s, const char *dir, FILE *gp, const char *sub, int *made,
-                 char *err, size_t errlen);
+/* natfreq.png (report_plot_fn): writes dir/data/natfreq.dat (time, raw,
+ * compensated, damping) and appends the plot's commands to the script, when
+ * the store holds an f1 (else nothing is written). */
+int natfreq_plot(report_plot_frame *p, int *made, char *err, size_t errlen);
 
 #endif /* REPORT_NATFREQ_H */

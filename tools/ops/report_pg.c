@@ -89,7 +89,7 @@ static int count_ok(const char *v)
 static const char *fleet_row_problem(PGresult *r, int i)
 {
     static const char *const states[] = {"-", "baseline", "normal", "watch", "alert", NULL};
-    if (PQgetisnull(r, i, 0) || !amfi_site_id_valid(PQgetvalue(r, i, 0)))
+    if (PQgetisnull(r, i, 0) || !amfi_config_site_id_valid(PQgetvalue(r, i, 0)))
         return "site_id is not a valid site id";
     if (PQgetisnull(r, i, 1) || !count_ok(PQgetvalue(r, i, 1)))
         return "fleet_sync_state.hwm is not a count";

@@ -1,8 +1,15 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * report_plot.h: amfi-report --plot: PNGs of a store drawn with gnuplot
- * (report_plot.c). Single-threaded, the caller's thread; the store handle
- * stays the caller's.
+ * report_plot.h: amfi-report --plot's gnuplot helpers (report_plot.c, which
+ * calls no other report file): the plot frame (the directory, the script
+ * being written, the site and subtitle, the time axis, and the passages,
+ * indicators, alerts and baseline that several plots draw, read once), the
+ * data files under DIR/data/, gnuplot's run and the PNG check. Each plot is
+ * a function of its subject's file (report_plot_fn) that writes its data
+ * files and appends its commands to the script; amfi-report.c's table of
+ * sections calls them in order. Single-threaded, the caller's thread; the
+ * store handle stays the caller's. Memory: four doubles per passage (a
+ * million passages: 32 MB).
  */
 #ifndef REPORT_PLOT_H
 #define REPORT_PLOT_H
@@ -13,22 +20,63 @@
 #include "indicators.h"
 #include "store.h"
 
-/* Write into `dir` (created if missing) gvw.png, trend.png,
- * gvw_histogram.png, passages_per_hour.png and speed.png (and
- * speed_correction.png when the store has estimated speeds; scale.png,
- * known_truck.png and temperature.png when it has scale blocks, known-truck
- * runs and environment readings, report_scale.h; natfreq.png when it has
- * natural frequencies, report_natfreq.h), plus their data
- * and the gnuplot script under dir/data/ (alerts.dat holds one line per
- * alert row). `site` titles every plot; `ip` gives the alert thresholds.
- * Prints one line per PNG ("plot  PATH  what") on stdout. Returns 0, or −1
+/* One passage as the plots see it. */
+typedef struct report_pas {
+    double t;     /* s since 1970 */
+    double gvw;   /* kg or NaN */
+    double speed; /* m/s or NaN */
+    int status;   /* index in amfi_store_status_name order */
+} report_pas;
+
+typedef struct report_plot_frame {
+    amfi_store *s;
+    const char *dir;                 /* --plot DIR */
+    const amfi_indicator_params *ip; /* the alert thresholds */
+    FILE *gp;                        /* DIR/data/plots.gp, being written */
+    char gdir[8200];                 /* dir in a gnuplot single-quoted string */
+    char site[128];                  /* the site, safe in a gnuplot string */
+    char sub[256];                   /* the plots' subtitle: site, span, passages */
+    double t0, t1;                   /* the time axis, s since 1970 */
+    report_pas *pas;                 /* every passage, oldest first */
+    size_t n_pas, cap_pas;
+    amfi_indicator_rec *ind;         /* every indicator row, newest first */
+    int n_ind;
+    amfi_alert_rec *al;              /* every alert row, newest first */
+    int n_al;
+    amfi_baseline b;                 /* the baseline in force, when found */
+    int found;
+} report_plot_frame;
+
+/* One plot: writes its data files and appends its commands to p->gp;
+ * *made = 1 when it drew its PNG (a plot without data draws none). 0, or −1
  * with a one-line message in err. */
-int report_plot(amfi_store *s, const char *dir, const char *site,
-                const amfi_indicator_params *ip, char *err, size_t errlen);
+typedef int (*report_plot_fn)(report_plot_frame *p, int *made, char *err, size_t errlen);
+
+/* Creates dir and dir/data, reads the shared data, opens the script and
+ * writes its preamble (terminal, the d and o variables, the time axis).
+ * `site` titles every plot; `ip` gives the alert thresholds. 0, or −1 with
+ * the message in err (report_plot_free frees it either way). */
+int report_plot_begin(report_plot_frame *p, amfi_store *s, const char *dir, const char *site,
+                      const amfi_indicator_params *ip, char *err, size_t errlen);
+/* Closes the script and runs gnuplot on it. 0, or −1 with err. */
+int report_plot_run(report_plot_frame *p, char *err, size_t errlen);
+/* A PNG gnuplot should have written: "plot  PATH  what" on stdout, or −1
+ * with err. */
+int report_plot_listed(const report_plot_frame *p, const char *png, const char *what, char *err,
+                       size_t errlen);
+void report_plot_free(report_plot_frame *p);
 
 /* dir/data/name opened for writing, or NULL with the message in err; closed
  * with report_data_close (0, or −1 when a write failed). */
 FILE *report_data_open(const char *dir, const char *name, char *err, size_t errlen);
 int report_data_close(FILE *f, const char *dir, const char *name, char *err, size_t errlen);
+
+/* A word from the store written to a data file (an alert's level and kind,
+ * an indicator's state): one whitespace-free token of printable ASCII, so
+ * that a line break or blank in the store cannot add rows or columns. */
+const char *report_dat_word(const char *s, char out[64]);
+
+/* Histogram of v[0..n) into nb bins from lo by w, as fractions. */
+void report_hist(const double *v, size_t n, double lo, double w, int nb, double *out);
 
 #endif /* REPORT_PLOT_H */

@@ -5,8 +5,6 @@
  */
 #include "report_scale.h"
 
-#include "report_plot.h"
-
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -115,84 +113,101 @@ static void time_axis(FILE *gp)
           gp);
 }
 
-int report_scale_plots(amfi_store *s, const char *dir, FILE *gp, const char *site, int *which,
-                       char *err, size_t errlen)
+int scale_plot_scale(report_plot_frame *p, int *made, char *err, size_t errlen)
 {
-    amfi_scale_eval_rec *sc = NULL, *kt = NULL;
-    amfi_environment_row *env = NULL;
-    size_t nsc = 0, nkt = 0, nenv = 0;
-    int rc = -1;
-    *which = 0;
-    if (amfi_store_scale_evals(s, "scale_shift", &sc, &nsc, err, errlen) != 0 ||
-        amfi_store_scale_evals(s, "known_truck", &kt, &nkt, err, errlen) != 0 ||
-        amfi_store_environment_rows(s, &env, &nenv, err, errlen) != 0)
-        goto out;
+    amfi_scale_eval_rec *sc = NULL;
+    size_t nsc = 0;
+    if (amfi_store_scale_evals(p->s, "scale_shift", &sc, &nsc, err, errlen) != 0)
+        return -1;
     size_t blocks = 0; /* gnuplot refuses a plot without one valid point */
     for (size_t i = 0; i < nsc; i++)
         blocks += strcmp(sc[i].state, "baseline") != 0;
+    int rc = 0;
     if (blocks > 0) {
-        if (write_evals(dir, "scale.dat", sc, nsc, err, errlen) != 0)
-            goto out;
-        fprintf(gp,
-            "unset label 99\nset autoscale y\nset xdata time\nset timefmt '%%s'\n"
-            "set format x \"%%H:%%M\\n%%d %%b\"\nset autoscale x\n"
-            "set terminal pngcairo size 960,700 noenhanced\nset output o.'scale.png'\n"
-            "set multiplot layout 2,1 title \"Scale indicator (scale_shift): %zu blocks after the baseline\\n%s\"\n"
-            "unset title\nset lmargin at screen 0.09\nset rmargin at screen 0.72\n"
-            "set format x ''\nunset xlabel\nset ylabel 'scale of inferred GVW'\n"
-            "plot d.'scale.dat' using 1:($8>0?$3:NaN) with linespoints pt 6 ps 0.5 lc rgb '#aaaaaa' title 'raw', \\\n"
-            "     d.'scale.dat' using 1:($8>0?$2:NaN) with linespoints pt 7 ps 0.5 lc rgb '#1f77b4' title 'temperature-compensated', \\\n"
-            "     1 with lines dt 2 lc rgb 'black' notitle\n"
-            "set format x \"%%H:%%M\\n%%d %%b\"\nset xlabel 'time (UTC, data time)'\n"
-            "set ylabel 'CUSUM (block SDs)'\n"
-            "plot d.'scale.dat' using 1:($8>0?$6:NaN) with steps lw 2 lc rgb '#ff7f0e' title 'CUSUM', \\\n"
-            "     d.'scale.dat' using 1:7 with lines dt 1 lc rgb '#d62728' title 'threshold h'\n"
-            "unset multiplot\nset lmargin\nset rmargin\nset terminal pngcairo size 960,540 noenhanced\nset output\n",
-            blocks, site);
-        *which |= REPORT_SCALE_PNG_SCALE;
+        rc = write_evals(p->dir, "scale.dat", sc, nsc, err, errlen);
+        if (rc == 0) {
+            fprintf(p->gp,
+                "unset label 99\nset autoscale y\nset xdata time\nset timefmt '%%s'\n"
+                "set format x \"%%H:%%M\\n%%d %%b\"\nset autoscale x\n"
+                "set terminal pngcairo size 960,700 noenhanced\nset output o.'scale.png'\n"
+                "set multiplot layout 2,1 title \"Scale indicator (scale_shift): %zu blocks after the baseline\\n%s\"\n"
+                "unset title\nset lmargin at screen 0.09\nset rmargin at screen 0.72\n"
+                "set format x ''\nunset xlabel\nset ylabel 'scale of inferred GVW'\n"
+                "plot d.'scale.dat' using 1:($8>0?$3:NaN) with linespoints pt 6 ps 0.5 lc rgb '#aaaaaa' title 'raw', \\\n"
+                "     d.'scale.dat' using 1:($8>0?$2:NaN) with linespoints pt 7 ps 0.5 lc rgb '#1f77b4' title 'temperature-compensated', \\\n"
+                "     1 with lines dt 2 lc rgb 'black' notitle\n"
+                "set format x \"%%H:%%M\\n%%d %%b\"\nset xlabel 'time (UTC, data time)'\n"
+                "set ylabel 'CUSUM (block SDs)'\n"
+                "plot d.'scale.dat' using 1:($8>0?$6:NaN) with steps lw 2 lc rgb '#ff7f0e' title 'CUSUM', \\\n"
+                "     d.'scale.dat' using 1:7 with lines dt 1 lc rgb '#d62728' title 'threshold h'\n"
+                "unset multiplot\nset lmargin\nset rmargin\nset terminal pngcairo size 960,540 noenhanced\nset output\n",
+                blocks, p->site);
+            *made = 1;
+        }
     }
-    if (nkt > 0) {
-        if (write_evals(dir, "known_truck.dat", kt, nkt, err, errlen) != 0)
-            goto out;
-        time_axis(gp);
-        fprintf(gp,
-            "set output o.'known_truck.png'\n"
-            "set title \"Known-truck runs (known_truck): %zu runs, inferred / reference GVW\\n%s\"\n"
-            "set ylabel 'ratio inferred / reference'\n"
-            "plot d.'known_truck.dat' using 1:3 with points pt 6 ps 0.8 lc rgb '#aaaaaa' title 'raw', \\\n"
-            "     d.'known_truck.dat' using 1:2 with linespoints pt 7 ps 0.8 lc rgb '#2ca02c' title 'temperature-compensated', \\\n"
-            "     d.'known_truck.dat' using 1:($8==3?$2:NaN) with points pt 7 ps 1.2 lc rgb '#d62728' title 'in alert', \\\n"
-            "     1 with lines dt 2 lc rgb 'black' notitle\nset output\n",
-            nkt, site);
-        *which |= REPORT_SCALE_PNG_TRUCK;
-    }
-    if (nenv > 0) {
-        FILE *f = report_data_open(dir, "temperature.dat", err, errlen);
-        if (!f)
-            goto out;
-        /* at most about 20 000 points: a year of minute readings is thinned */
-        size_t step = nenv / 20000 + 1;
-        fprintf(f, "# time_s deck_c air_c (every %zu-th reading)\n", step);
-        for (size_t i = 0; i < nenv; i += step)
-            fprintf(f, "%.3f %.2f %.2f\n", (double)env[i].utime / 1e6, env[i].deck_c,
-                    env[i].air_c);
-        if (report_data_close(f, dir, "temperature.dat", err, errlen) != 0)
-            goto out;
-        time_axis(gp);
-        fprintf(gp,
-            "set output o.'temperature.png'\n"
-            "set title \"Deck and air temperature (environment_t, %zu readings)\\n%s\"\n"
-            "set ylabel 'temperature (°C)'\n"
-            "plot d.'temperature.dat' using 1:2 with lines lw 1.5 lc rgb '#d62728' title 'deck', \\\n"
-            "     d.'temperature.dat' using 1:3 with lines lc rgb '#1f77b4' title 'air', \\\n"
-            "     0 with lines dt 2 lc rgb 'black' notitle\nset output\n",
-            nenv, site);
-        *which |= REPORT_SCALE_PNG_TEMPERATURE;
-    }
-    rc = 0;
-out:
     free(sc);
-    free(kt);
-    free(env);
     return rc;
+}
+
+int scale_plot_known_truck(report_plot_frame *p, int *made, char *err, size_t errlen)
+{
+    amfi_scale_eval_rec *kt = NULL;
+    size_t nkt = 0;
+    if (amfi_store_scale_evals(p->s, "known_truck", &kt, &nkt, err, errlen) != 0)
+        return -1;
+    int rc = 0;
+    if (nkt > 0) {
+        rc = write_evals(p->dir, "known_truck.dat", kt, nkt, err, errlen);
+        if (rc == 0) {
+            time_axis(p->gp);
+            fprintf(p->gp,
+                "set output o.'known_truck.png'\n"
+                "set title \"Known-truck runs (known_truck): %zu runs, inferred / reference GVW\\n%s\"\n"
+                "set ylabel 'ratio inferred / reference'\n"
+                "plot d.'known_truck.dat' using 1:3 with points pt 6 ps 0.8 lc rgb '#aaaaaa' title 'raw', \\\n"
+                "     d.'known_truck.dat' using 1:2 with linespoints pt 7 ps 0.8 lc rgb '#2ca02c' title 'temperature-compensated', \\\n"
+                "     d.'known_truck.dat' using 1:($8==3?$2:NaN) with points pt 7 ps 1.2 lc rgb '#d62728' title 'in alert', \\\n"
+                "     1 with lines dt 2 lc rgb 'black' notitle\nset output\n",
+                nkt, p->site);
+            *made = 1;
+        }
+    }
+    free(kt);
+    return rc;
+}
+
+int scale_plot_temperature(report_plot_frame *p, int *made, char *err, size_t errlen)
+{
+    amfi_environment_row *env = NULL;
+    size_t nenv = 0;
+    if (amfi_store_environment_rows(p->s, &env, &nenv, err, errlen) != 0)
+        return -1;
+    if (nenv == 0) {
+        free(env);
+        return 0;
+    }
+    FILE *f = report_data_open(p->dir, "temperature.dat", err, errlen);
+    if (!f) {
+        free(env);
+        return -1;
+    }
+    /* at most about 20 000 points: a year of minute readings is thinned */
+    size_t step = nenv / 20000 + 1;
+    fprintf(f, "# time_s deck_c air_c (every %zu-th reading)\n", step);
+    for (size_t i = 0; i < nenv; i += step)
+        fprintf(f, "%.3f %.2f %.2f\n", (double)env[i].utime / 1e6, env[i].deck_c, env[i].air_c);
+    free(env);
+    if (report_data_close(f, p->dir, "temperature.dat", err, errlen) != 0)
+        return -1;
+    time_axis(p->gp);
+    fprintf(p->gp,
+        "set output o.'temperature.png'\n"
+        "set title \"Deck and air temperature (environment_t, %zu readings)\\n%s\"\n"
+        "set ylabel 'temperature (°C)'\n"
+        "plot d.'temperature.dat' using 1:2 with lines lw 1.5 lc rgb '#d62728' title 'deck', \\\n"
+        "     d.'temperature.dat' using 1:3 with lines lc rgb '#1f77b4' title 'air', \\\n"
+        "     0 with lines dt 2 lc rgb 'black' notitle\nset output\n",
+        nenv, p->site);
+    *made = 1;
+    return 0;
 }

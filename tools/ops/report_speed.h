@@ -4,8 +4,10 @@
  * passages whose speed amfid estimated (solver.speed: estimate, issue 12):
  * the distribution of c = speed weighed with / detector's speed − 1 over the
  * selected passages (--from, --to, --lane), and its drift, one line per UTC
- * day, in the table, CSV and JSON formats (report_speed.c). Single-threaded;
- * the store is read through store/ only (amfi_store_speed_pairs).
+ * day, in the table, CSV and JSON formats (report_cols.h); and
+ * speed_correction.png, the daily median with its p5-p95 band
+ * (report_speed.c). Single-threaded; the store is read through store/ only
+ * (amfi_store_speed_pairs).
  */
 #ifndef REPORT_SPEED_H
 #define REPORT_SPEED_H
@@ -16,7 +18,8 @@
 
 #include <jansson.h>
 
-#include "report_export.h"
+#include "report.h"
+#include "report_plot.h"
 #include "store.h"
 
 /* Statistics of corrections, in % (c · 100). Percentiles are nearest-rank
@@ -40,9 +43,13 @@ typedef struct speed_day {
 int speed_corrections(amfi_store *s, const export_opts *o, speed_stats *all, speed_day **days,
                       size_t *ndays, char *err, size_t errlen);
 
-/* The section, written to f (table, csv) or added to root as "speed" (json).
- * 0, or −1 with the store's message in err. */
-int export_speed(amfi_store *s, const export_opts *o, int fmt, FILE *f, json_t *root, char *err,
-                 size_t errlen);
+/* The section, written to c->out (table, CSV) or added to c->root as
+ * "speed" (JSON). 0, or −1 with the store's message in c->err. */
+int speed_table(report_ctx *c);
+int speed_export(report_ctx *c);
+
+/* speed_correction.png (report_plot_fn), when the store has estimated
+ * speeds; writes speed_correction.dat. */
+int speed_plot_correction(report_plot_frame *p, int *made, char *err, size_t errlen);
 
 #endif /* REPORT_SPEED_H */

@@ -1,0 +1,690 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * report_passages.c: amfi-report's passage sections and plots
+ * (report_passages.h).
+ */
+#define _GNU_SOURCE
+#include "report_passages.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "report_cols.h"
+
+#define MAX_LANES 64 /* distinct lanes a histogram keeps apart */
+#define MAX_BINS 100000
+#define JSON_FLAGS (JSON_COMPACT | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10))
+
+/* The passages of o's range and lane and of `status` (NULL: any), read
+ * through the store's filtered iterator: the filter is SQL. */
+static int each(report_ctx *c, const char *status, amfi_store_passage_fn fn, void *ctx)
+{
+    const export_opts *o = &c->ex;
+    amfi_passage_filter f = {.from = o->from, .to = o->to, .status = status,
+                             .lane_given = o->lane_given, .lane = o->lane};
+    return amfi_store_each_passage_where(c->s, &f, fn, ctx, c->err, sizeof c->err);
+}
+
+/* ---- the passage list ------------------------------------------------------ */
+
+typedef struct pas_row {
+    int64_t id;
+    const amfi_passage_row *r;
+    char t[32]; /* its time, ISO 8601 */
+} pas_row;
+
+#define R(row) (((const pas_row *)(row))->r)
+static void p_time(const void *w, report_val *v) { v->s = ((const pas_row *)w)->t; }
+static void p_utime(const void *w, report_val *v) { v->i = R(w)->utime; }
+static void p_id(const void *w, report_val *v) { v->i = ((const pas_row *)w)->id; }
+static void p_vehicle(const void *w, report_val *v) { v->i = R(w)->vehicle_id; }
+static void p_lane(const void *w, report_val *v) { v->i = R(w)->lane; }
+static void p_speed(const void *w, report_val *v) { v->x = R(w)->speed_mps; }
+static void p_axles(const void *w, report_val *v) { v->i = R(w)->n_axles; }
+static void p_gvw(const void *w, report_val *v) { v->x = R(w)->gvw_kg; }
+static void p_loads(const void *w, report_val *v)
+{
+    v->v = R(w)->axle_kg;
+    v->n = R(w)->n_axles;
+}
+static void p_spacing(const void *w, report_val *v)
+{
+    v->v = R(w)->spacing_m;
+    v->n = R(w)->n_axles > 0 ? R(w)->n_axles - 1 : 0;
+}
+static void p_status(const void *w, report_val *v) { v->s = R(w)->status; }
+static void p_reason(const void *w, report_val *v) { v->s = R(w)->reason; }
+static void p_given(const void *w, report_val *v) { v->x = R(w)->speed_given_mps; }
+static void p_estimated(const void *w, report_val *v) { v->i = R(w)->speed_estimated; }
+static void p_vehicles(const void *w, report_val *v) { v->i = R(w)->n_vehicles; }
+static void p_quality(const void *w, report_val *v) { v->x = R(w)->quality; }
+
+static const report_col passage_cols[] = {
+    REPORT_COL("time_utc", COL_WORD, "", NULL, COL_BOTH, p_time),
+    REPORT_COL("utime", COL_INT, "us", NULL, COL_BOTH, p_utime),
+    REPORT_COL("passage_id", COL_INT, "", NULL, COL_BOTH, p_id),
+    REPORT_COL("vehicle_id", COL_INT, "", NULL, COL_BOTH, p_vehicle),
+    REPORT_COL("lane", COL_INT, "", NULL, COL_BOTH, p_lane),
+    REPORT_COL("speed_mps", COL_NUM, "m/s", "%.3f", COL_BOTH, p_speed),
+    REPORT_COL("n_axles", COL_INT, "", NULL, COL_BOTH, p_axles),
+    REPORT_COL("gvw_kg", COL_NUM, "kg", "%.1f", COL_BOTH, p_gvw),
+    REPORT_COL("axle%d_kg", COL_NUMS, "kg", "%.1f", COL_BOTH, p_loads,
+               .json = "axle_kg", .width = AMFI_MAX_AXLES),
+    REPORT_COL("spacing%d_m", COL_NUMS, "m", "%.3f", COL_BOTH, p_spacing,
+               .json = "spacing_m", .width = AMFI_MAX_AXLES - 1),
+    REPORT_COL("status", COL_TEXT, "", NULL, COL_BOTH, p_status),
+    REPORT_COL("reason", COL_TEXT, "", NULL, COL_BOTH, p_reason),
+    REPORT_COL("speed_given_mps", COL_NUM, "m/s", "%.3f", COL_BOTH, p_given),
+    REPORT_COL("speed_estimated", COL_BOOL, "", NULL, COL_BOTH, p_estimated),
+    REPORT_COL("n_vehicles", COL_INT, "", NULL, COL_BOTH, p_vehicles),
+    REPORT_COL("quality", COL_NUM, "", "%.4g", COL_BOTH, p_quality),
+};
+#undef R
+
+typedef struct list_ctx {
+    int fmt;
+    FILE *f;
+    int64_t n;
+    int werr; /* 1: the output refused a write */
+} list_ctx;
+
+static void table_line(FILE *f, int64_t id, const amfi_passage_row *r)
+{
+    char t[32], loads[12 * 10 + 1] = "";
+    size_t used = 0;
+    for (int a = 0; a < r->n_axles && used < sizeof loads; a++) {
+        int w = isnan(r->axle_kg[a])
+                    ? snprintf(loads + used, sizeof loads - used, "%s-", a ? "/" : "")
+                    : snprintf(loads + used, sizeof loads - used, "%s%.0f", a ? "/" : "",
+                               r->axle_kg[a]);
+        used += w > 0 ? (size_t)w : 0;
+    }
+    char sp[16] = "-", gvw[16] = "-";
+    if (!isnan(r->speed_mps))
+        snprintf(sp, sizeof sp, "%.2f", r->speed_mps);
+    if (!isnan(r->gvw_kg))
+        snprintf(gvw, sizeof gvw, "%.0f", r->gvw_kg);
+    fprintf(f, "%-20s  %8lld  %10lld  %4d  %6s  %2d  %8s  %-28s  %-8s  %.200s\n",
+            report_iso(r->utime, t), (long long)id, (long long)r->vehicle_id, r->lane, sp,
+            r->n_axles, gvw, loads[0] ? loads : "-", r->status, r->reason);
+}
+
+static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
+{
+    list_ctx *c = vctx;
+    c->n++;
+    if (c->fmt == FMT_TABLE) {
+        table_line(c->f, id, r);
+        return 0;
+    }
+    pas_row row = {.id = id, .r = r};
+    report_iso(r->utime, row.t);
+    if (c->fmt == FMT_CSV) {
+        report_cols_csv_row(c->f, passage_cols, REPORT_NCOLS(passage_cols), &row);
+        return 0;
+    }
+    /* streamed: one element at a time, never the whole array */
+    json_t *o = report_cols_json_row(passage_cols, REPORT_NCOLS(passage_cols), &row, COL_JSON);
+    if (!o || (c->n > 1 && fputc(',', c->f) == EOF) || json_dumpf(o, c->f, JSON_FLAGS)) {
+        json_decref(o);
+        c->werr = 1;
+        return 1;
+    }
+    json_decref(o);
+    return 0;
+}
+
+static int list(report_ctx *c, int fmt)
+{
+    list_ctx l = {fmt, c->out, 0, 0};
+    FILE *f = c->out;
+    if (fmt == FMT_TABLE)
+        fprintf(f, "== passages\n%-20s  %8s  %10s  %4s  %6s  %2s  %8s  %-28s  %-8s  %s\n",
+                "time (UTC)", "id", "vehicle", "lane", "m/s", "ax", "GVW kg", "axle loads kg",
+                "status", "reason");
+    else if (fmt == FMT_CSV)
+        report_cols_csv_header(f, passage_cols, REPORT_NCOLS(passage_cols), NULL, 0);
+    else
+        fputc('[', f);
+    int rc = each(c, c->ex.status, list_one, &l);
+    if (l.werr)
+        report_fail(c, "passages: cannot write the output");
+    if (fmt == FMT_TABLE && rc == 0)
+        fprintf(f, "(%lld passages)\n", (long long)l.n);
+    if (fmt == FMT_JSON && rc == 0)
+        fputc(']', f);
+    if (rc == 0 && ferror(f))
+        return report_fail(c, "passages: cannot write the output");
+    return rc ? -1 : 0;
+}
+
+int passages_table(report_ctx *c) { return list(c, FMT_TABLE); }
+int passages_export(report_ctx *c) { return list(c, c->format); }
+
+/* ---- histogram per lane ---------------------------------------------------------- */
+
+typedef struct hist_ctx {
+    double bin_kg;
+    int lanes[MAX_LANES], n_lanes;
+    int64_t *count; /* [bin * MAX_LANES + lane index] */
+    int n_bins;     /* bins in use: 0 .. n_bins − 1 */
+    int64_t other_lanes;
+    int oom;
+    /* lanes in increasing order, and their columns in count */
+    int sorted[MAX_LANES], order[MAX_LANES];
+} hist_ctx;
+
+static int hist_one(void *vctx, int64_t id, const amfi_passage_row *r)
+{
+    hist_ctx *h = vctx;
+    (void)id;
+    if (!(r->gvw_kg > 0))
+        return 0;
+    int li = 0;
+    while (li < h->n_lanes && h->lanes[li] != r->lane)
+        li++;
+    if (li == h->n_lanes) {
+        if (h->n_lanes == MAX_LANES) {
+            h->other_lanes++;
+            return 0;
+        }
+        h->lanes[h->n_lanes++] = r->lane;
+    }
+    long b = (long)floor(r->gvw_kg / h->bin_kg);
+    if (b >= MAX_BINS)
+        b = MAX_BINS - 1;
+    if (b >= h->n_bins) {
+        int64_t *n = realloc(h->count, sizeof *n * (size_t)(b + 1) * MAX_LANES);
+        if (!n) {
+            h->oom = 1;
+            return 1;
+        }
+        memset(n + (size_t)h->n_bins * MAX_LANES, 0,
+               sizeof *n * (size_t)(b + 1 - h->n_bins) * MAX_LANES);
+        h->count = n;
+        h->n_bins = (int)b + 1;
+    }
+    h->count[(size_t)b * MAX_LANES + (size_t)li]++;
+    return 0;
+}
+
+static int cmp_int(const void *a, const void *b)
+{
+    int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+/* The ok passages of the selection counted per bin and lane (h->count
+ * freed by the caller). */
+static int hist_count(report_ctx *c, hist_ctx *h)
+{
+    memset(h, 0, sizeof *h);
+    h->bin_kg = c->ex.bin_kg;
+    int rc = each(c, "ok", hist_one, h);
+    if (h->oom)
+        rc = report_fail(c, "out of memory for the histogram");
+    if (rc)
+        return -1;
+    /* lanes in increasing order: a permutation of the columns */
+    memcpy(h->sorted, h->lanes, sizeof(int) * (size_t)h->n_lanes);
+    qsort(h->sorted, (size_t)h->n_lanes, sizeof(int), cmp_int);
+    for (int i = 0; i < h->n_lanes; i++)
+        for (int j = 0; j < h->n_lanes; j++)
+            if (h->lanes[j] == h->sorted[i])
+                h->order[i] = j;
+    return 0;
+}
+
+/* One bin: its range and its counts per lane in increasing lane order. */
+typedef struct bin_row {
+    double lo, hi;
+    int64_t n[MAX_LANES];
+    int n_lanes;
+    int64_t all;
+} bin_row;
+
+static void bin_of(const hist_ctx *h, int b, bin_row *r)
+{
+    r->lo = b * h->bin_kg;
+    r->hi = (b + 1) * h->bin_kg;
+    r->n_lanes = h->n_lanes;
+    r->all = 0;
+    for (int i = 0; i < h->n_lanes; i++) {
+        r->n[i] = h->count[(size_t)b * MAX_LANES + (size_t)h->order[i]];
+        r->all += r->n[i];
+    }
+}
+
+static void b_lo(const void *w, report_val *v) { v->x = ((const bin_row *)w)->lo; }
+static void b_hi(const void *w, report_val *v) { v->x = ((const bin_row *)w)->hi; }
+static void b_counts(const void *w, report_val *v)
+{
+    v->iv = ((const bin_row *)w)->n;
+    v->n = ((const bin_row *)w)->n_lanes;
+}
+static void b_all(const void *w, report_val *v) { v->i = ((const bin_row *)w)->all; }
+
+static const report_col bin_cols[] = {
+    REPORT_COL("gvw_from_kg", COL_NUM, "kg", "%.0f", COL_BOTH, b_lo),
+    REPORT_COL("gvw_to_kg", COL_NUM, "kg", "%.0f", COL_BOTH, b_hi),
+    REPORT_COL("lane_%d", COL_INTS, "", NULL, COL_BOTH, b_counts,
+               .json = "counts"), /* one per lane */
+    REPORT_COL("all", COL_INT, "", NULL, COL_BOTH, b_all),
+};
+
+int histogram_table(report_ctx *c)
+{
+    hist_ctx h;
+    FILE *f = c->out;
+    if (hist_count(c, &h) != 0) {
+        free(h.count);
+        return -1;
+    }
+    int64_t lane_total[MAX_LANES] = {0};
+    fprintf(f, "== GVW histogram of ok passages, %.0f kg bins\n%-17s", c->ex.bin_kg, "GVW kg");
+    for (int i = 0; i < h.n_lanes; i++)
+        fprintf(f, "  lane %-4d", h.sorted[i]);
+    fprintf(f, "  %9s\n", "all");
+    for (int b = 0; b < h.n_bins; b++) {
+        bin_row r;
+        bin_of(&h, b, &r);
+        if (r.all == 0)
+            continue;
+        fprintf(f, "%7.0f .. %7.0f", r.lo, r.hi);
+        for (int i = 0; i < h.n_lanes; i++) {
+            lane_total[i] += r.n[i];
+            fprintf(f, "  %9lld", (long long)r.n[i]);
+        }
+        fprintf(f, "  %9lld\n", (long long)r.all);
+    }
+    fprintf(f, "%-17s", "total");
+    int64_t all = 0;
+    for (int i = 0; i < h.n_lanes; i++)
+        fprintf(f, "  %9lld", (long long)lane_total[i]), all += lane_total[i];
+    fprintf(f, "  %9lld\n", (long long)all);
+    if (h.other_lanes)
+        fprintf(f, "(%lld passages of lanes beyond the first %d not shown)\n",
+                (long long)h.other_lanes, MAX_LANES);
+    free(h.count);
+    return 0;
+}
+
+int histogram_export(report_ctx *c)
+{
+    hist_ctx h;
+    if (hist_count(c, &h) != 0) {
+        free(h.count);
+        return -1;
+    }
+    json_t *bins = c->format == FMT_JSON ? json_array() : NULL;
+    if (c->format == FMT_CSV)
+        report_cols_csv_header(c->out, bin_cols, REPORT_NCOLS(bin_cols), h.sorted, h.n_lanes);
+    for (int b = 0; b < h.n_bins; b++) {
+        bin_row r;
+        bin_of(&h, b, &r);
+        if (bins)
+            json_array_append_new(bins, report_cols_json_row(bin_cols, REPORT_NCOLS(bin_cols),
+                                                             &r, COL_JSON));
+        else
+            report_cols_csv_row(c->out, bin_cols, REPORT_NCOLS(bin_cols), &r);
+    }
+    if (bins) {
+        json_t *o = json_object(), *ln = json_array();
+        for (int i = 0; i < h.n_lanes; i++)
+            json_array_append_new(ln, json_integer(h.sorted[i]));
+        json_object_set_new(o, "bin_kg", json_real(c->ex.bin_kg));
+        json_object_set_new(o, "lanes", ln);
+        json_object_set_new(o, "bins", bins);
+        json_object_set_new(c->root, "histogram", o);
+    }
+    free(h.count);
+    return 0;
+}
+
+/* ---- overloads -------------------------------------------------------------------- */
+
+typedef struct over_row {
+    int64_t id;
+    const amfi_passage_row *r;
+    char t[32], what[16];
+    double gvw_pct, max_axle_kg, axle_pct;
+    int max_axle;
+} over_row;
+
+#define O(row) ((const over_row *)(row))
+static void o_time(const void *w, report_val *v) { v->s = O(w)->t; }
+static void o_utime(const void *w, report_val *v) { v->i = O(w)->r->utime; }
+static void o_id(const void *w, report_val *v) { v->i = O(w)->id; }
+static void o_vehicle(const void *w, report_val *v) { v->i = O(w)->r->vehicle_id; }
+static void o_lane(const void *w, report_val *v) { v->i = O(w)->r->lane; }
+static void o_gvw(const void *w, report_val *v) { v->x = O(w)->r->gvw_kg; }
+static void o_gvw_pct(const void *w, report_val *v) { v->x = O(w)->gvw_pct; }
+static void o_max_axle_kg(const void *w, report_val *v) { v->x = O(w)->max_axle_kg; }
+static void o_max_axle(const void *w, report_val *v) { v->i = O(w)->max_axle; }
+static void o_axle_pct(const void *w, report_val *v) { v->x = O(w)->axle_pct; }
+static void o_what(const void *w, report_val *v) { v->s = O(w)->what; }
+#undef O
+
+static const report_col over_cols[] = {
+    REPORT_COL("time_utc", COL_WORD, "", NULL, COL_BOTH, o_time),
+    REPORT_COL("utime", COL_INT, "us", NULL, COL_BOTH, o_utime),
+    REPORT_COL("passage_id", COL_INT, "", NULL, COL_BOTH, o_id),
+    REPORT_COL("vehicle_id", COL_INT, "", NULL, COL_BOTH, o_vehicle),
+    REPORT_COL("lane", COL_INT, "", NULL, COL_BOTH, o_lane),
+    REPORT_COL("gvw_kg", COL_NUM, "kg", "%.1f", COL_BOTH, o_gvw),
+    REPORT_COL("gvw_over_pct", COL_NUM, "%", "%.3f", COL_CSV, o_gvw_pct),
+    REPORT_COL("max_axle_kg", COL_NUM, "kg", "%.1f", COL_BOTH, o_max_axle_kg),
+    REPORT_COL("max_axle", COL_INT, "", NULL, COL_BOTH, o_max_axle),
+    REPORT_COL("axle_over_pct", COL_NUM, "%", "%.3f", COL_CSV, o_axle_pct),
+    REPORT_COL("over", COL_WORD, "", NULL, COL_BOTH, o_what),
+};
+
+typedef struct over_ctx {
+    const export_opts *o;
+    int fmt;
+    FILE *f;
+    json_t *arr;
+    int64_t checked, over_gvw, over_axle, over_any;
+} over_ctx;
+
+static int over_one(void *vctx, int64_t id, const amfi_passage_row *r)
+{
+    over_ctx *c = vctx;
+    c->checked++;
+    over_row w = {.id = id, .r = r, .max_axle_kg = -INFINITY};
+    for (int a = 0; a < r->n_axles; a++)
+        if (r->axle_kg[a] > w.max_axle_kg)
+            w.max_axle_kg = r->axle_kg[a], w.max_axle = a + 1;
+    int og = r->gvw_kg > c->o->gvw_limit_kg, oa = w.max_axle_kg > c->o->axle_limit_kg;
+    c->over_gvw += og;
+    c->over_axle += oa;
+    if (!og && !oa)
+        return 0;
+    c->over_any++;
+    snprintf(w.what, sizeof w.what, "%s%s%s", og ? "gvw" : "", og && oa ? "+" : "",
+             oa ? "axle" : "");
+    report_iso(r->utime, w.t);
+    w.gvw_pct = 100.0 * (r->gvw_kg / c->o->gvw_limit_kg - 1);
+    w.axle_pct = 100.0 * (w.max_axle_kg / c->o->axle_limit_kg - 1);
+    if (c->fmt == FMT_TABLE)
+        fprintf(c->f, "%-20s  %8lld  %10lld  %4d  %8.0f  %+6.1f %%  %8.0f (axle %d)  %+6.1f %%  %s\n",
+                w.t, (long long)id, (long long)r->vehicle_id, r->lane, r->gvw_kg, w.gvw_pct,
+                w.max_axle_kg, w.max_axle, w.axle_pct, w.what);
+    else if (c->fmt == FMT_CSV)
+        report_cols_csv_row(c->f, over_cols, REPORT_NCOLS(over_cols), &w);
+    else
+        json_array_append_new(c->arr,
+                              report_cols_json_row(over_cols, REPORT_NCOLS(over_cols), &w, COL_JSON));
+    return 0;
+}
+
+static int overloads(report_ctx *rc, int fmt)
+{
+    const export_opts *o = &rc->ex;
+    over_ctx c = {o, fmt, rc->out, NULL, 0, 0, 0, 0};
+    if (fmt == FMT_TABLE)
+        fprintf(c.f, "== overloads (ok passages; limits: GVW %.0f kg, axle %.0f kg)\n"
+                     "%-20s  %8s  %10s  %4s  %8s  %8s  %-19s  %8s  %s\n",
+                o->gvw_limit_kg, o->axle_limit_kg, "time (UTC)", "id", "vehicle", "lane",
+                "GVW kg", "over", "heaviest axle kg", "over", "limit");
+    else if (fmt == FMT_CSV)
+        report_cols_csv_header(c.f, over_cols, REPORT_NCOLS(over_cols), NULL, 0);
+    else
+        c.arr = json_array();
+    if (each(rc, "ok", over_one, &c) != 0) {
+        json_decref(c.arr);
+        return -1;
+    }
+    if (fmt == FMT_TABLE)
+        fprintf(c.f, "checked %lld ok passages: %lld over the GVW limit, %lld with an axle over "
+                     "the axle limit, %lld overloaded in all (%.2f %%)\n",
+                (long long)c.checked, (long long)c.over_gvw, (long long)c.over_axle,
+                (long long)c.over_any,
+                c.checked ? 100.0 * (double)c.over_any / (double)c.checked : 0.0);
+    else if (fmt == FMT_JSON) {
+        json_t *ob = json_object();
+        json_object_set_new(ob, "gvw_limit_kg", json_real(o->gvw_limit_kg));
+        json_object_set_new(ob, "axle_limit_kg", json_real(o->axle_limit_kg));
+        json_object_set_new(ob, "checked", json_integer(c.checked));
+        json_object_set_new(ob, "over_gvw", json_integer(c.over_gvw));
+        json_object_set_new(ob, "over_axle", json_integer(c.over_axle));
+        json_object_set_new(ob, "overloaded", json_integer(c.over_any));
+        json_object_set_new(ob, "passages", c.arr);
+        json_object_set_new(rc->root, "overloads", ob);
+    }
+    return 0;
+}
+
+int overloads_table(report_ctx *c) { return overloads(c, FMT_TABLE); }
+int overloads_export(report_ctx *c) { return overloads(c, c->format); }
+
+/* ---- plots ---------------------------------------------------------------------- */
+
+static const char *const status_colour[AMFI_STORE_N_STATUS] = {
+    "#1f77b4", "#ff7f0e", "#9467bd", "#d62728", "#8c564b", "#7f7f7f", "#000000"};
+
+/* gvw.png: the GVW per passage over time with the baseline band; writes
+ * passages.dat (t gvw_t status speed_kmh) and band.dat. */
+int passages_plot_gvw(report_plot_frame *p, int *made, char *err, size_t errlen)
+{
+    FILE *f = report_data_open(p->dir, "passages.dat", err, errlen);
+    if (!f)
+        return -1;
+    fprintf(f, "# time_s gvw_t status(0 ok,1 gap,2 late,3 overload,4 multiple,5 invalid,6 error) speed_kmh\n");
+    size_t n_gvw = 0;
+    for (size_t k = 0; k < p->n_pas; k++) {
+        const report_pas *a = &p->pas[k];
+        fprintf(f, "%.3f %.4f %d %.3f\n", a->t, isnan(a->gvw) ? NAN : a->gvw / 1000, a->status,
+                isnan(a->speed) ? NAN : a->speed * 3.6);
+        n_gvw += !isnan(a->gvw);
+    }
+    if (report_data_close(f, p->dir, "passages.dat", err, errlen) != 0)
+        return -1;
+    /* band.dat: baseline mean ± 2 STD from when it applies */
+    if (!(f = report_data_open(p->dir, "band.dat", err, errlen)))
+        return -1;
+    if (p->found) {
+        const amfi_baseline *b = &p->b;
+        double tb = fmax(p->t0, (double)b->utime_set / 1e6);
+        for (int k = 0; k < 2; k++)
+            fprintf(f, "%.3f %.4f %.4f %.4f\n", k ? p->t1 : tb, (b->mean_kg - 2 * b->std_kg) / 1000,
+                    (b->mean_kg + 2 * b->std_kg) / 1000, b->mean_kg / 1000);
+    } else {
+        fprintf(f, "%.3f NaN NaN NaN\n", p->t0);
+    }
+    if (report_data_close(f, p->dir, "band.dat", err, errlen) != 0)
+        return -1;
+    fprintf(p->gp,
+        "set output o.'gvw.png'\n"
+        "set title \"Inferred gross vehicle weight per passage\\n%s\"\n"
+        "set ylabel 'GVW (t)'\n"
+        "%s"
+        "plot d.'band.dat' using 1:2:3 with filledcurves fc rgb '#b0d0b0' fs transparent solid 0.5 title 'baseline mean +/- 2 STD', \\\n"
+        "     d.'band.dat' using 1:4 with lines lw 2 lc rgb '#2ca02c' title 'baseline mean', \\\n"
+        "     d.'passages.dat' using 1:($3==0?$2:NaN) with points pt 7 ps 0.4 lc rgb '#1f77b4' title 'ok', \\\n"
+        "     d.'passages.dat' using 1:($3!=0?$2:NaN) with points pt 2 ps 0.6 lc rgb '#d62728' title 'not ok (solved)'\n"
+        "unset label 99\nset autoscale y\n",
+        p->sub,
+        /* gnuplot refuses a plot without one valid point: a fixed range and a word */
+        n_gvw ? "" : "set yrange [0:60]\nset label 99 'no passage with an inferred GVW in this store' at graph 0.5, graph 0.5 center\n");
+    *made = 1;
+    return 0;
+}
+
+/* gvw_histogram.png: the baseline sample (the b.n ok passages up to the
+ * baseline's time, else the first window) against the latest window;
+ * writes histogram.dat. */
+int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t errlen)
+{
+    size_t n = p->n_pas, n_ok = 0;
+    double *ok = malloc((n + 1) * sizeof *ok);
+    if (!ok) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    for (size_t k = 0; k < n; k++)
+        if (p->pas[k].status == 0 && !isnan(p->pas[k].gvw))
+            ok[n_ok++] = p->pas[k].gvw / 1000;
+    int win = p->n_ind > 0 && p->ind[0].row.n > 0 ? p->ind[0].row.n : 500;
+    size_t nb_end = 0, nb = 0, nla = n_ok < (size_t)win ? n_ok : (size_t)win;
+    if (p->found) {
+        for (size_t k = 0, j = 0; k < n; k++)
+            if (p->pas[k].status == 0 && !isnan(p->pas[k].gvw)) {
+                j++;
+                if (p->pas[k].t <= (double)p->b.utime_set / 1e6)
+                    nb_end = j;
+            }
+        nb = nb_end < (size_t)p->b.n ? nb_end : (size_t)p->b.n;
+    } else {
+        nb_end = nb = nla;
+    }
+    const double *bl = ok + (nb_end - nb), *la = ok + (n_ok - nla);
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (size_t k = 0; k < n_ok; k++) {
+        lo = fmin(lo, ok[k]);
+        hi = fmax(hi, ok[k]);
+    }
+    if (!(hi > lo)) {
+        lo = 0;
+        hi = 60;
+    }
+    int nbins = 30;
+    double w = (hi - lo) / nbins, hb[64], hl[64];
+    report_hist(bl, nb, lo, w, nbins, hb);
+    report_hist(la, nla, lo, w * (1 + 1e-12), nbins, hl);
+    free(ok);
+    FILE *f = report_data_open(p->dir, "histogram.dat", err, errlen);
+    if (!f)
+        return -1;
+    fprintf(f, "# gvw_t_bin_centre baseline_fraction latest_fraction (bin %.3f t; baseline n %zu, latest n %zu)\n",
+            w, nb, nla);
+    for (int k = 0; k < nbins; k++)
+        fprintf(f, "%.4f %.5f %.5f\n", lo + (k + 0.5) * w, hb[k], hl[k]);
+    if (report_data_close(f, p->dir, "histogram.dat", err, errlen) != 0)
+        return -1;
+    fprintf(p->gp,
+        "set output o.'gvw_histogram.png'\n"
+        "set xdata\nset format x '%%g'\nset autoscale x\n"
+        "set title \"GVW distribution: baseline (%zu ok passages) against the latest window (%zu)\\n%s\"\n"
+        "set xlabel 'GVW (t), bins of %.2f t'\nset ylabel 'fraction of passages'\n"
+        "set style fill transparent solid 0.45 noborder\nset boxwidth %.4f\n"
+        "plot d.'histogram.dat' using 1:2 with boxes lc rgb '#2ca02c' title 'baseline', \\\n"
+        "     d.'histogram.dat' using 1:3 with boxes lc rgb '#d62728' title 'latest window'\n",
+        nb, nla, p->sub, w, w);
+    *made = 1;
+    return 0;
+}
+
+/* passages_per_hour.png: passages per hour by status, cumulative columns so
+ * the boxes stack; the bucket adapts to the span. Writes hourly.dat. */
+int passages_plot_per_hour(report_plot_frame *p, int *made, char *err, size_t errlen)
+{
+    static const double buckets[] = {60, 300, 900, 3600, 86400};
+    const double t0 = p->t0, t1 = p->t1;
+    double bw = 86400;
+    for (int k = 0; k < 5; k++)
+        if ((t1 - t0) / buckets[k] <= 200) {
+            bw = buckets[k];
+            break;
+        }
+    int nbk = (int)floor((t1 - t0) / bw) + 1;
+    if (nbk > 100000)
+        nbk = 100000;
+    double *cnt = calloc((size_t)nbk * AMFI_STORE_N_STATUS, sizeof *cnt);
+    if (!cnt) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    double tb0 = floor(t0 / bw) * bw;
+    for (size_t k = 0; k < p->n_pas; k++) {
+        int i = (int)floor((p->pas[k].t - tb0) / bw);
+        if (i >= 0 && i < nbk)
+            cnt[(size_t)i * AMFI_STORE_N_STATUS + (size_t)p->pas[k].status] += 3600.0 / bw;
+    }
+    FILE *f = report_data_open(p->dir, "hourly.dat", err, errlen);
+    if (!f) {
+        free(cnt);
+        return -1;
+    }
+    fprintf(f, "# bucket_centre_s then per hour, cumulative: ok +gap +late +overload +multiple +invalid +error (bucket %.0f s)\n", bw);
+    for (int i = 0; i < nbk; i++) {
+        double c = 0;
+        fprintf(f, "%.0f", tb0 + (i + 0.5) * bw);
+        for (int k = 0; k < AMFI_STORE_N_STATUS; k++) {
+            c += cnt[(size_t)i * AMFI_STORE_N_STATUS + (size_t)k];
+            fprintf(f, " %.2f", c);
+        }
+        fputc('\n', f);
+    }
+    free(cnt);
+    if (report_data_close(f, p->dir, "hourly.dat", err, errlen) != 0)
+        return -1;
+    fprintf(p->gp,
+        "set output o.'passages_per_hour.png'\n"
+        "set xdata time\nset format x \"%%H:%%M\\n%%d %%b\"\nset xrange [%.3f:%.3f]\n"
+        "set title \"Passages per hour by status (buckets of %.0f min)\\n%s\"\n"
+        "set xlabel 'time (UTC, data time)'\nset ylabel 'passages per hour'\n"
+        "set style fill solid 0.8 border lc rgb 'black'\nset boxwidth %.0f\nset yrange [0:*]\n"
+        "plot ",
+        tb0, tb0 + nbk * bw, bw / 60, p->sub, bw * 0.9);
+    for (int k = AMFI_STORE_N_STATUS - 1; k >= 0; k--)
+        fprintf(p->gp, "d.'hourly.dat' using 1:%d with boxes lc rgb '%s' title '%s'%s", k + 2,
+                status_colour[k], amfi_store_status_name(k), k ? ", \\\n     " : "\n");
+    *made = 1;
+    return 0;
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* speed.png: the speed distribution in 2 km/h bins; writes speed.dat. */
+int passages_plot_speed(report_plot_frame *p, int *made, char *err, size_t errlen)
+{
+    size_t n_sp = 0;
+    double *sp = malloc((p->n_pas + 1) * sizeof *sp);
+    if (!sp) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    for (size_t k = 0; k < p->n_pas; k++)
+        if (!isnan(p->pas[k].speed))
+            sp[n_sp++] = p->pas[k].speed * 3.6;
+    FILE *f = report_data_open(p->dir, "speed.dat", err, errlen);
+    if (!f) {
+        free(sp);
+        return -1;
+    }
+    fprintf(f, "# speed_kmh_bin_centre passages (bin 2 km/h)\n");
+    qsort(sp, n_sp, sizeof *sp, cmp_d);
+    for (size_t k = 0; k < n_sp;) {
+        double b0 = floor(sp[k] / 2) * 2;
+        size_t c = 0;
+        while (k < n_sp && sp[k] < b0 + 2) {
+            c++;
+            k++;
+        }
+        fprintf(f, "%.1f %zu\n", b0 + 1, c);
+    }
+    if (n_sp == 0)
+        fprintf(f, "NaN 0\n");
+    free(sp);
+    if (report_data_close(f, p->dir, "speed.dat", err, errlen) != 0)
+        return -1;
+    fprintf(p->gp,
+        "set output o.'speed.png'\n"
+        "set xdata\nset format x '%%g'\nset autoscale x\nset yrange [0:*]\n"
+        "set title \"Speed distribution (%zu passages with a speed)\\n%s\"\n"
+        "set xlabel 'speed (km/h), bins of 2 km/h'\nset ylabel 'passages'\n"
+        "set style fill solid 0.7 border lc rgb 'black'\nset boxwidth 1.8\n"
+        "%s"
+        "plot d.'speed.dat' using 1:2 with boxes lc rgb '#1f77b4' title 'passages'\n"
+        "set output\n",
+        n_sp, p->sub,
+        n_sp ? "" : "set xrange [0:150]\nset yrange [0:1]\nset label 99 'no passage with a speed in this store' at graph 0.5, graph 0.5 center\n");
+    *made = 1;
+    return 0;
+}
