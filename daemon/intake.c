@@ -2,8 +2,8 @@
 /*
  * intake.c: amfid's bus intake: the LCM handlers of accelerometer blocks,
  * vehicle events and (simulations) the truth (the environment's handler is
- * in environment.c, subscribed here; the truth only when daemon.simulation
- * is true), each message authenticated first (bus.c) and validated where
+ * environment.c's own; the truth only when daemon.simulation is true),
+ * each message authenticated first (bus.c) and validated where
  * it enters (messages name the channel and the field); samples into the
  * rings, vehicles into the tracker; and the windows the tracker decides,
  * filled from the rings into jobs for the solver pool (or straight to the
