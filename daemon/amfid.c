@@ -81,7 +81,6 @@ struct amfid {
     pool pool;
     timers *timers;
     int started;                 /* modules whose start ran (stop undoes them) */
-    int restored;                /* the modules were restored (final runs) */
     int bus_open;
     const char *bus_key_option;  /* --bus-key (argv), NULL none */
     int64_t lcm_errors;          /* receive errors on a live bus */
@@ -256,7 +255,6 @@ static int start_runtime(amfid *h)
         return 1;
     }
     c->pool = &h->pool;
-    h->restored = 1;
     for (int i = 0; i < N_MODULES; i++)
         if (modules[i]->restore && modules[i]->restore(c))
             return 1;
