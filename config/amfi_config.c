@@ -108,6 +108,7 @@ void amfi_config_defaults(amfi_site_config *c)
     d->bus_auth = 1;
     d->bus_max_skew_s = 300.0;
     d->sync_full = 1;
+    d->held_max_bytes = 101760000; /* 20 000 held passages of 5 088 bytes (x86-64) */
     d->workers = 2;
     d->queue_size = 256;
     d->recv_buf_bytes = 4194304;

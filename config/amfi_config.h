@@ -54,6 +54,8 @@ typedef struct amfi_daemon_config {
                                  refused, s, [1, 86400] */
     char db_path[512];        /* daemon.store.path */
     int sync_full;            /* daemon.store.sync: full (1) | normal (0) */
+    long long held_max_bytes; /* daemon.store.held_max_bytes: passages held while the
+                                 store cannot write, bytes, 1 MiB .. 64 GiB */
     int workers;              /* daemon.workers: solver threads, 1 .. 64 */
     int queue_size;           /* daemon.queue_size: passages waiting, 1 .. 100000 */
     int recv_buf_bytes;       /* daemon.recv_buf_bytes: UDP receive buffer asked of LCM

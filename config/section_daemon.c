@@ -40,6 +40,8 @@ static const enum_name sync_names[] = {{"normal", 0}, {"full", 1}, {NULL, 0}};
 static const field store_fields[] = {
     STR("path", db_path, 1),
     {.key = "sync", .kind = &amfi_cfg_k_enum, .off = DC(sync_full), .aux = sync_names},
+    {.key = "held_max_bytes", .kind = &amfi_cfg_k_llong, .off = DC(held_max_bytes),
+     .lo = 1048576, .hi = 68719476736.0},
     {.key = NULL}};
 
 /* Offsets of the engine's amfi_indicator_params inside the site config. */

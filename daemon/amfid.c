@@ -15,11 +15,16 @@
  * takes it), speaks sd_notify (READY, STATUS, WATCHDOG). Time is the data's
  * time (message utimes): replaying a log at any speed stores the same rows.
  *
- * This file: start-up, the loop and shutdown, on the main thread (main()
- * is in main.c, so that fuzz/fuzz_intake.c can drive the same daemon).
- * Start-up builds the daemon in dependency order; whatever happens, one
- * function (amfid_stop) tears down whatever was built, in reverse. The other
- * files and who owns what: amfid.h.
+ * This file: the core, on the main thread (main() is in main.c, so that
+ * fuzz/fuzz_intake.c can drive the same daemon): the configuration, the
+ * store, the bus, the solver threads, the context of shared services (ctx.h)
+ * and ONE table of modules. Start-up builds the core's services, then runs
+ * each module's start (from the configuration) and restore (from the
+ * store) in table order; the loop gives each module its tick, runs the
+ * timers the modules registered and, on SIGHUP, each module's reload in
+ * table order; the drain runs each module's final and the tear-down each
+ * one's stop, both in reverse. Adding a module is one file and one row of
+ * the table (docs/architecture.md).
  *
  * Signals: SIGTERM/SIGINT stop reading the bus, let the solver threads
  * finish what is queued, store every pending passage (those whose data never
@@ -34,36 +39,52 @@
 #include <limits.h>
 #include <poll.h>
 #include <signal.h>
-#include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-#include "amfid.h"
+#include "amfi_config_keys.h"
+#include "ctx.h"
 
-FILE *amfid_log_stream;
+/* ---- the table of modules ------------------------------------------------------
+ * start, restore, reload, row, on_passage and tick in this order; final and
+ * stop in reverse. The order is the order of the effects a user sees: a
+ * stored passage is counted (metrics), gets its natural frequency's
+ * baseline collected, is published on the passage channel, then feeds the
+ * speed-drift alert, the STD and mean rules and the scale indicator (their
+ * rows and messages in that order); the drain's lines come status first
+ * (the last heartbeat), intake last. */
+static const amfid_module *const modules[] = {
+    &environment_lost_module, /* final: the readings the store never took */
+    &intake_module,      /* the bus handlers, rings, tracker; tick: windows released */
+    &environment_module, /* the environment input */
+    &record_module,      /* the intake counters in the store (60 s) */
+    &metrics_module,     /* metrics.textfile */
+    &notify_module,      /* alerts.command */
+    &freevib_module,     /* the natural frequency */
+    &pipeline_module,    /* reorder → sink; tick: results stored; on_passage: published */
+    &drift_module,       /* the speed-drift alert */
+    &stdmean_module,     /* the STD and mean rules */
+    &scaleind_module,    /* the scale indicator and the known-truck runs */
+    &reject_module,      /* refused messages: summaries */
+    &status_module,      /* the heartbeat */
+};
+#define N_MODULES ((int)(sizeof modules / sizeof modules[0]))
 
-void amfid_log(const char *prefix, const char *fmt, ...)
-{
-    FILE *f = amfid_log_stream ? amfid_log_stream : stderr;
-    va_list ap;
-    va_start(ap, fmt);
-    fputs(prefix, f);
-    vfprintf(f, fmt, ap);
-    fputc('\n', f);
-    va_end(ap);
-}
-
-void set_error(daemon_s *d, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(d->last_error, sizeof d->last_error, fmt, ap);
-    va_end(ap);
-    LOG_WARN("%s", d->last_error);
-}
+/* The daemon: the core's own state. Every module's is in its own file. */
+struct amfid {
+    amfid_ctx c;                 /* the context handed to the modules */
+    amfi_site_config cfg;        /* the running configuration (c.cfg points here) */
+    amfi_bridge *bridge;
+    pool pool;
+    timers *timers;
+    int started;                 /* modules whose start ran (stop undoes them) */
+    int bus_open;
+    const char *bus_key_option;  /* --bus-key (argv), NULL none */
+    int64_t lcm_errors;          /* receive errors on a live bus */
+};
 
 static volatile sig_atomic_t stop_flag, reload_flag;
 static void on_stop(int sig)
@@ -77,38 +98,69 @@ static void on_hup(int sig)
     reload_flag = 1;
 }
 
-/* The configuration and what it builds: 0, or 2 (reported). */
-static int start_config(daemon_s *d, const amfid_options *o)
+static int load_config(const char *path, amfi_site_config *c)
 {
     char err[512];
-    d->config_path = o->config;
-    d->state = "starting";
-    if (load_config(o->config, &d->cfg))
+    amfi_config_defaults(c);
+    if (amfi_config_load(path, c, err, sizeof err)) {
+        fprintf(stderr, "amfid: %s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- the context's services --------------------------------------------------- */
+
+static void collect(amfid_ctx *c, amfid_stats *s)
+{
+    amfid *h = (amfid *)c; /* c is the first member */
+    memset(s, 0, sizeof *s);
+    s->queue_depth = queue_depth(&h->pool.jobs);
+    s->messages_malformed = h->lcm_errors;
+    bus_stats(s);
+    for (int i = 0; i < N_MODULES; i++)
+        if (modules[i]->metrics)
+            modules[i]->metrics(c, s);
+}
+
+/* ---- start-up ----------------------------------------------------------------------- */
+
+/* The configuration and what it builds, each module's start: 0, or 2 (reported). */
+static int start_config(amfid *h, const amfid_options *o)
+{
+    char err[512];
+    amfid_ctx *c = &h->c;
+    c->config_path = o->config;
+    c->state = "starting";
+    c->cfg = &h->cfg;
+    c->modules = modules;
+    c->n_modules = N_MODULES;
+    c->publish = bus_publish;
+    c->emit_alert = alert_emit;
+    c->collect = collect;
+    if (load_config(o->config, &h->cfg))
         return 2;
     if (o->db)
-        snprintf(d->cfg.daemon.db_path, sizeof d->cfg.daemon.db_path, "%s", o->db);
+        snprintf(h->cfg.daemon.db_path, sizeof h->cfg.daemon.db_path, "%s", o->db);
     if (o->lcm_url)
-        snprintf(d->cfg.daemon.lcm_url, sizeof d->cfg.daemon.lcm_url, "%s", o->lcm_url);
-    if (amfi_bridge_create(&d->cfg.bridge, &d->bridge, err, sizeof err)) {
+        snprintf(h->cfg.daemon.lcm_url, sizeof h->cfg.daemon.lcm_url, "%s", o->lcm_url);
+    if (amfi_bridge_create(&h->cfg.bridge, &h->bridge, err, sizeof err)) {
         fprintf(stderr, "amfid: %s: bridge: %s\n", o->config, err);
         return 2;
     }
-    indicator_params(&d->cfg.daemon, &d->ind_params);
-    if (amfi_indicators_create(&d->ind_params, &d->ind, err, sizeof err)) {
-        fprintf(stderr, "amfid: %s: daemon.indicators: %s\n", o->config, err);
-        return 2;
-    }
-    if (drift_create(d, err, sizeof err)) {
-        fprintf(stderr, "amfid: %s: alerts.speed_drift: %s\n", o->config, err);
-        return 2;
-    }
-    if (scaleind_create(d, err, sizeof err)) {
-        fprintf(stderr, "amfid: %s: alerts.scale / alerts.known_truck: %s\n", o->config, err);
-        return 2;
+    c->bridge = h->bridge;
+    for (; h->started < N_MODULES; h->started++) {
+        const amfid_module *m = modules[h->started];
+        if (m->start && m->start(c, err, sizeof err)) {
+            h->started++; /* its stop frees what it built before failing */
+            fprintf(stderr, "amfid: %s: %s: %s\n", o->config, m->section ? m->section : m->name,
+                    err);
+            return 2;
+        }
     }
     /* A solver is built once here to check the solver section. */
     amfi_solver *probe = NULL;
-    if (amfi_solver_create(d->bridge, &d->cfg.solver, &probe, err, sizeof err)) {
+    if (amfi_solver_create(h->bridge, &h->cfg.solver, &probe, err, sizeof err)) {
         fprintf(stderr, "amfid: %s: solver: %s\n", o->config, err);
         return 2;
     }
@@ -122,26 +174,26 @@ static int start_config(daemon_s *d, const amfid_options *o)
  * passages never mix in one store (or in a fleet's central database, which
  * keys rows by site). A changed site.name or position is written over the
  * stored one. 0, or 1 after a logged error. */
-static int claim_site(daemon_s *d)
+static int claim_site(amfid *h)
 {
-    const amfi_site_identity *site = &d->cfg.site;
+    const amfi_site_identity *site = &h->cfg.site;
+    amfi_store *st = h->c.store;
     char err[512], stored[AMFI_STORE_META_VALUE_MAX + 1];
     int found = 0;
 
-    if (amfi_store_meta_get(d->store, "site.id", stored, sizeof stored, &found, err,
-                            sizeof err)) {
-        LOG_ERR("store %s: %s", d->cfg.daemon.db_path, err);
+    if (amfi_store_meta_get(st, "site.id", stored, sizeof stored, &found, err, sizeof err)) {
+        LOG_ERR("store %s: %s", h->cfg.daemon.db_path, err);
         return 1;
     }
     if (found && strcmp(stored, site->id) != 0) {
         LOG_ERR("store %s belongs to site '%s', but %s configures site.id '%s': refusing "
                 "to mix two sites in one store (give this site its own daemon.store.path, "
                 "or correct site.id)",
-                d->cfg.daemon.db_path, stored, d->config_path, site->id);
+                h->cfg.daemon.db_path, stored, h->c.config_path, site->id);
         return 1;
     }
     if (!found)
-        LOG_INFO("store %s: first start of site '%s' (%s)", d->cfg.daemon.db_path, site->id,
+        LOG_INFO("store %s: first start of site '%s' (%s)", h->cfg.daemon.db_path, site->id,
                  site->name);
     struct {
         const char *key, *val;
@@ -154,24 +206,25 @@ static int claim_site(daemon_s *d)
         kv[3].key = "site.longitude", kv[3].val = lon;
     }
     for (int i = 0; i < 4 && kv[i].key; i++) {
-        if (amfi_store_meta_get(d->store, kv[i].key, stored, sizeof stored, &found, err,
+        if (amfi_store_meta_get(st, kv[i].key, stored, sizeof stored, &found, err,
                                 sizeof err) ||
             ((!found || strcmp(stored, kv[i].val)) &&
-             amfi_store_meta_set(d->store, kv[i].key, kv[i].val, err, sizeof err))) {
-            LOG_ERR("store %s: %s", d->cfg.daemon.db_path, err);
+             amfi_store_meta_set(st, kv[i].key, kv[i].val, err, sizeof err))) {
+            LOG_ERR("store %s: %s", h->cfg.daemon.db_path, err);
             return 1;
         }
         if (found && strcmp(stored, kv[i].val) && i > 0)
-            LOG_INFO("store %s: %s changed from '%s' to '%s'", d->cfg.daemon.db_path,
+            LOG_INFO("store %s: %s changed from '%s' to '%s'", h->cfg.daemon.db_path,
                      kv[i].key, stored, kv[i].val);
     }
     return 0;
 }
 
-/* The store, the tracker, the bus and the solver threads: 0, or 1. */
-static int start_runtime(daemon_s *d)
+/* The store, each module's restore, the bus and the solver threads: 0, 1 or 2. */
+static int start_runtime(amfid *h)
 {
     char err[512];
+    amfid_ctx *c = &h->c;
     /* First: a signal during start-up is remembered (the loop then stops
      * at once, or reloads), never the default action. */
     struct sigaction sa;
@@ -183,217 +236,50 @@ static int start_runtime(daemon_s *d)
     sigaction(SIGHUP, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);
     amfi_set_blas_threads(1);
-    if (amfi_store_open(d->cfg.daemon.db_path, d->cfg.daemon.sync_full, &d->store, err,
+    if (amfi_store_open(h->cfg.daemon.db_path, h->cfg.daemon.sync_full, &c->store, err,
                         sizeof err)) {
-        LOG_ERR("store %s: %s", d->cfg.daemon.db_path, err);
+        LOG_ERR("store %s: %s", h->cfg.daemon.db_path, err);
         return 1;
     }
-    if (claim_site(d))
+    if (claim_site(h))
         return 1;
-    d->metrics.start_wall = (double)time(NULL);
     char abs[PATH_MAX];
-    const char *cfg_path = realpath(d->config_path, abs) ? abs : d->config_path;
-    if (amfi_store_add_run(d->store, amfi_version(), cfg_path, &d->run_id, err, sizeof err)) {
-        LOG_ERR("store %s: %s", d->cfg.daemon.db_path, err);
+    const char *cfg_path = realpath(c->config_path, abs) ? abs : c->config_path;
+    if (amfi_store_add_run(c->store, amfi_version(), cfg_path, &c->run_id, err, sizeof err)) {
+        LOG_ERR("store %s: %s", h->cfg.daemon.db_path, err);
         return 1;
     }
-    restore_indicator_state(d);
-    drift_restore(d);
-    scaleind_restore(d);
-    freevib_start(d);
-    amfi_tracker_params tp = {d->cfg.bridge.span_m,
-                              d->cfg.solver.pre_roll_s + d->cfg.daemon.margin_s,
-                              d->cfg.solver.post_roll_s + d->cfg.daemon.margin_s,
-                              d->cfg.daemon.max_wait_s, d->cfg.solver.n_sensors,
-                              d->cfg.daemon.max_event_s, d->cfg.daemon.max_event_axles,
-                              /* room for the speed search, also when a reload
-                                 turns it on */
-                              amfi_speed_slowest_frac(&d->cfg.speed_prior),
-                              d->cfg.daemon.natfreq_free_s};
-    d->tracker = amfi_tracker_create(&tp);
-    d->pend_cap = d->cfg.daemon.queue_size + AMFI_TRACKER_MAX_PENDING + 16;
-    d->pending = calloc((size_t)d->pend_cap, sizeof *d->pending);
-    d->next_seq = 1;
-    if (!d->tracker || !d->pending) {
+    h->timers = c->timers = timers_create();
+    if (!h->timers) {
         LOG_ERR("out of memory at start-up");
         return 1;
     }
-    intake_limits(d); /* the rate limits of the inputs: full buckets */
-    char url[512];
-    bus_url(&d->cfg.daemon, url, sizeof url);
-    d->lcm = lcm_create(url);
-    if (!d->lcm) {
-        LOG_ERR("cannot open the LCM bus '%s'", url);
+    c->pool = &h->pool;
+    for (int i = 0; i < N_MODULES; i++)
+        if (modules[i]->restore && modules[i]->restore(c))
+            return 1;
+    int brc = bus_open(c, h->bus_key_option);
+    h->bus_open = 1;
+    if (brc)
+        return brc;
+    if (bus_subscribe_all(c))
         return 1;
-    }
-    int arc = bus_auth_start(d, d->bus_key_option);
-    if (arc)
-        return arc;
-    if (intake_subscribe(d))
-        return 1;
-    if (pool_start(&d->pool, d->bridge, &d->cfg.solver, d->cfg.daemon.workers,
-                   d->cfg.daemon.queue_size, err, sizeof err)) {
+    if (pool_start(&h->pool, h->bridge, &h->cfg.solver, h->cfg.daemon.workers,
+                   h->cfg.daemon.queue_size, err, sizeof err)) {
         LOG_ERR("%s", err);
         return 1;
     }
     return 0;
 }
 
-/* Read the bus until a signal or its end, then drain: every pending
- * passage is stored, solved or with its reason. 0, or 1. */
-int amfid_run(daemon_s *d)
+int amfid_start(amfid **out, const amfid_options *o)
 {
-    int rc = 0;
-    d->state = "running";
-    sd_notify(0, "READY=1");
-    LOG_INFO("running: amfid %s, bus '%s', store %s, %d solver thread(s), bridge %s",
-             amfi_version(), d->cfg.daemon.lcm_url[0] ? d->cfg.daemon.lcm_url : "(default)",
-             d->cfg.daemon.db_path, d->pool.n_threads, d->cfg.name);
-    uint64_t wd_usec = 0;
-    int wd = sd_watchdog_enabled(0, &wd_usec) > 0;
-    double last_beat = 0.0, last_wd = 0.0;
-    int lfd = lcm_get_fileno(d->lcm);
-    const int replay = strncmp(d->cfg.daemon.lcm_url, "file://", 7) == 0;
-    while (!stop_flag) {
-        /* Replaying a log, the bus waits for the solvers (no overload,
-         * the same rows at any speed); a live bus is always read. */
-        const int hold = replay && queue_depth(&d->pool.jobs) >= d->cfg.daemon.queue_size;
-        struct pollfd pf[2] = {{hold ? -1 : lfd, POLLIN, 0}, {d->pool.efd, POLLIN, 0}};
-        int pr = poll(pf, 2, 100);
-        if (pr < 0 && errno != EINTR) {
-            LOG_ERR("poll: %s", strerror(errno));
-            rc = 1;
-            break;
-        }
-        if (pr > 0 && (pf[0].revents & POLLIN) && lcm_handle(d->lcm) != 0) {
-            if (replay) { /* file:// provider: the end of the log */
-                LOG_INFO("the bus has no more data (end of log)");
-                break;
-            }
-            /* a live bus: a receive error is logged and counted, not fatal */
-            d->messages_malformed++;
-            set_error(d, "LCM receive error on '%s'", d->cfg.daemon.lcm_url);
-        }
-        /* A live bus: every message already queued, up to a bound that
-         * keeps the heartbeat and the watchdog going in a flood; one at a
-         * time (one poll round each) left LCM's queues to overflow. */
-        for (int k = 0; !replay && pr > 0 && (pf[0].revents & POLLIN) && k < 512; k++)
-            if (lcm_handle_timeout(d->lcm, 0) <= 0)
-                break;
-        if (pr > 0 && (pf[0].revents & (POLLHUP | POLLERR | POLLNVAL))) {
-            LOG_INFO("the bus closed");
-            break;
-        }
-        release_windows(d, 0);
-        pipeline_drain_results(d);
-        if (d->held_n > 0)
-            pipeline_retry(d, 0);
-        if (reload_flag) {
-            reload_flag = 0;
-            reload(d);
-        }
-        double now = amfi_mono_s();
-        if (now - last_beat >= d->cfg.daemon.status_period_s) {
-            heartbeat(d);
-            reject_tick(d);
-            last_beat = now;
-        }
-        notify_tick(d);
-        metrics_tick(d, 0);
-        if (!d->degraded)
-            record_intake(d, 0);
-        if (wd && now - last_wd >= 0.5e-6 * (double)wd_usec) {
-            sd_notify(0, "WATCHDOG=1");
-            last_wd = now;
-        }
+    amfid *h = calloc(1, sizeof *h);
+    *out = h;
+    if (!h) {
+        fprintf(stderr, "amfid: out of memory\n");
+        return 1;
     }
-    int drc = amfid_drain(d);
-    return rc ? rc : drc;
-}
-
-int amfid_drain(daemon_s *d)
-{
-    int rc = 0;
-    d->state = "draining";
-    sd_notify(0, "STOPPING=1");
-    release_windows(d, 1);
-    pool_join(&d->pool);
-    pipeline_drain_results(d);
-    if (d->held_n > 0) { /* the store still refuses: keep trying a while */
-        LOG_WARN("store: %d passages held at shutdown; retrying for up to 20 s", d->held_n);
-        pipeline_retry(d, 20.0);
-    }
-    heartbeat(d);
-    reject_final(d);
-    scaleind_final(d);
-    freevib_final(d);
-    notify_finish(d);
-    metrics_tick(d, 1);
-    if (!d->degraded)
-        record_intake(d, 1);
-    if (d->passages_lost > 0)
-        rc = 1; /* acknowledged passages are safe; these never were */
-    if (d->env.received + d->env.rejected > 0)
-        LOG_INFO("environment: %lld readings decoded, %lld refused, %lld stored%s",
-                 (long long)d->env.received, (long long)d->env.rejected,
-                 (long long)d->env.stored,
-                 d->env.lost + d->env.n > 0 ? ", some not stored (the store refused them)" : "");
-    if (d->env.thinned > 0)
-        LOG_INFO("environment: %lld accepted readings not stored (within "
-                 "daemon.intake.environment_min_interval_s of a stored one)",
-                 (long long)d->env.thinned);
-    if (d->vehicles_evicted + d->references_refused + d->invalid_unstored > 0)
-        LOG_INFO("intake: %lld waiting vehicles evicted (stored as overload), %lld calibration "
-                 "references not taken, %lld refused vehicles over the rate limit (summarised, "
-                 "no row)",
-                 (long long)d->vehicles_evicted, (long long)d->references_refused,
-                 (long long)d->invalid_unstored);
-    if (d->env.lost + d->env.n > 0)
-        LOG_WARN("environment: %lld readings dropped while the store refused them, %d still "
-                 "buffered at stop: not stored",
-                 (long long)d->env.lost, d->env.n);
-    LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld messages received: "
-             "%lld blocks, %lld vehicles, %lld rejected messages, %lld refused by the bus "
-             "authentication",
-             (long long)d->passages_stored, (long long)d->passages_ok,
-             (long long)d->passages_lost, (long long)d->messages_in,
-             (long long)d->blocks_received, (long long)d->vehicles_received,
-             (long long)(d->blocks_rejected + d->vehicles_rejected + d->messages_malformed),
-             (long long)d->auth_refused);
-    return rc;
-}
-
-/* The one tear-down: whatever start_* built, in reverse; NULL-safe. */
-void amfid_stop(daemon_s *d)
-{
-    notify_free(d);
-    for (; d->held && d->held_n > 0; d->held_n--) { /* only left on an early error */
-        job_free(d->held[d->held_head]);
-        d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;
-    }
-    free(d->held);
-    d->held = NULL;
-    pool_stop(&d->pool);
-    if (d->lcm)
-        lcm_destroy(d->lcm);
-    bus_auth_stop(d);
-    if (d->pending)
-        for (int i = 0; i < d->pend_cap; i++)
-            job_free(d->pending[i]);
-    free(d->pending);
-    for (int i = 0; i < AMFI_MAX_SENSORS; i++)
-        amfi_ring_destroy(d->rings[i]);
-    amfi_tracker_destroy(d->tracker);
-    amfi_store_close(d->store);
-    amfi_indicators_destroy(d->ind);
-    drift_destroy(d);
-    scaleind_destroy(d);
-    freevib_stop(d);
-    amfi_bridge_destroy(d->bridge);
-}
-
-int amfid_start(daemon_s *d, const amfid_options *o)
-{
     if (o->make_bus_key) {
         char err[PATH_MAX + 200];
         if (amfi_auth_key_make(o->make_bus_key, err, sizeof err)) {
@@ -405,13 +291,199 @@ int amfid_start(daemon_s *d, const amfid_options *o)
                o->make_bus_key);
         return 0;
     }
-    d->bus_key_option = o->bus_key;
-    int rc = start_config(d, o);
+    h->bus_key_option = o->bus_key;
+    int rc = start_config(h, o);
     if (rc == 0 && o->check_only)
-        printf("amfid: %s: ok (site %s, bridge %s, %d sensor(s), %d worker(s), store %s)\n", o->config,
-               d->cfg.site.id, d->cfg.name, d->cfg.solver.n_sensors, d->cfg.daemon.workers,
-               d->cfg.daemon.db_path);
+        printf("amfid: %s: ok (site %s, bridge %s, %d sensor(s), %d worker(s), store %s)\n",
+               o->config, h->cfg.site.id, h->cfg.name, h->cfg.solver.n_sensors,
+               h->cfg.daemon.workers, h->cfg.daemon.db_path);
     else if (rc == 0)
-        rc = start_runtime(d);
+        rc = start_runtime(h);
     return rc;
+}
+
+/* ---- reload ---------------------------------------------------------------------------- */
+
+/* A key that differs between the running configuration and the file: a
+ * restart-only one (the key table's live flag 0) is reported by name. */
+static int report_restart_only(const amfi_config_key *k, void *arg)
+{
+    (void)arg;
+    if (!k->live)
+        LOG_WARN("reload: %s changed; takes effect at the next start", k->path);
+    return 0;
+}
+
+/* SIGHUP: the file read again (refused: the running configuration is kept);
+ * every restart-only key that changed reported by name; the running
+ * configuration takes the file's live keys (the key table's live flag:
+ * the λ policy, the output channels, status_period_s, max_wait_s,
+ * environment_max_skew_s, daemon.intake.*), then each module's reload in
+ * table order with the configuration that ran until now and the new
+ * running one (the intake gives the tracker the new max_wait_s and re-reads
+ * its rate limits). */
+void amfid_reload(amfid *h)
+{
+    static amfi_site_config n, old; /* large */
+    if (load_config(h->c.config_path, &n)) {
+        LOG_ERR("reload: the new configuration is refused; keeping the running one");
+        return;
+    }
+    /* keep the command-line overrides */
+    memcpy(n.daemon.db_path, h->cfg.daemon.db_path, sizeof n.daemon.db_path);
+    memcpy(n.daemon.lcm_url, h->cfg.daemon.lcm_url, sizeof n.daemon.lcm_url);
+    amfi_config_diff(&h->cfg, &n, report_restart_only, NULL);
+    old = h->cfg;
+    amfi_config_apply_live(&h->cfg, &n);
+    for (int i = 0; i < N_MODULES; i++)
+        if (modules[i]->reload)
+            modules[i]->reload(&h->c, &old, &h->cfg);
+    LOG_INFO("reload: configuration %s applied", h->c.config_path);
+}
+
+/* ---- the loop ---------------------------------------------------------------------------- */
+
+void amfid_turn(amfid *h)
+{
+    lcm_t *lcm = bus_lcm();
+    while (lcm && lcm_handle_timeout(lcm, 0) > 0)
+        ;
+    for (int i = 0; i < N_MODULES; i++)
+        if (modules[i]->tick)
+            modules[i]->tick(&h->c);
+    timers_run(h->timers, &h->c, amfi_mono_s());
+}
+
+/* Read the bus until a signal or its end, then drain: every pending
+ * passage is stored, solved or with its reason. 0, or 1. */
+int amfid_run(amfid *h)
+{
+    int rc = 0;
+    amfid_ctx *c = &h->c;
+    c->state = "running";
+    sd_notify(0, "READY=1");
+    LOG_INFO("running: amfid %s, bus '%s', store %s, %d solver thread(s), bridge %s",
+             amfi_version(), h->cfg.daemon.lcm_url[0] ? h->cfg.daemon.lcm_url : "(default)",
+             h->cfg.daemon.db_path, h->pool.n_threads, h->cfg.name);
+    uint64_t wd_usec = 0;
+    int wd = sd_watchdog_enabled(0, &wd_usec) > 0;
+    double last_wd = 0.0;
+    lcm_t *lcm = bus_lcm();
+    int lfd = lcm_get_fileno(lcm);
+    const int replay = strncmp(h->cfg.daemon.lcm_url, "file://", 7) == 0;
+    while (!stop_flag) {
+        /* Replaying a log, the bus waits for the solvers (no overload,
+         * the same rows at any speed); a live bus is always read. */
+        const int hold = replay && queue_depth(&h->pool.jobs) >= h->cfg.daemon.queue_size;
+        struct pollfd pf[2] = {{hold ? -1 : lfd, POLLIN, 0}, {h->pool.efd, POLLIN, 0}};
+        int pr = poll(pf, 2, 100);
+        if (pr < 0 && errno != EINTR) {
+            LOG_ERR("poll: %s", strerror(errno));
+            rc = 1;
+            break;
+        }
+        if (pr > 0 && (pf[0].revents & POLLIN) && lcm_handle(lcm) != 0) {
+            if (replay) { /* file:// provider: the end of the log */
+                LOG_INFO("the bus has no more data (end of log)");
+                break;
+            }
+            /* a live bus: a receive error is logged and counted, not fatal */
+            h->lcm_errors++;
+            ctx_error(c, "LCM receive error on '%s'", h->cfg.daemon.lcm_url);
+        }
+        /* A live bus: every message already queued, up to a bound that
+         * keeps the heartbeat and the watchdog going in a flood; one at a
+         * time (one poll round each) left LCM's queues to overflow. */
+        for (int k = 0; !replay && pr > 0 && (pf[0].revents & POLLIN) && k < 512; k++)
+            if (lcm_handle_timeout(lcm, 0) <= 0)
+                break;
+        if (pr > 0 && (pf[0].revents & (POLLHUP | POLLERR | POLLNVAL))) {
+            LOG_INFO("the bus closed");
+            break;
+        }
+        for (int i = 0; i < N_MODULES; i++) /* windows released, results stored, ... */
+            if (modules[i]->tick)
+                modules[i]->tick(c);
+        if (reload_flag) {
+            reload_flag = 0;
+            amfid_reload(h);
+        }
+        double now = amfi_mono_s();
+        timers_run(h->timers, c, now); /* heartbeat, summaries, metrics, records */
+        if (wd && now - last_wd >= 0.5e-6 * (double)wd_usec) {
+            sd_notify(0, "WATCHDOG=1");
+            last_wd = now;
+        }
+    }
+    int drc = amfid_drain(h);
+    return rc ? rc : drc;
+}
+
+int amfid_drain(amfid *h)
+{
+    amfid_ctx *c = &h->c;
+    c->state = "draining";
+    sd_notify(0, "STOPPING=1");
+    intake_release(c, 1);
+    pool_join(&h->pool);
+    pipeline_drain_results(c);
+    if (pipeline_held() > 0) { /* the store still refuses: keep trying a while */
+        LOG_WARN("store: %d passages held at shutdown; retrying for up to 20 s",
+                 pipeline_held());
+        pipeline_retry(c, 20.0);
+    }
+    for (int i = N_MODULES - 1; i >= 0; i--)
+        if (modules[i]->final)
+            modules[i]->final(c);
+    amfid_stats s;
+    collect(c, &s);
+    LOG_INFO("stopped: %lld passages stored (%lld ok), %lld not stored, %lld messages received: "
+             "%lld blocks, %lld vehicles, %lld rejected messages, %lld refused by the bus "
+             "authentication",
+             (long long)s.passages_stored, (long long)s.passages_ok,
+             (long long)s.passages_lost, (long long)s.messages_in,
+             (long long)s.blocks_received, (long long)s.vehicles_received,
+             (long long)(s.blocks_rejected + s.vehicles_rejected + s.messages_malformed),
+             (long long)s.auth_refused);
+    return s.passages_lost > 0; /* acknowledged passages are safe; these never were */
+}
+
+/* The one tear-down: whatever amfid_start built, in reverse; NULL-safe. */
+void amfid_stop(amfid *h)
+{
+    if (!h)
+        return;
+    pool_stop(&h->pool);
+    for (int i = h->started - 1; i >= 0; i--)
+        if (modules[i]->stop)
+            modules[i]->stop(&h->c);
+    if (h->bus_open)
+        bus_close();
+    timers_destroy(h->timers);
+    amfi_store_close(h->c.store);
+    amfi_bridge_destroy(h->bridge);
+    free(h);
+}
+
+/* ---- for embedders ---------------------------------------------------------------------- */
+
+void amfid_counts(amfid *h, amfid_stats *s)
+{
+    collect(&h->c, s);
+}
+
+lcm_t *amfid_lcm(amfid *h)
+{
+    (void)h;
+    return bus_lcm();
+}
+
+amfi_store *amfid_store(amfid *h)
+{
+    return h->c.store;
+}
+
+const amfi_site_config *amfid_config(const amfid *h)
+{
+    return &h->cfg;
 }

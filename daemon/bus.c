@@ -11,9 +11,12 @@
  * messages when daemon.bus.auth is required, before any decoder sees them;
  * what amfid publishes is signed.
  *
+ * The modules say what they want to hear (bus_want, from their restore);
+ * amfid.c subscribes it all once the bus is open (bus_subscribe_all).
+ *
  * Thread: the main thread (start-up, the bus handlers, the heartbeat);
  * bus_publish also from wherever amfid publishes (the signer has a mutex).
- * Owns the verifier and the signer.
+ * Owns the LCM handle, the verifier, the signer and the subscriptions.
  */
 #include <dirent.h>
 #include <limits.h>
@@ -22,7 +25,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "amfid.h"
+#include "ctx.h"
 
 #define LCM_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0"
 
@@ -113,9 +116,28 @@ int64_t bus_udp_drops(void)
 
 /* ---- the authenticated bus ---------------------------------------------- */
 
-int bus_auth_start(daemon_s *d, const char *key_option)
+static struct {
+    lcm_t *lcm;
+    amfi_auth_verifier *auth;  /* daemon.bus.auth required; NULL: off */
+    amfi_auth_signer *signer;  /* NULL: no key, amfid publishes unsigned */
+    int64_t auth_refused;      /* messages refused by the authentication */
+    struct bus_sub {
+        amfid_ctx *c;
+        lcm_msg_handler_t fn;   /* NULL: not wanted */
+        const char *channel;
+        int input;
+    } subs[REJECT_NINPUTS];
+} B;
+
+lcm_t *bus_lcm(void)
 {
-    const amfi_daemon_config *dc = &d->cfg.daemon;
+    return B.lcm;
+}
+
+/* The authentication: 0, or 2 (reported). */
+static int auth_start(amfid_ctx *c, const char *key_option)
+{
+    const amfi_daemon_config *dc = &c->cfg->daemon;
     char path[PATH_MAX], err[PATH_MAX + 200];
     const char *origin = NULL;
     const char *kp = amfi_auth_key_path(key_option, dc->bus_key_file, path, sizeof path, &origin);
@@ -124,7 +146,7 @@ int bus_auth_start(daemon_s *d, const char *key_option)
                 "daemon.bus.key_file in %s, or the systemd credential %s "
                 "(LoadCredential=%s:/etc/amfid/bus.key); make one with amfid --make-bus-key "
                 "FILE",
-                d->config_path, AMFI_AUTH_CREDENTIAL, AMFI_AUTH_CREDENTIAL);
+                c->config_path, AMFI_AUTH_CREDENTIAL, AMFI_AUTH_CREDENTIAL);
         return 2;
     }
     if (!dc->bus_auth)
@@ -142,19 +164,19 @@ int bus_auth_start(daemon_s *d, const char *key_option)
         return 2;
     }
     char producer[AMFI_AUTH_PRODUCER_BYTES + 1];
-    amfi_auth_producer_name(producer, "amfid.", d->cfg.site.id);
-    d->signer = calloc(1, sizeof *d->signer);
-    if (!d->signer || amfi_auth_signer_init(d->signer, &key, producer, err, sizeof err)) {
-        LOG_ERR("bus key: %s", d->signer ? err : "out of memory");
-        free(d->signer);
-        d->signer = NULL;
+    amfi_auth_producer_name(producer, "amfid.", c->cfg->site.id);
+    B.signer = calloc(1, sizeof *B.signer);
+    if (!B.signer || amfi_auth_signer_init(B.signer, &key, producer, err, sizeof err)) {
+        LOG_ERR("bus key: %s", B.signer ? err : "out of memory");
+        free(B.signer);
+        B.signer = NULL;
         return 2;
     }
     if (dc->bus_auth) {
-        d->auth = malloc(sizeof *d->auth);
-        if (!d->auth ||
-            amfi_auth_verifier_init(d->auth, &key, replay ? 0.0 : dc->bus_max_skew_s)) {
-            LOG_ERR("bus key: %s", d->auth ? "libsodium cannot be initialised" : "out of memory");
+        B.auth = malloc(sizeof *B.auth);
+        if (!B.auth ||
+            amfi_auth_verifier_init(B.auth, &key, replay ? 0.0 : dc->bus_max_skew_s)) {
+            LOG_ERR("bus key: %s", B.auth ? "libsodium cannot be initialised" : "out of memory");
             return 2;
         }
     }
@@ -168,56 +190,92 @@ int bus_auth_start(daemon_s *d, const char *key_option)
     return 0;
 }
 
-void bus_auth_stop(daemon_s *d)
+int bus_open(amfid_ctx *c, const char *key_option)
 {
-    if (d->signer)
-        amfi_auth_signer_free(d->signer);
-    free(d->signer);
-    d->signer = NULL;
-    if (d->auth)
-        memset(d->auth, 0, sizeof *d->auth);
-    free(d->auth);
-    d->auth = NULL;
+    char url[512];
+    bus_url(&c->cfg->daemon, url, sizeof url);
+    B.lcm = lcm_create(url);
+    if (!B.lcm) {
+        LOG_ERR("cannot open the LCM bus '%s'", url);
+        return 1;
+    }
+    return auth_start(c, key_option);
+}
+
+void bus_close(void)
+{
+    if (B.lcm)
+        lcm_destroy(B.lcm);
+    if (B.signer)
+        amfi_auth_signer_free(B.signer);
+    free(B.signer);
+    if (B.auth)
+        memset(B.auth, 0, sizeof *B.auth);
+    free(B.auth);
+    memset(&B, 0, sizeof B);
 }
 
 static void on_bus_message(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
     struct bus_sub *s = user;
-    daemon_s *d = s->d;
     lcm_recv_buf_t bare = *rb;
-    if (!d->auth) {
+    if (!B.auth) {
         bare.data_size = (uint32_t)amfi_auth_bare_len(rb->data, rb->data_size);
-        s->fn(&bare, ch, d);
+        s->fn(&bare, ch, s->c);
         return;
     }
     size_t len = rb->data_size;
     char why[256];
-    int r = amfi_auth_verify(d->auth, ch, rb->data, rb->data_size, rb->recv_utime, &len, why,
+    int r = amfi_auth_verify(B.auth, ch, rb->data, rb->data_size, rb->recv_utime, &len, why,
                              sizeof why);
     if (r != AMFI_AUTH_OK) {
-        d->messages_in++;
-        d->auth_refused++;
-        reject_note(d, s->input, REJECT_AUTH + r, "%s: message of %u bytes refused: %s", ch,
+        admit_count_in();
+        B.auth_refused++;
+        reject_note(s->c, s->input, REJECT_AUTH + r, "%s: message of %u bytes refused: %s", ch,
                     rb->data_size, why);
         return;
     }
     bare.data_size = (uint32_t)len;
-    s->fn(&bare, ch, d);
+    s->fn(&bare, ch, s->c);
 }
 
-lcm_subscription_t *bus_subscribe(daemon_s *d, const char *channel, lcm_msg_handler_t fn,
-                                  int input)
+void bus_want(int input, const char *channel, lcm_msg_handler_t fn)
 {
     if (input < 0 || input >= REJECT_NINPUTS)
-        return NULL;
-    struct bus_sub *s = &d->bus_subs[input];
-    s->d = d;
-    s->fn = fn;
-    s->input = input;
-    return lcm_subscribe(d->lcm, channel, on_bus_message, s);
+        return;
+    B.subs[input].fn = fn;
+    B.subs[input].channel = channel;
+    B.subs[input].input = input;
 }
 
-int bus_publish(daemon_s *d, const char *channel, const void *data, size_t len)
+/* Each input channel keeps up to daemon.bus_queue messages between LCM's
+ * receive thread and the loop: LCM's default, 30, drops everything beyond
+ * without a trace as soon as the loop is busy for a moment (measured: more
+ * than half of a 2 500 messages/s stream lost, docs/daemon.md). */
+int bus_subscribe_all(amfid_ctx *c)
 {
-    return amfi_auth_publish(d->lcm, d->signer, channel, data, len);
+    for (int i = 0; i < REJECT_NINPUTS; i++) {
+        struct bus_sub *s = &B.subs[i];
+        if (!s->fn)
+            continue;
+        s->c = c;
+        lcm_subscription_t *sub = lcm_subscribe(B.lcm, s->channel, on_bus_message, s);
+        if (!sub || lcm_subscription_set_queue_capacity(sub, c->cfg->daemon.bus_queue) != 0) {
+            LOG_ERR("cannot subscribe to '%s' with a queue of %d messages", s->channel,
+                    c->cfg->daemon.bus_queue);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+int bus_publish(amfid_ctx *c, const char *channel, const void *data, size_t len)
+{
+    (void)c;
+    return amfi_auth_publish(B.lcm, B.signer, channel, data, len);
+}
+
+void bus_stats(amfid_stats *s)
+{
+    s->auth_refused = B.auth_refused;
 }

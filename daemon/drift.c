@@ -5,85 +5,101 @@
  * speed weighed with / detector's speed − 1 to the engine
  * (indicators/speed_drift.h), whose raise and clear events go out like the
  * other alerts (stored, published on the alert channel, counted in the
- * metrics, alerts.command, the journal: pipeline.c's emit_alert). At start
+ * metrics, alerts.command, the journal: the context's emit_alert). At start
  * the window is refilled from the store's newest estimated passages and an
  * alert open before a restart stays open (not raised twice).
  *
- * Thread: the main thread only. Owns d->drift (created by amfid_start from
- * alerts.speed_drift; a reload reports a change, which applies at the next
- * start, like the indicator settings).
+ * A module (ctx.h). Thread: the main thread only. Owns the engine (built
+ * at start from alerts.speed_drift; a reload reports a change, which
+ * applies at the next start, like the indicator settings).
  */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
-#include "amfid.h"
+#include "ctx.h"
+#include "speed_drift.h"
 
-int drift_create(daemon_s *d, char *err, size_t errlen)
+static struct {
+    amfi_speed_drift *drift;
+    amfi_speed_drift_params params; /* in force */
+} D;
+
+static int drift_start(amfid_ctx *c, char *err, size_t errlen)
 {
-    d->drift_params = d->cfg.daemon.speed_drift;
-    return amfi_speed_drift_create(&d->drift_params, &d->drift, err, errlen);
+    memset(&D, 0, sizeof D);
+    D.params = c->cfg->daemon.speed_drift;
+    return amfi_speed_drift_create(&D.params, &D.drift, err, errlen);
 }
 
-void drift_restore(daemon_s *d)
+static int drift_restore(amfid_ctx *c)
 {
     char err[512];
     int open = 0;
-    if (!d->drift || !d->drift_params.enabled)
-        return;
+    if (!D.drift || !D.params.enabled)
+        return 0;
     amfi_speed_pair *p = NULL;
     size_t n = 0;
-    if (amfi_store_recent_speed_pairs(d->store, d->drift_params.window, &p, &n, err,
+    if (amfi_store_recent_speed_pairs(c->store, D.params.window, &p, &n, err,
                                       sizeof err) != 0) {
         LOG_WARN("store: %s", err);
-        return;
+        return 0;
     }
-    double *c = malloc((n ? n : 1) * sizeof *c);
-    if (!c) {
+    double *x = malloc((n ? n : 1) * sizeof *x);
+    if (!x) {
         free(p);
         LOG_WARN("speed drift: out of memory for %zu corrections; the window starts empty", n);
-        return;
+        return 0;
     }
     for (size_t k = 0; k < n; k++)
-        c[k] = amfi_speed_correction(p[k].speed_mps, p[k].speed_given_mps);
-    int taken = amfi_speed_drift_prefill(d->drift, c, (int)n);
-    free(c);
+        x[k] = amfi_speed_correction(p[k].speed_mps, p[k].speed_given_mps);
+    int taken = amfi_speed_drift_prefill(D.drift, x, (int)n);
+    free(x);
     free(p);
-    if (amfi_store_alert_open(d->store, "speed_drift", &open, err, sizeof err) != 0) {
+    if (amfi_store_alert_open(c->store, "speed_drift", &open, err, sizeof err) != 0) {
         LOG_WARN("store: %s", err);
         open = 0;
     }
-    amfi_speed_drift_set_alerted(d->drift, open);
-    metrics_alert(d, "speed_drift", open);
+    amfi_speed_drift_set_alerted(D.drift, open);
+    metrics_alert("speed_drift", open);
     if (taken > 0 || open)
         LOG_INFO("speed drift: %d estimated passages from the store%s", taken,
                  open ? "; the speed_drift alert is open" : "");
+    return 0;
 }
 
-void drift_feed(daemon_s *d, int64_t utime, double speed_mps, double speed_given_mps)
+/* A stored passage whose speed was estimated: its two speeds, m/s. */
+static void drift_feed(amfid_ctx *c, const amfid_passage *ps)
 {
-    if (!d->drift || !d->drift_params.enabled)
+    if (!ps->j->speed_estimated || !D.drift || !D.params.enabled)
         return;
-    double c = amfi_speed_correction(speed_mps, speed_given_mps);
+    const double speed_mps = ps->r->speed_mps, speed_given_mps = ps->r->speed_given_mps;
+    double x = amfi_speed_correction(speed_mps, speed_given_mps);
     amfi_alert_event al;
     amfi_speed_drift_eval ev;
-    int bits = amfi_speed_drift_push(d->drift, c, &ev, &al);
+    int bits = amfi_speed_drift_push(D.drift, x, &ev, &al);
     if (bits < 0) {
-        set_error(d, "speed drift: correction of %.3f m/s against %.3f m/s refused", speed_mps,
+        ctx_error(c, "speed drift: correction of %.3f m/s against %.3f m/s refused", speed_mps,
                   speed_given_mps);
         return;
     }
     if (bits & AMFI_IND_ALERT)
-        emit_alert(d, utime, &al, 0);
+        c->emit_alert(c, ps->j->w.v.utime, &al, 0);
 }
 
-void drift_reload(daemon_s *d, const amfi_site_config *n)
+
+static void drift_stop(amfid_ctx *c)
 {
-    if (!amfi_speed_drift_params_equal(&n->daemon.speed_drift, &d->drift_params))
-        LOG_WARN("reload: alerts.speed_drift takes effect at the next start");
+    (void)c;
+    amfi_speed_drift_destroy(D.drift);
+    memset(&D, 0, sizeof D);
 }
 
-void drift_destroy(daemon_s *d)
-{
-    amfi_speed_drift_destroy(d->drift);
-    d->drift = NULL;
-}
+const amfid_module drift_module = {
+    .name = "drift",
+    .section = "alerts.speed_drift",
+    .start = drift_start,
+    .restore = drift_restore,
+    .on_passage = drift_feed,
+    .stop = drift_stop,
+};

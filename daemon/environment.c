@@ -18,8 +18,11 @@
  * as thinned). environment_t carries no source field: the readings' source
  * is the channel (and, with an authenticated bus, the producer's key).
  *
+ * A module (ctx.h): it wants its channel (bus_want) at restore; its final
+ * flushes and logs the counts.
+ *
  * Thread: the main thread only (the bus handler inside lcm_handle, the
- * heartbeat, the drain). Owns d->env (the buffer and its counters).
+ * heartbeat, the drain). Owns the buffer and its counters.
  */
 #include <math.h>
 #include <stdio.h>
@@ -27,7 +30,25 @@
 #include <time.h>
 
 #include "amfi_environment_t.h"
-#include "amfid.h"
+#include "ctx.h"
+
+#define ENV_BUF 64
+static struct env_state {
+    amfi_environment_row buf[ENV_BUF];
+    int n;                 /* readings in buf, oldest first */
+    int failing;           /* the last flush failed (logged once) */
+    int64_t received, rejected, stored, lost; /* since start */
+    int64_t thinned;       /* accepted, not stored: within environment_min_interval_s */
+    int have_ref;          /* a reading was accepted: ref_* hold it */
+    int64_t ref_utime, last_kept_utime;
+    double ref_deck;
+    /* implausible readings that agree with each other: adopted at the third
+     * in a row (a deck sensor replaced or recalibrated, a first reading that
+     * was wrong), as the rings adopt a time jump */
+    int cand_n;
+    int64_t cand_utime;
+    double cand_deck;
+} E;
 
 static int64_t wall_now_us(void)
 {
@@ -41,13 +62,13 @@ static int temp_ok(double c)
     return isfinite(c) && c >= AMFI_STORE_MIN_TEMP_C && c <= AMFI_STORE_MAX_TEMP_C;
 }
 
-void environment_flush(daemon_s *d)
+void environment_flush(amfid_ctx *c)
 {
-    env_state *e = &d->env;
-    if (e->n == 0 || !d->store)
+    struct env_state *e = &E;
+    if (e->n == 0 || !c->store)
         return;
     char err[256];
-    int rc = amfi_store_add_environment(d->store, e->buf, e->n, err, sizeof err);
+    int rc = amfi_store_add_environment(c->store, e->buf, e->n, err, sizeof err);
     if (rc == 0) {
         e->stored += e->n;
         e->n = 0;
@@ -58,34 +79,34 @@ void environment_flush(daemon_s *d)
     }
 }
 
-double environment_deck_at(daemon_s *d, int64_t utime, double max_gap_s)
+double environment_deck_at(amfid_ctx *c, int64_t utime, double max_gap_s)
 {
-    environment_flush(d); /* the readings received so far are in the store */
+    environment_flush(c); /* the readings received so far are in the store */
     char err[256];
     double t = NAN;
-    if (amfi_store_deck_c_at(d->store, utime, (int64_t)llround(1e6 * max_gap_s), &t, err,
+    if (amfi_store_deck_c_at(c->store, utime, (int64_t)llround(1e6 * max_gap_s), &t, err,
                              sizeof err) != 0) {
-        set_error(d, "store: %s", err);
+        ctx_error(c, "store: %s", err);
         return NAN;
     }
     return t;
 }
 
-void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user)
+static void on_message(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
-    daemon_s *d = user;
-    env_state *e = &d->env;
+    amfid_ctx *x = user;
+    struct env_state *e = &E;
     amfi_environment_t m;
-    if (intake_decode(d, AMFI_MSG_ENVIRONMENT_T, REJECT_ENVIRONMENT, "environment_t", rb, ch,
+    if (admit_decode(x, AMFI_MSG_ENVIRONMENT_T, REJECT_ENVIRONMENT, "environment_t", rb, ch,
                       &m)) {
         e->rejected++;
         return;
     }
     e->received++;
-    const amfi_daemon_config *c = &d->cfg.daemon;
-    if (!intake_take(d, REJECT_ENVIRONMENT, 1.0)) {
+    const amfi_daemon_config *c = &x->cfg->daemon;
+    if (!admit_take(x, REJECT_ENVIRONMENT, 1.0)) {
         e->rejected++;
-        reject_note(d, REJECT_ENVIRONMENT, REJECT_RATE,
+        reject_note(x, REJECT_ENVIRONMENT, REJECT_RATE,
                     "%s: environment_t refused: over the channel's rate limit "
                     "(daemon.intake.environment_per_s %g)",
                     ch, c->environment_per_s);
@@ -95,18 +116,18 @@ void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user
     char why[200] = "";
     if (m.utime <= 0 || m.utime > AMFI_STORE_MAX_UTIME)
         snprintf(why, sizeof why, "utime %lld out of (0, year 9999]", (long long)m.utime);
-    else if (d->newest_utime > 0 && fabs((double)m.utime - (double)d->newest_utime) > 1e6 * skew_s)
+    else if (x->newest_utime > 0 && fabs((double)m.utime - (double)x->newest_utime) > 1e6 * skew_s)
         snprintf(why, sizeof why,
                  "utime %lld is %.0f s from the stream's newest data time (more than "
                  "daemon.environment_max_skew_s %.0f s)",
-                 (long long)m.utime, 1e-6 * ((double)m.utime - (double)d->newest_utime), skew_s);
+                 (long long)m.utime, 1e-6 * ((double)m.utime - (double)x->newest_utime), skew_s);
     else if (!temp_ok(m.deck_c))
         snprintf(why, sizeof why, "deck_c %.6g is not a temperature in [-60, 80] °C", m.deck_c);
     else if (!temp_ok(m.air_c))
         snprintf(why, sizeof why, "air_c %.6g is not a temperature in [-60, 80] °C", m.air_c);
     if (why[0]) {
         e->rejected++;
-        reject_note(d, REJECT_ENVIRONMENT, REJECT_INVALID, "%s: environment_t rejected: %s", ch,
+        reject_note(x, REJECT_ENVIRONMENT, REJECT_INVALID, "%s: environment_t rejected: %s", ch,
                     why);
         return;
     }
@@ -132,7 +153,7 @@ void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user
             e->cand_deck = m.deck_c;
             if (e->cand_n < 3) {
                 e->rejected++;
-                reject_note(d, REJECT_ENVIRONMENT, REJECT_IMPLAUSIBLE,
+                reject_note(x, REJECT_ENVIRONMENT, REJECT_IMPLAUSIBLE,
                             "%s: environment_t rejected: deck_c %.2f °C is %.2f °C from the last "
                             "accepted reading (%.2f °C, %.1f min before or after): more than "
                             "daemon.intake.deck_max_rate_c_per_min %g °C/min allows",
@@ -159,7 +180,7 @@ void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user
     }
     e->last_kept_utime = m.utime;
     if (e->n == ENV_BUF) {
-        environment_flush(d);
+        environment_flush(x);
         if (e->n == ENV_BUF) { /* the store refuses: the oldest reading goes */
             memmove(e->buf, e->buf + 1, sizeof e->buf[0] * (ENV_BUF - 1));
             e->n--;
@@ -172,3 +193,65 @@ void environment_on_message(const lcm_recv_buf_t *rb, const char *ch, void *user
     r->air_c = m.air_c;
     r->received_utime = wall_now_us();
 }
+
+static int env_start(amfid_ctx *c, char *err, size_t errlen)
+{
+    (void)c, (void)err, (void)errlen;
+    memset(&E, 0, sizeof E);
+    return 0;
+}
+
+static int env_restore(amfid_ctx *c)
+{
+    bus_want(REJECT_ENVIRONMENT, c->cfg->daemon.ch_environment, on_message);
+    return 0;
+}
+
+static void env_final(amfid_ctx *c)
+{
+    (void)c;
+    if (E.received + E.rejected > 0)
+        LOG_INFO("environment: %lld readings decoded, %lld refused, %lld stored%s",
+                 (long long)E.received, (long long)E.rejected, (long long)E.stored,
+                 E.lost + E.n > 0 ? ", some not stored (the store refused them)" : "");
+    if (E.thinned > 0)
+        LOG_INFO("environment: %lld accepted readings not stored (within "
+                 "daemon.intake.environment_min_interval_s of a stored one)",
+                 (long long)E.thinned);
+}
+
+/* After the intake's final line: what was lost. */
+static void env_lost(amfid_ctx *c)
+{
+    (void)c;
+    if (E.lost + E.n > 0)
+        LOG_WARN("environment: %lld readings dropped while the store refused them, %d still "
+                 "buffered at stop: not stored",
+                 (long long)E.lost, E.n);
+}
+
+static void env_metrics(amfid_ctx *c, amfid_stats *s)
+{
+    (void)c;
+    s->env_received = E.received;
+    s->env_rejected = E.rejected;
+    s->env_stored = E.stored;
+    s->env_lost = E.lost;
+    s->env_thinned = E.thinned;
+    s->env_buffered = E.n;
+}
+
+const amfid_module environment_module = {
+    .name = "environment",
+    .start = env_start,
+    .restore = env_restore,
+    .metrics = env_metrics,
+    .final = env_final,
+};
+
+/* The lost readings' line comes last in the drain (after the intake's):
+ * a module of its own at the head of the table. */
+const amfid_module environment_lost_module = {
+    .name = "environment_lost",
+    .final = env_lost,
+};

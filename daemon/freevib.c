@@ -20,44 +20,58 @@
  * estimates; a temperature interpolated then where only the reading before
  * was known live can move the fit slightly).
  *
- * Thread: the main thread only. Owns d->fv (the compensation and the
- * counters); the estimate reads the rings, which the main thread owns.
+ * A module (ctx.h): restore refills the baseline, row fills the f1
+ * columns, on_passage collects the baseline, a 60 s timer (and final)
+ * writes the counters into the store's meta table.
+ *
+ * Thread: the main thread only. Owns the compensation and the counters;
+ * the estimate reads the rings it is handed (the intake's).
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "amfid.h"
+#include "ctx.h"
+
+static struct freevib_state {
+    amfi_natfreq_comp *comp;  /* NULL: off (free_s 0) or not compensated */
+    int64_t estimated;        /* passages with an f1 */
+    int64_t no_segment;       /* ok passages without free vibration (cut, data missing) */
+    int64_t refused[AMFI_NATFREQ_NREFUSALS]; /* by amfi_natfreq_estimate's code; [0] invalid */
+    int64_t no_temperature;   /* baseline candidates without a deck temperature */
+} F;
 
 /* At start (the baseline from the store): readings at most
  * alerts.scale.max_temp_gap_s apart are interpolated for a
  * passage's deck temperature (amfi_store_deck_c_at), as for the scale
  * indicator's; µs of data time. */
-static int64_t deck_gap_us(const daemon_s *d)
+static const double record_period_s = 60.0;
+static int freevib_tick(amfid_ctx *c);
+
+static int64_t deck_gap_us(const amfid_ctx *d)
 {
-    return (int64_t)llround(1e6 * d->cfg.daemon.scale_max_temp_gap_s);
+    return (int64_t)llround(1e6 * d->cfg->daemon.scale_max_temp_gap_s);
 }
 
-void freevib_start(daemon_s *d)
+static int freevib_restore(amfid_ctx *d)
 {
     char err[256];
-    freevib_state *fv = &d->fv;
-    memset(fv, 0, sizeof *fv);
-    if (!(d->cfg.daemon.natfreq_free_s > 0))
-        return;
+    struct freevib_state *fv = &F;
+    if (!(d->cfg->daemon.natfreq_free_s > 0))
+        return 0;
     /* the site's temperature model: alerts.scale's knee, floor, calibration
      * temperature and prior slopes (halved and turned for f1 by natfreq.c) */
-    if (amfi_natfreq_comp_create(&d->cfg.daemon.scale, d->cfg.daemon.natfreq_baseline_n,
+    if (amfi_natfreq_comp_create(&d->cfg->daemon.scale, d->cfg->daemon.natfreq_baseline_n,
                                  &fv->comp, err, sizeof err) != 0) {
         LOG_WARN("natural frequency: %s: not compensated for temperature", err);
-        return;
+        return 0;
     }
     amfi_f1_rec *a = NULL;
     size_t n = 0;
     if (amfi_store_f1_series(d->store, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err, sizeof err)) {
         LOG_WARN("store: %s", err);
-        return;
+        return 0;
     }
     int used = 0, fitted = 0;
     for (size_t k = 0; k < n && !fitted; k++) {
@@ -76,34 +90,26 @@ void freevib_start(daemon_s *d)
                  m.n, m.f_ref_hz, m.warm, m.frost);
     else if (used > 0)
         LOG_INFO("natural frequency: %d of %d baseline estimates from the store", used,
-                 d->cfg.daemon.natfreq_baseline_n);
+                 d->cfg->daemon.natfreq_baseline_n);
+    return timer_add(d->timers, &record_period_s, freevib_tick) ? 1 : 0;
 }
 
-void freevib_reload(daemon_s *d, const amfi_site_config *n)
-{
-    const amfi_daemon_config *a = &d->cfg.daemon, *b = &n->daemon;
-    const amfi_natfreq_params *p = &a->natfreq, *q = &b->natfreq;
-    if (a->natfreq_free_s != b->natfreq_free_s || a->natfreq_baseline_n != b->natfreq_baseline_n ||
-        p->f_lo_hz != q->f_lo_hz || p->f_hi_hz != q->f_hi_hz || p->n_modes != q->n_modes ||
-        p->min_periods != q->min_periods || p->min_r2 != q->min_r2 ||
-        p->max_zeta != q->max_zeta || p->max_se_frac != q->max_se_frac)
-        LOG_WARN("reload: daemon.natural_frequency takes effect at the next start");
-}
 
-void freevib_stop(daemon_s *d)
+static void freevib_stop(amfid_ctx *c)
 {
-    amfi_natfreq_comp_destroy(d->fv.comp);
-    d->fv.comp = NULL;
+    (void)c;
+    amfi_natfreq_comp_destroy(F.comp);
+    memset(&F, 0, sizeof F);
 }
 
 /* The event's vehicle that leaves the span last (at its measured speed). */
-static int64_t last_out(const daemon_s *d, const amfi_window *w)
+static int64_t last_out(const amfid_ctx *d, const amfi_window *w)
 {
     int64_t id = w->v.vehicle_id;
     double latest = -INFINITY;
     for (int i = 0; i < w->n_vehicles; i++) {
         const amfi_vehicle_ev *v = &w->ev[i];
-        const amfi_passage_times pt = amfi_passage_window(d->cfg.bridge.span_m, v->speed_mps,
+        const amfi_passage_times pt = amfi_passage_window(d->cfg->bridge.span_m, v->speed_mps,
                                                           v->n_axles, v->spacing_m, 0.0, 0.0);
         const double out = (double)v->utime + 1e6 * pt.on_span_s;
         if (out > latest) {
@@ -114,12 +120,12 @@ static int64_t last_out(const daemon_s *d, const amfi_window *w)
     return id;
 }
 
-void freevib_estimate(daemon_s *d, job *j)
+void freevib_estimate(amfid_ctx *d, job *j, amfi_ring *const *rings)
 {
-    freevib_state *fv = &d->fv;
+    struct freevib_state *fv = &F;
     j->f1_hz = j->f1_zeta = j->f1_r2 = NAN;
     j->f1_vehicle_id = j->w.v.vehicle_id;
-    if (!(d->cfg.daemon.natfreq_free_s > 0) || strcmp(j->w.status, "ok") != 0)
+    if (!(d->cfg->daemon.natfreq_free_s > 0) || strcmp(j->w.status, "ok") != 0)
         return;
     j->f1_vehicle_id = last_out(d, &j->w);
     const int n = j->w.free_n;
@@ -129,18 +135,18 @@ void freevib_estimate(daemon_s *d, job *j)
     }
     double *x = malloc(sizeof(double) * (size_t)n);
     if (!x) {
-        set_error(d, "natural frequency: out of memory for %d samples", n);
+        ctx_error(d, "natural frequency: out of memory for %d samples", n);
         return;
     }
     amfi_natfreq_result best;
     memset(&best, 0, sizeof best);
     int have = 0, first_code = AMFI_NATFREQ_EINVAL;
     for (int s = 0; s < j->n_sensors; s++) {
-        if (!d->rings[s] || amfi_ring_get(d->rings[s], j->w.free_k0[s], n, x) != 0)
+        if (!rings[s] || amfi_ring_get(rings[s], j->w.free_k0[s], n, x) != 0)
             continue;
         amfi_natfreq_result r;
-        const int code = amfi_natfreq_estimate(x, n, amfi_ring_rate(d->rings[s]),
-                                               &d->cfg.daemon.natfreq, &r);
+        const int code = amfi_natfreq_estimate(x, n, amfi_ring_rate(rings[s]),
+                                               &d->cfg->daemon.natfreq, &r);
         if (s == 0 || first_code == AMFI_NATFREQ_EINVAL)
             first_code = code;
         if (code == AMFI_NATFREQ_OK &&
@@ -161,9 +167,9 @@ void freevib_estimate(daemon_s *d, job *j)
 }
 
 /* The deck temperature at utime, or NaN (environment_deck_at). */
-static double deck_at(daemon_s *d, int64_t utime)
+static double deck_at(amfid_ctx *d, int64_t utime)
 {
-    return environment_deck_at(d, utime, d->cfg.daemon.scale_max_temp_gap_s);
+    return environment_deck_at(d, utime, d->cfg->daemon.scale_max_temp_gap_s);
 }
 
 /* Whether this row (of an event: one vehicle's) carries the f1. */
@@ -172,24 +178,26 @@ static int carries(const job *j)
     return j->w.v.vehicle_id == j->f1_vehicle_id && j->f1_hz > 0;
 }
 
-void freevib_row(daemon_s *d, const job *j, amfi_passage_row *r)
+static void freevib_row(amfid_ctx *d, const amfid_passage *p, amfi_passage_row *r)
 {
+    const job *j = p->j;
     r->f1_hz = r->f1_comp_hz = r->f1_zeta = r->f1_r2 = NAN;
     if (!carries(j))
         return;
     r->f1_hz = j->f1_hz;
     r->f1_zeta = j->f1_zeta;
     r->f1_r2 = j->f1_r2;
-    if (d->fv.comp) {
+    if (F.comp) {
         amfi_natfreq_model m;
-        if (amfi_natfreq_comp_model(d->fv.comp, &m))
-            r->f1_comp_hz = amfi_natfreq_comp_apply(d->fv.comp, j->f1_hz, deck_at(d, j->w.v.utime));
+        if (amfi_natfreq_comp_model(F.comp, &m))
+            r->f1_comp_hz = amfi_natfreq_comp_apply(F.comp, j->f1_hz, deck_at(d, j->w.v.utime));
     }
 }
 
-void freevib_stored(daemon_s *d, const job *j)
+static void freevib_stored(amfid_ctx *d, const amfid_passage *p)
 {
-    freevib_state *fv = &d->fv;
+    const job *j = p->j;
+    struct freevib_state *fv = &F;
     amfi_natfreq_model m;
     if (!carries(j) || !fv->comp || amfi_natfreq_comp_model(fv->comp, &m))
         return;
@@ -209,10 +217,10 @@ void freevib_stored(daemon_s *d, const job *j)
 /* The counters and their names (natfreq.<name> in the meta table, and the
  * log), "estimated" first: how many, or 0 when the feature is off. */
 #define N_COUNTERS (AMFI_NATFREQ_NREFUSALS + 3)
-static int counters(const daemon_s *d, const char **name, long long *v)
+static int counters(const amfid_ctx *d, const char **name, long long *v)
 {
-    const freevib_state *fv = &d->fv;
-    if (!(d->cfg.daemon.natfreq_free_s > 0))
+    const struct freevib_state *fv = &F;
+    if (!(d->cfg->daemon.natfreq_free_s > 0))
         return 0;
     int k = 0;
     name[k] = "estimated", v[k++] = (long long)fv->estimated;
@@ -224,7 +232,7 @@ static int counters(const daemon_s *d, const char **name, long long *v)
     return k;
 }
 
-void freevib_record(daemon_s *d)
+static void freevib_record(amfid_ctx *d)
 {
     const char *name[N_COUNTERS];
     long long v[N_COUNTERS];
@@ -234,14 +242,16 @@ void freevib_record(daemon_s *d)
         snprintf(key, sizeof key, "natfreq.%s", name[i]);
         snprintf(val, sizeof val, "%lld", v[i]);
         if (amfi_store_meta_set(d->store, key, val, err, sizeof err) != 0) {
-            set_error(d, "store: %s", err);
+            ctx_error(d, "store: %s", err);
             return;
         }
     }
 }
 
-void freevib_final(daemon_s *d)
+static void freevib_final(amfid_ctx *d)
 {
+    if (!pipeline_degraded())
+        freevib_record(d);
     const char *name[N_COUNTERS];
     long long v[N_COUNTERS];
     const int n = counters(d, name, v);
@@ -253,3 +263,30 @@ void freevib_final(daemon_s *d)
     if (n > 0)
         LOG_INFO("natural frequency: %lld passages estimated; not: %s", v[0], line);
 }
+
+/* The counters into the meta table with the intake record (status.c), every
+ * 60 s and not while the store refuses writes (tried at each turn then). */
+static int freevib_tick(amfid_ctx *c)
+{
+    if (pipeline_degraded())
+        return 1;
+    freevib_record(c);
+    return 0;
+}
+
+static int freevib_start(amfid_ctx *c, char *err, size_t errlen)
+{
+    (void)c, (void)err, (void)errlen;
+    memset(&F, 0, sizeof F);
+    return 0;
+}
+
+const amfid_module freevib_module = {
+    .name = "freevib",
+    .start = freevib_start,
+    .restore = freevib_restore,
+    .row = freevib_row,
+    .on_passage = freevib_stored,
+    .final = freevib_final,
+    .stop = freevib_stop,
+};

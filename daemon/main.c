@@ -17,10 +17,10 @@ int main(int argc, char **argv)
     gsl_set_error_handler_off();
     amfid_options o;
     amfid_parse_options(argc, argv, &o);
-    static daemon_s d; /* large; zeroed */
+    amfid *d = NULL;
     int rc = amfid_start(&d, &o);
     if (rc == 0 && !o.check_only && !o.make_bus_key)
-        rc = amfid_run(&d);
-    amfid_stop(&d);
+        rc = amfid_run(d);
+    amfid_stop(d);
     return rc;
 }

@@ -12,6 +12,10 @@
  * never sees half of it; a failed write is logged once
  * (until a write succeeds again) and counted.
  *
+ * A module (ctx.h): on_passage counts, a timer (metrics.interval_s)
+ * writes the file, final writes it once more; the other modules' counters
+ * come through the context's collect (amfid_stats).
+ *
  * Thread: the main thread only; the counters it reads are the main thread's.
  */
 #define _GNU_SOURCE
@@ -25,15 +29,38 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "amfid.h"
+#include "ctx.h"
+
+#define SOLVE_BUCKETS 12
+#define SOLVE_RECENT 1024
+#define OPEN_KINDS 8
+static struct metrics_state {
+    int64_t by_status[16];        /* stored passages per amfi_store_status_name(k) */
+    int64_t solve_le[SOLVE_BUCKETS]; /* solves of at most bucket_s[i] s */
+    int64_t solve_count;
+    double solve_sum_s;
+    double recent_s[SOLVE_RECENT]; /* the newest solve times, a ring */
+    int recent_n, recent_at;
+    int have_indicator;
+    double std_ratio, p_value, mean_ratio; /* the newest evaluation */
+    char open_kind[OPEN_KINDS][32];      /* alert kinds seen, and whether open */
+    int open[OPEN_KINDS];
+    double start_wall;            /* time(NULL) at start */
+    int64_t write_errors;
+    int failing;                  /* the last write failed (logged once) */
+} MS;
 
 /* Upper bounds of the solve-time histogram, s. */
 static const double bucket_s[SOLVE_BUCKETS] = {0.002, 0.005, 0.01, 0.02, 0.05, 0.1,
                                                0.2,   0.5,   1.0,  2.0,  5.0,  10.0};
 
-void metrics_passage(daemon_s *d, const char *status, int solved, double solve_ms)
+static void metrics_passage(amfid_ctx *d, const amfid_passage *p)
 {
-    metrics_state *m = &d->metrics;
+    (void)d;
+    const char *status = p->j->status;
+    const int solved = p->j->solved;
+    const double solve_ms = p->j->solve_ms;
+    struct metrics_state *m = &MS;
     for (int k = 0; k < AMFI_STORE_N_STATUS; k++)
         if (strcmp(status, amfi_store_status_name(k)) == 0)
             m->by_status[k]++;
@@ -51,18 +78,18 @@ void metrics_passage(daemon_s *d, const char *status, int solved, double solve_m
         m->recent_n++;
 }
 
-void metrics_indicator(daemon_s *d, double std_ratio, double p_value, double mean_ratio)
+void metrics_indicator(double std_ratio, double p_value, double mean_ratio)
 {
-    metrics_state *m = &d->metrics;
+    struct metrics_state *m = &MS;
     m->have_indicator = 1;
     m->std_ratio = std_ratio;
     m->p_value = p_value;
     m->mean_ratio = mean_ratio;
 }
 
-void metrics_alert(daemon_s *d, const char *kind, int raised)
+void metrics_alert(const char *kind, int raised)
 {
-    metrics_state *m = &d->metrics;
+    struct metrics_state *m = &MS;
     for (int i = 0; i < OPEN_KINDS; i++) {
         if (!m->open_kind[i][0])
             snprintf(m->open_kind[i], sizeof m->open_kind[i], "%s", kind);
@@ -113,14 +140,14 @@ static void sample(FILE *f, const char *name, double v)
     put_value(f, v);
 }
 
-static void write_all(daemon_s *d, FILE *f)
+static void write_all(amfid_ctx *d, const amfid_stats *st, FILE *f)
 {
-    const metrics_state *m = &d->metrics;
+    const struct metrics_state *m = &MS;
     head(f, "amfi_build_info", "gauge", "amfid's version and site (value 1).");
     fputs("amfi_build_info{version=\"", f);
     put_label(f, amfi_version());
     fputs("\",site=\"", f);
-    put_label(f, d->cfg.site.id);
+    put_label(f, d->cfg->site.id);
     fputs("\"} 1\n", f);
     head(f, "amfi_start_time_seconds", "gauge", "Start of this amfid, Unix time.");
     sample(f, "amfi_start_time_seconds", m->start_wall);
@@ -138,40 +165,40 @@ static void write_all(daemon_s *d, FILE *f)
                 (long long)m->by_status[k]);
     head(f, "amfi_passages_lost_total", "counter",
          "Passages not stored (held queue full, or the store refused at shutdown).");
-    fprintf(f, "amfi_passages_lost_total %lld\n", (long long)d->passages_lost);
+    fprintf(f, "amfi_passages_lost_total %lld\n", (long long)st->passages_lost);
     head(f, "amfi_passages_held", "gauge", "Passages held because the store cannot write.");
-    fprintf(f, "amfi_passages_held %d\n", d->held_n);
+    fprintf(f, "amfi_passages_held %d\n", st->passages_held);
     head(f, "amfi_queue_depth", "gauge", "Passages waiting for a solver thread.");
-    fprintf(f, "amfi_queue_depth %d\n", queue_depth(&d->pool.jobs));
+    fprintf(f, "amfi_queue_depth %d\n", st->queue_depth);
 
     head(f, "amfi_messages_received_total", "counter",
          "Bus messages the input channels handed to amfid.");
-    fprintf(f, "amfi_messages_received_total %lld\n", (long long)d->messages_in);
+    fprintf(f, "amfi_messages_received_total %lld\n", (long long)st->messages_in);
     head(f, "amfi_messages_refused_total", "counter",
          "Bus messages refused, by input and reason.");
     static const char *const inputs[REJECT_NINPUTS] = {"accel", "vehicle", "truth",
                                                          "environment"};
     for (int i = 0; i < REJECT_NINPUTS; i++)
         for (int k = 0; k < REJECT_NREASONS; k++)
-            if (d->rej.count[i][k] > 0)
+            if (st->refused[i][k] > 0)
                 fprintf(f, "amfi_messages_refused_total{input=\"%s\",reason=\"%s\"} %lld\n",
-                        inputs[i], reject_reason_name(k), (long long)d->rej.count[i][k]);
+                        inputs[i], reject_reason_name(k), (long long)st->refused[i][k]);
     head(f, "amfi_intake_bounded_total", "counter",
          "What the intake's bounds did (daemon.intake): waiting vehicles evicted from a full "
          "tracker, calibration references not taken, environment readings accepted but not "
          "stored, refusal summary rows lost.");
     fprintf(f, "amfi_intake_bounded_total{what=\"vehicles_evicted\"} %lld\n",
-            (long long)d->vehicles_evicted);
+            (long long)st->vehicles_evicted);
     fprintf(f, "amfi_intake_bounded_total{what=\"references_refused\"} %lld\n",
-            (long long)d->references_refused);
+            (long long)st->references_refused);
     fprintf(f, "amfi_intake_bounded_total{what=\"environment_thinned\"} %lld\n",
-            (long long)d->env.thinned);
+            (long long)st->env_thinned);
     fprintf(f, "amfi_intake_bounded_total{what=\"summaries_lost\"} %lld\n",
-            (long long)d->rej.summaries_lost);
+            (long long)st->summaries_lost);
     head(f, "amfi_datagrams_dropped_total", "counter",
          "UDP datagrams the kernel dropped on amfid's sockets.");
     fprintf(f, "amfi_datagrams_dropped_total %lld\n",
-            (long long)(d->udp_drops > 0 ? d->udp_drops : 0));
+            (long long)(st->udp_drops > 0 ? st->udp_drops : 0));
 
     head(f, "amfi_solve_seconds", "histogram", "Wall time of the solves since start.");
     for (int i = 0; i < SOLVE_BUCKETS; i++)
@@ -207,15 +234,15 @@ static void write_all(daemon_s *d, FILE *f)
     head(f, "amfi_scale", "gauge",
          "The scale indicator's newest block: temperature-compensated scale of the inferred "
          "GVW (NaN: none yet).");
-    sample(f, "amfi_scale", d->sc.last_scale);
+    sample(f, "amfi_scale", st->last_scale);
     head(f, "amfi_scale_cusum", "gauge", "The scale indicator's CUSUM after the newest block.");
-    sample(f, "amfi_scale_cusum", d->sc.last_cusum);
+    sample(f, "amfi_scale_cusum", st->last_cusum);
     head(f, "amfi_scale_passages_total", "counter",
          "Solved passages since start by what the scale indicator did with them (fed, or "
          "skipped without a deck temperature).");
-    fprintf(f, "amfi_scale_passages_total{use=\"fed\"} %lld\n", (long long)d->sc.fed);
+    fprintf(f, "amfi_scale_passages_total{use=\"fed\"} %lld\n", (long long)st->scale_fed);
     fprintf(f, "amfi_scale_passages_total{use=\"no_temperature\"} %lld\n",
-            (long long)d->sc.no_temp);
+            (long long)st->scale_no_temp);
     head(f, "amfi_alert_open", "gauge", "1 while an alert of this kind is raised.");
     for (int i = 0; i < OPEN_KINDS && m->open_kind[i][0]; i++) {
         fputs("amfi_alert_open{kind=\"", f);
@@ -224,32 +251,29 @@ static void write_all(daemon_s *d, FILE *f)
     }
 
     head(f, "amfi_notices_total", "counter", "Alert notices (alerts.command) by result.");
-    const notify_state *ns = &d->notify;
-    fprintf(f, "amfi_notices_total{result=\"ok\"} %lld\n", (long long)ns->ok);
-    fprintf(f, "amfi_notices_total{result=\"failed\"} %lld\n", (long long)ns->failed);
-    fprintf(f, "amfi_notices_total{result=\"timeout\"} %lld\n", (long long)ns->timeouts);
-    fprintf(f, "amfi_notices_total{result=\"dropped\"} %lld\n", (long long)ns->dropped);
+    fprintf(f, "amfi_notices_total{result=\"ok\"} %lld\n", (long long)st->notices_ok);
+    fprintf(f, "amfi_notices_total{result=\"failed\"} %lld\n", (long long)st->notices_failed);
+    fprintf(f, "amfi_notices_total{result=\"timeout\"} %lld\n",
+            (long long)st->notices_timeouts);
+    fprintf(f, "amfi_notices_total{result=\"dropped\"} %lld\n",
+            (long long)st->notices_dropped);
     head(f, "amfi_notices_running", "gauge", "Alert notices running now.");
-    fprintf(f, "amfi_notices_running %d\n", ns->running);
+    fprintf(f, "amfi_notices_running %d\n", st->notices_running);
     head(f, "amfi_metrics_write_errors_total", "counter",
          "Failed writes of this file (the previous file stays).");
     fprintf(f, "amfi_metrics_write_errors_total %lld\n", (long long)m->write_errors);
 }
 
-void metrics_tick(daemon_s *d, int force)
+static void write_file(amfid_ctx *d)
 {
-    metrics_state *m = &d->metrics;
-    const char *path = d->cfg.daemon.metrics_path;
+    struct metrics_state *m = &MS;
+    const char *path = d->cfg->daemon.metrics_path;
     if (!path[0])
         return;
-    double now = amfi_mono_s();
-    if (!force && m->last_write > 0 && now - m->last_write < d->cfg.daemon.metrics_interval_s)
-        return;
-    m->last_write = now;
     /* A new file of a name nobody can guess, in the same folder (the
      * rename stays atomic): mkostemp opens it O_CREAT|O_EXCL, mode 0600, so a
      * file or symlink planted there is never followed nor truncated. */
-    char tmp[sizeof d->cfg.daemon.metrics_path + 32];
+    char tmp[sizeof d->cfg->daemon.metrics_path + 32];
     snprintf(tmp, sizeof tmp, "%s.tmp.XXXXXX", path);
     int fd = mkostemp(tmp, O_CLOEXEC);
     FILE *f = NULL;
@@ -266,7 +290,9 @@ void metrics_tick(daemon_s *d, int force)
          * UMask=0027 would hide the file from it */
         if (fchmod(fd, 0644) != 0)
             e = errno ? errno : EIO;
-        write_all(d, f);
+        amfid_stats st;
+        d->collect(d, &st);
+        write_all(d, &st, f);
         if ((fflush(f) != 0 || fsync(fileno(f)) != 0) && !e)
             e = errno ? errno : EIO;
         if (fclose(f) != 0 && !e)
@@ -285,6 +311,33 @@ void metrics_tick(daemon_s *d, int force)
     m->write_errors++;
     if (!m->failing)
         LOG_ERR("metrics: cannot write %s: %s (retried every %.0f s; logged once)", path,
-                strerror(e), d->cfg.daemon.metrics_interval_s);
+                strerror(e), d->cfg->daemon.metrics_interval_s);
     m->failing = 1;
 }
+
+static int metrics_tick(amfid_ctx *d)
+{
+    write_file(d);
+    return 0;
+}
+
+static int metrics_start(amfid_ctx *d, char *err, size_t errlen)
+{
+    (void)d, (void)err, (void)errlen;
+    memset(&MS, 0, sizeof MS);
+    return 0;
+}
+
+static int metrics_restore(amfid_ctx *d)
+{
+    MS.start_wall = (double)time(NULL);
+    return timer_add(d->timers, &d->cfg->daemon.metrics_interval_s, metrics_tick) ? 1 : 0;
+}
+
+const amfid_module metrics_module = {
+    .name = "metrics",
+    .start = metrics_start,
+    .restore = metrics_restore,
+    .on_passage = metrics_passage,
+    .final = write_file,
+};

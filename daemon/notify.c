@@ -13,6 +13,9 @@
  * ignores SIGPIPE), an empty mask, a process group of its own. At stop,
  * notify_finish gives the notices alerts.command_stop_wait_s, then kills.
  *
+ * A module (ctx.h): its tick reaps, its final is notify_finish, its stop
+ * notify_free.
+ *
  * Thread: the main thread only (the pipeline raises alerts there; the loop
  * calls notify_tick). Owns the queued environments and the child table.
  */
@@ -28,7 +31,10 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "amfid.h"
+#include "ctx.h"
+
+#define NOTIFY_MAX_RUNNING 64 /* alerts.command_max_running's upper bound */
+#define NOTIFY_QUEUE 256      /* notices waiting; beyond: dropped, counted */
 
 #define KILL_AFTER_S 5.0 /* SIGKILL this long after SIGTERM */
 #define STOP_KILL_AFTER_S 2.0 /* at stop: SIGKILL this long after SIGTERM */
@@ -37,6 +43,17 @@ struct notice {
     char *envp[16];
     char text[2048 + 1024]; /* the strings envp points into */
 };
+
+static struct notify_state {
+    int pid[NOTIFY_MAX_RUNNING];        /* running children, 0: free slot */
+    double started[NOTIFY_MAX_RUNNING]; /* amfi_mono_s() at spawn */
+    int term_sent[NOTIFY_MAX_RUNNING];  /* SIGTERM sent (timed out, or amfid stopping) */
+    int stopping;                       /* notify_finish gave up waiting: killed at stop */
+    int running;
+    struct notice *queue[NOTIFY_QUEUE];
+    int qhead, queued;
+    int64_t started_total, ok, failed, timeouts, dropped;
+} N;
 
 /* One environment string "NAME=value" appended to n; control characters
  * of the value (a message is free text) become spaces. */
@@ -77,10 +94,10 @@ static void kill_group(pid_t pid, int sig)
         kill(pid, sig);
 }
 
-static int start_child(daemon_s *d, struct notice *n)
+static int start_child(amfid_ctx *d, struct notice *n)
 {
-    notify_state *ns = &d->notify;
-    char *argv[] = {d->cfg.daemon.alert_command, NULL};
+    struct notify_state *ns = &N;
+    char *argv[] = {(char *)d->cfg->daemon.alert_command, NULL};
     posix_spawn_file_actions_t fa;
     posix_spawnattr_t at;
     sigset_t all, none;
@@ -128,11 +145,11 @@ static int start_child(daemon_s *d, struct notice *n)
     return 0; /* not reached: callers keep running < the table's size */
 }
 
-void notify_alert(daemon_s *d, int64_t utime, int64_t alert_id, const char *level,
+void notify_alert(amfid_ctx *d, int64_t utime, int64_t alert_id, const char *level,
                   const char *kind, const char *message, int64_t indicator_id, int raised)
 {
-    notify_state *ns = &d->notify;
-    if (!d->cfg.daemon.alert_command[0])
+    struct notify_state *ns = &N;
+    if (!d->cfg->daemon.alert_command[0])
         return;
     struct notice *n = calloc(1, sizeof *n);
     if (!n) {
@@ -159,12 +176,12 @@ void notify_alert(daemon_s *d, int64_t utime, int64_t alert_id, const char *leve
     put_env(n, &k, &used, "AMFI_ALERT_TIME", iso);
     snprintf(num, sizeof num, "%lld", (long long)indicator_id);
     put_env(n, &k, &used, "AMFI_ALERT_INDICATOR_ID", num);
-    put_env(n, &k, &used, "AMFI_SITE_ID", d->cfg.site.id);
-    put_env(n, &k, &used, "AMFI_SITE_NAME", d->cfg.site.name);
-    put_env(n, &k, &used, "AMFI_DB", d->cfg.daemon.db_path);
+    put_env(n, &k, &used, "AMFI_SITE_ID", d->cfg->site.id);
+    put_env(n, &k, &used, "AMFI_SITE_NAME", d->cfg->site.name);
+    put_env(n, &k, &used, "AMFI_DB", d->cfg->daemon.db_path);
     const char *path = getenv("PATH");
     put_env(n, &k, &used, "PATH", path ? path : "/usr/sbin:/usr/bin:/sbin:/bin");
-    if (ns->running < d->cfg.daemon.alert_max_running && ns->queued == 0) {
+    if (ns->running < d->cfg->daemon.alert_max_running && ns->queued == 0) {
         start_child(d, n);
         free(n);
         return;
@@ -181,18 +198,18 @@ void notify_alert(daemon_s *d, int64_t utime, int64_t alert_id, const char *leve
 }
 
 /* A child ended: count and log how. */
-static void ended(daemon_s *d, int i, int status)
+static void ended(amfid_ctx *d, int i, int status)
 {
-    notify_state *ns = &d->notify;
-    const char *cmd = d->cfg.daemon.alert_command;
+    struct notify_state *ns = &N;
+    const char *cmd = d->cfg->daemon.alert_command;
     if (ns->term_sent[i]) {
         ns->timeouts++;
         if (ns->stopping)
             LOG_ERR("alert notice: %s killed at stop after %.0f s "
-                    "(alerts.command_stop_wait_s)", cmd, d->cfg.daemon.alert_stop_wait_s);
+                    "(alerts.command_stop_wait_s)", cmd, d->cfg->daemon.alert_stop_wait_s);
         else
             LOG_ERR("alert notice: %s killed after %.0f s (alerts.command_timeout_s)", cmd,
-                    d->cfg.daemon.alert_timeout_s);
+                    d->cfg->daemon.alert_timeout_s);
     } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
         ns->ok++;
     } else {
@@ -207,9 +224,9 @@ static void ended(daemon_s *d, int i, int status)
     ns->running--;
 }
 
-void notify_tick(daemon_s *d)
+static void notify_tick(amfid_ctx *d)
 {
-    notify_state *ns = &d->notify;
+    struct notify_state *ns = &N;
     if (ns->running == 0 && ns->queued == 0)
         return;
     double now = amfi_mono_s();
@@ -227,14 +244,14 @@ void notify_tick(daemon_s *d)
             continue;
         }
         double age = now - ns->started[i];
-        if (!ns->term_sent[i] && age > d->cfg.daemon.alert_timeout_s) {
+        if (!ns->term_sent[i] && age > d->cfg->daemon.alert_timeout_s) {
             kill_group(ns->pid[i], SIGTERM);
             ns->term_sent[i] = 1;
-        } else if (ns->term_sent[i] && age > d->cfg.daemon.alert_timeout_s + KILL_AFTER_S) {
+        } else if (ns->term_sent[i] && age > d->cfg->daemon.alert_timeout_s + KILL_AFTER_S) {
             kill_group(ns->pid[i], SIGKILL);
         }
     }
-    while (ns->queued > 0 && ns->running < d->cfg.daemon.alert_max_running) {
+    while (ns->queued > 0 && ns->running < d->cfg->daemon.alert_max_running) {
         struct notice *n = ns->queue[ns->qhead];
         ns->queue[ns->qhead] = NULL;
         ns->qhead = (ns->qhead + 1) % NOTIFY_QUEUE;
@@ -248,12 +265,12 @@ void notify_tick(daemon_s *d)
  * alerts.command_stop_wait_s; then SIGTERM to every group still running,
  * SIGKILL STOP_KILL_AFTER_S later, and the notices never started are
  * dropped and counted. Bounded: stop_wait + STOP_KILL_AFTER_S + 1 s. */
-void notify_finish(daemon_s *d)
+static void notify_finish(amfid_ctx *d)
 {
-    notify_state *ns = &d->notify;
+    struct notify_state *ns = &N;
     if (ns->running == 0 && ns->queued == 0)
         return;
-    double wait = d->cfg.daemon.alert_stop_wait_s, t0 = amfi_mono_s();
+    double wait = d->cfg->daemon.alert_stop_wait_s, t0 = amfi_mono_s();
     LOG_INFO("waiting for %d alert notice(s) (%d queued), at most %.0f s "
              "(alerts.command_stop_wait_s)", ns->running, ns->queued, wait);
     struct timespec ts = {0, 20000000};
@@ -294,9 +311,10 @@ void notify_finish(daemon_s *d)
     }
 }
 
-void notify_free(daemon_s *d)
+static void notify_free(amfid_ctx *d)
 {
-    notify_state *ns = &d->notify;
+    (void)d;
+    struct notify_state *ns = &N;
     for (; ns->queued > 0; ns->queued--) {
         free(ns->queue[ns->qhead]);
         ns->queue[ns->qhead] = NULL;
@@ -310,3 +328,30 @@ void notify_free(daemon_s *d)
         }
     ns->running = 0;
 }
+
+static int notify_start(amfid_ctx *d, char *err, size_t errlen)
+{
+    (void)d, (void)err, (void)errlen;
+    memset(&N, 0, sizeof N);
+    return 0;
+}
+
+static void notify_metrics(amfid_ctx *d, amfid_stats *s)
+{
+    (void)d;
+    s->notices_ok = N.ok;
+    s->notices_failed = N.failed;
+    s->notices_timeouts = N.timeouts;
+    s->notices_dropped = N.dropped;
+    s->notices_running = N.running;
+    s->notices_queued = N.queued;
+}
+
+const amfid_module notify_module = {
+    .name = "notify",
+    .start = notify_start,
+    .tick = notify_tick,
+    .metrics = notify_metrics,
+    .final = notify_finish,
+    .stop = notify_free,
+};

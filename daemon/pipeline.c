@@ -3,27 +3,35 @@
  * pipeline.c: amfid's in-order pipeline: finished passages (solved or not)
  * parked by their release order and, in that order, stored (one
  * transaction each), published on the passage channel, and the ok ones fed
- * to the indicator engine, whose baselines, indicators and alerts are
- * stored and published too; the estimated speeds feed the speed-drift
- * alert (drift.c); the solved ones get their deck temperature and feed the
- * scale indicator and the known-truck runs (scaleind.c). An event of several vehicles weighed together
+ * to the modules: each module's row hook fills its columns before the row
+ * is stored, each one's on_passage runs after it is stored, in the order
+ * of the table of modules (amfid.c): the natural frequency, the metrics,
+ * the passage channel (here), the speed-drift alert, the STD and mean
+ * rules, the scale indicator and the known-truck runs. An event of several vehicles weighed together
  * (tracker.h) becomes one row per vehicle, in entry order, each with the
  * event's size and its own weight and quality; with
  * daemon.indicators.single_presence_only the indicators take only the
  * passages weighed alone (the one filter here, not in the engine).
  *
- * A passage is acknowledged when its transaction has committed; only then
- * is it published and fed to the indicators. When the store cannot write
- * (disk full, I/O error, read-only, locked) the passage is held, in order,
- * in a bounded queue (STORE_HOLD_MAX) and retried with a backoff (1 s
- * doubling to 30 s); amfid is then degraded (status message state,
+ * The pipeline is three parts: the reorder buffer (reorder.c: results parked
+ * by their release order, handed on consecutively), the store sink (sink.c)
+ * and, here, the fan-out of a stored passage. A passage is acknowledged
+ * when its transaction has committed; only then is it published and fed to
+ * the indicators. When the store cannot write (disk full, I/O error,
+ * read-only, locked) the sink holds the passage, in order, in a queue
+ * bounded in bytes (daemon.store.held_max_bytes) and retries with a backoff
+ * (1 s doubling to 30 s); amfid is then degraded (status message state,
  * sd_notify STATUS, a `store_degraded` alert on the bus and in the log,
- * cleared when the queue has drained). What overflows the queue is counted
- * and each such vehicle logged with its id and time.
+ * raised and cleared here, cleared when the queue has drained). What
+ * overflows the queue is counted and each such vehicle logged with its id
+ * and time.
  *
- * Thread: the main thread only. Owns the reorder buffer (d->pending), the
- * held queue, the store handle's writes and the indicator engine; it takes jobs back from
- * the solver pool's result queue (pool.h), after which they are its own.
+ * A module (ctx.h): its tick stores what the solvers handed back and
+ * retries the held passages; its on_passage publishes the passage.
+ *
+ * Thread: the main thread only. Owns the reorder buffer and the sink and
+ * the store handle's passage writes; it takes jobs back from the solver
+ * pool's result queue (pool.h), after which they are its own.
  */
 #include <errno.h>
 #include <math.h>
@@ -34,9 +42,19 @@
 #include <unistd.h>
 
 #include "amfi_alert_t.h"
-#include "amfi_indicator_t.h"
 #include "amfi_passage_t.h"
-#include "amfid.h"
+#include "ctx.h"
+#include "reorder.h"
+#include "sink.h"
+
+static struct {
+    reorder *reorder;
+    sink *sink;
+    int64_t stored, ok;         /* passages stored, of which ok */
+    /* the store_degraded alert while the sink holds passages */
+    int64_t degraded_utime;     /* data time it was raised */
+    char degraded_msg[1024];    /* its message, stored once the store writes again */
+} P;
 
 /* The speed the passage was weighed with: the estimate when the solver
  * estimated it (solver.speed: estimate), else the detector's. */
@@ -45,8 +63,11 @@ static double speed_used(const job *j)
     return j->speed_estimated ? j->speed_used_mps : j->w.v.speed_mps;
 }
 
-static void publish_passage(daemon_s *d, const job *j, int64_t id, const amfi_passage_row *r)
+static void publish_passage(amfid_ctx *d, const amfid_passage *p)
 {
+    const job *j = p->j;
+    const int64_t id = p->id;
+    const amfi_passage_row *r = p->r;
     amfi_passage_t m;
     memset(&m, 0, sizeof m);
     m.utime = j->w.v.utime;
@@ -61,9 +82,9 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id, const amfi_pa
     m.axle_kg = (double *)j->axle_kg;
     m.lambda = j->solved ? j->lambda_used : NAN;
     m.residual_rms = j->solved ? j->residual_rms : NAN;
-    m.formulation = (char *)amfi_formulation_name(d->cfg.solver.formulation);
+    m.formulation = (char *)amfi_formulation_name(d->cfg->solver.formulation);
     m.solve_ms = j->solve_ms;
-    m.site_id = d->cfg.site.id;
+    m.site_id = (char *)d->cfg->site.id;
     m.speed_given_mps = j->w.v.speed_mps;
     m.speed_estimated = (int8_t)j->speed_estimated;
     m.n_vehicles = (int16_t)(j->w.n_vehicles > 1 ? j->w.n_vehicles : 1);
@@ -71,75 +92,11 @@ static void publish_passage(daemon_s *d, const job *j, int64_t id, const amfi_pa
     m.reference_gvw_kg = j->w.v.reference_gvw_kg > 0 ? j->w.v.reference_gvw_kg : NAN;
     m.f1_hz = r->f1_hz;
     m.f1_comp_hz = r->f1_comp_hz;
-    BUS_PUBLISH(d, amfi_passage_t, d->cfg.daemon.ch_passage, &m);
-}
-
-/* The STD and mean rules get gvw_kg: the passage's GVW, at the calibration
- * temperature where it is compensated (scaleind_comp). */
-static void feed_indicators(daemon_s *d, const job *j, double gvw_kg)
-{
-    amfi_indicator_eval ev;
-    amfi_alert_event al[2];
-    int n_al = 0;
-    int bits = amfi_indicators_push(d->ind, gvw_kg, &ev, al, &n_al);
-    if (bits < 0) {
-        set_error(d, "indicators: GVW %.1f kg of vehicle %lld refused", gvw_kg,
-                  (long long)j->w.v.vehicle_id);
-        return;
-    }
-    char err[256];
-    if (bits & AMFI_IND_BASELINE) {
-        amfi_baseline b;
-        memset(&b, 0, sizeof b);
-        b.utime_set = j->w.v.utime;
-        b.n = ev.n;
-        b.mean_kg = ev.baseline_mean_kg;
-        b.std_kg = ev.baseline_std_kg;
-        snprintf(b.source, sizeof b.source, "auto");
-        snprintf(b.note, sizeof b.note, "first %d ok passages", ev.n);
-        if (amfi_store_set_baseline(d->store, &b, err, sizeof err))
-            set_error(d, "store: %s", err);
-        LOG_INFO("baseline established: mean %.0f kg, STD %.0f kg over %d passages",
-                 ev.baseline_mean_kg, ev.baseline_std_kg, ev.n);
-    }
-    int64_t ind_id = 0;
-    if (bits & AMFI_IND_EVAL) {
-        amfi_indicator_row row = {j->w.v.utime, ev.n, ev.mean_kg, ev.std_kg,
-                                  ev.baseline_mean_kg, ev.baseline_std_kg, ev.std_ratio,
-                                  ev.p_value, ev.state};
-        if (amfi_store_add_indicator(d->store, &row, &ind_id, err, sizeof err))
-            set_error(d, "store: %s", err);
-        amfi_indicator_t m = {j->w.v.utime, ind_id, ev.n, ev.mean_kg, ev.std_kg,
-                              ev.baseline_mean_kg, ev.baseline_std_kg, ev.std_ratio,
-                              ev.p_value, (char *)ev.state, d->cfg.site.id};
-        BUS_PUBLISH(d, amfi_indicator_t, d->cfg.daemon.ch_indicator, &m);
-        metrics_indicator(d, ev.std_ratio, ev.p_value,
-                          ev.baseline_mean_kg > 0 ? ev.mean_kg / ev.baseline_mean_kg : NAN);
-    }
-    for (int i = 0; (bits & AMFI_IND_ALERT) && i < n_al; i++)
-        emit_alert(d, j->w.v.utime, &al[i], ind_id);
-}
-
-void emit_alert(daemon_s *d, int64_t utime, const amfi_alert_event *a, int64_t ind_id)
-{
-    char err[256];
-    int64_t aid = 0;
-    if (amfi_store_add_alert(d->store, utime, a->level, a->kind, a->message, ind_id, a->raised,
-                             &aid, err, sizeof err))
-        set_error(d, "store: %s", err);
-    amfi_alert_t m = {utime, aid, (char *)a->level, (char *)a->kind, (char *)a->message, ind_id,
-                      (int8_t)a->raised, d->cfg.site.id};
-    BUS_PUBLISH(d, amfi_alert_t, d->cfg.daemon.ch_alert, &m);
-    metrics_alert(d, a->kind, a->raised);
-    notify_alert(d, utime, aid, a->level, a->kind, a->message, ind_id, a->raised);
-    if (a->raised)
-        LOG_WARN("ALERT %s (%s): %s", a->kind, a->level, a->message);
-    else
-        LOG_INFO("alert cleared %s: %s", a->kind, a->message);
+    BUS_PUBLISH(d, amfi_passage_t, d->cfg->daemon.ch_passage, &m);
 }
 
 /* The row of a job. */
-static void job_row(daemon_s *d, const job *j, amfi_passage_row *r)
+static void job_row(amfid_ctx *d, const job *j, amfi_passage_row *r)
 {
     memset(r, 0, sizeof *r);
     r->vehicle_id = j->w.v.vehicle_id;
@@ -158,29 +115,36 @@ static void job_row(daemon_s *d, const job *j, amfi_passage_row *r)
     r->reason = j->reason;
     r->lambda = j->solved ? j->lambda_used : NAN;
     r->residual_rms = j->solved ? j->residual_rms : NAN;
-    r->formulation = amfi_formulation_name(d->cfg.solver.formulation);
+    r->formulation = amfi_formulation_name(d->cfg->solver.formulation);
     r->solve_ms = j->solve_ms;
     r->n_vehicles = j->w.n_vehicles > 1 ? j->w.n_vehicles : 1;
     r->quality = j->quality > 0 ? j->quality : NAN;
     r->reference_gvw_kg = j->w.v.reference_gvw_kg;
-    freevib_row(d, j, r);
 }
 
-static int store_now(daemon_s *d, job *j)
+/* The row of a passage: the job's columns, then each module's (row hooks,
+ * in table order). */
+static void fill_row(amfid_ctx *d, const amfid_passage *p, amfi_passage_row *r)
+{
+    job_row(d, p->j, r);
+    for (int i = 0; i < d->n_modules; i++)
+        if (d->modules[i]->row)
+            d->modules[i]->row(d, p, r);
+}
+
+/* Store one vehicle's passage (a transaction); once committed, each
+ * module's on_passage in table order. 0, or −1 when the store refused
+ * (the job untouched: the sink holds it). */
+static int store_now(amfid_ctx *d, job *j)
 {
     amfi_passage_row r;
-    job_row(d, j, &r);
     /* an inseparable vehicle's joint estimate (status multiple) is not fed */
-    const int feeds = strcmp(j->status, "ok") == 0 &&
-                      (!d->cfg.daemon.single_presence_only || j->w.n_vehicles <= 1);
-    if (j->solved) {
-        scaleind_deck(d, &r);
-        if (feeds)
-            scaleind_comp(d, &r);
-    }
-    int64_t id = 0;
+    amfid_passage p = {j, &r, 0,
+                       j->solved && strcmp(j->status, "ok") == 0 &&
+                           (!d->cfg->daemon.single_presence_only || j->w.n_vehicles <= 1)};
+    fill_row(d, &p, &r);
     char err[256];
-    int rc = amfi_store_add_passage(d->store, &r, &id, err, sizeof err);
+    int rc = amfi_store_add_passage(d->store, &r, &p.id, err, sizeof err);
     if (rc == AMFI_EINVAL && strcmp(j->status, "error") != 0) {
         /* A value the store cannot hold (a solver result beyond the
          * schema's ranges: garbage samples within the intake's limits can
@@ -190,27 +154,22 @@ static int store_now(daemon_s *d, job *j)
         snprintf(j->reason, sizeof j->reason, "result not storable: %.160s", err);
         snprintf(j->status, sizeof j->status, "error");
         j->solved = 0;
-        job_row(d, j, &r);
-        set_error(d, "store: passage of vehicle %lld stored as error: %s",
+        p.feeds = 0;
+        fill_row(d, &p, &r);
+        ctx_error(d, "store: passage of vehicle %lld stored as error: %s",
                   (long long)r.vehicle_id, err);
-        rc = amfi_store_add_passage(d->store, &r, &id, err, sizeof err);
+        rc = amfi_store_add_passage(d->store, &r, &p.id, err, sizeof err);
     }
     if (rc) {
-        set_error(d, "store: passage of vehicle %lld: %s", (long long)r.vehicle_id, err);
+        ctx_error(d, "store: passage of vehicle %lld: %s", (long long)r.vehicle_id, err);
         return -1;
     }
-    d->passages_stored++;
-    freevib_stored(d, j);
-    metrics_passage(d, j->status, j->solved, j->solve_ms);
-    publish_passage(d, j, id, &r);
-    if (j->speed_estimated)
-        drift_feed(d, j->w.v.utime, r.speed_mps, r.speed_given_mps);
-    if (j->solved && strcmp(j->status, "ok") == 0) {
-        d->passages_ok++;
-        if (feeds)
-            feed_indicators(d, j, r.gvw_comp_kg);
-        scaleind_feed(d, &r);
-    }
+    P.stored++;
+    if (j->solved && strcmp(j->status, "ok") == 0)
+        P.ok++;
+    for (int i = 0; i < d->n_modules; i++)
+        if (d->modules[i]->on_passage)
+            d->modules[i]->on_passage(d, &p);
     return 0;
 }
 
@@ -218,25 +177,25 @@ static int store_now(daemon_s *d, job *j)
  * says): it is published and logged, and its time and text are kept; once
  * the store takes writes again, the raise and the clear are both written to
  * the alerts table, so that the store's history shows the outage. */
-static void publish_store_alert(daemon_s *d, int raised, const char *msg)
+static void publish_store_alert(amfid_ctx *d, int raised, const char *msg)
 {
     int64_t aid = 0;
     int64_t now = d->newest_utime > 0 ? d->newest_utime : 0;
     if (raised) {
-        d->degraded_utime = now;
-        snprintf(d->degraded_msg, sizeof d->degraded_msg, "%s", msg);
+        P.degraded_utime = now;
+        snprintf(P.degraded_msg, sizeof P.degraded_msg, "%s", msg);
     } else {
         char err[256];
-        if (amfi_store_add_alert(d->store, d->degraded_utime, "warning", "store_degraded",
-                                 d->degraded_msg, 0, 1, NULL, err, sizeof err) ||
+        if (amfi_store_add_alert(d->store, P.degraded_utime, "warning", "store_degraded",
+                                 P.degraded_msg, 0, 1, NULL, err, sizeof err) ||
             amfi_store_add_alert(d->store, now, "warning", "store_degraded", msg, 0, 0, &aid,
                                  err, sizeof err))
-            set_error(d, "store: the store_degraded alert: %s", err);
+            ctx_error(d, "store: the store_degraded alert: %s", err);
     }
     amfi_alert_t m = {now, aid, (char *)"warning", (char *)"store_degraded",
-                      (char *)msg, 0, (int8_t)raised, d->cfg.site.id};
-    BUS_PUBLISH(d, amfi_alert_t, d->cfg.daemon.ch_alert, &m);
-    metrics_alert(d, "store_degraded", raised);
+                      (char *)msg, 0, (int8_t)raised, (char *)d->cfg->site.id};
+    BUS_PUBLISH(d, amfi_alert_t, d->cfg->daemon.ch_alert, &m);
+    metrics_alert("store_degraded", raised);
     notify_alert(d, now, aid, "warning", "store_degraded", msg, 0, raised);
     if (raised)
         LOG_ERR("ALERT store_degraded (warning): %s", msg);
@@ -244,69 +203,35 @@ static void publish_store_alert(daemon_s *d, int raised, const char *msg)
         LOG_INFO("alert cleared store_degraded: %s", msg);
 }
 
-static void set_degraded(daemon_s *d, int on)
+/* The sink became degraded, or is not any more (sink.h). */
+static void on_degraded(void *arg, int on)
 {
+    amfid_ctx *d = arg;
     char msg[1000];
-    if (on && !d->degraded) {
-        d->degraded = 1;
+    sink_stats st;
+    sink_stats_of(P.sink, &st);
+    if (on) {
         d->state = "degraded";
         snprintf(msg, sizeof msg,
                  "the store %.300s cannot be written (%.300s); passages are held in memory (up to %d) "
                  "and retried",
-                 d->cfg.daemon.db_path, d->last_error, STORE_HOLD_MAX);
+                 d->cfg->daemon.db_path, d->last_error, sink_capacity(P.sink));
         publish_store_alert(d, 1, msg);
-        sd_notifyf(0, "STATUS=degraded: store cannot be written, %d passages held", d->held_n);
-    } else if (!on && d->degraded) {
-        d->degraded = 0;
+        sd_notifyf(0, "STATUS=degraded: store cannot be written, %d passages held", st.held);
+    } else {
         if (strcmp(d->state, "degraded") == 0)
             d->state = "running";
         snprintf(msg, sizeof msg,
                  "the store %.300s takes writes again; every held passage is stored (%d at most "
                  "were held, %lld lost to overflow)",
-                 d->cfg.daemon.db_path, d->held_peak, (long long)d->passages_lost);
+                 d->cfg->daemon.db_path, st.peak, (long long)st.lost);
         publish_store_alert(d, 0, msg);
     }
 }
 
-/* Hold a passage the store refused, in order (the job keeps only what the
- * row needs: its samples are freed). */
-static void hold(daemon_s *d, job *j)
+static int write_passage(void *arg, job *j)
 {
-    if (!d->held) {
-        d->held = calloc(STORE_HOLD_MAX, sizeof *d->held);
-        d->held_n = d->held_head = 0;
-    }
-    if (!d->held || d->held_n >= STORE_HOLD_MAX) {
-        d->passages_lost++;
-        LOG_ERR("store: passage of vehicle %lld at utime %lld LOST: the held queue is full "
-                "(%d passages; %lld lost in all)",
-                (long long)j->w.v.vehicle_id, (long long)j->w.v.utime, STORE_HOLD_MAX,
-                (long long)d->passages_lost);
-        job_free(j);
-        return;
-    }
-    free(j->accel);
-    j->accel = NULL;
-    d->held[(d->held_head + d->held_n) % STORE_HOLD_MAX] = j;
-    d->held_n++;
-    if (d->held_n > d->held_peak)
-        d->held_peak = d->held_n;
-    if (!d->degraded) {
-        d->retry_wait = 1.0;
-        d->retry_at = amfi_mono_s() + d->retry_wait;
-    }
-    set_degraded(d, 1);
-}
-
-/* Store in order: behind any held passage, or now. Takes the job. */
-static int store_one(daemon_s *d, job *j)
-{
-    if (d->held_n > 0 || store_now(d, j) != 0) {
-        hold(d, j);
-        return -1;
-    }
-    job_free(j);
-    return 0;
+    return store_now(arg, j);
 }
 
 /* The job of vehicle i of an event: its own vehicle, result and status
@@ -359,11 +284,11 @@ static int coincident_with(const job *e, int i)
     return -1;
 }
 
-static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
+static void mark_inseparable(const amfid_ctx *d, const job *e, int i, job *j)
 {
     if (!j->solved || strcmp(j->status, "ok") != 0)
         return;
-    const amfi_daemon_config *c = &d->cfg.daemon;
+    const amfi_daemon_config *c = &d->cfg->daemon;
     if (e->w.outside[i]) {
         snprintf(j->reason, sizeof j->reason,
                  "inseparable: vehicle %lld was on the span inside its window but not weighed "
@@ -381,7 +306,7 @@ static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
                  (long long)e->w.ev[k].vehicle_id, e->veh[i].group_gvw_kg, n);
     } else if (e->w.n_vehicles > 1) {
         amfi_nearness nr;
-        amfi_window_nearness(&e->w, d->cfg.bridge.span_m, c->inseparable_gap_m, i, &nr);
+        amfi_window_nearness(&e->w, d->cfg->bridge.span_m, c->inseparable_gap_m, i, &nr);
         int lanes = 1; /* 2: the event has vehicles of more than one lane */
         for (int k = 1; k < e->w.n_vehicles; k++)
             if (e->w.ev[k].lane != e->w.ev[0].lane)
@@ -414,11 +339,11 @@ static void mark_inseparable(const daemon_s *d, const job *e, int i, job *j)
 }
 
 /* Store a passage, or each vehicle of an event in entry order. Takes the job. */
-static int store_job(daemon_s *d, job *e)
+static int store_job(amfid_ctx *d, job *e)
 {
     if (e->w.n_vehicles <= 1) {
         mark_inseparable(d, e, 0, e);
-        return store_one(d, e);
+        return sink_put(P.sink, e);
     }
     int rc = 0;
     for (int i = 0; i < e->w.n_vehicles; i++) {
@@ -426,112 +351,132 @@ static int store_job(daemon_s *d, job *e)
         if (j)
             mark_inseparable(d, e, i, j);
         if (!j) {
-            d->passages_lost++;
-            set_error(d, "out of memory: passage of vehicle %lld at utime %lld LOST",
+            sink_lost(P.sink, 1);
+            ctx_error(d, "out of memory: passage of vehicle %lld at utime %lld LOST",
                       (long long)e->w.ev[i].vehicle_id, (long long)e->w.ev[i].utime);
             rc = -1;
             continue;
         }
-        if (store_one(d, j))
+        if (sink_put(P.sink, j))
             rc = -1;
     }
     job_free(e);
     return rc;
 }
 
-void pipeline_retry(daemon_s *d, double final)
+static int pipeline_start(amfid_ctx *d, char *err, size_t errlen)
 {
-    double until = amfi_mono_s() + final;
-    while (d->held_n > 0) {
-        double now = amfi_mono_s();
-        if (now < d->retry_at) {
-            if (final <= 0)
-                return;
-            if (now >= until)
-                break; /* stopping, and out of time: counted below */
-            double w = fmin(d->retry_at - now, until - now);
-            struct timespec ts = {(time_t)w, (long)(1e9 * (w - floor(w)))};
-            nanosleep(&ts, NULL);
-            continue;
-        }
-        while (d->held_n > 0 && store_now(d, d->held[d->held_head]) == 0) {
-            job_free(d->held[d->held_head]);
-            d->held[d->held_head] = NULL;
-            d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;
-            d->held_n--;
-        }
-        if (d->held_n == 0) {
-            LOG_INFO("store: the held passages are stored (peak %d)", d->held_peak);
-            set_degraded(d, 0);
-            return;
-        }
-        d->retry_wait = fmin(2.0 * d->retry_wait, 30.0);
-        d->retry_at = amfi_mono_s() + d->retry_wait;
-        sd_notifyf(0, "STATUS=degraded: store cannot be written, %d passages held", d->held_n);
-        if (final <= 0 || amfi_mono_s() >= until) {
-            if (final > 0)
-                break;
-            return;
-        }
-    }
-    for (; d->held_n > 0; d->held_n--) { /* stopping, and the store still refuses */
-        job *j = d->held[d->held_head];
-        LOG_ERR("store: passage of vehicle %lld at utime %lld NOT STORED: the store still "
-                "refuses writes at shutdown (%s)",
-                (long long)j->w.v.vehicle_id, (long long)j->w.v.utime, d->last_error);
-        d->passages_lost++;
-        job_free(j);
-        d->held_head = (d->held_head + 1) % STORE_HOLD_MAX;
-    }
+    (void)d, (void)err, (void)errlen;
+    memset(&P, 0, sizeof P);
+    return 0;
 }
 
-/* Park a finished job by seq; store every consecutive one from next_seq.
- * The parking ring grows when the solvers fall far behind (windows that
- * bypass them keep arriving): a passage is never dropped for lack of room. */
-int pipeline_complete(daemon_s *d, job *j)
+static int pipeline_restore(amfid_ctx *d)
 {
-    int64_t seq = j->w.seq;
-    if (seq - d->next_seq >= d->pend_cap) {
-        int cap = d->pend_cap;
-        while (seq - d->next_seq >= cap)
-            cap *= 2;
-        job **np = calloc((size_t)cap, sizeof *np);
-        if (!np) { /* out of memory: store it now, out of order, rather than lose it */
-            set_error(d, "out of memory for the reorder buffer: passage %lld stored out of order",
-                      (long long)seq);
-            return store_job(d, j);
-        }
-        for (int i = 0; i < d->pend_cap; i++)
-            if (d->pending[i])
-                np[d->pending[i]->w.seq % cap] = d->pending[i];
-        free(d->pending);
-        d->pending = np;
-        d->pend_cap = cap;
+    sink_params sp = {(size_t)d->cfg->daemon.held_max_bytes, 1.0, 30.0};
+    sink_ops ops = {write_passage, on_degraded, d, d->last_error};
+    P.reorder = reorder_create(d->cfg->daemon.queue_size + AMFI_TRACKER_MAX_PENDING + 16, 1);
+    P.sink = sink_create(&sp, &ops);
+    if (!P.reorder || !P.sink) {
+        LOG_ERR("out of memory at start-up");
+        return 1;
     }
-    d->pending[seq % d->pend_cap] = j;
+    return 0;
+}
+
+static void pipeline_stop(amfid_ctx *d)
+{
+    (void)d;
+    sink_destroy(P.sink);
+    reorder_destroy(P.reorder);
+    memset(&P, 0, sizeof P);
+}
+
+void pipeline_retry(amfid_ctx *d, double final)
+{
+    (void)d;
+    if (P.sink)
+        sink_retry(P.sink, final);
+}
+
+int pipeline_held(void)
+{
+    sink_stats st;
+    if (!P.sink)
+        return 0;
+    sink_stats_of(P.sink, &st);
+    return st.held;
+}
+
+int pipeline_degraded(void)
+{
+    sink_stats st;
+    if (!P.sink)
+        return 0;
+    sink_stats_of(P.sink, &st);
+    return st.degraded;
+}
+
+/* Park a finished job by seq (reorder.c); store every consecutive one. */
+int pipeline_complete(amfid_ctx *d, job *j)
+{
+    if (reorder_park(P.reorder, j)) { /* out of memory: stored now, out of order, not lost */
+        ctx_error(d, "out of memory for the reorder buffer: passage %lld stored out of order",
+                  (long long)j->w.seq);
+        return store_job(d, j);
+    }
     int rc = 0;
-    while (d->pending[d->next_seq % d->pend_cap] &&
-           d->pending[d->next_seq % d->pend_cap]->w.seq == d->next_seq) {
-        job *k = d->pending[d->next_seq % d->pend_cap];
-        d->pending[d->next_seq % d->pend_cap] = NULL;
+    job *k;
+    while ((k = reorder_next(P.reorder)) != NULL)
         if (store_job(d, k))
             rc = -1;
-        d->next_seq++;
-    }
     return rc;
 }
 
-void pipeline_drain_results(daemon_s *d)
+void pipeline_drain_results(amfid_ctx *d)
 {
     uint64_t v;
-    if (read(d->pool.efd, &v, sizeof v) < 0 && errno != EAGAIN)
-        set_error(d, "eventfd: %s", strerror(errno));
+    if (read(d->pool->efd, &v, sizeof v) < 0 && errno != EAGAIN)
+        ctx_error(d, "eventfd: %s", strerror(errno));
     job *j;
-    while ((j = queue_pop(&d->pool.results, 0)) != NULL)
+    while ((j = queue_pop(&d->pool->results, 0)) != NULL)
         pipeline_complete(d, j);
 }
 
-int pipeline_store_now(daemon_s *d, job *j)
+int pipeline_store_now(amfid_ctx *d, job *j)
 {
     return store_job(d, j);
 }
+
+/* Each turn: what the solvers handed back, then the held passages when
+ * their time has come. */
+static void pipeline_tick(amfid_ctx *d)
+{
+    pipeline_drain_results(d);
+    if (pipeline_held() > 0)
+        pipeline_retry(d, 0);
+}
+
+static void pipeline_metrics(amfid_ctx *d, amfid_stats *s)
+{
+    (void)d;
+    sink_stats st;
+    memset(&st, 0, sizeof st);
+    if (P.sink)
+        sink_stats_of(P.sink, &st);
+    s->passages_stored = P.stored;
+    s->passages_ok = P.ok;
+    s->passages_lost = st.lost;
+    s->passages_held = st.held;
+    s->degraded = st.degraded;
+}
+
+const amfid_module pipeline_module = {
+    .name = "pipeline",
+    .start = pipeline_start,
+    .restore = pipeline_restore,
+    .on_passage = publish_passage,
+    .tick = pipeline_tick,
+    .metrics = pipeline_metrics,
+    .stop = pipeline_stop,
+};

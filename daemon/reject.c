@@ -11,8 +11,12 @@
  * at stop, with the first refused message's line: a flood costs a few rows
  * a period, never one fsync'd row per message.
  *
- * Thread: the main thread only (the bus handlers, the heartbeat, the drain).
- * Owns d->rej.
+ * A module (ctx.h): its timer (every daemon.status_period_s) closes the
+ * log period and stores the summary rows when their period is over; its
+ * final writes the last summary and the totals.
+ *
+ * Thread: the main thread only (the bus handlers, the timers, the drain).
+ * Owns the counts.
  */
 #include <stdarg.h>
 #include <stdio.h>
@@ -20,10 +24,26 @@
 #include <time.h>
 
 #include "amfi_msg_check.h"
-#include "amfid.h"
+#include "ctx.h"
 
 #define REJECT_LOG_BURST 20
 #define REJECT_LOG_PERIOD_S 60.0
+
+#define REJECT_EXAMPLE 512
+
+static struct reject_state {
+    int64_t count[REJECT_NINPUTS][REJECT_NREASONS]; /* since start */
+    int64_t total;
+    int64_t held, held_by[REJECT_NINPUTS][REJECT_NREASONS]; /* not logged this period */
+    int logged;                                             /* lines logged this period */
+    double period_start;                                    /* amfi_mono_s() */
+    /* the store's summary (table refusals), every daemon.intake.summary_period_s */
+    int64_t sum_count[REJECT_NINPUTS][REJECT_NREASONS];     /* this summary period */
+    char sum_example[REJECT_NINPUTS][REJECT_NREASONS][REJECT_EXAMPLE]; /* the first's line */
+    double sum_start;                                       /* amfi_mono_s() */
+    int64_t sum_start_wall;                                 /* µs, wall clock */
+    int64_t summaries_stored, summaries_lost;               /* rows */
+} R;
 
 static const char *const input_name[REJECT_NINPUTS] = {"accel", "vehicle", "truth",
                                                          "environment"};
@@ -52,20 +72,20 @@ const char *reject_reason_name(int reason)
     return amfi_msg_reason_name(reason);
 }
 
-static const char *channel_of(const daemon_s *d, int input)
+static const char *channel_of(const amfid_ctx *c, int input)
 {
     switch (input) {
-    case REJECT_ACCEL: return d->cfg.daemon.ch_accel;
-    case REJECT_VEHICLE: return d->cfg.daemon.ch_vehicle;
-    case REJECT_ENVIRONMENT: return d->cfg.daemon.ch_environment;
-    default: return d->cfg.daemon.ch_truth;
+    case REJECT_ACCEL: return c->cfg->daemon.ch_accel;
+    case REJECT_VEHICLE: return c->cfg->daemon.ch_vehicle;
+    case REJECT_ENVIRONMENT: return c->cfg->daemon.ch_environment;
+    default: return c->cfg->daemon.ch_truth;
     }
 }
 
 /* One line: what was held back since the period began (nothing if none). */
-static void summarise(daemon_s *d, double now)
+static void summarise(amfid_ctx *c, double now)
 {
-    reject_state *r = &d->rej;
+    struct reject_state *r = &R;
     if (r->held > 0) {
         char line[1024];
         size_t n = (size_t)snprintf(line, sizeof line,
@@ -75,7 +95,7 @@ static void summarise(daemon_s *d, double now)
             for (int k = 0; k < REJECT_NREASONS; k++)
                 if (r->held_by[i][k] > 0 && n < sizeof line)
                     n += (size_t)snprintf(line + n, sizeof line - n, " %s/%s %lld",
-                                          channel_of(d, i), reject_reason_name(k),
+                                          channel_of(c, i), reject_reason_name(k),
                                           (long long)r->held_by[i][k]);
         LOG_WARN("%s (totals since start: amfid's status message and log at stop)", line);
     }
@@ -94,9 +114,9 @@ static int64_t wall_us(void)
 
 /* The summary period's rows into the store, one transaction (the counts
  * are kept for the next try when the store refuses, up to one more period). */
-static void store_summary(daemon_s *d, double now)
+static void store_summary(amfid_ctx *c, double now)
 {
-    reject_state *r = &d->rej;
+    struct reject_state *r = &R;
     amfi_refusal_row rows[REJECT_NINPUTS * REJECT_NREASONS];
     int n = 0;
     const int64_t end = wall_us();
@@ -107,13 +127,13 @@ static void store_summary(daemon_s *d, double now)
             if (r->sum_count[i][k] > 0)
                 rows[n++] = (amfi_refusal_row){r->sum_start_wall,
                                                end < r->sum_start_wall ? r->sum_start_wall : end,
-                                               channel_of(d, i), input_name[i],
+                                               channel_of(c, i), input_name[i],
                                                reject_reason_name(k), r->sum_count[i][k],
                                                r->sum_example[i][k]};
-    if (n > 0 && d->store) {
+    if (n > 0 && c->store) {
         char err[256];
-        if (amfi_store_add_refusals(d->store, rows, n, err, sizeof err) != 0) {
-            if (now - r->sum_start < 2.0 * d->cfg.daemon.summary_period_s)
+        if (amfi_store_add_refusals(c->store, rows, n, err, sizeof err) != 0) {
+            if (now - r->sum_start < 2.0 * c->cfg->daemon.summary_period_s)
                 return; /* kept, retried at the next tick (the counts grow) */
             LOG_WARN("store: the summary of refused messages (%d rows) is lost: %s (the "
                      "counts since start are in the log at stop and in the status message)",
@@ -128,25 +148,25 @@ static void store_summary(daemon_s *d, double now)
     r->sum_start_wall = end;
 }
 
-void reject_note(daemon_s *d, int input, int reason, const char *fmt, ...)
+void reject_note(amfid_ctx *c, int input, int reason, const char *fmt, ...)
 {
-    reject_state *r = &d->rej;
+    struct reject_state *r = &R;
     if (input < 0 || input >= REJECT_NINPUTS || reason < 0 || reason >= REJECT_NREASONS)
         return;
     r->count[input][reason]++;
     r->total++;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(d->last_error, sizeof d->last_error, fmt, ap);
+    vsnprintf(c->last_error, sizeof c->last_error, fmt, ap);
     va_end(ap);
     if (r->sum_count[input][reason]++ == 0)
-        snprintf(r->sum_example[input][reason], REJECT_EXAMPLE, "%s", d->last_error);
+        snprintf(r->sum_example[input][reason], REJECT_EXAMPLE, "%s", c->last_error);
     double now = amfi_mono_s();
     if (now - r->period_start >= REJECT_LOG_PERIOD_S)
-        summarise(d, now);
+        summarise(c, now);
     if (r->logged < REJECT_LOG_BURST) {
         r->logged++;
-        LOG_WARN("%s", d->last_error);
+        LOG_WARN("%s", c->last_error);
         if (r->logged == REJECT_LOG_BURST)
             LOG_WARN("further refused messages are counted and summarised once per %.0f s",
                      REJECT_LOG_PERIOD_S);
@@ -156,27 +176,57 @@ void reject_note(daemon_s *d, int input, int reason, const char *fmt, ...)
     }
 }
 
-void reject_tick(daemon_s *d)
+static int reject_tick(amfid_ctx *c)
 {
     double now = amfi_mono_s();
-    if (now - d->rej.period_start >= REJECT_LOG_PERIOD_S)
-        summarise(d, now);
-    if (d->rej.sum_start == 0.0) {
-        d->rej.sum_start = now;
-        d->rej.sum_start_wall = wall_us();
+    if (now - R.period_start >= REJECT_LOG_PERIOD_S)
+        summarise(c, now);
+    if (R.sum_start == 0.0) {
+        R.sum_start = now;
+        R.sum_start_wall = wall_us();
     }
-    if (now - d->rej.sum_start >= d->cfg.daemon.summary_period_s)
-        store_summary(d, now);
+    if (now - R.sum_start >= c->cfg->daemon.summary_period_s)
+        store_summary(c, now);
+    return 0;
 }
 
-void reject_final(daemon_s *d)
+static int reject_start(amfid_ctx *c, char *err, size_t errlen)
 {
-    summarise(d, amfi_mono_s());
-    store_summary(d, 1e300); /* at stop: stored now or lost (counted) */
-    const reject_state *r = &d->rej;
+    (void)c, (void)err, (void)errlen;
+    memset(&R, 0, sizeof R);
+    return 0;
+}
+
+static int reject_restore(amfid_ctx *c)
+{
+    R.sum_start = amfi_mono_s();
+    R.sum_start_wall = wall_us();
+    return timer_add(c->timers, &c->cfg->daemon.status_period_s, reject_tick) ? 1 : 0;
+}
+
+static void reject_final(amfid_ctx *c)
+{
+    summarise(c, amfi_mono_s());
+    store_summary(c, 1e300); /* at stop: stored now or lost (counted) */
     for (int i = 0; i < REJECT_NINPUTS; i++)
         for (int k = 0; k < REJECT_NREASONS; k++)
-            if (r->count[i][k] > 0)
-                LOG_INFO("refused since start: %s (%s) %s: %lld", channel_of(d, i),
-                         input_name[i], reject_reason_name(k), (long long)r->count[i][k]);
+            if (R.count[i][k] > 0)
+                LOG_INFO("refused since start: %s (%s) %s: %lld", channel_of(c, i),
+                         input_name[i], reject_reason_name(k), (long long)R.count[i][k]);
 }
+
+static void reject_metrics(amfid_ctx *c, amfid_stats *s)
+{
+    (void)c;
+    s->refused_total = R.total;
+    memcpy(s->refused, R.count, sizeof s->refused);
+    s->summaries_lost = R.summaries_lost;
+}
+
+const amfid_module reject_module = {
+    .name = "reject",
+    .start = reject_start,
+    .restore = reject_restore,
+    .metrics = reject_metrics,
+    .final = reject_final,
+};

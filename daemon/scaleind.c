@@ -9,7 +9,7 @@
  * (indicators/scale.h: GVW and temperature) and, when its vehicle carried a
  * reference GVW (a calibration truck), the known-truck indicator
  * (indicators/known_truck.h). Their evaluations are stored (scale_evals),
- * their raise and clear events go out like every alert (pipeline.c's
+ * their raise and clear events go out like every alert (the context's
  * emit_alert). A passage without a temperature feeds neither: counted
  * (status line at stop, metrics).
  *
@@ -26,21 +26,43 @@
  * and publishes nothing. An alert open in the store stays open (not raised
  * twice); one the store does not have open is not held.
  *
- * Thread: the main thread only. Owns d->sc (the two indicators, their
- * parameters in force and the counters); a reload reports a change, which
- * applies at the next start.
+ * A module (ctx.h): row gives a solved passage its deck temperature and
+ * its compensated weight, on_passage feeds both indicators.
+ *
+ * Thread: the main thread only. Owns the two indicators, their parameters
+ * in force and the counters; a reload reports a change, which applies at
+ * the next start.
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "amfid.h"
+#include "ctx.h"
+#include "known_truck.h"
+#include "scale.h"
 
-int scaleind_create(daemon_s *d, char *err, size_t errlen)
+static struct scale_state {
+    amfi_scale *scale;             /* NULL: alerts.scale.enabled off */
+    amfi_known_truck *truck;       /* NULL: alerts.known_truck.enabled off */
+    int enabled, truck_enabled;    /* in force (a reload reports changes) */
+    int compensate;                /* daemon.indicators.temperature: compensated */
+    double max_gap_s;
+    amfi_scale_params params;
+    amfi_known_truck_params truck_params;
+    int64_t fed, no_temp, runs, refused; /* this run's: inputs, solved passages
+                                    without a temperature, truck runs, refused */
+    int64_t comp_fed, comp_raw;    /* this run's passages fed to the STD and mean
+                                    rules compensated, and raw for want of a
+                                    deck temperature (compensate on) */
+    double last_scale, last_cusum; /* the newest block's (NaN: none yet) */
+} S;
+
+static int scaleind_start(amfid_ctx *d, char *err, size_t errlen)
 {
-    scale_state *c = &d->sc;
-    const amfi_daemon_config *dc = &d->cfg.daemon;
+    struct scale_state *c = &S;
+    memset(c, 0, sizeof *c);
+    const amfi_daemon_config *dc = &d->cfg->daemon;
     c->enabled = dc->scale_enabled;
     c->truck_enabled = dc->known_truck_enabled;
     c->compensate = dc->ind_temp_compensated;
@@ -62,17 +84,17 @@ static double ratio_or_nan(double x)
     return isfinite(x) && x > 0 && x <= 100 ? x : NAN;
 }
 
-static void store_eval(daemon_s *d, const amfi_scale_eval_row *r)
+static void store_eval(amfid_ctx *d, const amfi_scale_eval_row *r)
 {
     char err[256];
     if (amfi_store_add_scale_eval(d->store, r, NULL, err, sizeof err))
-        set_error(d, "store: %s", err);
+        ctx_error(d, "store: %s", err);
 }
 
 /* The baseline was just fitted: the known truck takes its slopes. */
-static void baseline_fitted(daemon_s *d, int64_t utime, int live)
+static void baseline_fitted(amfid_ctx *d, int64_t utime, int live)
 {
-    scale_state *c = &d->sc;
+    struct scale_state *c = &S;
     amfi_scale_model m;
     if (amfi_scale_get_model(c->scale, &m) != 0)
         return;
@@ -91,10 +113,10 @@ static void baseline_fitted(daemon_s *d, int64_t utime, int live)
 }
 
 /* One input into both indicators; live: store, publish and count. */
-static void push(daemon_s *d, int64_t utime, double gvw_kg, double deck_c, double ref_kg,
+static void push(amfid_ctx *d, int64_t utime, double gvw_kg, double deck_c, double ref_kg,
                  int live)
 {
-    scale_state *c = &d->sc;
+    struct scale_state *c = &S;
     amfi_alert_event al;
     if (c->scale) {
         amfi_scale_eval ev;
@@ -102,7 +124,7 @@ static void push(daemon_s *d, int64_t utime, double gvw_kg, double deck_c, doubl
         if (bits < 0) {
             c->refused++;
             if (live)
-                set_error(d, "scale indicator: GVW %.1f kg at deck %.2f °C refused", gvw_kg,
+                ctx_error(d, "scale indicator: GVW %.1f kg at deck %.2f °C refused", gvw_kg,
                           deck_c);
         } else {
             c->fed++;
@@ -119,7 +141,7 @@ static void push(daemon_s *d, int64_t utime, double gvw_kg, double deck_c, doubl
                 }
             }
             if ((bits & AMFI_IND_ALERT) && live)
-                emit_alert(d, utime, &al, 0);
+                d->emit_alert(d, utime, &al, 0);
         }
     }
     if (c->truck && isfinite(ref_kg) && ref_kg > 0) {
@@ -128,7 +150,7 @@ static void push(daemon_s *d, int64_t utime, double gvw_kg, double deck_c, doubl
         if (bits < 0) {
             c->refused++;
             if (live)
-                set_error(d, "known truck: GVW %.1f kg against reference %.1f kg refused",
+                ctx_error(d, "known truck: GVW %.1f kg against reference %.1f kg refused",
                           gvw_kg, ref_kg);
             return;
         }
@@ -142,17 +164,17 @@ static void push(daemon_s *d, int64_t utime, double gvw_kg, double deck_c, doubl
             LOG_INFO("known truck: run %d, ratio %.4f (%.4f at %.1f °C), %s", ev.run,
                      ev.ratio_comp, ev.ratio, deck_c, ev.state);
             if (bits & AMFI_IND_ALERT)
-                emit_alert(d, utime, &al, 0);
+                d->emit_alert(d, utime, &al, 0);
         }
     }
 }
 
-static int wanted(const daemon_s *d, int n_vehicles)
+static int wanted(const amfid_ctx *d, int n_vehicles)
 {
-    return !d->cfg.daemon.single_presence_only || n_vehicles <= 1;
+    return !d->cfg->daemon.single_presence_only || n_vehicles <= 1;
 }
 
-static int restore_open(daemon_s *d, const char *kind)
+static int restore_open(amfid_ctx *d, const char *kind)
 {
     char err[256];
     int open = 0;
@@ -160,15 +182,15 @@ static int restore_open(daemon_s *d, const char *kind)
         LOG_WARN("store: %s", err);
         open = 0;
     }
-    metrics_alert(d, kind, open);
+    metrics_alert(kind, open);
     return open;
 }
 
-void scaleind_restore(daemon_s *d)
+static int scaleind_restore(amfid_ctx *d)
 {
-    scale_state *c = &d->sc;
+    struct scale_state *c = &S;
     if (!c->scale && !c->truck)
-        return;
+        return 0;
     char err[512];
     int64_t after = 0;
     int64_t replayed = 0;
@@ -206,11 +228,12 @@ void scaleind_restore(daemon_s *d)
                  (long long)c->runs, open_s ? "; the scale_shift alert is open" : "",
                  open_t ? "; the known_truck alert is open" : "");
     c->fed = c->runs = c->refused = 0; /* the counters are this run's */
+    return 0;
 }
 
-void scaleind_deck(daemon_s *d, amfi_passage_row *r)
+static void scaleind_deck(amfid_ctx *d, amfi_passage_row *r)
 {
-    scale_state *c = &d->sc;
+    struct scale_state *c = &S;
     r->has_deck_c = 0;
     if (!c->scale && !c->truck && !c->compensate)
         return;
@@ -229,9 +252,9 @@ void scaleind_deck(daemon_s *d, amfi_passage_row *r)
 #define COMP_FACTOR_MIN 0.5
 #define COMP_FACTOR_MAX 2.0
 
-void scaleind_comp(daemon_s *d, amfi_passage_row *r)
+static void scaleind_comp(amfi_passage_row *r)
 {
-    scale_state *c = &d->sc;
+    struct scale_state *c = &S;
     r->gvw_comp_kg = r->gvw_kg;
     if (!c->compensate)
         return;
@@ -253,47 +276,24 @@ void scaleind_comp(daemon_s *d, amfi_passage_row *r)
     }
 }
 
-void scaleind_feed(daemon_s *d, const amfi_passage_row *r)
+static void scaleind_feed(amfid_ctx *d, const amfid_passage *p)
 {
+    const amfi_passage_row *r = p->r;
+    if (!p->j->solved || strcmp(p->j->status, "ok") != 0)
+        return;
     if (!r->has_deck_c || !wanted(d, r->n_vehicles))
         return;
     push(d, r->utime, r->gvw_kg, r->deck_c,
          r->reference_gvw_kg != 0.0 ? r->reference_gvw_kg : NAN, 1);
 }
 
-static int scale_params_equal(const amfi_scale_params *a, const amfi_scale_params *b)
-{
-    return a->block == b->block && a->baseline_blocks == b->baseline_blocks &&
-           a->class_split_kg == b->class_split_kg && a->share_range == b->share_range &&
-           a->ref_c == b->ref_c && a->knee_c == b->knee_c && a->floor_c == b->floor_c &&
-           a->warm_slope == b->warm_slope && a->frost_slope == b->frost_slope &&
-           a->slope_prior_sd == b->slope_prior_sd && a->design_shift == b->design_shift &&
-           a->false_alarms_per_year == b->false_alarms_per_year &&
-           a->vehicles_per_day == b->vehicles_per_day && a->clear_after == b->clear_after;
-}
 
-static int truck_params_equal(const amfi_known_truck_params *a, const amfi_known_truck_params *b)
-{
-    return a->baseline_runs == b->baseline_runs && a->run_sd == b->run_sd &&
-           a->design_shift == b->design_shift &&
-           a->false_alarms_per_year == b->false_alarms_per_year &&
-           a->runs_per_year == b->runs_per_year && a->clear_after == b->clear_after;
-}
 
-void scaleind_reload(daemon_s *d, const amfi_site_config *n)
-{
-    const amfi_daemon_config *a = &n->daemon;
-    if (a->scale_enabled != d->sc.enabled || a->scale_max_temp_gap_s != d->sc.max_gap_s ||
-        !scale_params_equal(&a->scale, &d->sc.params))
-        LOG_WARN("reload: alerts.scale takes effect at the next start");
-    if (a->known_truck_enabled != d->sc.truck_enabled ||
-        !truck_params_equal(&a->known_truck, &d->sc.truck_params))
-        LOG_WARN("reload: alerts.known_truck takes effect at the next start");
-}
 
-void scaleind_final(daemon_s *d)
+static void scaleind_final(amfid_ctx *d)
 {
-    const scale_state *c = &d->sc;
+    (void)d;
+    const struct scale_state *c = &S;
     if (c->compensate && (c->comp_fed > 0 || c->comp_raw > 0))
         LOG_INFO("STD and mean rules: %lld passages fed at the calibration temperature "
                  "(%.1f °C), %lld raw (no deck temperature within %.0f s)",
@@ -306,10 +306,57 @@ void scaleind_final(daemon_s *d)
              (long long)c->no_temp, c->max_gap_s, (long long)c->runs, (long long)c->refused);
 }
 
-void scaleind_destroy(daemon_s *d)
+static void scaleind_stop(amfid_ctx *d)
 {
-    amfi_scale_destroy(d->sc.scale);
-    amfi_known_truck_destroy(d->sc.truck);
-    d->sc.scale = NULL;
-    d->sc.truck = NULL;
+    (void)d;
+    amfi_scale_destroy(S.scale);
+    amfi_known_truck_destroy(S.truck);
+    memset(&S, 0, sizeof S);
 }
+
+/* A solved passage's row: its deck temperature (scaleind_deck) and, when it
+ * feeds the STD and mean rules, the weight they are fed (scaleind_comp). */
+static void scaleind_row(amfid_ctx *d, const amfid_passage *p, amfi_passage_row *r)
+{
+    if (!p->j->solved)
+        return;
+    scaleind_deck(d, r);
+    if (p->feeds)
+        scaleind_comp(r);
+}
+
+static void scaleind_metrics(amfid_ctx *d, amfid_stats *s)
+{
+    (void)d;
+    s->last_scale = S.last_scale;
+    s->last_cusum = S.last_cusum;
+    s->scale_fed = S.fed;
+    s->scale_no_temp = S.no_temp;
+}
+
+void scaleind_view_of(scaleind_view *v)
+{
+    v->scale_state = S.scale ? amfi_scale_state(S.scale) : NULL;
+    v->truck_state = S.truck ? amfi_known_truck_state(S.truck) : NULL;
+    v->fed = S.fed;
+    v->no_temp = S.no_temp;
+    v->comp_fed = S.comp_fed;
+    v->comp_raw = S.comp_raw;
+    v->compensate = S.compensate;
+    amfi_scale_model m;
+    v->fitted = S.scale && amfi_scale_get_model(S.scale, &m) == AMFI_IND_OK;
+    v->warm_slope = v->fitted ? m.warm_slope : NAN;
+    v->frost_slope = v->fitted ? m.frost_slope : NAN;
+}
+
+const amfid_module scaleind_module = {
+    .name = "scaleind",
+    .section = "alerts.scale / alerts.known_truck",
+    .start = scaleind_start,
+    .restore = scaleind_restore,
+    .row = scaleind_row,
+    .on_passage = scaleind_feed,
+    .metrics = scaleind_metrics,
+    .final = scaleind_final,
+    .stop = scaleind_stop,
+};

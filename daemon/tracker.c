@@ -50,6 +50,14 @@ amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p)
 void amfi_tracker_destroy(amfi_tracker *t) { free(t); }
 int amfi_tracker_pending(const amfi_tracker *t) { return t->n_pend; }
 
+int amfi_tracker_set_max_wait(amfi_tracker *t, double max_wait_s)
+{
+    if (!t || !(max_wait_s > 0))
+        return -1;
+    t->p.max_wait_s = max_wait_s;
+    return 0;
+}
+
 /* The vehicle's passage window (libamfi's one definition), seconds from its
  * entry, at its speed·(1 − frac). */
 static amfi_passage_times window_at(const amfi_tracker *t, const amfi_vehicle_ev *v,

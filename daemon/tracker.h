@@ -29,7 +29,8 @@
  * 13. A vehicle whose event arrives after a partner was released is
  * "multiple" too.
  *
- * Not thread-safe: the bus thread owns it. Capacity fixed at creation.
+ * Not thread-safe: the bus thread owns it. Capacity fixed at creation; of
+ * its parameters only max_wait_s changes afterwards (amfi_tracker_set_max_wait).
  */
 #ifndef AMFI_TRACKER_H
 #define AMFI_TRACKER_H
@@ -127,6 +128,12 @@ int amfi_tracker_take_after(amfi_tracker *t, int64_t limit, amfi_vehicle_ev *out
 int amfi_tracker_next(amfi_tracker *t, amfi_ring *const *rings, int flush, amfi_window *out);
 
 int amfi_tracker_pending(const amfi_tracker *t);
+
+/* A reload's max_wait_s (daemon.max_wait_s, applies at once): the windows
+ * still pending and every later one wait this long. 0, or −1 when it is
+ * not > 0 (the tracker keeps its wait). The tracker reads its own copy of
+ * the parameters: without this call a reload never reached it. */
+int amfi_tracker_set_max_wait(amfi_tracker *t, double max_wait_s);
 
 /* Vehicle i of window w against the event's other vehicles: axles of two
  * vehicles within gap_m of each other load the beam at one point, which no

@@ -90,7 +90,7 @@ static void finding(const char *what, long long a, long long b)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static daemon_s d;
+    amfid *d = NULL;
     amfid_options o = {.config = FUZZ_INTAKE_CONFIG, .db = db, .lcm_url = "memq://",
                        .bus_key = keyfile};
     static amfi_auth_signer signer;
@@ -108,12 +108,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         signer_ready = 1;
     }
 
-    memset(&d, 0, sizeof d);
     remove_store();
     if (amfid_start(&d, &o) != 0)
         finding("amfid_start failed", 0, 0);
-    const char *ch[4] = {d.cfg.daemon.ch_accel, d.cfg.daemon.ch_vehicle, d.cfg.daemon.ch_truth,
-                         d.cfg.daemon.ch_environment};
+    const amfi_daemon_config *dc = &amfid_config(d)->daemon;
+    const char *ch[4] = {dc->ch_accel, dc->ch_vehicle, dc->ch_truth, dc->ch_environment};
+    lcm_t *lcm = amfid_lcm(d);
     size_t at = 0;
     while (at < size) {
         int c = data[at] % 4, how = (data[at] >> 2) % 4, bit = data[at] >> 4;
@@ -126,9 +126,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         long n = how == 1 ? 0
                           : amfi_auth_sign_into(&signer, ch[c], data + at, len, 0, sb, sizeof sb);
         if (how == 1 || n < 0) {
-            lcm_publish(d.lcm, ch[c], data + at, (unsigned)len);
+            lcm_publish(lcm, ch[c], data + at, (unsigned)len);
         } else if (how == 3 && prev_len > 0) {
-            lcm_publish(d.lcm, ch[prev_c], prev, (unsigned)prev_len);
+            lcm_publish(lcm, ch[prev_c], prev, (unsigned)prev_len);
         } else {
             if (how == 2)
                 sb[((size_t)bit * 131 + len) % (size_t)n] ^= (unsigned char)(1u << (bit % 8));
@@ -137,29 +137,28 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 prev_len = n;
                 prev_c = c;
             }
-            lcm_publish(d.lcm, ch[c], sb, (unsigned)n);
+            lcm_publish(lcm, ch[c], sb, (unsigned)n);
         }
         at += len;
-        while (lcm_handle_timeout(d.lcm, 0) > 0)
-            ;
-        release_windows(&d, 0);
-        pipeline_drain_results(&d);
-        if (d.held_n > 0)
-            pipeline_retry(&d, 0);
+        amfid_turn(d); /* the messages handled, windows released, results stored */
     }
-    if (amfid_drain(&d) != 0)
-        finding("amfid_drain failed: passages lost", d.passages_lost, 0);
+    amfid_stats st;
+    if (amfid_drain(d) != 0) {
+        amfid_counts(d, &st);
+        finding("amfid_drain failed: passages lost", st.passages_lost, 0);
+    }
+    amfid_counts(d, &st);
     int64_t rows = -1, truth = -1;
     char err[256];
-    if (amfi_store_count(d.store, AMFI_STORE_PASSAGES, &rows, err, sizeof err) ||
-        amfi_store_count(d.store, AMFI_STORE_TRUTH, &truth, err, sizeof err))
+    if (amfi_store_count(amfid_store(d), AMFI_STORE_PASSAGES, &rows, err, sizeof err) ||
+        amfi_store_count(amfid_store(d), AMFI_STORE_TRUTH, &truth, err, sizeof err))
         finding("store count failed", 0, 0);
-    if (rows != d.vehicles_received)
-        finding("stored passages != vehicles received", rows, d.vehicles_received);
-    if (rows != d.passages_stored)
-        finding("stored passages != the daemon's counter", rows, d.passages_stored);
-    if (truth != d.truth_received)
-        finding("truth rows != truth accepted", truth, d.truth_received);
-    amfid_stop(&d);
+    if (rows != st.vehicles_received)
+        finding("stored passages != vehicles received", rows, st.vehicles_received);
+    if (rows != st.passages_stored)
+        finding("stored passages != the daemon's counter", rows, st.passages_stored);
+    if (truth != st.truth_received)
+        finding("truth rows != truth accepted", truth, st.truth_received);
+    amfid_stop(d);
     return 0;
 }

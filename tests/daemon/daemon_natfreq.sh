@@ -89,7 +89,7 @@ grep -q "natural frequency: baseline from the store: 10 estimates, f1 $base Hz" 
 sed -i 's/^    free_s: 2 .*/    free_s: 3/' "$dir/amfid.yaml"
 kill -HUP $apid
 wait_for "reload: configuration .* applied" "$dir/amfid.log" "" 60 || fail "no reload"
-grep -q "reload: daemon.natural_frequency takes effect at the next start" "$dir/amfid.log" ||
+grep -q "reload: daemon.natural_frequency.free_s changed; takes effect at the next start" "$dir/amfid.log" ||
   fail "reload: $(grep reload "$dir/amfid.log")"
 # 3. vehicles 1.5 s apart: 0.5 s of free vibration each, refused as short
 timeout 120 "$sim" --vehicles 4 --headway 1.5 --speedup 20 --seed 6 --dt 2.5e-4 \

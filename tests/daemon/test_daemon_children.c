@@ -14,6 +14,8 @@
  *    started (which ignores SIGTERM) is killed too; at stop notify_finish
  *    returns within alerts.command_stop_wait_s + 3 s though the command's
  *    timeout is 600 s, the notice never started dropped and counted.
+ * The modules are driven through their interface (ctx.h) with a context
+ * of the test's own.
  * usage: test_daemon_children PATH/TO/alert_probe
  */
 #define _GNU_SOURCE
@@ -35,14 +37,35 @@
 
 #include <cmocka.h>
 
-#include "amfid.h"
+#include "ctx.h"
 
 static const char *probe;
 
 typedef struct fixture {
     char dir[256];
-    daemon_s *d;
+    amfid_ctx *d;
+    amfi_site_config *cfg;
 } fixture;
+
+/* The counters of the two modules under test (the context's collect). */
+static void collect(amfid_ctx *c, amfid_stats *s)
+{
+    memset(s, 0, sizeof *s);
+    notify_module.metrics(c, s);
+}
+
+static int no_publish(amfid_ctx *c, const char *ch, const void *data, size_t len)
+{
+    (void)c, (void)ch, (void)data, (void)len;
+    return 0;
+}
+
+static amfid_stats counts(fixture *f)
+{
+    amfid_stats s;
+    collect(f->d, &s);
+    return s;
+}
 
 static int setup(void **state)
 {
@@ -52,14 +75,23 @@ static int setup(void **state)
              getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
     assert_non_null(mkdtemp(f->dir));
     f->d = calloc(1, sizeof *f->d);
+    f->cfg = calloc(1, sizeof *f->cfg);
     assert_non_null(f->d);
-    assert_int_equal(0, queue_init(&f->d->pool.jobs, 4));
-    snprintf(f->d->cfg.daemon.alert_command, sizeof f->d->cfg.daemon.alert_command, "%s", probe);
-    snprintf(f->d->cfg.daemon.db_path, sizeof f->d->cfg.daemon.db_path, "%s/a.db", f->dir);
-    f->d->cfg.daemon.alert_timeout_s = 30;
-    f->d->cfg.daemon.alert_max_running = 4;
-    f->d->cfg.daemon.alert_stop_wait_s = 10;
-    f->d->cfg.daemon.metrics_interval_s = 15;
+    assert_non_null(f->cfg);
+    amfi_config_defaults(f->cfg);
+    f->d->cfg = f->cfg;
+    f->d->collect = collect;
+    f->d->publish = no_publish;
+    f->d->state = "running";
+    snprintf(f->cfg->daemon.alert_command, sizeof f->cfg->daemon.alert_command, "%s", probe);
+    snprintf(f->cfg->daemon.db_path, sizeof f->cfg->daemon.db_path, "%s/a.db", f->dir);
+    f->cfg->daemon.alert_timeout_s = 30;
+    f->cfg->daemon.alert_max_running = 4;
+    f->cfg->daemon.alert_stop_wait_s = 10;
+    f->cfg->daemon.metrics_interval_s = 15;
+    char err[64];
+    assert_int_equal(0, notify_module.start(f->d, err, sizeof err));
+    assert_int_equal(0, metrics_module.start(f->d, err, sizeof err));
     *state = f;
     return 0;
 }
@@ -67,8 +99,8 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     fixture *f = *state;
-    notify_free(f->d);
-    queue_fini(&f->d->pool.jobs);
+    notify_module.stop(f->d);
+    free(f->cfg);
     free(f->d);
     char cmd[512];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", f->dir);
@@ -98,7 +130,7 @@ static void metrics_symlink_not_followed(void **state)
     char victim[512], link[600], prom[512];
     snprintf(victim, sizeof victim, "%s/victim", f->dir);
     snprintf(prom, sizeof prom, "%s/amfid.prom", f->dir);
-    snprintf(f->d->cfg.daemon.metrics_path, sizeof f->d->cfg.daemon.metrics_path, "%s", prom);
+    snprintf(f->cfg->daemon.metrics_path, sizeof f->cfg->daemon.metrics_path, "%s", prom);
     FILE *v = fopen(victim, "w");
     assert_non_null(v);
     fputs("secret\n", v);
@@ -108,10 +140,8 @@ static void metrics_symlink_not_followed(void **state)
     snprintf(link, sizeof link, "%s.tmp.%ld", prom, (long)getpid());
     assert_int_equal(0, symlink(victim, link));
 
-    for (int k = 0; k < 2; k++) { /* a first file, then one renamed over it */
-        metrics_tick(f->d, 1);
-        assert_int_equal(0, f->d->metrics.write_errors);
-    }
+    for (int k = 0; k < 2; k++) /* a first file, then one renamed over it */
+        metrics_module.final(f->d); /* the forced write */
     struct stat st;
     assert_int_equal(0, stat(victim, &st));
     if ((st.st_mode & 07777) != 0600)
@@ -144,15 +174,18 @@ static void metrics_symlink_not_followed(void **state)
 /* ---- alerts.command ------------------------------------------------------- */
 
 /* Tick until no notice runs or waits, at most limit_s; the seconds taken. */
-static double run_out(daemon_s *d, double limit_s)
+static double run_out(amfid_ctx *d, double limit_s)
 {
     double t0 = amfi_mono_s();
     struct timespec ts = {0, 20000000};
-    while ((d->notify.running > 0 || d->notify.queued > 0) && amfi_mono_s() - t0 < limit_s) {
-        notify_tick(d);
+    amfid_stats s;
+    for (collect(d, &s); (s.notices_running > 0 || s.notices_queued > 0) &&
+                         amfi_mono_s() - t0 < limit_s;
+         collect(d, &s)) {
+        notify_module.tick(d);
         nanosleep(&ts, NULL);
     }
-    if (d->notify.running > 0 || d->notify.queued > 0)
+    if (s.notices_running > 0 || s.notices_queued > 0)
         fail_msg("notices still running after %.0f s", limit_s);
     return amfi_mono_s() - t0;
 }
@@ -160,8 +193,8 @@ static double run_out(daemon_s *d, double limit_s)
 /* The probe's report for alert id, waiting (10 s at most) for `want`. */
 static const char *report(fixture *f, int id, const char *want)
 {
-    char path[sizeof f->d->cfg.daemon.db_path + 32];
-    snprintf(path, sizeof path, "%s.probe.%d", f->d->cfg.daemon.db_path, id);
+    char path[sizeof f->cfg->daemon.db_path + 32];
+    snprintf(path, sizeof path, "%s.probe.%d", f->cfg->daemon.db_path, id);
     for (int k = 0; k < 500; k++) {
         const char *r = slurp(path);
         if (r && strstr(r, want))
@@ -219,7 +252,7 @@ static void notify_inherits_nothing(void **state)
 
     notify_alert(f->d, 1764547200000000LL, 1, "warning", "probe", "inherited?", 0, 1);
     run_out(f->d, 20);
-    assert_int_equal(1, f->d->notify.ok);
+    assert_int_equal(1, counts(f).notices_ok);
     const char *r = report(f, 1, "pgrp ");
     if (!strstr(r, "fds 0 1 2\n"))
         fail_msg("the alert command inherited descriptors: %s", r);
@@ -247,11 +280,11 @@ static void notify_inherits_nothing(void **state)
 static void notify_timeout_kills_the_group(void **state)
 {
     fixture *f = *state;
-    f->d->cfg.daemon.alert_timeout_s = 1;
+    f->cfg->daemon.alert_timeout_s = 1;
     notify_alert(f->d, 1764547200000000LL, 2, "warning", "hang", "sleeps", 0, 1);
     long g = grandchild_of(f, 2);
     run_out(f->d, 20);
-    assert_int_equal(1, f->d->notify.timeouts);
+    assert_int_equal(1, counts(f).notices_timeouts);
     if (!gone(g)) {
         kill((pid_t)g, SIGKILL);
         fail_msg("the grandchild %ld outlived the alert command's timeout", g);
@@ -270,27 +303,28 @@ static void on_alarm(int sig)
 static void notify_stop_is_bounded(void **state)
 {
     fixture *f = *state;
-    f->d->cfg.daemon.alert_timeout_s = 600;
-    f->d->cfg.daemon.alert_stop_wait_s = 1;
-    f->d->cfg.daemon.alert_max_running = 1;
+    f->cfg->daemon.alert_timeout_s = 600;
+    f->cfg->daemon.alert_stop_wait_s = 1;
+    f->cfg->daemon.alert_max_running = 1;
     notify_alert(f->d, 1764547200000000LL, 3, "warning", "hang", "sleeps", 0, 1);
     notify_alert(f->d, 1764547200000000LL, 4, "warning", "probe", "waits its turn", 0, 1);
-    assert_int_equal(1, f->d->notify.running);
-    assert_int_equal(1, f->d->notify.queued);
+    assert_int_equal(1, counts(f).notices_running);
+    assert_int_equal(1, counts(f).notices_queued);
     long g = grandchild_of(f, 3);
     signal(SIGALRM, on_alarm);
     alarm(30);
     double t0 = amfi_mono_s();
-    notify_finish(f->d);
+    notify_module.final(f->d); /* notify_finish */
     double took = amfi_mono_s() - t0;
     alarm(0);
     signal(SIGALRM, SIG_DFL);
     if (took > 1 + 2 + 1 + 0.5)
         fail_msg("notify_finish took %.1f s with command_stop_wait_s 1", took);
-    assert_int_equal(0, f->d->notify.running);
-    assert_int_equal(0, f->d->notify.queued);
-    assert_int_equal(1, f->d->notify.dropped);
-    assert_int_equal(1, f->d->notify.timeouts);
+    amfid_stats s = counts(f);
+    assert_int_equal(0, s.notices_running);
+    assert_int_equal(0, s.notices_queued);
+    assert_int_equal(1, s.notices_dropped);
+    assert_int_equal(1, s.notices_timeouts);
     if (!gone(g)) {
         kill((pid_t)g, SIGKILL);
         fail_msg("the grandchild %ld outlived amfid's stop", g);

@@ -7,7 +7,11 @@
  * amfid restarted in the middle of a block (after the baseline) continues
  * exactly as one that never stopped: the same scale_evals rows and the same
  * alerts, raised once; a restart while the alerts are open does not raise
- * them again. Single-threaded (the main thread's functions, called here).
+ * them again. Single-threaded: the module is driven through its interface
+ * (ctx.h: start, restore, row, on_passage, metrics, stop) with a context
+ * of the test's own; one amfid at a time (the modules' state is their
+ * files'), so the continuous and the restarted runs go one after the other
+ * on stores of their own.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -21,7 +25,8 @@
 
 #include <cmocka.h>
 
-#include "amfid.h"
+#include "amfi_environment_t.h"
+#include "ctx.h"
 #include "store_testing.h"
 
 #define T0 INT64_C(1767225600000000) /* 2026-01-01, µs */
@@ -58,38 +63,97 @@ static double deck_at(int64_t minute)
     return 4.0 + 10.0 * sin(2.0 * PI * (double)minute / 240.0);
 }
 
-static void open_daemon(daemon_s *d, const char *dir, const char *name, int with_env)
+/* The daemon under test: the context and its configuration. */
+static amfid_ctx C;
+static amfi_site_config CFG;
+
+static int no_publish(amfid_ctx *c, const char *ch, const void *data, size_t len)
+{
+    (void)c, (void)ch, (void)data, (void)len;
+    return 0;
+}
+
+static void collect(amfid_ctx *c, amfid_stats *s)
+{
+    memset(s, 0, sizeof *s);
+    scaleind_module.metrics(c, s);
+    environment_module.metrics(c, s);
+}
+
+static scaleind_view view(void)
+{
+    scaleind_view v;
+    scaleind_view_of(&v);
+    return v;
+}
+
+enum { ALL_ON, INDICATORS_OFF, ALL_OFF };
+
+/* mode: ALL_ON (the defaults: the scale indicator, the known truck and the
+ * compensated STD and mean rules), INDICATORS_OFF (only the compensation),
+ * ALL_OFF (and the rules raw). */
+static void open_daemon(const char *dir, const char *name, int with_env, int mode)
 {
     char path[128], err[512];
-    memset(d, 0, sizeof *d);
-    amfi_config_defaults(&d->cfg);
-    amfi_daemon_config *dc = &d->cfg.daemon;
+    memset(&C, 0, sizeof C);
+    amfi_config_defaults(&CFG);
+    amfi_daemon_config *dc = &CFG.daemon;
     dc->scale.block = 50;
     dc->scale.baseline_blocks = 4;
     dc->scale.design_shift = 0.1;
     dc->scale.false_alarms_per_year = 10;
     dc->scale.vehicles_per_day = 500;
     dc->known_truck.baseline_runs = 3;
-    d->lcm = lcm_create("memq://");
-    assert_non_null(d->lcm);
+    if (mode != ALL_ON)
+        dc->scale_enabled = dc->known_truck_enabled = 0;
+    if (mode == ALL_OFF)
+        dc->ind_temp_compensated = 0;
+    dc->bus_auth = 0;
+    snprintf(dc->lcm_url, sizeof dc->lcm_url, "memq://");
+    C.cfg = &CFG;
+    C.state = "running";
+    C.publish = no_publish;
+    C.emit_alert = alert_emit;
+    C.collect = collect;
     snprintf(path, sizeof path, "%s/%s.db", dir, name);
-    assert_int_equal(0, amfi_store_open(path, 0, &d->store, err, sizeof err));
+    assert_int_equal(0, amfi_store_open(path, 0, &C.store, err, sizeof err));
     if (with_env) { /* a reading every 5 minutes over the whole test */
         static amfi_environment_row rows[800];
         for (int k = 0; k < 800; k++)
             rows[k] = (amfi_environment_row){T0 + 5 * k * MIN_US, deck_at(5 * k),
                                              deck_at(5 * k) - 2.0, T0};
-        assert_int_equal(0, amfi_store_add_environment(d->store, rows, 800, err, sizeof err));
+        assert_int_equal(0, amfi_store_add_environment(C.store, rows, 800, err, sizeof err));
     }
-    assert_int_equal(0, scaleind_create(d, err, sizeof err));
-    scaleind_restore(d);
+    assert_int_equal(0, metrics_module.start(&C, err, sizeof err));
+    assert_int_equal(0, notify_module.start(&C, err, sizeof err));
+    assert_int_equal(0, environment_module.start(&C, err, sizeof err));
+    assert_int_equal(0, scaleind_module.start(&C, err, sizeof err));
+    assert_int_equal(0, scaleind_module.restore(&C));
 }
 
-static void close_daemon(daemon_s *d)
+static void close_daemon(void)
 {
-    scaleind_destroy(d);
-    amfi_store_close(d->store);
-    lcm_destroy(d->lcm);
+    scaleind_module.stop(&C);
+    notify_module.stop(&C);
+    amfi_store_close(C.store);
+}
+
+/* A passage through the module as the pipeline hands it: its row (the deck
+ * temperature; feeds: the weight the STD and mean rules get), stored, then
+ * on_passage (solved and ok: fed to the indicators). */
+static void through(amfi_passage_row *r, int feeds)
+{
+    char err[512];
+    static job j;
+    memset(&j, 0, sizeof j);
+    j.solved = 1;
+    snprintf(j.status, sizeof j.status, "ok");
+    j.w.n_vehicles = r->n_vehicles;
+    amfid_passage p = {&j, r, 0, feeds};
+    scaleind_module.row(&C, &p, r);
+    if (r->vehicle_id > 0)
+        assert_int_equal(0, amfi_store_add_passage(C.store, r, &p.id, err, sizeof err));
+    scaleind_module.on_passage(&C, &p);
 }
 
 /* A reproducible normal draw for vehicle k (xorshift, Box-Muller). */
@@ -109,9 +173,8 @@ static double gauss(uint64_t k)
 /* Passage k (one a minute) as amfid would store and feed it: half empty,
  * half loaded, stretched by the temperature (the indicator's prior law) and
  * by 1 / 0.9 when damaged; every 10th the calibration truck (14 t). */
-static void pass(daemon_s *d, int k, int damaged)
+static void pass(int k, int damaged)
 {
-    char err[512];
     amfi_passage_row r;
     memset(&r, 0, sizeof r);
     r.vehicle_id = k + 1;
@@ -124,7 +187,7 @@ static void pass(daemon_s *d, int k, int damaged)
                      : (k % 2 == 0) ? 6500.0 + 900.0 * gauss((uint64_t)k)
                                     : 11000.0 + 1300.0 * gauss((uint64_t)k);
     double t = deck_at(k);
-    double temp = 1.0 / amfi_scale_temp_factor(&d->cfg.daemon.scale, 0.0025, 0.018, t);
+    double temp = 1.0 / amfi_scale_temp_factor(&CFG.daemon.scale, 0.0025, 0.018, t);
     r.gvw_kg = true_kg * temp * (damaged ? 1.0 / 0.9 : 1.0) * (1.0 + 0.01 * gauss(k + 7919u));
     r.axle_kg[0] = 0.4 * r.gvw_kg;
     r.axle_kg[1] = 0.6 * r.gvw_kg;
@@ -136,9 +199,7 @@ static void pass(daemon_s *d, int k, int damaged)
     r.solve_ms = 5;
     r.n_vehicles = 1;
     r.reference_gvw_kg = k % 10 == 9 ? 14000.0 : 0.0;
-    scaleind_deck(d, &r);
-    assert_int_equal(0, amfi_store_add_passage(d->store, &r, NULL, err, sizeof err));
-    scaleind_feed(d, &r);
+    through(&r, 0);
 }
 
 /* scale_evals and alerts after utime `from`, as text, malloc'd. */
@@ -193,25 +254,26 @@ static int count(const char *dir, const char *name, const char *sql)
 static void test_restart_continues_exactly(void **state)
 {
     fixture *f = *state;
-    daemon_s a, c;
     const int split = 333, onset = 420, end = 700;
-    open_daemon(&c, f->dir, "continuous", 1);
-    open_daemon(&a, f->dir, "restarted", 1);
-    for (int k = 0; k < split; k++) {
-        pass(&c, k, 0);
-        pass(&a, k, 0);
-    }
+    /* an amfid that never stops */
+    open_daemon(f->dir, "continuous", 1, ALL_ON);
+    for (int k = 0; k < end; k++)
+        pass(k, k >= onset);
+    close_daemon();
+    /* one restarted in the middle of a block */
+    open_daemon(f->dir, "restarted", 1, ALL_ON);
+    for (int k = 0; k < split; k++)
+        pass(k, 0);
     /* the baseline is in, a block is under way, the truck's baseline done */
-    assert_string_not_equal("baseline", amfi_scale_state(a.sc.scale));
-    assert_int_equal(split, a.sc.fed);
-    assert_int_equal(0, a.sc.no_temp);
-    close_daemon(&a);
-    open_daemon(&a, f->dir, "restarted", 0);
-    assert_int_equal(0, a.sc.fed); /* the counters are this run's */
-    for (int k = split; k < end; k++) {
-        pass(&c, k, k >= onset);
-        pass(&a, k, k >= onset);
-    }
+    assert_string_not_equal("baseline", view().scale_state);
+    assert_int_equal(split, view().fed);
+    assert_int_equal(0, view().no_temp);
+    close_daemon();
+    open_daemon(f->dir, "restarted", 0, ALL_ON);
+    assert_int_equal(0, view().fed); /* the counters are this run's */
+    for (int k = split; k < end; k++)
+        pass(k, k >= onset);
+    close_daemon();
     char *x = dump(f->dir, "continuous", T0 + (split - 1) * MIN_US);
     char *y = dump(f->dir, "restarted", T0 + (split - 1) * MIN_US);
     assert_string_equal(x, y);
@@ -237,24 +299,20 @@ static void test_restart_continues_exactly(void **state)
     free(y);
 
     /* a restart with both alerts open: restored, not raised again */
-    close_daemon(&a);
-    open_daemon(&a, f->dir, "restarted", 0);
-    assert_string_equal("alert", amfi_scale_state(a.sc.scale));
-    assert_string_equal("alert", amfi_known_truck_state(a.sc.truck));
+    open_daemon(f->dir, "restarted", 0, ALL_ON);
+    assert_string_equal("alert", view().scale_state);
+    assert_string_equal("alert", view().truck_state);
     for (int k = end; k < end + 100; k++)
-        pass(&a, k, 1);
+        pass(k, 1);
     assert_int_equal(2, count(f->dir, "restarted",
                               "SELECT count(*) FROM alerts WHERE raised = 1"));
-    close_daemon(&a);
-    close_daemon(&c);
+    close_daemon();
 }
 
 static void test_no_temperature_is_skipped(void **state)
 {
     fixture *f = *state;
-    daemon_s d;
-    char err[512];
-    open_daemon(&d, f->dir, "notemp", 1);
+    open_daemon(f->dir, "notemp", 1, ALL_ON);
     amfi_passage_row r;
     memset(&r, 0, sizeof r);
     r.utime = T0 + 800 * 5 * MIN_US + 3 * 3600 * INT64_C(1000000); /* 3 h after the last */
@@ -262,40 +320,61 @@ static void test_no_temperature_is_skipped(void **state)
     r.n_vehicles = 1;
     r.has_deck_c = 1;
     r.deck_c = 99.0;
-    scaleind_deck(&d, &r);
+    through(&r, 0);
     assert_int_equal(0, r.has_deck_c);
-    assert_int_equal(1, d.sc.no_temp);
-    scaleind_feed(&d, &r);
-    assert_int_equal(0, d.sc.fed);
+    assert_int_equal(1, view().no_temp);
+    assert_int_equal(0, view().fed);
     /* within half the gap of the last reading: its temperature */
     r.utime = T0 + 799 * 5 * MIN_US + 30 * MIN_US;
-    scaleind_deck(&d, &r);
+    through(&r, 0);
     assert_int_equal(1, r.has_deck_c);
     assert_float_equal(deck_at(799 * 5), r.deck_c, 1e-9);
-    /* buffered readings are flushed before the lookup */
-    d.env.buf[0] = (amfi_environment_row){r.utime + 10 * MIN_US, 21.5, 20.0, T0};
-    d.env.n = 1;
+    /* buffered readings are flushed before the lookup: one received on the
+     * (in-memory) bus waits in the environment's buffer */
+    assert_int_equal(0, bus_open(&C, NULL));
+    assert_int_equal(0, environment_module.restore(&C));
+    assert_int_equal(0, bus_subscribe_all(&C));
+    amfi_environment_t m = {r.utime + 10 * MIN_US, 20.0, 21.5}; /* utime, air, deck */
+    unsigned char buf[256];
+    int n = amfi_environment_t_encode(buf, 0, sizeof buf, &m);
+    assert_true(n > 0);
+    assert_int_equal(0, lcm_publish(bus_lcm(), CFG.daemon.ch_environment, buf, (unsigned)n));
+    while (lcm_handle_timeout(bus_lcm(), 0) > 0)
+        ;
+    amfid_stats s;
+    collect(&C, &s);
+    assert_int_equal(1, s.env_buffered);
     r.utime += 10 * MIN_US;
-    scaleind_deck(&d, &r);
-    assert_int_equal(0, d.env.n);
+    through(&r, 0);
+    collect(&C, &s);
+    assert_int_equal(0, s.env_buffered);
     assert_float_equal(21.5, r.deck_c, 1e-9);
+    bus_close();
+    close_daemon();
     /* the scale indicator and the known truck off: the lookup is still made
      * for the STD and mean rules' compensation (daemon.indicators.temperature) */
-    close_daemon(&d);
-    open_daemon(&d, f->dir, "off", 0);
-    scaleind_destroy(&d);
-    d.sc.no_temp = 0;
-    scaleind_deck(&d, &r);
+    open_daemon(f->dir, "off", 0, INDICATORS_OFF);
+    assert_null(view().scale_state);
+    through(&r, 0);
     assert_int_equal(0, r.has_deck_c);
-    assert_int_equal(1, d.sc.no_temp);
+    assert_int_equal(1, view().no_temp);
+    close_daemon();
     /* all three off: no lookup, nothing counted */
-    d.sc.compensate = 0;
-    d.sc.no_temp = 0;
-    scaleind_deck(&d, &r);
+    open_daemon(f->dir, "off", 0, ALL_OFF);
+    through(&r, 0);
     assert_int_equal(0, r.has_deck_c);
-    assert_int_equal(0, d.sc.no_temp);
-    (void)err;
-    close_daemon(&d);
+    assert_int_equal(0, view().no_temp);
+    close_daemon();
+}
+
+/* The prior law (alerts.scale: 0.0025 warm, 0.018 frost, knee 0, floor
+ * -10, calibration 10 °C): the factor that brings a GVW measured at t to
+ * the calibration temperature. */
+static double prior_factor(double t)
+{
+    if (t >= 0.0)
+        return exp(-0.0025 * (t - 10.0));
+    return exp(0.0025 * 10.0 + 0.018 * fmin(-t, 10.0));
 }
 
 /* The weight the STD and mean rules are fed (daemon.indicators.temperature):
@@ -305,58 +384,66 @@ static void test_no_temperature_is_skipped(void **state)
 static void test_std_rules_compensated(void **state)
 {
     fixture *f = *state;
-    daemon_s d;
-    open_daemon(&d, f->dir, "comp", 1);
-    const amfi_scale_params *p = &d.sc.params;
-    assert_int_equal(1, d.sc.compensate); /* the default */
-    amfi_passage_row r;
-    memset(&r, 0, sizeof r);
-    r.gvw_kg = 10000.0;
-    r.has_deck_c = 1;
-    /* prior slopes (0.0025 warm, 0.018 frost, knee 0, floor -10, ref 10 °C) */
-    const double t[5] = {30.0, 10.0, 0.0, -5.0, -25.0};
-    const double want[5] = {10000.0 * exp(-0.0025 * 20.0), 10000.0,
-                            10000.0 * exp(0.0025 * 10.0),
-                            10000.0 * exp(0.0025 * 10.0 + 0.018 * 5.0),
-                            10000.0 * exp(0.0025 * 10.0 + 0.018 * 10.0)};
-    for (int k = 0; k < 5; k++) {
-        r.deck_c = t[k];
-        scaleind_comp(&d, &r);
-        assert_float_equal(want[k], r.gvw_comp_kg, 1e-6);
-    }
+    open_daemon(f->dir, "comp", 1, ALL_ON);
+    const amfi_scale_params *p = &CFG.daemon.scale;
+    assert_int_equal(1, view().compensate); /* the default */
     assert_true(fabs(p->warm_slope - 0.0025) < 1e-12 && fabs(p->frost_slope - 0.018) < 1e-12);
-    assert_int_equal(5, d.sc.comp_fed);
+    amfi_passage_row r;
+    /* at readings of 14, 11.07, 4, -3.07 and -6 °C (minutes 60, 30, 0, 210, 180) */
+    const int minute[5] = {60, 30, 0, 210, 180};
+    for (int k = 0; k < 5; k++) {
+        memset(&r, 0, sizeof r);
+        r.utime = T0 + minute[k] * MIN_US;
+        r.n_vehicles = 1;
+        r.gvw_kg = 10000.0;
+        through(&r, 1);
+        assert_int_equal(1, r.has_deck_c);
+        assert_float_equal(10000.0 * prior_factor(deck_at(minute[k])), r.gvw_comp_kg, 1e-6);
+    }
+    assert_int_equal(5, view().comp_fed);
     /* no deck temperature: raw, counted */
-    r.has_deck_c = 0;
-    scaleind_comp(&d, &r);
+    memset(&r, 0, sizeof r);
+    r.utime = T0 + 800 * 5 * MIN_US + 3 * 3600 * INT64_C(1000000);
+    r.n_vehicles = 1;
+    r.gvw_kg = 10000.0;
+    through(&r, 1);
     assert_float_equal(10000.0, r.gvw_comp_kg, 0);
-    assert_int_equal(1, d.sc.comp_raw);
+    assert_int_equal(1, view().comp_raw);
     /* after the scale baseline: the fitted slopes */
     amfi_passage_row q;
-    for (int64_t k = 0; !amfi_scale_has_baseline(d.sc.scale); k++) {
+    for (int64_t k = 0; strcmp(view().scale_state, "baseline") == 0; k++) {
         memset(&q, 0, sizeof q);
         q.utime = T0 + k * MIN_US;
         q.n_vehicles = 1;
         q.gvw_kg = (k % 2 ? 12000.0 : 6000.0) + 300.0 * gauss((uint64_t)k);
-        scaleind_deck(&d, &q);
+        through(&q, 0);
         assert_int_equal(1, q.has_deck_c);
-        scaleind_feed(&d, &q);
         assert_true(k < 1000);
     }
-    amfi_scale_model m;
-    assert_int_equal(AMFI_IND_OK, amfi_scale_get_model(d.sc.scale, &m));
-    r.has_deck_c = 1;
-    r.deck_c = -5.0;
-    scaleind_comp(&d, &r);
-    assert_float_equal(amfi_scale_temp_factor(p, m.warm_slope, m.frost_slope, -5.0) * 10000.0,
+    memset(&r, 0, sizeof r);
+    r.utime = T0 + 180 * MIN_US; /* -6 °C */
+    r.n_vehicles = 1;
+    r.gvw_kg = 10000.0;
+    through(&r, 1);
+    scaleind_view v = view();
+    assert_int_equal(1, v.fitted);
+    assert_float_equal(amfi_scale_temp_factor(p, v.warm_slope, v.frost_slope, deck_at(180)) *
+                           10000.0,
                        r.gvw_comp_kg, 1e-6);
+    assert_float_not_equal(10000.0 * prior_factor(deck_at(180)), r.gvw_comp_kg, 1e-3);
+    assert_int_equal(6, view().comp_fed);
+    close_daemon();
     /* raw: the GVW, nothing counted */
-    d.sc.compensate = 0;
-    scaleind_comp(&d, &r);
+    open_daemon(f->dir, "raw", 1, ALL_OFF);
+    memset(&r, 0, sizeof r);
+    r.utime = T0 + 180 * MIN_US;
+    r.n_vehicles = 1;
+    r.gvw_kg = 10000.0;
+    through(&r, 1);
     assert_float_equal(10000.0, r.gvw_comp_kg, 0);
-    assert_int_equal(6, d.sc.comp_fed);
-    assert_int_equal(1, d.sc.comp_raw);
-    close_daemon(&d);
+    assert_int_equal(0, view().comp_fed);
+    assert_int_equal(0, view().comp_raw);
+    close_daemon();
 }
 
 int main(void)

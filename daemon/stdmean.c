@@ -1,0 +1,146 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * stdmean.c: amfid's STD and mean rules (indicators/indicators.h,
+ * daemon.indicators): every ok passage that feeds them (single presence
+ * when daemon.indicators.single_presence_only) pushes its GVW, at the
+ * calibration temperature where it is compensated (scaleind.c fills
+ * gvw_comp_kg); the baseline, each evaluation and the alerts are stored and
+ * published (the evaluation on the indicator channel, the alerts through
+ * the context's emit_alert) and the newest evaluation goes to the metrics.
+ * At start the baseline, the window's GVWs and the open alerts come back
+ * from the store (an alert open before a restart stays open, not raised
+ * twice).
+ *
+ * A module (ctx.h). Thread: the main thread only. Owns the engine and its
+ * parameters in force (a reload reports a change, which applies at the
+ * next start).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amfi_indicator_t.h"
+#include "ctx.h"
+
+static struct {
+    amfi_indicators *ind;
+    amfi_indicator_params params; /* in force */
+} M;
+
+static int stdmean_start(amfid_ctx *c, char *err, size_t errlen)
+{
+    memset(&M, 0, sizeof M);
+    M.params = c->cfg->daemon.indicators;
+    return amfi_indicators_create(&M.params, &M.ind, err, errlen);
+}
+
+/* 1 when the newest alert of `kind` in the store was a raise (still open). */
+static int last_alert_raised(amfi_store *st, const char *kind)
+{
+    char err[256];
+    int open = 0;
+    if (amfi_store_alert_open(st, kind, &open, err, sizeof err) != 0) {
+        LOG_WARN("store: %s", err);
+        return 0;
+    }
+    return open;
+}
+
+/* The baseline, the window's GVWs and the open alerts from the store. */
+static int stdmean_restore(amfid_ctx *c)
+{
+    amfi_baseline b;
+    int found = 0;
+    char err[512];
+    if (amfi_store_get_baseline(c->store, &b, &found, err, sizeof err) != 0) {
+        LOG_WARN("store: %s", err);
+        return 0;
+    }
+    if (!found)
+        return 0;
+    amfi_indicators_set_baseline(M.ind, b.mean_kg, b.std_kg, b.n);
+    LOG_INFO("baseline from the store: mean %.0f kg, STD %.0f kg (%d, %s)", b.mean_kg,
+             b.std_kg, b.n, b.source);
+    double *g = malloc(sizeof(double) * (size_t)M.params.window);
+    int n = 0;
+    if (g && amfi_store_recent_ok_gvw(c->store, M.params.window, g, &n, err, sizeof err) == 0)
+        amfi_indicators_prefill(M.ind, g, n);
+    free(g);
+    /* An alert open before a restart stays open, not raised twice. */
+    int open_std = last_alert_raised(c->store, "std_increase");
+    int open_mean = last_alert_raised(c->store, "mean_shift");
+    amfi_indicators_set_alerted(M.ind, open_std, open_mean);
+    metrics_alert("std_increase", open_std);
+    metrics_alert("mean_shift", open_mean);
+    if (open_std || open_mean)
+        LOG_INFO("open alerts restored from the store:%s%s", open_std ? " std_increase" : "",
+                 open_mean ? " mean_shift" : "");
+    return 0;
+}
+
+/* A stored passage that feeds the rules: its GVW (compensated: gvw_comp_kg). */
+static void stdmean_feed(amfid_ctx *c, const amfid_passage *p)
+{
+    if (!p->feeds)
+        return;
+    const job *j = p->j;
+    const double gvw_kg = p->r->gvw_comp_kg;
+    amfi_indicator_eval ev;
+    amfi_alert_event al[2];
+    int n_al = 0;
+    int bits = amfi_indicators_push(M.ind, gvw_kg, &ev, al, &n_al);
+    if (bits < 0) {
+        ctx_error(c, "indicators: GVW %.1f kg of vehicle %lld refused", gvw_kg,
+                  (long long)j->w.v.vehicle_id);
+        return;
+    }
+    char err[256];
+    if (bits & AMFI_IND_BASELINE) {
+        amfi_baseline b;
+        memset(&b, 0, sizeof b);
+        b.utime_set = j->w.v.utime;
+        b.n = ev.n;
+        b.mean_kg = ev.baseline_mean_kg;
+        b.std_kg = ev.baseline_std_kg;
+        snprintf(b.source, sizeof b.source, "auto");
+        snprintf(b.note, sizeof b.note, "first %d ok passages", ev.n);
+        if (amfi_store_set_baseline(c->store, &b, err, sizeof err))
+            ctx_error(c, "store: %s", err);
+        LOG_INFO("baseline established: mean %.0f kg, STD %.0f kg over %d passages",
+                 ev.baseline_mean_kg, ev.baseline_std_kg, ev.n);
+    }
+    int64_t ind_id = 0;
+    if (bits & AMFI_IND_EVAL) {
+        amfi_indicator_row row = {j->w.v.utime, ev.n, ev.mean_kg, ev.std_kg,
+                                  ev.baseline_mean_kg, ev.baseline_std_kg, ev.std_ratio,
+                                  ev.p_value, ev.state};
+        if (amfi_store_add_indicator(c->store, &row, &ind_id, err, sizeof err))
+            ctx_error(c, "store: %s", err);
+        amfi_indicator_t m = {j->w.v.utime, ind_id, ev.n, ev.mean_kg, ev.std_kg,
+                              ev.baseline_mean_kg, ev.baseline_std_kg, ev.std_ratio,
+                              ev.p_value, (char *)ev.state, (char *)c->cfg->site.id};
+        BUS_PUBLISH(c, amfi_indicator_t, c->cfg->daemon.ch_indicator, &m);
+        metrics_indicator(ev.std_ratio, ev.p_value,
+                          ev.baseline_mean_kg > 0 ? ev.mean_kg / ev.baseline_mean_kg : NAN);
+    }
+    for (int i = 0; (bits & AMFI_IND_ALERT) && i < n_al; i++)
+        c->emit_alert(c, j->w.v.utime, &al[i], ind_id);
+}
+
+
+static void stdmean_stop(amfid_ctx *c)
+{
+    (void)c;
+    amfi_indicators_destroy(M.ind);
+    memset(&M, 0, sizeof M);
+}
+
+const amfid_module stdmean_module = {
+    .name = "stdmean",
+    .section = "daemon.indicators",
+    .start = stdmean_start,
+    .restore = stdmean_restore,
+    .on_passage = stdmean_feed,
+    .stop = stdmean_stop,
+};
