@@ -13,9 +13,12 @@
 
 struct timers {
     struct timer {
-        const double *period_s; /* read at each run: a live key follows a reload */
+        const double *period_s; /* read at each check: a live key follows a reload
+                                   at once (a shorter period is not held back by
+                                   a due time computed with the old one) */
         timer_fn fn;
-        double due;             /* amfi_mono_s(); 0: at once */
+        double last;            /* amfi_mono_s() of the last run that succeeded */
+        int ran;                /* 0: due at once */
     } t[TIMERS_MAX];
     int n;
 };
@@ -34,7 +37,7 @@ int timer_add(timers *t, const double *period_s, timer_fn fn)
 {
     if (!t || t->n >= TIMERS_MAX || !period_s || !fn)
         return -1;
-    t->t[t->n++] = (struct timer){period_s, fn, 0.0};
+    t->t[t->n++] = (struct timer){period_s, fn, 0.0, 0};
     return 0;
 }
 
@@ -42,7 +45,9 @@ void timers_run(timers *t, amfid_ctx *c, double now)
 {
     for (int i = 0; t && i < t->n; i++) {
         struct timer *k = &t->t[i];
-        if (now >= k->due && k->fn(c) == 0)
-            k->due = now + *k->period_s;
+        if ((!k->ran || now >= k->last + *k->period_s) && k->fn(c) == 0) {
+            k->last = now;
+            k->ran = 1;
+        }
     }
 }

@@ -32,8 +32,8 @@ fail() {
   exit 1
 }
 q() { sqlite3 "$dir/s.db" "PRAGMA busy_timeout = 5000; $1" | tail -n +2; }
-# wait_for DESCRIPTION COMMAND...: until COMMAND succeeds (up to 30 s)
-wait_for() {
+# wait_until DESCRIPTION COMMAND...: until COMMAND succeeds (up to 30 s)
+wait_until() {
   _what=$1; shift
   _i=0; until "$@"; do
     _i=$((_i + 1)); [ $_i -lt 300 ] || fail "not seen within 30 s: $_what"
@@ -163,7 +163,7 @@ reload() {
   grep -q "^ *$(echo "$1" | sed 's/.*\.//'): $2\$" "$dir/amfid.yaml" || fail "$2 not written"
   applied=$((applied + 1))
   kill -HUP $apid
-  wait_for "reload $applied applied" sh -c \
+  wait_until "reload $applied applied" sh -c \
     "[ \$(grep -c 'reload: configuration .* applied' '$dir/amfid.log') -ge $applied ]"
   ! grep -q "reload: the new configuration is refused" "$dir/amfid.log" ||
     fail "the new configuration was refused: $(grep -B2 refused "$dir/amfid.log" | head -3)"
@@ -190,7 +190,7 @@ traffic_to() {
   [ "$1" -lt 40 ] || end=166.1
   "$tool" segment "$dir/sim.log" "$dir/m$n.log" "reload.$n" "$cur" "$end" 0 0 || fail "segment"
   play "$dir/m$n.log"; cur=$end
-  wait_for "passages of vehicles 1 .. $1 stored" nonzero \
+  wait_until "passages of vehicles 1 .. $1 stored" nonzero \
     "SELECT count(*) = $1 FROM passages WHERE vehicle_id BETWEEN 1 AND $1"
 }
 # replay K ID_ADD [HOLE_AFTER_ENTRY_S HOLE_LEN_S]: vehicle K's 5.5 s of data
@@ -239,21 +239,21 @@ for key in $ORDER; do
   daemon.channels.passage)
     reload $key RL_PASSAGE2
     traffic_to 21
-    wait_for "a passage on RL_PASSAGE2" seen_on RL_PASSAGE2 ;;
+    wait_until "a passage on RL_PASSAGE2" seen_on RL_PASSAGE2 ;;
   daemon.channels.indicator)
     [ "$(on_channel RL_INDICATOR)" -gt 0 ] || fail "no indicator on the first channel before the change"
     reload $key RL_INDICATOR2
     traffic_to 26
-    wait_for "an indicator on RL_INDICATOR2" seen_on RL_INDICATOR2 ;;
+    wait_until "an indicator on RL_INDICATOR2" seen_on RL_INDICATOR2 ;;
   daemon.channels.alert)
     [ "$(on_channel RL_ALERT)" -eq 0 ] || fail "an alert before the damage (the test's premise)"
     reload $key RL_ALERT2
     traffic_to 40
-    wait_for "an alert on RL_ALERT2" seen_on RL_ALERT2 ;;
+    wait_until "an alert on RL_ALERT2" seen_on RL_ALERT2 ;;
   solver.lambda)
     # two replays of vehicle 5 before any change: the same result
     replay 5 1000; replay 5 2000
-    wait_for "replays stored" nonzero "SELECT count(*) = 2 FROM passages WHERE vehicle_id IN (1005, 2005)"
+    wait_until "replays stored" nonzero "SELECT count(*) = 2 FROM passages WHERE vehicle_id IN (1005, 2005)"
     [ "$(row 1005)" = "$(row 2005)" ] || fail "one vehicle's data solved twice differs: $(row 1005) / $(row 2005)"
     case "$(row 1005)" in "ok "*) ;; *) fail "the replay is not solved: $(row 1005)" ;; esac
     prev=2005; id=3000
@@ -273,92 +273,92 @@ for key in $ORDER; do
     [ "$(on_channel RL_STATUS)" -gt 0 ] || fail "no status message before the change"
     reload $key 0.2
     t=$(date +%s%6N)
-    wait_for "status messages every 0.2 s" sh -c \
+    wait_until "status messages every 0.2 s" sh -c \
       "[ \$('$tool' list '$dir/out.log' | awk -v t=$t '\$2 == \"RL_STATUS\" && \$1 > t && \$1 < t + 2000000' | wc -l) -ge 5 ]" ;;
   daemon.channels.status)
     reload $key RL_STATUS2
-    wait_for "a status message on RL_STATUS2" seen_on RL_STATUS2 ;;
+    wait_until "a status message on RL_STATUS2" seen_on RL_STATUS2 ;;
   daemon.intake.summary_period_s)
     probe vehicles "$(now_us)" 500000 1 -3 4 sim_publisher 0
     sleep 1.5
     [ "$(q "SELECT count(*) FROM refusals")" -eq 0 ] || fail "a refusal summarised before the change"
     reload $key 1
-    wait_for "a refusal summary within the new period" nonzero "SELECT count(*) FROM refusals" ;;
+    wait_until "a refusal summary within the new period" nonzero "SELECT count(*) FROM refusals" ;;
   daemon.intake.vehicle_ahead_s)
     reload $key 10
     probe vehicles "$(($(now_us) + 50000000))" 510000 1 20 4 sim_publisher 0
-    wait_for "vehicle 50 s ahead refused at 10 s" nonzero \
+    wait_until "vehicle 50 s ahead refused at 10 s" nonzero \
       "SELECT count(*) FROM passages WHERE vehicle_id = 510000 AND status = 'invalid' AND reason LIKE '%daemon.intake.vehicle_ahead_s 10 s%'" ;;
   daemon.intake.min_speed_mps)
     reload $key 5
     probe vehicles "$(now_us)" 520000 1 3 4 sim_publisher 0
-    wait_for "a 3 m/s vehicle refused below 5 m/s" nonzero \
+    wait_until "a 3 m/s vehicle refused below 5 m/s" nonzero \
       "SELECT count(*) FROM passages WHERE vehicle_id = 520000 AND status = 'invalid' AND reason LIKE '%min_speed_mps (5 m/s)%'" ;;
   daemon.intake.max_length_m)
     reload $key 20
     probe vehicles "$(now_us)" 530000 1 20 30 sim_publisher 0
-    wait_for "a 30 m vehicle refused above 20 m" nonzero \
+    wait_until "a 30 m vehicle refused above 20 m" nonzero \
       "SELECT count(*) FROM passages WHERE vehicle_id = 530000 AND status = 'invalid' AND reason LIKE '%max_length_m (20 m)%'" ;;
   daemon.intake.burst_s)
     # vehicles_per_s 5: a burst of 30 s allows 150 at once, of 1 s five
     before=$(refused_count vehicle rate_limited)
     reload $key 1
     probe vehicles "$(now_us)" 540000 12 -3 4 sim_publisher 0
-    wait_for "12 vehicles at once over a burst of 5" sh -c \
+    wait_until "12 vehicles at once over a burst of 5" sh -c \
       "[ \$(sqlite3 '$dir/s.db' \"SELECT coalesce(sum(count), 0) FROM refusals WHERE input = 'vehicle' AND reason = 'rate_limited'\") -ge $((before + 6)) ]" ;;
   daemon.intake.vehicles_per_s)
     reload $key 0.1
     probe vehicles "$(now_us)" 550000 3 -3 4 sim_publisher 0
-    wait_for "vehicles refused at 0.1 a second" refused vehicle "daemon.intake.vehicles_per_s 0.1)"
+    wait_until "vehicles refused at 0.1 a second" refused vehicle "daemon.intake.vehicles_per_s 0.1)"
     reload $key 5 ;; # the vehicles below pass
   daemon.intake.truth_per_s)
     reload $key 0.1
     probe truth "$(now_us)" 560000 3
-    wait_for "truth refused at 0.1 a second" refused truth "daemon.intake.truth_per_s 0.1)" ;;
+    wait_until "truth refused at 0.1 a second" refused truth "daemon.intake.truth_per_s 0.1)" ;;
   daemon.intake.accel_margin)
     # a burst of 1 s: at a margin of 4, 8000 samples at once; of 1, 2000. 3000
     # sent, dated 10 s back (the allowance also refills with the data time)
     reload $key 1
     probe accel "$(($(now_us) - 10000000))" "$(($(seq_now) - 100))" 30 1000
-    wait_for "accel refused at a margin of 1" refused accel "daemon.intake.accel_margin 1 "
+    wait_until "accel refused at a margin of 1" refused accel "daemon.intake.accel_margin 1 "
     reload $key 4 ;; # the data time advances below
   daemon.intake.environment_min_interval_s)
     u=$(now_us)
     probe env "$(($u - 40000000))" 10.0 2 10000000 # 10.0 °C, 10 s apart: both kept
-    wait_for "two readings 10 s apart stored" nonzero \
+    wait_until "two readings 10 s apart stored" nonzero \
       "SELECT count(*) = 2 FROM environment WHERE deck_c = 10.0"
     reload $key 100
     probe env "$(($u - 20000000))" 10.2 2 10000000 # within 100 s of the last kept
     probe env "$(($u + 75000000))" 10.4 1 0        # 105 s after it: kept
-    wait_for "a reading 105 s after the last kept" nonzero \
+    wait_until "a reading 105 s after the last kept" nonzero \
       "SELECT count(*) FROM environment WHERE deck_c = 10.4"
     [ "$(q "SELECT count(*) FROM environment WHERE deck_c = 10.2")" -eq 0 ] ||
       fail "readings within 100 s of the last kept one were stored" ;;
   daemon.intake.deck_max_rate_c_per_min)
     reload $key 0.5
     probe env "$(($(now_us) + 76000000))" 11.9 1 0 # 1.5 °C in a minute
-    wait_for "a 1.5 °C step refused at 0.5 °C/min" refused environment "deck_max_rate_c_per_min 0.5 " ;;
+    wait_until "a 1.5 °C step refused at 0.5 °C/min" refused environment "deck_max_rate_c_per_min 0.5 " ;;
   daemon.environment_max_skew_s)
     reload $key 60
     probe env "$(($(now_us) - 200000000))" 10.4 1 0
-    wait_for "a reading 200 s old refused at 60 s" refused environment "daemon.environment_max_skew_s 60 s)" ;;
+    wait_until "a reading 200 s old refused at 60 s" refused environment "daemon.environment_max_skew_s 60 s)" ;;
   daemon.intake.environment_per_s)
     reload $key 0.1
     probe env "$(now_us)" 10.4 3 1000
-    wait_for "readings refused at 0.1 a second" refused environment "daemon.intake.environment_per_s 0.1)" ;;
+    wait_until "readings refused at 0.1 a second" refused environment "daemon.intake.environment_per_s 0.1)" ;;
   daemon.intake.calibration_sources)
     reload $key sim_publisher
     probe vehicles "$(now_us)" 570000 1 20 4 rig 10000
-    wait_for "a reference from rig refused" refused vehicle \
+    wait_until "a reference from rig refused" refused vehicle \
       "vehicle_t 570000: reference_gvw_kg 10000 not taken: source _rig_ is not in daemon.intake.calibration_sources" ;;
   daemon.intake.calibration_max_kg)
     reload $key 9000
     probe vehicles "$(now_us)" 580000 1 20 4 sim_publisher 10000
-    wait_for "a 10000 kg reference refused above 9000 kg" refused vehicle "3500 .. 9000 kg" ;;
+    wait_until "a 10000 kg reference refused above 9000 kg" refused vehicle "3500 .. 9000 kg" ;;
   daemon.intake.calibration_min_kg)
     reload $key 8000
     probe vehicles "$(now_us)" 590000 1 20 4 sim_publisher 7000
-    wait_for "a 7000 kg reference refused below 8000 kg" refused vehicle "8000 .. 9000 kg" ;;
+    wait_until "a 7000 kg reference refused below 8000 kg" refused vehicle "8000 .. 9000 kg" ;;
   daemon.max_wait_s)
     advance 3 # the probes' vehicles behind, in data time (they wait for sensor 1)
     # vehicle 7 again without sensor 1's data: the window waits for it
@@ -368,13 +368,13 @@ for key in $ORDER; do
     [ -z "$(row 7007)" ] || fail "the window with a hole was stored before the change: $(row 7007)"
     reload $key 1
     advance 3
-    wait_for "the window with a hole stored 1 s after its end" nonzero \
+    wait_until "the window with a hole stored 1 s after its end" nonzero \
       "SELECT count(*) FROM passages WHERE vehicle_id = 7007" ;;
   esac
   # the λ policy: the same data solved again, to another λ or force
   case $key in solver.*)
     id=$((id + 1000)); replay 5 $((id - 5))
-    wait_for "the replay after the change stored" nonzero "SELECT count(*) FROM passages WHERE vehicle_id = $id"
+    wait_until "the replay after the change stored" nonzero "SELECT count(*) FROM passages WHERE vehicle_id = $id"
     [ "$(row $id)" != "$(row $prev)" ] || fail "the same data solved to the same result after the change: $(row $id)"
     case "$(row $id)" in "ok "*) ;; *) fail "the replay is not solved: $(row $id)" ;; esac
     echo "$key $(get_key $key): $(row $prev) -> $(row $id)"
