@@ -11,6 +11,7 @@
  *   section_simulation.c         simulation:
  *   section_site.c               site:
  *   section_ops.c                alerts:, metrics:
+ *   section_classes.c            classes:
  *   model_check.c                the bridge built, the solver's workspace bounded
  *
  * and holds the defaults, the order of the checks that run once the whole
@@ -46,6 +47,7 @@ static const field top_fields[] = {
     {.key = "metrics", .kind = &K_MAP, .aux = metrics_fields},
     {.key = "report", .kind = &K_MAP, .aux = report_fields},
     {.key = "detector", .kind = &K_MAP, .aux = detector_fields},
+    {.key = "classes", .kind = &K_MAP, .aux = classes_fields},
     {.key = NULL}};
 
 /* Checks that involve several keys, once the whole file is read; each finds
@@ -57,7 +59,8 @@ static int check_site(ctx *x, void *base)
     amfi_site_config *c = base;
 
     if (bridge_check(x, c) || sensors_check(x, c) || solver_check(x, c) ||
-        daemon_check(x, c) || sim_check(x, c) || site_check(x, c) || ops_check(x, c))
+        daemon_check(x, c) || sim_check(x, c) || site_check(x, c) || ops_check(x, c) ||
+        classes_check(x, c))
         return -1;
     return model_check(x, c);
 }
@@ -129,6 +132,7 @@ void amfi_config_defaults(amfi_site_config *c)
     /* a detector in step with the accelerometers until commissioning says */
     c->detector.clock_offset_s = 0.0;
     c->detector.speed_scale = 1.0;
+    amfi_class_params_default(&c->classes); /* the European classes, 96/53/EC's limits */
     /* The engine's defaults (docs/indicators.md has the simulation behind
      * each value); set field by field, so the padding stays zero. */
     amfi_indicator_params_default(&d->indicators);

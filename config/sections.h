@@ -15,6 +15,7 @@
  *   section_ops.c         alerts:, metrics:  notices and health metrics
  *   section_report.c      report:      what amfi-report holds passages against
  *   section_detector.c    detector:    the vehicle detector's clock offset and speed scale
+ *   section_classes.c     classes:     axle groups, vehicle classes, legal limits
  *
  * Every function runs on the loader's (caller's) thread.
  */
@@ -46,6 +47,7 @@ extern const field alerts_fields[]; /* alerts: */
 extern const field metrics_fields[]; /* metrics: */
 extern const field report_fields[]; /* report: */
 extern const field detector_fields[]; /* detector: */
+extern const field classes_fields[];  /* classes: */
 extern const enum_name onoff_names[]; /* off | on (section_daemon.c) */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */
@@ -60,6 +62,7 @@ int daemon_check(ctx *x, amfi_site_config *c);
 int sim_check(ctx *x, amfi_site_config *c);
 int site_check(ctx *x, amfi_site_config *c);
 int ops_check(ctx *x, amfi_site_config *c);
+int classes_check(ctx *x, amfi_site_config *c);
 
 /* The model itself: the bridge built with libamfi (its refusals reported at
  * the line of the bridge key or section that caused them) and the solver's
