@@ -42,23 +42,24 @@ amfi_passage_times amfi_multi_window(double span_m, const amfi_multi_passage *p,
     return w;
 }
 
-/* Normal matrix A (na × na) of the constant-axle-load model: column a is the
- * sensors' response, in the solver's output equation (paper: backward
- * difference of modal velocities), to a unit load moving with axle a while it
- * is on the span. Modes: the solver's (modal) or all (nodal). */
 /* The quality figures' scratch for events of up to na axles (0, or
  * AMFI_ENOMEM), in doubles: normal_matrix's Φ (4m), G (2m), c (ns·m),
  * q (2m·na), mode values (n), y (ns·na); then A (na²), U (na² + na) and
  * quad_inverse's M (na²) and u (na); m the modes of the sweep (all n in
  * nodal coordinates). Reallocated only when na exceeds every event's
  * before. */
+static size_t mq_head(const struct amfi_solver *s, int na)
+{
+    const size_t m = (size_t)(s->mode ? s->m : s->n), ns = (size_t)s->ns, k = (size_t)na;
+    return 6 * m + ns * m + 2 * m * k + (size_t)s->n + ns * k; /* normal_matrix's part */
+}
+
 static int mq_reserve(struct amfi_solver *s, int na)
 {
     if (na <= s->mq_na)
         return AMFI_OK;
-    const size_t m = (size_t)(s->mode ? s->m : s->n), ns = (size_t)s->ns, n = (size_t)s->n;
     const size_t k = (size_t)na;
-    const size_t len = 6 * m + ns * m + 2 * m * k + n + ns * k + 3 * k * k + 2 * k;
+    const size_t len = mq_head(s, na) + 3 * k * k + 2 * k;
     double *p = malloc(sizeof(double) * len);
     if (!p)
         return AMFI_ENOMEM;
@@ -366,9 +367,7 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
 
     /* separability on the unknowns (s->na = nu still): A, U, and
      * quad_inverse's M and u after normal_matrix's scratch in s->mq */
-    const size_t m_nm = (size_t)(s->mode ? s->m : s->n);
-    double *A = s->mq + 6 * m_nm + (size_t)s->ns * m_nm + 2 * m_nm * s->mq_na + (size_t)s->n +
-                (size_t)s->ns * s->mq_na;
+    double *A = s->mq + mq_head(s, s->mq_na);
     double *U = A + (size_t)nu * nu;
     double *Mq = U + (size_t)nu * nu + nu;
     double *uq = Mq + (size_t)nu * nu;
