@@ -20,8 +20,8 @@
  * coarse model and minimiser): amfi_solve, amfi_solve_speed and
  * amfi_solve_multi grow the workspace once, before any time loop
  * (tests/libamfi/test_solve_alloc.c counts). A handle is not thread-safe;
- * distinct handles are independent (the bridge model is read-only after creation and may be
- * shared by several solvers and threads).
+ * distinct handles are independent (the bridge model is read-only after
+ * creation and may be shared by several solvers and threads).
  */
 #ifndef AMFI_AMFI_H
 #define AMFI_AMFI_H
