@@ -11,6 +11,7 @@
  *   section_simulation.c         simulation:
  *   section_site.c               site:
  *   section_ops.c                alerts:, metrics:
+ *   section_classes.c            classes:
  *   model_check.c                the bridge built, the solver's workspace bounded
  *
  * and holds the defaults, the order of the checks that run once the whole
@@ -53,6 +54,7 @@ const field amfi_cfg_top_fields[] = {
     {.key = "report", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_report_fields},
     {.key = "detector", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_detector_fields},
     {.key = "ingest", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_ingest_fields},
+    {.key = "classes", .kind = &amfi_cfg_k_map, .aux = amfi_cfg_classes_fields},
     {.key = NULL}};
 
 /* Checks that involve several keys, once the whole file is read; each finds
@@ -65,7 +67,7 @@ static int check_site(ctx *x, void *base)
 
     if (amfi_cfg_bridge_check(x, c) || amfi_cfg_sensors_check(x, c) || amfi_cfg_solver_check(x, c) ||
         amfi_cfg_daemon_check(x, c) || amfi_cfg_sim_check(x, c) || amfi_cfg_site_check(x, c) || amfi_cfg_ops_check(x, c) ||
-        amfi_cfg_ingest_check(x, c))
+        amfi_cfg_ingest_check(x, c) || amfi_cfg_classes_check(x, c))
         return -1;
     return amfi_cfg_model_check(x, c);
 }
@@ -139,6 +141,7 @@ void amfi_config_defaults(amfi_site_config *c)
     c->detector.clock_offset_s = 0.0;
     c->detector.speed_scale = 1.0;
     amfi_config_ingest_defaults(&c->ingest);
+    amfi_class_params_default(&c->classes); /* the European classes, 96/53/EC's limits */
     /* The engine's defaults (docs/indicators.md has the simulation behind
      * each value); set field by field, so the padding stays zero. */
     amfi_indicator_params_default(&d->indicators);

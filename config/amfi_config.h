@@ -22,6 +22,7 @@
 #include <stddef.h>
 
 #include "amfi/amfi.h"
+#include "amfi_classify.h"
 #include "indicators.h"
 #include "known_truck.h"
 #include "scale.h"
@@ -299,6 +300,7 @@ typedef struct amfi_site_config {
                                         speed_pick (amfi_speed_prior_default) */
     amfi_detector_config detector;   /* detector.* */
     amfi_ingest_config ingest;       /* ingest.* (amfi-ingest) */
+    amfi_class_params classes;       /* classes.* (amfi_class_params_default) */
 } amfi_site_config;
 
 /* Fill `c` (not NULL) with the paper-20m defaults: amfi_bridge_params_paper20,

@@ -15,6 +15,7 @@
  *   section_ops.c         alerts:, metrics:  notices and health metrics
  *   section_report.c      report:      what amfi-report holds passages against
  *   section_detector.c    detector:    the vehicle detector's clock offset and speed scale
+ *   section_classes.c     classes:     axle groups, vehicle classes, legal limits
  *
  * Every function runs on the loader's (caller's) thread.
  */
@@ -49,6 +50,7 @@ extern const field amfi_cfg_metrics_fields[]; /* metrics: */
 extern const field amfi_cfg_report_fields[]; /* report: */
 extern const field amfi_cfg_detector_fields[]; /* detector: */
 extern const field amfi_cfg_ingest_fields[]; /* ingest: (section_ingest.c) */
+extern const field amfi_cfg_classes_fields[]; /* classes: (section_classes.c) */
 
 /* The rows of detector.clock_offset_s and detector.speed_scale (names,
  * meanings, ranges), for an amfi_detector_config at byte `at` of the base:
@@ -74,6 +76,7 @@ int amfi_cfg_sim_check(ctx *x, amfi_site_config *c);
 int amfi_cfg_site_check(ctx *x, amfi_site_config *c);
 int amfi_cfg_ops_check(ctx *x, amfi_site_config *c);
 int amfi_cfg_ingest_check(ctx *x, amfi_site_config *c);
+int amfi_cfg_classes_check(ctx *x, amfi_site_config *c);
 
 /* The model itself: the bridge built with libamfi (its refusals reported at
  * the line of the bridge key or section that caused them) and the solver's

@@ -20,24 +20,34 @@
 
 #include "solver_internal.h"
 
-static int grow(struct amfi_solver *s, int want)
+/* Points of the search l: the grid (at least 3) and the refinement. */
+static int lcurve_points(const amfi_lambda *l, int *ngrid)
 {
+    const double dec = log10(l->lcurve_hi / l->lcurve_lo);
+    int n = (int)floor(dec * l->lcurve_per_decade + 1e-9) + 1;
+    if (n < 3)
+        n = 3;
+    if (ngrid)
+        *ngrid = n;
+    return n + l->lcurve_refine_points;
+}
+
+/* One block of 4 × want doubles (λ, ρ, η, κ), replacing the old one only
+ * when it is too small. */
+int amfi_lcurve_reserve(struct amfi_solver *s, const amfi_lambda *l)
+{
+    const int want = lcurve_points(l, NULL);
     if (want <= s->lc_cap)
         return 0;
-    double *a = realloc(s->lc_lam, sizeof(double) * want);
-    if (a)
-        s->lc_lam = a;
-    double *b = realloc(s->lc_res, sizeof(double) * want);
-    if (b)
-        s->lc_res = b;
-    double *c = realloc(s->lc_smo, sizeof(double) * want);
-    if (c)
-        s->lc_smo = c;
-    double *d = realloc(s->lc_kap, sizeof(double) * want);
-    if (d)
-        s->lc_kap = d;
-    if (!a || !b || !c || !d)
+    double *a = malloc(sizeof(double) * 4 * (size_t)want);
+    if (!a)
         return AMFI_ENOMEM;
+    free(s->lc_lam);
+    s->bytes += sizeof(double) * 4 * (size_t)(want - s->lc_cap);
+    s->lc_lam = a;
+    s->lc_res = a + want;
+    s->lc_smo = a + 2 * (size_t)want;
+    s->lc_kap = a + 3 * (size_t)want;
     s->lc_cap = want;
     return 0;
 }
@@ -83,10 +93,9 @@ int amfi_lcurve(struct amfi_solver *s, const amfi_lambda *l, double scale, doubl
                 int *n_solves)
 {
     const double dec = log10(l->lcurve_hi / l->lcurve_lo);
-    int ngrid = (int)floor(dec * l->lcurve_per_decade + 1e-9) + 1;
-    if (ngrid < 3)
-        ngrid = 3;
-    if (grow(s, ngrid + l->lcurve_refine_points))
+    int ngrid;
+    lcurve_points(l, &ngrid);
+    if (amfi_lcurve_reserve(s, l))
         return AMFI_ENOMEM;
     s->lc_n = 0;
     int rc;

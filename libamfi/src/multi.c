@@ -12,8 +12,9 @@
  * (see amfi_vehicle_result in amfi.h). An event of several vehicles may be
  * solved at a fraction of λ (amfi_multi_passage.lambda_factor, round five).
  * Pure computation; runs on the caller's thread and uses the solver handle's
- * workspace (grown here, before any time loop) plus per-call scratch for the
- * quality figure.
+ * workspace, the quality figures' part included (mq_reserve): grown here,
+ * before any time loop, at the first event of a given size; an event no
+ * larger than one before allocates nothing.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -41,26 +42,53 @@ amfi_passage_times amfi_multi_window(double span_m, const amfi_multi_passage *p,
     return w;
 }
 
+/* The quality figures' scratch for events of up to na axles (0, or
+ * AMFI_ENOMEM), in doubles: normal_matrix's Φ (4m), G (2m), c (ns·m),
+ * q (2m·na), mode values (n), y (ns·na); then A (na²), U (na² + na) and
+ * quad_inverse's M (na²) and u (na); m the modes of the sweep (all n in
+ * nodal coordinates). Reallocated only when na exceeds every event's
+ * before. */
+static size_t mq_head(const struct amfi_solver *s, int na)
+{
+    const size_t m = (size_t)(s->mode ? s->m : s->n), ns = (size_t)s->ns, k = (size_t)na;
+    return 6 * m + ns * m + 2 * m * k + (size_t)s->n + ns * k; /* normal_matrix's part */
+}
+
+static int mq_reserve(struct amfi_solver *s, int na)
+{
+    if (na <= s->mq_na)
+        return AMFI_OK;
+    const size_t k = (size_t)na;
+    const size_t len = mq_head(s, na) + 3 * k * k + 2 * k;
+    double *p = malloc(sizeof(double) * len);
+    if (!p)
+        return AMFI_ENOMEM;
+    free(s->mq);
+    s->bytes += sizeof(double) * (len - s->mq_len);
+    s->mq = p;
+    s->mq_len = len;
+    s->mq_na = na;
+    return AMFI_OK;
+}
+
 /* Normal matrix A (na × na) of the constant-axle-load model: column a is the
  * sensors' response, in the solver's output equation (paper: backward
  * difference of modal velocities), to a unit load moving with axle a while it
- * is on the span. Modes: the solver's (modal) or all (nodal). */
-static int normal_matrix(const struct amfi_solver *s, double *A)
+ * is on the span. Modes: the solver's (modal) or all (nodal). Scratch: the
+ * head of s->mq (mq_reserve for at least na axles), A not in it. */
+static void normal_matrix(const struct amfi_solver *s, double *A)
 {
     const amfi_bridge *b = s->b;
     const int n = s->n, na = s->na, ns = s->ns, N = s->N;
     const int m = s->mode ? s->m : n;
     const double L = b->p.span_m, h = s->h;
-    double *Phi = malloc(sizeof(double) * 4 * m);
-    double *G = malloc(sizeof(double) * 2 * m);
-    double *c = malloc(sizeof(double) * ns * m);
-    double *q = calloc((size_t)2 * m * na, sizeof(double));
-    double *all = malloc(sizeof(double) * n);
-    double *y = malloc(sizeof(double) * ns * na);
-    if (!Phi || !G || !c || !q || !all || !y) {
-        free(Phi), free(G), free(c), free(q), free(all), free(y);
-        return AMFI_ENOMEM;
-    }
+    double *Phi = s->mq;
+    double *G = Phi + 4 * (size_t)m;
+    double *c = G + 2 * (size_t)m;
+    double *q = c + (size_t)ns * m;
+    double *all = q + (size_t)2 * m * na;
+    double *y = all + n;
+    memset(q, 0, sizeof(double) * 2 * (size_t)m * na);
     int *mode = s->mode;
     for (int si = 0; si < ns; si++) {
         amfi_bridge_mode_values(b, s->p.sensor_x_m[si], all);
@@ -102,8 +130,6 @@ static int normal_matrix(const struct amfi_solver *s, double *A)
     for (int a = 0; a < na; a++)
         for (int bb = 0; bb < a; bb++)
             A[a * na + bb] = A[bb * na + a];
-    free(Phi), free(G), free(c), free(q), free(all), free(y);
-    return AMFI_OK;
 }
 
 /* Coincident axles. Axle a moves as x = vf[a]·t − off[a] and is on the span
@@ -208,15 +234,10 @@ static void vehicle_gvw(const struct amfi_solver *s, const amfi_multi_passage *p
 }
 
 /* uᵀ M⁻¹ u for the SPD block M of A (na × na) on the k rows/cols idx[0..k),
- * u = ones. */
-static int quad_inverse(const double *A, int na, const int *idx, int k, double *out)
+ * u = ones; M: k² doubles of scratch, u: k. */
+static int quad_inverse(const double *A, int na, const int *idx, int k, double *out, double *M,
+                        double *u)
 {
-    double *M = malloc(sizeof(double) * k * k);
-    double *u = malloc(sizeof(double) * k);
-    if (!M || !u) {
-        free(M), free(u);
-        return AMFI_ENOMEM;
-    }
     for (int i = 0; i < k; i++) {
         u[i] = 1.0;
         for (int j = 0; j < k; j++)
@@ -227,7 +248,6 @@ static int quad_inverse(const double *A, int na, const int *idx, int k, double *
     for (int i = 0; i < k; i++)
         v += u[i];
     *out = v;
-    free(M), free(u);
     return rc ? AMFI_ENUM : AMFI_OK;
 }
 
@@ -289,7 +309,7 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
     REQ(p->t_first_s <= win.start_s + tol && t_last >= win.end_s - tol, AMFI_ERANGE,
         "the data spans [%.6g, %.6g] s but the event needs [%.6g, %.6g] s", p->t_first_s,
         t_last, win.start_s, win.end_s);
-    if (amfi_solver_grow_axles(s, na) != 0)
+    if (amfi_solver_grow_axles(s, na) != 0 || mq_reserve(s, na) != 0)
         return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory for %d axles", na);
     /* axle i of vehicle v at x = v·(t − entry) − offset_i = v·t − (v·entry + offset_i):
      * speed 1, the vehicle's speed as the axle's factor (solver_internal.h) */
@@ -345,15 +365,13 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
         return rc;
     REQ(isfinite(res->all.gvw_kg), AMFI_ENUM, "the joint solution is not finite");
 
-    /* separability on the unknowns (s->na = nu still) */
-    double *A = malloc(sizeof(double) * nu * nu);
-    if (!A)
-        return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory");
-    rc = normal_matrix(s, A);
-    if (rc) {
-        free(A);
-        return amfi_fail(err, errlen, rc, "quality: %s", amfi_strerror(rc));
-    }
+    /* separability on the unknowns (s->na = nu still): A, U, and
+     * quad_inverse's M and u after normal_matrix's scratch in s->mq */
+    double *A = s->mq + mq_head(s, s->mq_na);
+    double *U = A + (size_t)nu * nu;
+    double *Mq = U + (size_t)nu * nu + nu;
+    double *uq = Mq + (size_t)nu * nu;
+    normal_matrix(s, A);
     /* a relative ridge of 1e-12 keeps A invertible for axles close to each
      * other but outside the coincidence tolerance */
     double tr = 0.0;
@@ -384,11 +402,6 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
     res->n_unknowns = nu;
     res->n_vehicles = p->n_vehicles;
     res->total_gvw_kg = 0.0;
-    double *U = malloc(sizeof(double) * (nu * nu + nu));
-    if (!U) {
-        free(A);
-        return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory");
-    }
     i = 0;
     for (int v = 0; v < p->n_vehicles; v++) {
         amfi_vehicle_result *vr = &res->vehicle[v];
@@ -438,10 +451,9 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
             joint = 0.0;
             for (int q = 0; q < k; q++)
                 joint += u[idx[q]];
-            rc = quad_inverse(A, nu, idx, k, &alone);
+            rc = quad_inverse(A, nu, idx, k, &alone, Mq, uq);
         }
         if (rc) {
-            free(U), free(A);
             return amfi_fail(err, errlen, rc, "quality of vehicle %d: %s", v + 1,
                              amfi_strerror(rc));
         }
@@ -453,13 +465,11 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
         } else if (p->n_vehicles > 1) {
             vr->quality = 1.0 + 100.0 * fabs(loose[v] - vr->gvw_kg) / fabs(vr->gvw_kg);
             if (!isfinite(vr->quality)) {
-                free(U), free(A);
                 return amfi_fail(err, errlen, AMFI_ENUM, "quality of vehicle %d is not finite",
                                  v + 1);
             }
         }
     }
-    free(U), free(A);
 #undef REQ
     return AMFI_OK;
 }

@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <gsl/gsl_min.h>
+
 #include "solver_internal.h"
 
 void amfi_solver_destroy(amfi_solver *s)
@@ -35,10 +37,10 @@ void amfi_solver_destroy(amfi_solver *s)
     free(s->gain);
     free(s->gofs);
     free(s->scratch);
-    free(s->lc_lam);
-    free(s->lc_res);
-    free(s->lc_smo);
-    free(s->lc_kap);
+    free(s->lc_lam); /* one block with lc_res, lc_smo, lc_kap */
+    free(s->mq);
+    if (s->brent)
+        gsl_min_fminimizer_free(s->brent);
     amfi_solver_destroy(s->coarse);
     free(s->grid_f);
     free(s);
@@ -256,6 +258,13 @@ int amfi_solver_create(const amfi_bridge *b, const amfi_solver_params *p, amfi_s
     int cap = (int)ceil((p->max_duration_s + p->pre_roll_s + p->post_roll_s) * p->calc_rate_hz) + 1;
     if ((rc = reserve(s, cap)) != 0) {
         rc = amfi_fail(err, errlen, rc, "out of memory for %d steps", cap);
+        goto fail;
+    }
+    /* the L-curve's points for the default search (a longer one grows them) */
+    amfi_lambda deflam;
+    amfi_lambda_default(&deflam);
+    if ((rc = amfi_lcurve_reserve(s, &deflam)) != 0) {
+        rc = amfi_fail(err, errlen, rc, "out of memory");
         goto fail;
     }
     *out = s;

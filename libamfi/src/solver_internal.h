@@ -53,9 +53,21 @@ struct amfi_solver {
     size_t scratch_len;
     size_t bytes;   /* workspace bytes */
 
-    /* L-curve (points sorted by λ) */
+    /* L-curve (points sorted by λ): sized at create for the default search
+     * (amfi_lambda_default), grown once by a longer one (lcurve.c) */
     int lc_cap, lc_n;
     double *lc_lam, *lc_res, *lc_smo, *lc_kap;
+
+    /* amfi_solve_multi's quality figures (multi.c): the normal matrix and its
+     * solves for up to mq_na unknowns, sized at the first event of that many
+     * axles, grown by a larger one */
+    int mq_na;
+    double *mq;
+    size_t mq_len;
+
+    /* speed search (speed.c): Brent's minimiser (gsl_min_fminimizer),
+     * allocated at the first search, owned and freed with this solver */
+    void *brent;
 
     /* speed search (speed.c): the coarse model, created at the first
      * two-level search, owned and freed with this solver */
@@ -98,6 +110,9 @@ static inline double amfi_lambda_scale(const struct amfi_solver *s, const amfi_l
  * amfi_lambda_scale(). Returns the chosen per-step λ in *lam_h (lcurve.c). */
 int amfi_lcurve(struct amfi_solver *s, const amfi_lambda *l, double scale, double *lam_h,
                 int *n_solves);
+/* The L-curve's points for the search l (0, or AMFI_ENOMEM): at most one
+ * reallocation, only when l needs more points than any search before. */
+int amfi_lcurve_reserve(struct amfi_solver *s, const amfi_lambda *l);
 
 /* amfi_solve in three steps, so that a search (speed.c) can run several
  * sweeps over one window (solver.c):

@@ -170,7 +170,11 @@ static double brent(search *q, double a, double fa, double x, double fx, double 
         return x;
     }
     gsl_function F = {objective, q};
-    gsl_min_fminimizer *m = gsl_min_fminimizer_alloc(gsl_min_fminimizer_brent);
+    /* one minimiser per solver, allocated at its first search: set_with_values
+     * starts it afresh each time */
+    if (!q->s->brent)
+        q->s->brent = gsl_min_fminimizer_alloc(gsl_min_fminimizer_brent);
+    gsl_min_fminimizer *m = q->s->brent;
     if (!m) {
         q->rc = AMFI_ENOMEM;
         *fbest = fx;
@@ -193,7 +197,6 @@ static double brent(search *q, double a, double fa, double x, double fx, double 
                 break;
         }
     }
-    gsl_min_fminimizer_free(m);
     *fbest = fmin;
     return best;
 }

@@ -531,7 +531,16 @@ static const bad_case bad_cases[] = {
     {"unknown_key", "solver:\n  calc_rate_hz: 5000\n  lamda: 1e-9\n", 3, "solver.lamda",
      "unknown key"},
     {"unknown_section", "bridge: {}\nmonitor:\n  bus: udpm://\n", 2, "monitor",
-     "unknown key (known: site, bridge, sensors, solver, daemon, simulation, alerts, metrics, report, detector, ingest)"},
+     "unknown key (known: site, bridge, sensors, solver, daemon, simulation, alerts, metrics, report, detector, ingest, classes)"},
+    {"classes_scheme", "classes:\n  scheme: tls8\n", 2, "classes.scheme", "eu, fhwa13"},
+    {"classes_group_spacing", "classes:\n  group_spacing_m: 3\n", 2, "classes.group_spacing_m",
+     "[1, 2.5]"},
+    {"classes_gvw_small", "classes:\n  scheme: eu\n  gvw_limit_kg:\n    A23: 500\n", 4,
+     "classes.gvw_limit_kg.A23", "0 (none) or 1000 .. 100000 kg"},
+    {"classes_unknown_class", "classes:\n  gvw_limit_kg:\n    A24: 40000\n", 3,
+     "classes.gvw_limit_kg.A24", "unknown key (known: CAR, R2, R3, R4, A22, A23, A32, A33)"},
+    {"classes_container", "classes:\n  container_44t: yes\n", 2, "classes.container_44t",
+     "off, on"},
     {"report_gvw_zero", "report:\n  limits:\n    gvw_kg: 0\n", 3, "report.limits.gvw_kg",
      "(0, 1e+06]"},
     {"report_axle_text", "report:\n  limits:\n    axle_kg: heavy\n", 3,
@@ -950,6 +959,32 @@ static void test_bad(void **state)
         fail_msg("want '%s' in '%s'", bc->problem, err);
 }
 
+/* classes: lands in amfi_class_params; absent, the European defaults. */
+static void classes_section(void **state)
+{
+    amfi_site_config c, d;
+    char err[ERRLEN];
+
+    (void)state;
+    amfi_config_defaults(&d);
+    assert_int_equal(d.classes.scheme, AMFI_CLASS_SCHEME_EU);
+    assert_true(d.classes.group_spacing_m == 2.0);
+    assert_true(d.classes.gvw_limit_kg[AMFI_EU_A23] == 40000.0);
+    if (load_text("classes:\n  scheme: fhwa13\n  group_spacing_m: 2.44\n"
+                  "  container_44t: on\n  gvw_limit_kg:\n    R2: 19000\n    CAR: 3500\n"
+                  "  driving_axle_kg: 11000\n  motor_tandem_air: off\n",
+                  &c, err) != 0)
+        fail_msg("%s", err);
+    assert_int_equal(c.classes.scheme, AMFI_CLASS_SCHEME_FHWA13);
+    assert_true(c.classes.group_spacing_m == 2.44);
+    assert_int_equal(c.classes.container_44t, 1);
+    assert_true(c.classes.gvw_limit_kg[AMFI_EU_R2] == 19000.0);
+    assert_true(c.classes.gvw_limit_kg[AMFI_EU_CAR] == 3500.0);
+    assert_true(c.classes.gvw_limit_kg[AMFI_EU_R3] == 26000.0); /* not given: default */
+    assert_true(c.classes.driving_axle_kg == 11000.0);
+    assert_int_equal(c.classes.motor_tandem_air, 0);
+}
+
 /* Bearings with springs and segments land in libamfi's parameters. */
 static void bearings_and_segments(void **state)
 {
@@ -1060,6 +1095,7 @@ int main(void)
     static const struct CMUnitTest fixed[] = {
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(bearings_and_segments),
+        cmocka_unit_test(classes_section),
         cmocka_unit_test(test_site_section),
         cmocka_unit_test(test_shipped_file_is_the_defaults),
         cmocka_unit_test(test_shipped_sim_file_is_the_defaults),

@@ -62,10 +62,11 @@ paste -d ' ' "$tmp/one.tok" "$tmp/joint.tok" | awk '
     END { exit bad }' ||
     fail "the joint solve differs from the one-vehicle solve of the same axles"
 
-# "vehicles":[{"gvw_kg":G,...,"quality":Q,...,"separability":S},{...}] -> "G Q S" per line
+# "vehicles":[{"gvw_kg":G,...,"quality":Q,...,"separability":S,...},{...}] -> "G Q S" per line
+# (the keys after separability, the class and its groups, are not read)
 vehicles() {
     sed 's/.*"vehicles":\[//' "$1" | tr '}' '\n' |
-        sed -n 's/.*"gvw_kg":\([^,]*\),.*"quality":\([^,]*\),.*"separability":\([^,]*\)$/\1 \2 \3/p'
+        sed -n 's/.*"gvw_kg":\([^,]*\),.*"quality":\([^,]*\),.*"separability":\([^,]*\).*/\1 \2 \3/p'
 }
 check() { # FILE TRUTH1 TRUTH2
     vehicles "$1" | awk -v t1="$2" -v t2="$3" '

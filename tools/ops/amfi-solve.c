@@ -479,10 +479,48 @@ static int write_speed_trace(const char *path, const amfi_speed_result *sr,
     return finish_file(f, "--speed-trace", path);
 }
 
-/* The result as one JSON line on stdout (common/amfi_json.h). */
+/* The vehicle's class and axle groups under the site's classes: section
+ * (classify/amfi_classify.h) into o: "class", "groups" (each group's axles,
+ * 0-based within the vehicle, its load, kind and legal limit),
+ * "gvw_limit_kg" and "overload" (its gross weight or a group above its
+ * limit). 0, or −1 (out of memory; a classification error on stderr). */
+static int class_json(const amfi_class_params *cp, int n_axles, const double *spacing_m,
+                      const double *axle_kg, json_t *o)
+{
+    amfi_classification k;
+    char err[256];
+    if (amfi_classify(cp, n_axles, spacing_m, axle_kg, &k, err, sizeof err) != 0) {
+        fprintf(stderr, PROG ": classification: %s\n", err);
+        return -1;
+    }
+    json_t *gs = json_array();
+    for (int i = 0; gs && i < k.n_groups; i++) {
+        const amfi_axle_group *g = &k.group[i];
+        json_t *ax = json_array();
+        for (int a = 0; ax && a < g->n_axles; a++)
+            json_array_append_new(ax, json_integer(g->first + a));
+        json_t *go = json_pack("{s:o, s:o, s:s, s:o}", "axles", ax, "load_kg",
+                               amfi_json_num(g->load_kg), "kind", amfi_group_kind_name(g->kind),
+                               "limit_kg", amfi_json_num(g->limit_kg));
+        if (!go || json_array_append_new(gs, go)) {
+            json_decref(gs);
+            return -1;
+        }
+    }
+    if (!gs || json_object_set_new(o, "class", json_string(k.name)) ||
+        json_object_set_new(o, "groups", gs) ||
+        json_object_set_new(o, "gvw_limit_kg", amfi_json_num(k.gvw_limit_kg)) ||
+        json_object_set_new(o, "overload", json_boolean(k.over != 0)))
+        return -1;
+    return 0;
+}
+
+/* The result as one JSON line on stdout (common/amfi_json.h). spacing_m:
+ * the one vehicle's spacings; with m, mp's vehicles hold each one's. */
 static int print_json(const amfi_site_config *c, const amfi_result *r,
                       const amfi_speed_result *sr, int estimated,
-                      const amfi_multi_result *m, double scan_rate_hz, double solve_ms)
+                      const amfi_multi_result *m, const double *spacing_m,
+                      const amfi_multi_passage *mp, double scan_rate_hz, double solve_ms)
 {
     json_t *axle = json_array(), *force = json_array();
     for (int a = 0; a < r->n_axles; a++) {
@@ -517,6 +555,10 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
         json_decref(o);
         o = NULL;
     }
+    if (o && !m && class_json(&c->classes, r->n_axles, spacing_m, r->axle_kg, o) != 0) {
+        json_decref(o);
+        return -1;
+    }
     if (o && m) { /* --vehicle: one object per vehicle, in the order given */
         json_t *vs = json_array();
         for (int v = 0; v < m->n_vehicles; v++) {
@@ -536,6 +578,13 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
                 json_object_set_new(vo, "group", json_integer(vr->group));
                 json_object_set_new(vo, "n_merged", json_integer(vr->n_merged));
                 json_object_set_new(vo, "group_gvw_kg", amfi_json_num(vr->group_gvw_kg));
+            }
+            if (vo && class_json(&c->classes, vr->n_axles, mp->vehicle[v].axle_spacing_m,
+                                 vr->axle_kg, vo) != 0) {
+                json_decref(vo);
+                json_decref(vs);
+                json_decref(o);
+                return -1;
             }
             json_array_append_new(vs, vo);
         }
@@ -737,7 +786,7 @@ int main(int argc, char **argv)
     if (o.speed_trace && write_speed_trace(o.speed_trace, &sres, &cfg.speed_prior) != 0)
         goto done;
     if (print_json(&cfg, &res, &sres, cfg.speed_estimate, o.n_vehicles ? &mres : NULL,
-                   csv.rate_hz,
+                   o.spacing_m, &mp, csv.rate_hz,
                    elapsed_ms(&t_a, &t_b)) != 0
         || fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, PROG ": stdout: %s\n", strerror(errno));

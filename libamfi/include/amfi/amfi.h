@@ -14,9 +14,14 @@
  * Workload: one bridge model per site (created once), one solver workspace
  * per worker thread (created once per problem size), then many passages of
  * about 1 s at 5000 Hz, each solved in milliseconds. Nothing here allocates
- * inside a time-step loop. A handle is not thread-safe; distinct handles are
- * independent (the bridge model is read-only after creation and may be
- * shared by several solvers and threads).
+ * inside a time-step loop, and a solve allocates nothing unless its problem
+ * is larger than every one the solver has seen (more steps or axles, a
+ * longer L-curve search than the default; the first speed search, its
+ * coarse model and minimiser): amfi_solve, amfi_solve_speed and
+ * amfi_solve_multi grow the workspace once, before any time loop
+ * (tests/libamfi/test_solve_alloc.c counts). A handle is not thread-safe;
+ * distinct handles are independent (the bridge model is read-only after
+ * creation and may be shared by several solvers and threads).
  */
 #ifndef AMFI_AMFI_H
 #define AMFI_AMFI_H
@@ -542,7 +547,9 @@ amfi_passage_times amfi_multi_window(double span_m, const amfi_multi_passage *p,
 
 /* Solve all vehicles' axles in one sweep, coincident axles as one unknown
  * (AMFI_MULTI_COINCIDENT_M). The workspace grows (outside the
- * time loop) to the event's total axles and duration. Refused: no vehicles,
+ * time loop) to the event's total axles and duration, the quality figures'
+ * scratch included; an event no larger than one before allocates nothing.
+ * Refused: no vehicles,
  * more than AMFI_MAX_VEHICLES, more than AMFI_MAX_AXLES axles in all
  * (AMFI_EINVAL); data not covering the window (AMFI_ERANGE). */
 int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lambda *lam,

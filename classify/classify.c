@@ -1,0 +1,341 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * classify.c: axle groups, classes and legal limits (amfi_classify.h; the
+ * rules and their sources in docs/classes.md).
+ */
+#include "amfi_classify.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* A two-axle front of a four-axle rigid truck (twin steer, 1.7 .. 2.1 m in
+ * the simulated population) when farther apart than the group threshold:
+ * a first spacing up to this is a twin steer, above it (3.3 m and more for
+ * a two-axle tractor) a tractor's wheelbase. */
+#define TWIN_STEER_MAX_M 2.5
+
+static const char *const eu_names[AMFI_EU_N] = {"CAR", "R2",  "R3",  "R4",
+                                                "A22", "A23", "A32", "A33"};
+
+const char *amfi_eu_class_name(amfi_eu_class c)
+{
+    return c >= 0 && c < AMFI_EU_N ? eu_names[c] : "unknown";
+}
+
+const char *amfi_class_scheme_name(amfi_class_scheme s)
+{
+    return s == AMFI_CLASS_SCHEME_FHWA13 ? "fhwa13" : "eu";
+}
+
+const char *amfi_group_kind_name(amfi_group_kind k)
+{
+    switch (k) {
+    case AMFI_GROUP_SINGLE: return "single";
+    case AMFI_GROUP_DRIVING: return "driving";
+    case AMFI_GROUP_STEER_PAIR: return "steer pair";
+    case AMFI_GROUP_MOTOR_TANDEM: return "motor tandem";
+    case AMFI_GROUP_TANDEM: return "tandem";
+    case AMFI_GROUP_TRIDEM: return "tridem";
+    default: return "other";
+    }
+}
+
+void amfi_class_params_default(amfi_class_params *p)
+{
+    memset(p, 0, sizeof *p);
+    p->scheme = AMFI_CLASS_SCHEME_EU;
+    p->group_spacing_m = 2.0;
+    p->light_max_kg = 3500.0;
+    p->container_44t = 0;
+    /* Directive 96/53/EC, Annex I, point 2 (docs/classes.md) */
+    p->gvw_limit_kg[AMFI_EU_CAR] = 0.0; /* none: not a heavy vehicle */
+    p->gvw_limit_kg[AMFI_EU_R2] = 18000.0;
+    p->gvw_limit_kg[AMFI_EU_R3] = 26000.0;
+    p->gvw_limit_kg[AMFI_EU_R4] = 32000.0;
+    p->gvw_limit_kg[AMFI_EU_A22] = 36000.0;
+    p->gvw_limit_kg[AMFI_EU_A23] = 40000.0;
+    p->gvw_limit_kg[AMFI_EU_A32] = 40000.0;
+    p->gvw_limit_kg[AMFI_EU_A33] = 40000.0;
+    /* Annex I, point 3 */
+    p->single_axle_kg = 10000.0;
+    p->driving_axle_kg = 11500.0;
+    p->motor_tandem_air = 1;
+}
+
+#define WHY(name, ...)                                                    \
+    do {                                                                  \
+        if (blamed)                                                       \
+            *blamed = (name);                                             \
+        if (why && whylen)                                                \
+            snprintf(why, whylen, __VA_ARGS__);                           \
+        return -1;                                                        \
+    } while (0)
+
+int amfi_class_params_check(const amfi_class_params *p, const char **blamed, char *why,
+                            size_t whylen)
+{
+    if (p->scheme != AMFI_CLASS_SCHEME_EU && p->scheme != AMFI_CLASS_SCHEME_FHWA13)
+        WHY("scheme", "scheme %d: eu or fhwa13", (int)p->scheme);
+    if (!(p->group_spacing_m >= 1.0 && p->group_spacing_m <= 2.5))
+        WHY("group_spacing_m",
+            "group_spacing_m %g: 1.0 .. 2.5 m (tandem and tridem axles are about 1.3 m "
+            "apart, the groups of a truck 2.6 m and more)",
+            p->group_spacing_m);
+    if (!(p->light_max_kg >= 500.0 && p->light_max_kg <= 7500.0))
+        WHY("light_max_kg", "light_max_kg %g: 500 .. 7500 kg", p->light_max_kg);
+    if (p->container_44t != 0 && p->container_44t != 1)
+        WHY("container_44t", "container_44t %d: 0 or 1", p->container_44t);
+    if (p->motor_tandem_air != 0 && p->motor_tandem_air != 1)
+        WHY("motor_tandem_air", "motor_tandem_air %d: 0 or 1", p->motor_tandem_air);
+    for (int c = 0; c < AMFI_EU_N; c++) {
+        const double v = p->gvw_limit_kg[c];
+        if (!(v == 0.0 || (v >= 1000.0 && v <= 100000.0)))
+            WHY(eu_names[c], "gvw_limit_kg.%s %g: 0 (none) or 1000 .. 100000 kg", eu_names[c],
+                v);
+    }
+    if (!(p->single_axle_kg >= 1000.0 && p->single_axle_kg <= 30000.0))
+        WHY("single_axle_kg", "single_axle_kg %g: 1000 .. 30000 kg", p->single_axle_kg);
+    if (!(p->driving_axle_kg >= 1000.0 && p->driving_axle_kg <= 30000.0))
+        WHY("driving_axle_kg", "driving_axle_kg %g: 1000 .. 30000 kg", p->driving_axle_kg);
+    return 0;
+}
+
+int amfi_axle_groups(int n_axles, const double *spacing_m, const double *axle_kg,
+                     double group_spacing_m, amfi_axle_group *g)
+{
+    if (n_axles < 1 || n_axles > AMFI_MAX_AXLES || (n_axles > 1 && !spacing_m) || !g ||
+        !(group_spacing_m > 0.0))
+        return -1;
+    for (int a = 0; a + 1 < n_axles; a++)
+        if (!(isfinite(spacing_m[a]) && spacing_m[a] > 0.0))
+            return -1;
+    int ng = 0;
+    for (int a = 0; a < n_axles;) {
+        int b = a + 1;
+        double sum_sp = 0.0;
+        while (b < n_axles && spacing_m[b - 1] <= group_spacing_m) {
+            sum_sp += spacing_m[b - 1];
+            b++;
+        }
+        amfi_axle_group *gr = &g[ng++];
+        gr->first = a;
+        gr->n_axles = b - a;
+        gr->spacing_m = gr->n_axles > 1 ? sum_sp / (gr->n_axles - 1) : 0.0;
+        gr->load_kg = NAN;
+        if (axle_kg) {
+            gr->load_kg = 0.0;
+            for (int k = a; k < b; k++)
+                gr->load_kg += axle_kg[k];
+        }
+        gr->kind = AMFI_GROUP_OTHER;
+        gr->limit_kg = NAN;
+        a = b;
+    }
+    return ng;
+}
+
+/* ---- the European classes -------------------------------------------------- */
+
+/* Group sizes as a number: [1,1,3] is 113. */
+static int pattern(const amfi_classification *c)
+{
+    int v = 0;
+    for (int i = 0; i < c->n_groups; i++)
+        v = 10 * v + (c->group[i].n_axles < 9 ? c->group[i].n_axles : 9);
+    return v;
+}
+
+static int eu_class(const amfi_class_params *p, const amfi_classification *c,
+                    const double *spacing_m)
+{
+    switch (pattern(c)) {
+    case 11: /* two single axles: a car or van up to light_max_kg */
+        return isfinite(c->gvw_kg) && c->gvw_kg <= p->light_max_kg ? AMFI_EU_CAR : AMFI_EU_R2;
+    case 12:
+        return AMFI_EU_R3;
+    case 22:
+        return AMFI_EU_R4;
+    case 112: /* twin steer wider than the threshold, or a two-axle tractor */
+        return spacing_m[0] <= TWIN_STEER_MAX_M ? AMFI_EU_R4 : AMFI_EU_A22;
+    case 113:
+        return AMFI_EU_A23;
+    case 122:
+        return AMFI_EU_A32;
+    case 123:
+        return AMFI_EU_A33;
+    default:
+        return -1;
+    }
+}
+
+/* Directive 96/53/EC, Annex I, point 3, by the group's (mean) spacing d. */
+static double group_limit(const amfi_class_params *p, amfi_group_kind k, double d)
+{
+    switch (k) {
+    case AMFI_GROUP_SINGLE: return p->single_axle_kg;
+    case AMFI_GROUP_DRIVING: return p->driving_axle_kg;
+    case AMFI_GROUP_STEER_PAIR: return 2.0 * p->single_axle_kg;
+    case AMFI_GROUP_MOTOR_TANDEM: /* 3.5: bands up to 1.8 m; beyond, the last band's */
+        return d < 1.0 ? 11500.0 : d < 1.3 ? 16000.0 : p->motor_tandem_air ? 19000.0 : 18000.0;
+    case AMFI_GROUP_TANDEM: /* 3.2 */
+        return d < 1.0 ? 11000.0 : d < 1.3 ? 16000.0 : d < 1.8 ? 18000.0 : 20000.0;
+    case AMFI_GROUP_TRIDEM: /* 3.3: bands up to 1.4 m; beyond, the last band's */
+        return d <= 1.3 ? 21000.0 : 24000.0;
+    default: return NAN;
+    }
+}
+
+/* The kinds of the groups of a European class. */
+static void eu_kinds(int cls, amfi_classification *c)
+{
+    const int ng = c->n_groups;
+    for (int i = 0; i < ng; i++)
+        c->group[i].kind = AMFI_GROUP_SINGLE;
+    switch (cls) {
+    case AMFI_EU_R2:
+        c->group[1].kind = AMFI_GROUP_DRIVING;
+        break;
+    case AMFI_EU_R3:
+        c->group[1].kind = AMFI_GROUP_MOTOR_TANDEM;
+        break;
+    case AMFI_EU_R4:
+        if (ng == 2) {
+            c->group[0].kind = AMFI_GROUP_STEER_PAIR;
+            c->group[1].kind = AMFI_GROUP_MOTOR_TANDEM;
+        } else {
+            c->group[2].kind = AMFI_GROUP_MOTOR_TANDEM;
+        }
+        break;
+    case AMFI_EU_A22:
+        c->group[1].kind = AMFI_GROUP_DRIVING;
+        c->group[2].kind = AMFI_GROUP_TANDEM;
+        break;
+    case AMFI_EU_A23:
+        c->group[1].kind = AMFI_GROUP_DRIVING;
+        c->group[2].kind = AMFI_GROUP_TRIDEM;
+        break;
+    case AMFI_EU_A32:
+        c->group[1].kind = AMFI_GROUP_MOTOR_TANDEM;
+        c->group[2].kind = AMFI_GROUP_TANDEM;
+        break;
+    case AMFI_EU_A33:
+        c->group[1].kind = AMFI_GROUP_MOTOR_TANDEM;
+        c->group[2].kind = AMFI_GROUP_TRIDEM;
+        break;
+    default:
+        break;
+    }
+}
+
+/* ---- the FHWA 13 classes --------------------------------------------------- */
+
+#define FT 0.3048
+
+/* FHWA Traffic Monitoring Guide's 13 classes from the axle count and the
+ * groups (docs/classes.md gives the table and its simplifications). */
+static int fhwa_class(const amfi_classification *c, const double *spacing_m)
+{
+    const int n = c->n_axles, ng = c->n_groups;
+    if (n < 2)
+        return -1;
+    if (n == 2) {
+        const double s = spacing_m[0];
+        if (s < 6.0 * FT)
+            return 1;  /* motorcycle */
+        if (s < 10.2 * FT)
+            return 2;  /* passenger car */
+        if (s < 13.3 * FT)
+            return 3;  /* pickup, van */
+        if (s < 23.0 * FT)
+            return 5;  /* two-axle six-tyre single unit */
+        return 4;      /* bus */
+    }
+    if (n == 3) {
+        if (ng == 2 && c->group[0].n_axles == 1)
+            return spacing_m[0] >= 23.0 * FT ? 4 : 6; /* bus, or three-axle single unit */
+        return 8;
+    }
+    if (n == 4)
+        return ng == 2 && c->group[0].n_axles == 1 ? 7 : 8;
+    if (n == 5)
+        return ng == 2 ? 7 : ng == 3 ? 9 : 11;
+    if (n == 6)
+        return ng == 2 ? 7 : ng == 3 ? 10 : 12;
+    return ng <= 3 ? 10 : 13;
+}
+
+int amfi_classify(const amfi_class_params *p, int n_axles, const double *spacing_m,
+                  const double *axle_kg, amfi_classification *out, char *err,
+                  size_t errlen)
+{
+#define BAD(...)                                                          \
+    do {                                                                  \
+        if (err && errlen)                                                \
+            snprintf(err, errlen, __VA_ARGS__);                           \
+        return -1;                                                        \
+    } while (0)
+    if (!p || !out)
+        BAD("classify: NULL argument");
+    if (n_axles < 1 || n_axles > AMFI_MAX_AXLES)
+        BAD("%d axles: 1 .. %d", n_axles, AMFI_MAX_AXLES);
+    if (n_axles > 1 && !spacing_m)
+        BAD("%d axles but no spacings", n_axles);
+    for (int a = 0; a + 1 < n_axles; a++)
+        if (!(isfinite(spacing_m[a]) && spacing_m[a] > 0.0))
+            BAD("spacing %d (axles %d-%d): %g m, must be > 0", a + 1, a + 1, a + 2,
+                spacing_m[a]);
+    if (axle_kg)
+        for (int a = 0; a < n_axles; a++)
+            if (!(isfinite(axle_kg[a]) && axle_kg[a] >= 0.0))
+                BAD("axle %d: load %g kg, must be finite and >= 0", a + 1, axle_kg[a]);
+    memset(out, 0, sizeof *out);
+    out->n_axles = n_axles;
+    out->n_groups = amfi_axle_groups(n_axles, spacing_m, axle_kg, p->group_spacing_m,
+                                     out->group);
+    if (out->n_groups < 1)
+        BAD("group_spacing_m %g: must be > 0", p->group_spacing_m);
+    for (int i = 0; i < out->n_groups; i++)
+        for (int k = 0; k < out->group[i].n_axles; k++)
+            out->separable[out->group[i].first + k] = out->group[i].n_axles == 1;
+    out->gvw_kg = NAN;
+    if (axle_kg) {
+        out->gvw_kg = 0.0;
+        for (int a = 0; a < n_axles; a++)
+            out->gvw_kg += axle_kg[a];
+    }
+    out->gvw_limit_kg = NAN;
+    int cls;
+    if (p->scheme == AMFI_CLASS_SCHEME_FHWA13) {
+        cls = fhwa_class(out, spacing_m);
+        if (cls > 0)
+            snprintf(out->name, sizeof out->name, "FHWA%d", cls);
+    } else {
+        cls = eu_class(p, out, spacing_m);
+        if (cls >= 0) {
+            snprintf(out->name, sizeof out->name, "%s", eu_names[cls]);
+            double lim = p->gvw_limit_kg[cls];
+            if (cls == AMFI_EU_A33 && p->container_44t)
+                lim = 44000.0;
+            out->gvw_limit_kg = lim > 0.0 ? lim : NAN;
+            if (cls != AMFI_EU_CAR) {
+                eu_kinds(cls, out);
+                for (int i = 0; i < out->n_groups; i++)
+                    out->group[i].limit_kg =
+                        group_limit(p, out->group[i].kind, out->group[i].spacing_m);
+            }
+        }
+    }
+    out->known = cls >= 0;
+    if (!out->known)
+        snprintf(out->name, sizeof out->name, "unknown");
+    if (isfinite(out->gvw_kg) && isfinite(out->gvw_limit_kg) &&
+        out->gvw_kg > out->gvw_limit_kg)
+        out->over |= AMFI_OVER_GVW;
+    for (int i = 0; i < out->n_groups; i++)
+        if (isfinite(out->group[i].load_kg) && isfinite(out->group[i].limit_kg) &&
+            out->group[i].load_kg > out->group[i].limit_kg)
+            out->over |= AMFI_OVER_GROUP;
+    return 0;
+#undef BAD
+}

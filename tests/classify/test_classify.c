@@ -1,0 +1,284 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * test_classify.c: classify/amfi_classify.h. Axle groups from the spacings
+ * at the threshold's edges; every European class recognised from
+ * sim_publisher's own class definitions (vclass.c: the spacings at their
+ * means and at the ends of their ranges, light and heavy); the FHWA 13
+ * classes of typical vehicles; the legal limits of 96/53/EC by class and
+ * group, overloads of the gross weight and of a group; bad parameters and
+ * arguments refused with a message naming them.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "amfi_classify.h"
+#include "vclass.h"
+
+static amfi_class_params eu(void)
+{
+    amfi_class_params p;
+    amfi_class_params_default(&p);
+    return p;
+}
+
+/* Groups at the threshold: a spacing equal to it joins, one a hair above
+ * it parts; loads are summed per group; axles inside a group are not
+ * separable. */
+static void groups_at_threshold(void **state)
+{
+    (void)state;
+    amfi_axle_group g[AMFI_MAX_AXLES];
+    const double t = 2.0;
+    const double kg[5] = {6000, 10000, 7000, 7100, 7200};
+    double sp[4] = {3.6, 6.0, t, t};
+    assert_int_equal(amfi_axle_groups(5, sp, kg, t, g), 3);
+    assert_int_equal(g[2].first, 2);
+    assert_int_equal(g[2].n_axles, 3);
+    assert_true(fabs(g[2].load_kg - 21300.0) < 1e-9);
+    assert_true(fabs(g[2].spacing_m - t) < 1e-12);
+    sp[3] = nextafter(t, 3.0); /* the last axle parts */
+    assert_int_equal(amfi_axle_groups(5, sp, kg, t, g), 4);
+    assert_int_equal(g[2].n_axles, 2);
+    assert_int_equal(g[3].first, 4);
+    assert_true(fabs(g[3].load_kg - 7200.0) < 1e-9);
+    sp[2] = nextafter(t, 3.0); /* all single */
+    assert_int_equal(amfi_axle_groups(5, sp, kg, t, g), 5);
+    /* one axle: one group; no loads: NaN */
+    assert_int_equal(amfi_axle_groups(1, NULL, NULL, t, g), 1);
+    assert_int_equal(g[0].n_axles, 1);
+    assert_true(isnan(g[0].load_kg));
+    /* the separable flags through amfi_classify */
+    amfi_class_params p = eu();
+    amfi_classification c;
+    const double a23[4] = {3.75, 6.0, 1.31, 1.31};
+    assert_int_equal(amfi_classify(&p, 5, a23, kg, &c, NULL, 0), 0);
+    const int want[5] = {1, 1, 0, 0, 0};
+    for (int a = 0; a < 5; a++)
+        assert_int_equal(c.separable[a], want[a]);
+    /* bad input */
+    const double bad[1] = {0.0};
+    assert_int_equal(amfi_axle_groups(2, bad, NULL, t, g), -1);
+    assert_int_equal(amfi_axle_groups(0, sp, NULL, t, g), -1);
+    assert_int_equal(amfi_axle_groups(AMFI_MAX_AXLES + 1, sp, NULL, t, g), -1);
+}
+
+/* sim_publisher's class of vehicle i with spacings at `at` (0 mean, −1 the
+ * low ends, +1 the high ends) and loads shared as loaded (GVW at the
+ * class's loaded mean) or empty. */
+static void vclass_vehicle(const amfi_vclass *vc, int at, int loaded, double *sp, double *kg)
+{
+    for (int i = 0; i + 1 < vc->n_axles; i++)
+        sp[i] = at < 0 ? vc->sp_lo[i] : at > 0 ? vc->sp_hi[i] : vc->sp_mu[i];
+    const double gvw = loaded ? vc->loaded_mu : vc->empty_mu;
+    for (int a = 0; a < vc->n_axles; a++)
+        kg[a] = gvw * (loaded ? vc->share_loaded[a] : vc->share_empty[a]);
+}
+
+/* Every class sim_publisher simulates is recognised under its own name,
+ * with the groups of its definition (vclass.c's group[]) or, for R4's twin
+ * steer wider than the threshold, its steering axles single; at the means
+ * and at both ends of every spacing range, empty and loaded. */
+static void every_eu_class_from_vclass(void **state)
+{
+    (void)state;
+    amfi_class_params p = eu();
+    assert_true(amfi_vclass_count() == 7);
+    for (int i = 0; i < amfi_vclass_count(); i++) {
+        const amfi_vclass *vc = amfi_vclass_get(i);
+        for (int at = -1; at <= 1; at++)
+            for (int loaded = 0; loaded <= 1; loaded++) {
+                double sp[AMFI_MAX_AXLES], kg[AMFI_MAX_AXLES];
+                vclass_vehicle(vc, at, loaded, sp, kg);
+                amfi_classification c;
+                char err[128];
+                assert_int_equal(amfi_classify(&p, vc->n_axles, sp, kg, &c, err, sizeof err),
+                                 0);
+                if (strcmp(c.name, vc->name) != 0)
+                    fail_msg("%s (spacings %s, %s): classed %s", vc->name,
+                             at < 0 ? "low" : at > 0 ? "high" : "mean",
+                             loaded ? "loaded" : "empty", c.name);
+                assert_true(c.known);
+                /* the definition's groups, but a twin steer beyond the threshold */
+                int gid[AMFI_MAX_AXLES];
+                for (int k = 0; k < c.n_groups; k++)
+                    for (int a = 0; a < c.group[k].n_axles; a++)
+                        gid[c.group[k].first + a] = k;
+                for (int a = 0; a + 1 < vc->n_axles; a++) {
+                    const int same = gid[a] == gid[a + 1];
+                    const int def = vc->group[a] == vc->group[a + 1];
+                    if (def != same && !(vc->n_axles == 4 && vc->tractor_axles == 0 && a == 0 &&
+                                         sp[0] > p.group_spacing_m))
+                        fail_msg("%s: axles %d and %d grouped %d, defined %d", vc->name, a + 1,
+                                 a + 2, same, def);
+                }
+                assert_true(isfinite(c.gvw_limit_kg) && c.gvw_limit_kg >= 18000.0);
+                for (int k = 0; k < c.n_groups; k++)
+                    assert_true(isfinite(c.group[k].limit_kg));
+            }
+    }
+}
+
+/* Two axles: a car or van up to light_max_kg, a truck above; 96/53/EC's
+ * gross-weight limits by class; the container option. */
+static void eu_limits(void **state)
+{
+    (void)state;
+    amfi_class_params p = eu();
+    amfi_classification c;
+    const double sp2[1] = {2.7}, car[2] = {900, 800}, truck[2] = {7000, 11000};
+    assert_int_equal(amfi_classify(&p, 2, sp2, car, &c, NULL, 0), 0);
+    assert_string_equal(c.name, "CAR");
+    assert_true(isnan(c.gvw_limit_kg) && c.over == 0);
+    const double sp2t[1] = {4.8};
+    assert_int_equal(amfi_classify(&p, 2, sp2t, truck, &c, NULL, 0), 0);
+    assert_string_equal(c.name, "R2");
+    assert_true(c.gvw_limit_kg == 18000.0);
+    assert_int_equal(c.group[1].kind, AMFI_GROUP_DRIVING);
+    assert_true(c.group[1].limit_kg == 11500.0);
+    assert_int_equal(c.over, 0);
+    const double heavy[2] = {7000, 11600}; /* GVW 18.6 t, driving axle 11.6 t */
+    assert_int_equal(amfi_classify(&p, 2, sp2t, heavy, &c, NULL, 0), 0);
+    assert_int_equal(c.over, AMFI_OVER_GVW | AMFI_OVER_GROUP);
+    /* A33 at 43 t: over 40 t, not over 44 t with the container option */
+    const double sp6[5] = {3.3, 1.35, 5.3, 1.31, 1.31};
+    const double kg6[6] = {7500, 9000, 9000, 5833, 5833, 5834};
+    assert_int_equal(amfi_classify(&p, 6, sp6, kg6, &c, NULL, 0), 0);
+    assert_string_equal(c.name, "A33");
+    assert_int_equal(c.over, AMFI_OVER_GVW);
+    assert_int_equal(c.group[1].kind, AMFI_GROUP_MOTOR_TANDEM);
+    assert_true(c.group[1].limit_kg == 19000.0); /* 1.35 m, air suspension */
+    assert_int_equal(c.group[2].kind, AMFI_GROUP_TRIDEM);
+    assert_true(c.group[2].limit_kg == 24000.0); /* 1.31 m: 1.3 < d <= 1.4 */
+    p.container_44t = 1;
+    assert_int_equal(amfi_classify(&p, 6, sp6, kg6, &c, NULL, 0), 0);
+    assert_true(c.gvw_limit_kg == 44000.0 && c.over == 0);
+    p.motor_tandem_air = 0;
+    assert_int_equal(amfi_classify(&p, 6, sp6, kg6, &c, NULL, 0), 0);
+    assert_true(c.group[1].limit_kg == 18000.0);
+    /* a trailer's tandem by spacing (A22): 1.0 / 1.3 / 1.8 m edges */
+    p = eu();
+    const double kg4[4] = {6000, 10000, 8000, 8000};
+    const struct {
+        double d, limit;
+    } tandem[] = {{0.99, 11000}, {1.0, 16000}, {1.29, 16000}, {1.3, 18000}, {1.79, 18000},
+                  {1.8, 20000}, {2.0, 20000}};
+    for (size_t k = 0; k < sizeof tandem / sizeof tandem[0]; k++) {
+        const double sp4[3] = {3.7, 6.6, tandem[k].d};
+        assert_int_equal(amfi_classify(&p, 4, sp4, kg4, &c, NULL, 0), 0);
+        assert_string_equal(c.name, "A22");
+        assert_int_equal(c.group[2].kind, AMFI_GROUP_TANDEM);
+        if (c.group[2].limit_kg != tandem[k].limit)
+            fail_msg("tandem %.2f m: limit %g, want %g", tandem[k].d, c.group[2].limit_kg,
+                     tandem[k].limit);
+    }
+    /* a tridem of 1.3 m: 21 t, over it at 22 t (A23) */
+    const double sp5[4] = {3.75, 6.0, 1.3, 1.3}, kg5[5] = {6000, 10000, 7400, 7300, 7300};
+    assert_int_equal(amfi_classify(&p, 5, sp5, kg5, &c, NULL, 0), 0);
+    assert_string_equal(c.name, "A23");
+    assert_true(c.group[2].limit_kg == 21000.0);
+    assert_int_equal(c.over, AMFI_OVER_GROUP);
+    /* an R4 with its twin steer within the threshold: one steer pair, 20 t */
+    const double sp4r[3] = {1.9, 3.4, 1.35}, kg4r[4] = {7000, 7000, 8000, 8000};
+    assert_int_equal(amfi_classify(&p, 4, sp4r, kg4r, &c, NULL, 0), 0);
+    assert_string_equal(c.name, "R4");
+    assert_int_equal(c.n_groups, 2);
+    assert_int_equal(c.group[0].kind, AMFI_GROUP_STEER_PAIR);
+    assert_true(c.group[0].limit_kg == 20000.0);
+    /* what the scheme does not know: a three-axle car and trailer, a 7-axle */
+    const double sp3[2] = {2.7, 3.5}, sp7[6] = {3, 1.3, 5, 1.3, 1.3, 1.3};
+    assert_int_equal(amfi_classify(&p, 3, sp3, NULL, &c, NULL, 0), 0);
+    assert_false(c.known);
+    assert_string_equal(c.name, "unknown");
+    assert_int_equal(c.n_groups, 3);
+    assert_int_equal(amfi_classify(&p, 7, sp7, NULL, &c, NULL, 0), 0);
+    assert_false(c.known);
+}
+
+/* The FHWA 13 classes of typical vehicles (US spacings, feet). */
+static void fhwa_typical(void **state)
+{
+    (void)state;
+    amfi_class_params p = eu();
+    p.scheme = AMFI_CLASS_SCHEME_FHWA13;
+    p.group_spacing_m = 2.44; /* 96 in, the US tandem */
+    const double ft = 0.3048;
+    const struct {
+        const char *what, *want;
+        int n;
+        double sp_ft[8];
+    } v[] = {
+        {"motorcycle", "FHWA1", 2, {4.8}},
+        {"passenger car", "FHWA2", 2, {9.0}},
+        {"pickup", "FHWA3", 2, {11.5}},
+        {"two-axle bus", "FHWA4", 2, {24.0}},
+        {"two-axle six-tyre single unit", "FHWA5", 2, {15.0}},
+        {"three-axle bus", "FHWA4", 3, {25.0, 4.0}},
+        {"three-axle single unit (dump truck)", "FHWA6", 3, {15.0, 4.3}},
+        {"four-axle single unit (concrete mixer)", "FHWA7", 4, {12.0, 4.3, 4.3}},
+        {"three-axle tractor semi-trailer", "FHWA8", 3, {11.0, 25.0}},
+        {"four-axle tractor semi-trailer", "FHWA8", 4, {12.0, 4.3, 30.0}},
+        {"five-axle tractor semi-trailer (3-S2)", "FHWA9", 5, {14.0, 4.3, 33.0, 4.2}},
+        {"six-axle tractor semi-trailer (3-S3)", "FHWA10", 6, {14.0, 4.3, 33.0, 4.2, 4.2}},
+        {"five-axle double (2-S1-2)", "FHWA11", 5, {12.0, 22.0, 9.0, 21.0}},
+        {"six-axle double (3-S1-2)", "FHWA12", 6, {12.0, 4.3, 21.0, 9.0, 21.0}},
+        {"seven-axle triple", "FHWA13", 7, {12.0, 21.0, 9.0, 21.0, 9.0, 21.0}},
+    };
+    for (size_t k = 0; k < sizeof v / sizeof v[0]; k++) {
+        double sp[8];
+        for (int i = 0; i + 1 < v[k].n; i++)
+            sp[i] = v[k].sp_ft[i] * ft;
+        amfi_classification c;
+        assert_int_equal(amfi_classify(&p, v[k].n, sp, NULL, &c, NULL, 0), 0);
+        if (strcmp(c.name, v[k].want) != 0)
+            fail_msg("%s: %s, want %s", v[k].what, c.name, v[k].want);
+        assert_true(isnan(c.gvw_limit_kg)); /* no US limits here */
+    }
+}
+
+/* Bad parameters name their field; bad arguments their axle or spacing. */
+static void refusals(void **state)
+{
+    (void)state;
+    amfi_class_params p = eu();
+    const char *blamed = NULL;
+    char why[256];
+    assert_int_equal(amfi_class_params_check(&p, &blamed, why, sizeof why), 0);
+    p.group_spacing_m = 0.9;
+    assert_int_equal(amfi_class_params_check(&p, &blamed, why, sizeof why), -1);
+    assert_string_equal(blamed, "group_spacing_m");
+    p = eu();
+    p.gvw_limit_kg[AMFI_EU_A32] = 900;
+    assert_int_equal(amfi_class_params_check(&p, &blamed, why, sizeof why), -1);
+    assert_string_equal(blamed, "A32");
+    p = eu();
+    p.scheme = (amfi_class_scheme)7;
+    assert_int_equal(amfi_class_params_check(&p, &blamed, why, sizeof why), -1);
+    assert_string_equal(blamed, "scheme");
+    p = eu();
+    amfi_classification c;
+    char err[128];
+    const double sp[2] = {3.0, NAN}, kg[3] = {1000, -5, 1000};
+    assert_int_equal(amfi_classify(&p, 3, sp, NULL, &c, err, sizeof err), -1);
+    assert_non_null(strstr(err, "spacing 2"));
+    const double sp2[2] = {3.0, 1.3};
+    assert_int_equal(amfi_classify(&p, 3, sp2, kg, &c, err, sizeof err), -1);
+    assert_non_null(strstr(err, "axle 2"));
+    assert_int_equal(amfi_classify(&p, 0, sp2, NULL, &c, err, sizeof err), -1);
+    assert_int_equal(amfi_classify(&p, AMFI_MAX_AXLES + 1, sp2, NULL, &c, err, sizeof err), -1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(groups_at_threshold),  cmocka_unit_test(every_eu_class_from_vclass),
+        cmocka_unit_test(eu_limits),            cmocka_unit_test(fhwa_typical),
+        cmocka_unit_test(refusals),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
