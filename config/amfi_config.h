@@ -20,6 +20,7 @@
 #define AMFI_CONFIG_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "amfi/amfi.h"
 #include "amfi_classify.h"
@@ -247,6 +248,14 @@ typedef struct amfi_detector_config {
     double clock_offset_s; /* [-1, 1], default 0 */
     double speed_scale;    /* [0.5, 2], default 1 */
 } amfi_detector_config;
+
+/* A vehicle as the detector reported it, corrected as `d` says (the one
+ * formula of amfi-solve and amfid, section_detector.c): the true entry is
+ * the reported one minus clock_offset_s (*entry_s in s, *utime in µs,
+ * rounded to the µs; either may be NULL), the true speed and each of the
+ * n_spacings spacings the reported ones divided by speed_scale. */
+void amfi_config_detector_correct(const amfi_detector_config *d, double *entry_s, int64_t *utime,
+                           double *speed_mps, double *spacing_m, int n_spacings);
 
 /* ingest.*: what amfi-ingest(1) reads (section_ingest.c, docs/ingest.md). */
 #define AMFI_INGEST_MAX_CHANNELS AMFI_MAX_SENSORS

@@ -116,7 +116,7 @@ _Static_assert(offsetof(amfi_detector_error, clock_offset_s) ==
                        offsetof(amfi_detector_config, speed_scale),
                "amfi_detector_error starts as amfi_detector_config");
 static const field ab_detector_fields[] = {
-    AMFI_CFG_DETECTOR_ROWS(AB(detector)),
+    AMFI_CFG_DETECTOR_ROWS(AB(detector), 0),
     {.key = "spacing_scale", .kind = &amfi_cfg_k_double, .off = AB(detector.spacing_scale),
      .lo = 0.5, .hi = 2},
     {.key = NULL}};

@@ -53,14 +53,17 @@ extern const field amfi_cfg_ingest_fields[]; /* ingest: (section_ingest.c) */
 extern const field amfi_cfg_classes_fields[]; /* classes: (section_classes.c) */
 
 /* The rows of detector.clock_offset_s and detector.speed_scale (names,
- * meanings, ranges), for an amfi_detector_config at byte `at` of the base:
+ * meanings, ranges), for an amfi_detector_config at byte `at` of the base,
+ * with `fl` added to their flags (F_LIVE in the site file, 0 as built):
  * the site file's detector: section and the as-built file's (whose
  * amfi_detector_error starts alike, checked in as_built.c). */
-#define AMFI_CFG_DETECTOR_ROWS(at)                                                   \
+#define AMFI_CFG_DETECTOR_ROWS(at, fl)                                               \
     {.key = "clock_offset_s", .kind = &amfi_cfg_k_double,                            \
-     .off = (at) + offsetof(amfi_detector_config, clock_offset_s), .lo = -1, .hi = 1}, \
+     .off = (at) + offsetof(amfi_detector_config, clock_offset_s), .lo = -1, .hi = 1, \
+     .flags = (fl)},                                                                 \
     {.key = "speed_scale", .kind = &amfi_cfg_k_double,                               \
-     .off = (at) + offsetof(amfi_detector_config, speed_scale), .lo = 0.5, .hi = 2}
+     .off = (at) + offsetof(amfi_detector_config, speed_scale), .lo = 0.5, .hi = 2,   \
+     .flags = (fl)}
 extern const enum_name amfi_cfg_onoff_names[]; /* off | on (section_daemon.c) */
 
 /* Free DOFs of the beam once the supports (snapped to nodes) are applied. */

@@ -2,7 +2,8 @@
 /*
  * drift.c: amfid's speed-drift alert (issue 12): each stored passage whose
  * speed was estimated (solver.speed: estimate) feeds its correction c =
- * speed weighed with / detector's speed − 1 to the engine
+ * speed weighed with / detector's speed − 1 to the engine (the detector's
+ * speed as detector.speed_scale corrects it: the drift since commissioning)
  * (indicators/speed_drift.h), whose raise and clear events go out like the
  * other alerts (stored, published on the alert channel, counted in the
  * metrics, alerts.command, the journal: the context's emit_alert). At start
@@ -36,6 +37,7 @@ static int drift_restore(amfid_ctx *c)
 {
     char err[512];
     int open = 0;
+    const double scale = c->cfg->detector.speed_scale;
     if (!D.drift || !D.params.enabled)
         return 0;
     amfi_speed_pair *p = NULL;
@@ -52,7 +54,7 @@ static int drift_restore(amfid_ctx *c)
         return 0;
     }
     for (size_t k = 0; k < n; k++)
-        x[k] = amfi_speed_correction(p[k].speed_mps, p[k].speed_given_mps);
+        x[k] = amfi_speed_correction(p[k].speed_mps, p[k].speed_given_mps / scale);
     int taken = amfi_speed_drift_prefill(D.drift, x, (int)n);
     free(x);
     free(p);
@@ -73,8 +75,10 @@ static void drift_feed(amfid_ctx *c, const amfid_passage *ps)
 {
     if (!ps->j->speed_estimated || !D.drift || !D.params.enabled)
         return;
+    /* against the detector's speed as commissioning corrects it: the drift
+     * since commissioning (a known speed_scale is no drift) */
     const double speed_mps = ps->r->speed_mps, speed_given_mps = ps->r->speed_given_mps;
-    double x = amfi_speed_correction(speed_mps, speed_given_mps);
+    double x = amfi_speed_correction(speed_mps, speed_given_mps / c->cfg->detector.speed_scale);
     amfi_alert_event al;
     amfi_speed_drift_eval ev;
     int bits = amfi_speed_drift_push(D.drift, x, &ev, &al);

@@ -15,7 +15,8 @@
  *
  * A module (ctx.h): restore builds the tracker and wants the inputs
  * (bus_want); reload applies the live intake bounds and max_wait_s (the
- * tracker's own copy); its tick releases the windows decided; final logs
+ * tracker's own copy) and logs the detector's corrections (detector.*,
+ * applied to every vehicle where it is admitted, read live); its tick releases the windows decided; final logs
  * what the bounds did.
  *
  * Thread: the main thread only (inside lcm_handle and the loop). Owns the
@@ -243,7 +244,7 @@ static void store_refused(amfid_ctx *d, int64_t vehicle_id, int64_t utime, int l
         j->w.v.utime = (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
     }
     j->w.v.lane = lane;
-    j->w.v.speed_mps = NAN;
+    j->w.v.speed_mps = j->w.v.speed_given_mps = NAN;
     j->w.v.n_axles = 0;
     j->gvw_kg = NAN;
     snprintf(j->status, sizeof j->status, "%s", status);
@@ -313,18 +314,33 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
         why = "n_spacings must be n_axles - 1";
     else if (m.utime <= 0 || m.utime > AMFI_STORE_MAX_UTIME)
         why = "utime out of (0, year 9999]";
-    for (int a = 0; !why && a < m.n_spacings; a++) {
+    for (int a = 0; !why && a < m.n_spacings; a++)
         if (!(m.axle_spacing_m[a] >= 0.5 && m.axle_spacing_m[a] <= 30.0))
             why = "axle_spacing_m out of [0.5, 30]";
-        length_m += m.axle_spacing_m[a];
+    /* The vehicle as the detector's commissioning says it really was
+     * (detector.*, amfi_config_detector_correct, as amfi-solve): entry time on the
+     * accelerometers' clock, speed and spacings unscaled. The checks below
+     * and the tracker see the corrected vehicle; the stored row keeps the
+     * detector's speed beside the one weighed with (docs/daemon.md). */
+    int64_t utime = m.utime;
+    double speed_mps = m.speed_mps, spacing_m[AMFI_MAX_AXLES];
+    if (!why) {
+        for (int a = 0; a < m.n_spacings; a++)
+            spacing_m[a] = m.axle_spacing_m[a];
+        amfi_config_detector_correct(&d->cfg->detector, NULL, &utime, &speed_mps, spacing_m,
+                              m.n_spacings);
+        for (int a = 0; a < m.n_spacings; a++)
+            length_m += spacing_m[a];
+        if (utime <= 0)
+            why = "utime before 1970 once corrected by detector.clock_offset_s";
     }
     /* Plausible for the span: a crawling or endless "vehicle" would hold the
      * span for every real one around it (one at 1 m/s once made 12 real
      * passages multiple); and not dated past the data (256 dated 2286 once
      * filled the tracker). */
-    if (!why && m.speed_mps < c->min_speed_mps) {
+    if (!why && speed_mps < c->min_speed_mps) {
         snprintf(wbuf, sizeof wbuf, "speed_mps %.3g below daemon.intake.min_speed_mps (%g m/s)",
-                 m.speed_mps, c->min_speed_mps);
+                 speed_mps, c->min_speed_mps);
         why = wbuf;
     } else if (!why && length_m > c->max_length_m) {
         snprintf(wbuf, sizeof wbuf,
@@ -369,12 +385,13 @@ static void on_vehicle(const lcm_recv_buf_t *rb, const char *ch, void *user)
         amfi_vehicle_ev v, ev;
         memset(&v, 0, sizeof v);
         v.vehicle_id = m.vehicle_id;
-        v.utime = m.utime;
+        v.utime = utime;
         v.lane = m.lane;
-        v.speed_mps = m.speed_mps;
+        v.speed_mps = speed_mps;
+        v.speed_given_mps = m.speed_mps;
         v.n_axles = m.n_axles;
         for (int a = 0; a < m.n_spacings; a++)
-            v.spacing_m[a] = m.axle_spacing_m[a];
+            v.spacing_m[a] = spacing_m[a];
         v.reference_gvw_kg = has_ref ? m.reference_gvw_kg : 0.0;
         const char *twhy = NULL;
         int trc = amfi_tracker_add(I.tracker, &v, &ev, &twhy);
@@ -425,6 +442,16 @@ static void on_truth(const lcm_recv_buf_t *rb, const char *ch, void *user)
 
 /* ---- the module ---------------------------------------------------------- */
 
+/* The detector's corrections in force (the detector's own entry time of a
+ * stored passage is its utime plus the offset logged here). */
+static void log_detector(const char *when, const amfi_detector_config *dt)
+{
+    LOG_INFO("%sdetector: entry times corrected by detector.clock_offset_s %g s, speeds and "
+             "spacings by detector.speed_scale %g",
+             when, dt->clock_offset_s, dt->speed_scale);
+}
+
+
 static int intake_start(amfid_ctx *c, char *err, size_t errlen)
 {
     (void)c, (void)err, (void)errlen;
@@ -451,6 +478,8 @@ static int intake_restore(amfid_ctx *c)
         return 1;
     }
     admit_limits(c, cfg); /* the rate limits of the inputs: full buckets */
+    if (cfg->detector.clock_offset_s != 0.0 || cfg->detector.speed_scale != 1.0)
+        log_detector("", &cfg->detector);
     bus_want(REJECT_ACCEL, cfg->daemon.ch_accel, on_accel);
     bus_want(REJECT_VEHICLE, cfg->daemon.ch_vehicle, on_vehicle);
     /* the truth is a simulation's: in production not even subscribed */
@@ -464,9 +493,12 @@ static int intake_restore(amfid_ctx *c)
  * tracker reads its own copy of its parameters. */
 static void intake_reload(amfid_ctx *c, const amfi_site_config *old, const amfi_site_config *n)
 {
-    (void)old, (void)n;
     admit_limits(c, c->cfg);
     amfi_tracker_set_max_wait(I.tracker, c->cfg->daemon.max_wait_s);
+    /* the detector's corrections: from the next vehicle admitted on */
+    if (old->detector.clock_offset_s != n->detector.clock_offset_s ||
+        old->detector.speed_scale != n->detector.speed_scale)
+        log_detector("reload: ", &n->detector);
 }
 
 static void intake_tick(amfid_ctx *c)

@@ -23,7 +23,7 @@ static void usage(FILE *f)
             "of the weights and raises alerts (docs/daemon.md).\n"
             "\n"
             "  -c, --config FILE   configuration (default " AMFID_DEFAULT_CONFIG ")\n"
-            "  -d, --db PATH       the store, over daemon.db_path of the file\n"
+            "  -d, --db PATH       the store, over daemon.store.path of the file\n"
             "  -u, --lcm-url URL   the LCM bus, over daemon.lcm_url of the file\n"
             "                      (file://LOG?speed=0 replays a log)\n"
             "  -k, --bus-key FILE  the site's bus key, over daemon.bus.key_file and the\n"

@@ -85,7 +85,7 @@ static void publish_passage(amfid_ctx *d, const amfid_passage *p)
     m.formulation = (char *)amfi_formulation_name(d->cfg->solver.formulation);
     m.solve_ms = j->solve_ms;
     m.site_id = (char *)d->cfg->site.id;
-    m.speed_given_mps = j->w.v.speed_mps;
+    m.speed_given_mps = j->w.v.speed_given_mps;
     m.speed_estimated = (int8_t)j->speed_estimated;
     m.n_vehicles = (int16_t)(j->w.n_vehicles > 1 ? j->w.n_vehicles : 1);
     m.quality = j->quality > 0 ? j->quality : NAN;
@@ -103,7 +103,7 @@ static void job_row(amfid_ctx *d, const job *j, amfi_passage_row *r)
     r->utime = j->w.v.utime;
     r->lane = j->w.v.lane;
     r->speed_mps = speed_used(j);
-    r->speed_given_mps = j->w.v.speed_mps;
+    r->speed_given_mps = j->w.v.speed_given_mps;
     r->speed_estimated = j->speed_estimated;
     r->n_axles = j->w.v.n_axles;
     for (int a = 0; a + 1 < r->n_axles; a++)

@@ -46,7 +46,8 @@ typedef struct amfi_vehicle_ev {
     int64_t vehicle_id;
     int64_t utime;       /* first axle at the bridge entry, µs */
     int lane;
-    double speed_mps;
+    double speed_mps;    /* m/s; utime, speed and spacings as detector.* corrects them */
+    double speed_given_mps; /* the detector's speed as it reported it (stored) */
     int n_axles;
     double spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1 */
     double reference_gvw_kg; /* a calibration truck's pre-weighed GVW, kg; 0: none */

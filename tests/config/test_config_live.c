@@ -285,8 +285,9 @@ static void test_apply_live_copies_exactly_the_live_keys(void **state)
 }
 
 /* The keys amfid's reload applies at once (daemon/control.c reload()):
- * the λ policy, the output channels, the heartbeat, the waits and the
- * intake's bounds. A flag flipped by mistake in a table shows here. */
+ * the λ policy, the output channels, the heartbeat, the waits, the
+ * intake's bounds and the detector's corrections. A flag flipped by
+ * mistake in a table shows here. */
 static int expected_live(const char *p)
 {
     static const char *const exact[] = {
@@ -297,7 +298,8 @@ static int expected_live(const char *p)
     for (int i = 0; exact[i]; i++)
         if (strcmp(p, exact[i]) == 0)
             return 1;
-    return strncmp(p, "solver.lcurve.", 14) == 0 || strncmp(p, "daemon.intake.", 14) == 0;
+    return strncmp(p, "solver.lcurve.", 14) == 0 || strncmp(p, "daemon.intake.", 14) == 0 ||
+           strncmp(p, "detector.", 9) == 0;
 }
 
 static void test_the_live_set(void **state)
@@ -314,7 +316,7 @@ static void test_the_live_set(void **state)
                      expected_live(keys.path[i]) ? "at once" : "at the next start");
         n += keys.live[i];
     }
-    assert_int_equal(9 + 4 + 14, n);
+    assert_int_equal(9 + 4 + 14 + 2, n);
 }
 
 /* ---- through files: the keys a custom parser writes -------------------------- */

@@ -3,11 +3,12 @@
 # amfid_cli.sh: amfid's command line (getopt_long): --help and --version
 # exit 0 on stdout; long and short options, "--opt=value" and "--opt value",
 # "--" ending the options; every bad command line exits 2 with one line on
-# stderr naming the option by its long name, and nothing on stdout.
-# Usage: amfid_cli.sh AMFID CONFIG
+# stderr naming the option by its long name, and nothing on stdout; every
+# configuration key --help names is a key of the loader's table.
+# Usage: amfid_cli.sh AMFID CONFIG TEST_CONFIG_MAN
 set -u
 . "$(dirname "$0")/../common/proc.sh"
-amfid=$1 config=$2
+amfid=$1 config=$2 keys=$3
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 failures=0
@@ -38,6 +39,15 @@ bad() {
 ok help '^usage: amfid ' --help
 ok help-short '--check-config' -h
 ok version '^amfid [0-9]+\.[0-9]+' --version
+# the keys --help names (daemon.store.path, daemon.lcm_url, ...) exist
+name=help-keys
+"$keys" --print > "$tmp/keys" || problem "test_config_man --print"
+"$amfid" --help > "$tmp/help"
+named=$(grep -Eo '(site|bridge|sensors|solver|daemon|simulation|alerts|metrics|report|detector|ingest|classes)\.[a-z_.]*[a-z_]' "$tmp/help" | grep -v '\.md$' | sort -u)
+[ -n "$named" ] || problem "--help names no configuration key"
+for k in $named; do
+    grep -q "^\*$k\* (" "$tmp/keys" || problem "--help names $k, not a configuration key"
+done
 ok version-short '^amfid [0-9]+\.[0-9]+' -V
 ok check-long ': ok \(site local, bridge' --config "$config" --check-config
 ok check-equals ': ok \(site local, bridge' --config="$config" --check-config

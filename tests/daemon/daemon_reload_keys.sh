@@ -10,6 +10,8 @@
 #   solver.lambda, .lambda_ref_rate_hz, .lcurve.*: the same vehicle's data
 #       replayed (later in data time) is solved to another λ or GVW, where
 #       two replays before any change gave the same
+#   detector.*: the same vehicle's data replayed is weighed otherwise (its
+#       entry time or speed corrected by the new value)
 #   daemon.channels.*: passages, indicators, alerts, status on the new
 #       channel (lcm-logger's record)
 #   daemon.status_period_s: status messages at the new period
@@ -51,7 +53,7 @@ sed -n 's/^\*\([^*]*\)\* (.*; applies at once on SIGHUP)$/\1/p' "$dir/keys.txt" 
 # max_wait_s last: on a tracker that ignores it, its window blocks the rest).
 ORDER="daemon.channels.passage daemon.channels.indicator daemon.channels.alert
   solver.lambda solver.lambda_ref_rate_hz solver.lcurve.lo solver.lcurve.hi
-  solver.lcurve.per_decade solver.lcurve.refine
+  solver.lcurve.per_decade solver.lcurve.refine detector.clock_offset_s detector.speed_scale
   daemon.status_period_s daemon.channels.status
   daemon.intake.summary_period_s daemon.intake.vehicle_ahead_s daemon.intake.min_speed_mps
   daemon.intake.max_length_m daemon.intake.calibration_sources daemon.intake.calibration_max_kg
@@ -78,6 +80,8 @@ set_key solver.lcurve.lo 1e-12
 set_key solver.lcurve.hi 1e-10
 set_key solver.lcurve.per_decade 2
 set_key solver.lcurve.refine 2
+set_key detector.clock_offset_s 0
+set_key detector.speed_scale 1
 set_key daemon.channels.passage RL_PASSAGE
 set_key daemon.channels.indicator RL_INDICATOR
 set_key daemon.channels.alert RL_ALERT
@@ -115,6 +119,9 @@ solver:
     hi: $v_solver_lcurve_hi
     per_decade: $v_solver_lcurve_per_decade
     refine: $v_solver_lcurve_refine
+detector:
+  clock_offset_s: $v_detector_clock_offset_s
+  speed_scale: $v_detector_speed_scale
 daemon:
   channels:
     passage: $v_daemon_channels_passage
@@ -268,6 +275,10 @@ for key in $ORDER; do
     reload $key 3 ;;
   solver.lcurve.refine)
     reload $key 3 ;;
+  detector.clock_offset_s)
+    reload $key 0.01 ;; # the replays below enter 10 ms earlier on the data's clock
+  detector.speed_scale)
+    reload $key 1.02 ;;
   daemon.status_period_s)
     t=$(date +%s%6N)
     [ "$(on_channel RL_STATUS)" -gt 0 ] || fail "no status message before the change"
@@ -371,8 +382,9 @@ for key in $ORDER; do
     wait_until "the window with a hole stored 1 s after its end" nonzero \
       "SELECT count(*) FROM passages WHERE vehicle_id = 7007" ;;
   esac
-  # the λ policy: the same data solved again, to another λ or force
-  case $key in solver.*)
+  # the λ policy or the detector's corrections: the same data solved
+  # again, to another λ or force
+  case $key in solver.* | detector.*)
     id=$((id + 1000)); replay 5 $((id - 5))
     wait_until "the replay after the change stored" nonzero "SELECT count(*) FROM passages WHERE vehicle_id = $id"
     [ "$(row $id)" != "$(row $prev)" ] || fail "the same data solved to the same result after the change: $(row $id)"

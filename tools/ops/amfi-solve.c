@@ -655,18 +655,14 @@ int main(int argc, char **argv)
     }
 
     /* the detector as commissioning found it (detector.*): true entry =
-     * reported − clock offset, true speed and spacings = reported / scale */
-    const double dscale = cfg.detector.speed_scale, doff = cfg.detector.clock_offset_s;
-    o.entry_time_s -= doff;
-    o.speed_mps /= dscale;
-    for (int k = 0; k < o.n_spacings; k++)
-        o.spacing_m[k] /= dscale;
-    for (int v = 0; v < o.n_vehicles; v++) {
-        o.vehicle[v].entry_s -= doff;
-        o.vehicle[v].speed_mps /= dscale;
-        for (int k = 0; k + 1 < o.vehicle[v].n_axles; k++)
-            o.vehicle[v].axle_spacing_m[k] /= dscale;
-    }
+     * reported − clock offset, true speed and spacings = reported / scale,
+     * as amfid corrects every vehicle (amfi_config_detector_correct) */
+    amfi_config_detector_correct(&cfg.detector, &o.entry_time_s, NULL, &o.speed_mps, o.spacing_m,
+                          o.n_spacings);
+    for (int v = 0; v < o.n_vehicles; v++)
+        amfi_config_detector_correct(&cfg.detector, &o.vehicle[v].entry_s, NULL,
+                              &o.vehicle[v].speed_mps, o.vehicle[v].axle_spacing_m,
+                              o.vehicle[v].n_axles - 1);
 
     int n_axles = o.n_spacings + 1;
     /* the window, relative to entry (amfi.h: entry − pre_roll .. last exit
