@@ -16,6 +16,9 @@
 #          [RUNS_PER_TRUCK (10)] [VEHICLES (200)] [POPULATION.csv]
 # environment: COMMISSION_ARGS (extra amfi-commission options),
 #              SIM_ARGS (extra sim_publisher options for both simulations),
+#              CAL_ARGS (extra sim_publisher options for the calibration runs
+#                        only, after SIM_ARGS),
+#              SOLVE_ARGS (extra amfi-solve options, e.g. --estimate-speed),
 #              SEED (seed of the road and the traffic, 11),
 #              CAL_SEED (the calibration runs' seed, SEED: the same road)
 set -u
@@ -42,7 +45,7 @@ rm -rf "$out" && mkdir -p "$out" || die "cannot create $out"
 # configuration's seed, 1).
 # shellcheck disable=SC2086
 "$sim" --config "$design" --as-built "$case" --calibration-runs "$out/cal" \
-  --runs-per-truck "$rpt" --seed "${CAL_SEED:-$seed}" ${SIM_ARGS:-} 2>"$out/sim-cal.err" || die "sim_publisher --calibration-runs: $(cat "$out/sim-cal.err")"
+  --runs-per-truck "$rpt" --seed "${CAL_SEED:-$seed}" ${SIM_ARGS:-} ${CAL_ARGS:-} 2>"$out/sim-cal.err" || die "sim_publisher --calibration-runs: $(cat "$out/sim-cal.err")"
 t0=$(date +%s.%N)
 # shellcheck disable=SC2086
 "$com" --config "$design" --runs "$out/cal/RUNS.csv" --out "$out/site.yaml" \
@@ -67,8 +70,13 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
     print $c["name"], $c["entry_time_s"], $c["speed_mps"], sp, $c["gvw_kg"] }' \
   "$out/traffic/meta.csv" > "$out/vehicles.txt" || die "meta.csv"
 while read -r name entry speed sp gvw; do
+  # one vehicle: --vehicle, or (SOLVE_ARGS: --estimate-speed does not take
+  # --vehicle) the same passage given by --entry-time, --speed, --axle-spacing
+  if [ -z "${SOLVE_ARGS:-}" ]; then set -- --vehicle "$entry:$speed:$sp"
+  else set -- --entry-time "$entry" --speed "$speed" --axle-spacing "$sp"; fi
+  # shellcheck disable=SC2086
   r=$("$solve" --config "$out/site.yaml" --accel "$out/traffic/$name.csv" \
-        --vehicle "$entry:$speed:$sp" 2>>"$out/solve.err") || die "amfi-solve $name: $(tail -1 "$out/solve.err")"
+        "$@" ${SOLVE_ARGS:-} 2>>"$out/solve.err") || die "amfi-solve $name: $(tail -1 "$out/solve.err")"
   got=$(printf '%s' "$r" | sed 's/.*"gvw_kg":\([-0-9.e+]*\).*/\1/')
   echo "gross,$got,$gvw"
 done < "$out/vehicles.txt" >> "$out/gross.csv"
