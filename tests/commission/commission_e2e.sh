@@ -45,7 +45,7 @@ near "$ck" 0.010 0.002 || fail "clock offset $ck s, as built 0.010 s"
 near "$ss" 1.00 1e-9 || fail "speed scale x$ss, held at the design's 1"
 # the search's evaluations (each: every searched run solved at the site's
 # rate): the Jacobian's base point is the point just evaluated, and the
-# search stops after 4 trial steps in a row that do not lower the cost
+# search stops when a trial step is within the difference steps of its point
 # (this set: 7, before both 28, the model the same within 0.03 % and
 # 0.06 ms); a count, not a time
 ev=$(num evaluations)
