@@ -327,7 +327,7 @@ typedef struct nls {
     int have_last, in_jacobian;
     /* the lowest cost (the accepted point's) and its point */
     double cost_best, x_best[CM_N_PARAMS];
-    int stalled; /* a rejected trial within the steps: the search stops */
+    int stalled; /* a trial within the difference steps of it: the search stops */
 } nls;
 
 /* residuals: the f1 term, then per run the GVW, the axles and the fit */
