@@ -16,7 +16,11 @@
 #          [RUNS_PER_TRUCK (10)] [VEHICLES (200)] [POPULATION.csv]
 # environment: COMMISSION_ARGS (extra amfi-commission options),
 #              SIM_ARGS (extra sim_publisher options for both simulations),
-#              SEED (traffic seed, 11)
+#              CAL_ARGS (extra sim_publisher options for the calibration runs
+#                        only, after SIM_ARGS),
+#              SOLVE_ARGS (extra amfi-solve options, e.g. --estimate-speed),
+#              SEED (seed of the road and the traffic, 11),
+#              CAL_SEED (the calibration runs' seed, SEED: the same road)
 set -u
 bin=$1 design=$2 case=$3 out=$4
 rpt=${5:-10} nveh=${6:-200}
@@ -30,9 +34,18 @@ acc=$bin/tools/ops/amfi-accuracy
 die() { echo "commission-trial: $*" >&2; exit 1; }
 
 rm -rf "$out" && mkdir -p "$out" || die "cannot create $out"
+# The calibration trucks cross the same road as the traffic (the seed draws
+# the road profile, one carpet per seed): a site has one road. On another
+# seed's road the trucks were weighed against another road's bias: the
+# design bridge weighed with its exact model gives the seed-11 traffic a
+# mean +0.70 %, the same traffic's mean axle force over the span being
+# +0.78 % above the static loads, and that mean force ranges -1.3 .. +1.3 %
+# over seeds 1-14 (docs/results/commissioning.md, "The positive mean").
+# CAL_SEED: another road for the calibration (the former trials: the
+# configuration's seed, 1).
 # shellcheck disable=SC2086
 "$sim" --config "$design" --as-built "$case" --calibration-runs "$out/cal" \
-  --runs-per-truck "$rpt" ${SIM_ARGS:-} 2>"$out/sim-cal.err" || die "sim_publisher --calibration-runs: $(cat "$out/sim-cal.err")"
+  --runs-per-truck "$rpt" --seed "${CAL_SEED:-$seed}" ${SIM_ARGS:-} ${CAL_ARGS:-} 2>"$out/sim-cal.err" || die "sim_publisher --calibration-runs: $(cat "$out/sim-cal.err")"
 t0=$(date +%s.%N)
 # shellcheck disable=SC2086
 "$com" --config "$design" --runs "$out/cal/RUNS.csv" --out "$out/site.yaml" \
@@ -57,8 +70,13 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
     print $c["name"], $c["entry_time_s"], $c["speed_mps"], sp, $c["gvw_kg"] }' \
   "$out/traffic/meta.csv" > "$out/vehicles.txt" || die "meta.csv"
 while read -r name entry speed sp gvw; do
+  # one vehicle: --vehicle, or (SOLVE_ARGS: --estimate-speed does not take
+  # --vehicle) the same passage given by --entry-time, --speed, --axle-spacing
+  if [ -z "${SOLVE_ARGS:-}" ]; then set -- --vehicle "$entry:$speed:$sp"
+  else set -- --entry-time "$entry" --speed "$speed" --axle-spacing "$sp"; fi
+  # shellcheck disable=SC2086
   r=$("$solve" --config "$out/site.yaml" --accel "$out/traffic/$name.csv" \
-        --vehicle "$entry:$speed:$sp" 2>>"$out/solve.err") || die "amfi-solve $name: $(tail -1 "$out/solve.err")"
+        "$@" ${SOLVE_ARGS:-} 2>>"$out/solve.err") || die "amfi-solve $name: $(tail -1 "$out/solve.err")"
   got=$(printf '%s' "$r" | sed 's/.*"gvw_kg":\([-0-9.e+]*\).*/\1/')
   echo "gross,$got,$gvw"
 done < "$out/vehicles.txt" >> "$out/gross.csv"

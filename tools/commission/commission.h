@@ -142,8 +142,12 @@ typedef struct cm_result {
     amfi_site_config site;      /* the commissioned site */
     cm_eval before, after;      /* the design model and the commissioned one, all runs */
     double loo_gvw_err_pct[CM_MAX_RUNS]; /* leave one run out */
-    int iterations, evaluations;
+    int iterations, evaluations; /* the search's */
+    int scan_evaluations;       /* the scans' (at their coarse rate, on fewer runs) */
     double seconds;
+    /* process CPU seconds of the stages: modal identification with the
+     * design's weighing, the scans, the search, the final weighing */
+    double cpu_modal_s, cpu_scan_s, cpu_search_s, cpu_final_s;
 } cm_result;
 
 /* Stage 1 on every run's tail and the ambient records (n_amb, each amb[i]

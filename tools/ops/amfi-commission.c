@@ -534,7 +534,14 @@ int main(int argc, char **argv)
     json_object_set_new(j, "class_runs", have_class ? json_string(cls.class_name) : json_null());
     json_object_set_new(j, "iterations", json_integer(res.iterations));
     json_object_set_new(j, "evaluations", json_integer(res.evaluations));
+    json_object_set_new(j, "scan_evaluations", json_integer(res.scan_evaluations));
     json_object_set_new(j, "seconds", amfi_json_num(res.seconds));
+    json_t *cpu = json_object();
+    json_object_set_new(cpu, "modal_and_design", amfi_json_num(res.cpu_modal_s));
+    json_object_set_new(cpu, "scans", amfi_json_num(res.cpu_scan_s));
+    json_object_set_new(cpu, "search", amfi_json_num(res.cpu_search_s));
+    json_object_set_new(cpu, "final", amfi_json_num(res.cpu_final_s));
+    json_object_set_new(j, "cpu_s", cpu);
     rc = amfi_json_print(stdout, j) != 0;
 done:
     for (int i = 0; i < n_amb; i++)
