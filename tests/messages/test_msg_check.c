@@ -145,7 +145,7 @@ static enc random_message(amfi_msg_type t, int big)
                             rnd_double(), NULL, NULL, rnd_double(), 0, NULL, rnd_double(),
                             rnd_double(), NULL, rnd_double(), NULL, rnd_double(),
                             (int8_t)rnd(), (int16_t)rnd(), rnd_double(), rnd_double(),
-                            rnd_double(), rnd_double()};
+                            rnd_double(), rnd_double(), NULL, 0, NULL, NULL, 0};
         m.status = rnd_string(AMFI_MSG_MAX_PASSAGE_STATUS);
         m.site_id = rnd_string(AMFI_MSG_MAX_PASSAGE_SITE_ID);
         m.reason = rnd_string(AMFI_MSG_MAX_PASSAGE_REASON);
@@ -153,11 +153,22 @@ static enc random_message(amfi_msg_type t, int big)
                                   : rnd_int(0, AMFI_MSG_MAX_PASSAGE_N_AXLES));
         m.axle_kg = rnd_doubles(m.n_axles);
         m.formulation = rnd_string(AMFI_MSG_MAX_PASSAGE_FORMULATION);
+        m.vehicle_class = rnd_string(AMFI_MSG_MAX_PASSAGE_VEHICLE_CLASS);
+        m.n_groups = (int8_t)(big ? AMFI_MSG_MAX_PASSAGE_N_GROUPS
+                                  : rnd_int(0, AMFI_MSG_MAX_PASSAGE_N_GROUPS));
+        int16_t ga[AMFI_MSG_MAX_PASSAGE_N_GROUPS];
+        for (int k = 0; k < m.n_groups; k++)
+            ga[k] = (int16_t)rnd();
+        m.group_axles = ga;
+        m.group_load_kg = rnd_doubles(m.n_groups);
+        m.overload = (int8_t)rnd();
         ENCODE(passage_t, m);
         free(m.site_id);
         free(m.status);
         free(m.reason);
         free(m.axle_kg);
+        free(m.vehicle_class);
+        free(m.group_load_kg);
         free(m.formulation);
         break;
     }
@@ -473,7 +484,7 @@ static enc empty_arrays(amfi_msg_type t)
     case AMFI_MSG_PASSAGE_T: {
         amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
                             1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0,
-                            5.73, 5.70};
+                            5.73, 5.70, (char *)"A23", 0, NULL, NULL, 0};
         ENCODE(passage_t, m);
         break;
     }
