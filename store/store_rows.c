@@ -273,15 +273,10 @@ int st_read_row(sqlite3_stmt *st, int first, const amfi_store_tabledef *t, void 
             continue;
         if (c->sql_type == AMFI_SQL_INTEGER) {
             int64_t v = 0;
-            int null = c->null_ok && sqlite3_column_type(st, col) == SQLITE_NULL;
-            if (!null)
+            if (!(c->null_ok && sqlite3_column_type(st, col) == SQLITE_NULL))
                 rc = st_read_int(st, col, c->ilo, c->ihi, o, &v, err, errlen);
             if (rc == 0)
                 put_int(c, row, v);
-            if (rc == 0 && c->null_rule == AMFI_NULL_FLAG) {
-                int flag = !null;
-                memcpy((char *)row + c->flag_off, &flag, sizeof flag);
-            }
         } else if (c->sql_type == AMFI_SQL_REAL) {
             range rg = {c->lo, c->hi, c->open & 1, c->unit, (c->open & 2) != 0};
             double x = NAN;
