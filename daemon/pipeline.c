@@ -95,8 +95,8 @@ static void publish_passage(amfid_ctx *d, const amfid_passage *p)
     m.f1_comp_hz = r->f1_comp_hz;
     /* the class and groups as stored (the classes module's row hook): the
      * groups' axles and, solved, their loads from the row's axles */
-    int16_t g_axles[AMFI_MAX_AXLES];
-    double g_kg[AMFI_MAX_AXLES];
+    int16_t g_axles[AMFI_MAX_AXLES] = {0};
+    double g_kg[AMFI_MAX_AXLES] = {0};
     m.vehicle_class = (char *)(r->vclass ? r->vclass : "");
     m.overload = (int8_t)(r->has_overload ? r->overload : -1);
     if (r->vclass && r->axle_groups) {
