@@ -10,11 +10,14 @@
 # truth the simulator built the vehicle from), the stored groups are the
 # record's spacings grouped at 2.0 m, overload is decided (0 or 1) for the
 # ok passages; passage_t on the bus carries the same class and groups, and
-# its group loads sum to the stored GVW.
-# Usage: daemon_classes.sh AMFID SIM_PUBLISHER LCM_PASSAGES CONFIG POPULATION_EU
+# its group loads sum to the stored GVW. Then the same vehicles without
+# their sensor data (the recorded bus, vehicle_t only, replayed through
+# file://): each is stored as gap, not solved, and still gets its class and
+# groups from the spacings, with overload NULL.
+# Usage: daemon_classes.sh AMFID SIM_PUBLISHER LCM_PASSAGES LCM_INJECT CONFIG POPULATION_EU
 set -u
 . "$(dirname "$0")/../common/bus_prologue.sh"
-amfid=$1 sim=$2 listen=$3 config=$4 popeu=$5
+amfid=$1 sim=$2 listen=$3 inject=$4 config=$5 popeu=$6
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 q() { sqlite3 "$dir/s.db" "$1"; }
 
@@ -41,7 +44,7 @@ sed -e "s/^  max_axles: [0-9]* /  max_axles: 6 /" "$config" > "$dir/amfid.yaml"
 grep -q "^  max_axles: 6 " "$dir/amfid.yaml" || fail "the test's solver.max_axles did not apply"
 "$amfid" --config "$dir/amfid.yaml" --check-config > /dev/null || fail "check-config"
 amfid_start "$amfid" "$dir/amfid.yaml"
-lcm-logger -c AMFI_PASSAGE -f "$dir/passages.log" > "$dir/logger.log" 2>&1 &
+lcm-logger -f "$dir/passages.log" > "$dir/logger.log" 2>&1 &  # every channel
 lpid=$!; pids="$pids $lpid"
 sleep 0.3
 timeout 240 "$sim" --population "$dir/pop.csv" --vehicles $N --headway 3 --speedup 20 \
@@ -82,3 +85,18 @@ awk 'NR == FNR { cls[$1] = $2; grp[$1] = $3; st[$1] = $4; ov[$1] = $5; gvw[$1] =
        } }
      END { exit bad > 0 }' "$dir/got.txt" "$dir/bus.txt" || { cat "$dir/bus.txt"; fail "passage_t class or groups"; }
 echo "daemon_classes: $N vehicles of $(cut -d' ' -f2 "$dir/want.txt" | sort -u | tr '\n' ' ')stored and published with their class and groups"
+
+# Not solved: the vehicles without their sensor data, stored as gap with
+# their class and groups, overload NULL.
+"$inject" --vehicles-only "$dir/passages.log" "$dir/novdata.log" || fail "lcm_inject --vehicles-only"
+"$amfid" --config "$dir/amfid.yaml" --db "$dir/gap.db" --lcm-url "file://$dir/novdata.log?speed=0" \
+  2> "$dir/amfid.log" || fail "amfid on vehicles without data: exit status $?"
+sqlite3 "$dir/gap.db" "SELECT vehicle_id, class, axle_groups, status, ifnull(overload, 'NULL')
+   FROM passages ORDER BY vehicle_id" | tr '|' ' ' > "$dir/gap.txt"
+cat "$dir/gap.txt"
+[ "$(wc -l < "$dir/gap.txt")" -eq "$N" ] || fail "without data: $(wc -l < "$dir/gap.txt") passages"
+awk 'NR == FNR { cls[$1] = $2; grp[$1] = $3; next }
+     { if ($2 != cls[$1] || $3 != grp[$1]) { print "vehicle " $1 " not solved: " $2 " " $3 ", truth " cls[$1] " " grp[$1]; bad++ }
+       if ($4 != "gap" || $5 != "NULL") { print "vehicle " $1 ": status " $4 ", overload " $5 ", expected gap NULL"; bad++ } }
+     END { exit bad > 0 }' "$dir/want.txt" "$dir/gap.txt" || fail "passages not solved: class or groups wrong"
+echo "daemon_classes: the same $N vehicles without sensor data stored as gap with their class and groups"
