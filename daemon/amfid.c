@@ -64,6 +64,7 @@ static const amfid_module *const modules[] = {
     &metrics_module,     /* metrics.textfile */
     &notify_module,      /* alerts.command */
     &freevib_module,     /* the natural frequency */
+    &classes_module,     /* row: the class, axle groups and overload */
     &pipeline_module,    /* reorder → sink; tick: results stored; on_passage: published */
     &drift_module,       /* the speed-drift alert */
     &stdmean_module,     /* the STD and mean rules */

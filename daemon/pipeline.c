@@ -42,6 +42,7 @@
 #include <unistd.h>
 
 #include "amfi_alert_t.h"
+#include "amfi_classify.h"
 #include "amfi_passage_t.h"
 #include "ctx.h"
 #include "reorder.h"
@@ -92,6 +93,24 @@ static void publish_passage(amfid_ctx *d, const amfid_passage *p)
     m.reference_gvw_kg = j->w.v.reference_gvw_kg > 0 ? j->w.v.reference_gvw_kg : NAN;
     m.f1_hz = r->f1_hz;
     m.f1_comp_hz = r->f1_comp_hz;
+    /* the class and groups as stored (the classes module's row hook): the
+     * groups' axles and, solved, their loads from the row's axles */
+    int16_t g_axles[AMFI_MAX_AXLES] = {0};
+    double g_kg[AMFI_MAX_AXLES] = {0};
+    m.vehicle_class = (char *)(r->vclass ? r->vclass : "");
+    m.overload = (int8_t)(r->has_overload ? r->overload : -1);
+    if (r->vclass && r->axle_groups) {
+        amfi_axle_group g[AMFI_MAX_AXLES];
+        int ng = amfi_axle_groups(r->n_axles, r->spacing_m, j->solved ? r->axle_kg : NULL,
+                                  d->cfg->classes.group_spacing_m, g);
+        for (int k = 0; k < ng; k++) {
+            g_axles[k] = (int16_t)g[k].n_axles;
+            g_kg[k] = g[k].load_kg;
+        }
+        m.n_groups = (int8_t)(ng > 0 ? ng : 0);
+    }
+    m.group_axles = g_axles;
+    m.group_load_kg = g_kg;
     BUS_PUBLISH(d, amfi_passage_t, d->cfg->daemon.ch_passage, &m);
 }
 

@@ -207,6 +207,13 @@ static const char fleet_v6[] =
     "  END LOOP;\n"
     "END $$;\n";
 
+/* Version 7 (site store version 10): the passages' vehicle class, axle
+ * groups and overload, as amfid's classes module stores them. Rows shipped
+ * before keep NULL (as the site store's rows written before its migration). */
+static const char fleet_v7[] =
+    "ALTER TABLE passages ADD COLUMN class text, ADD COLUMN axle_groups text,\n"
+    "  ADD COLUMN overload integer;\n";
+
 /* A later version that adds a site table enables row-level security on it
  * with the two policies of version 6 (fleet_site, fleet_reader), grants
  * amfi_site SELECT, INSERT and amfi_reader SELECT on it, and revokes a new
@@ -221,6 +228,7 @@ const struct fleet_migration fleet_migrations[] = {
         "environment, scale_evals, fleet_latest_scale", fleet_v5},
     {6, "one role per site: fleet_site_roles, row-level security on every site table, "
         "fleet_migrations written by the owner only", fleet_v6},
+    {7, "passages: class, axle_groups and overload", fleet_v7},
 };
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
 

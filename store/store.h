@@ -72,7 +72,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 9
+#define AMFI_STORE_SCHEMA_VERSION 10
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -180,6 +180,13 @@ typedef struct amfi_passage_row {
     double gvw_comp_kg;  /* the weight the STD and mean rules were fed (the GVW
                             at the calibration temperature, or the GVW itself),
                             (0, 1e6] kg; NaN or 0: did not feed them, NULL */
+    const char *vclass;  /* the vehicle class (classify/: "A23", "FHWA9",
+                            "unknown"), 1 .. 15 bytes; NULL: none (NULL) */
+    const char *axle_groups; /* axles per group, front to back, joined by '-'
+                            ("1-1-3"), 1 .. 31 bytes; NULL: none (NULL) */
+    int has_overload;    /* 1: overload holds the legal-limit check; 0: not
+                            decided (not solved), NULL */
+    int overload;        /* 1: the GVW or a group above its limit, else 0 */
 } amfi_passage_row;
 /* The range of a reference GVW (a calibration truck), kg. */
 #define AMFI_STORE_MIN_REF_KG 1000.0

@@ -107,6 +107,14 @@ static const amfi_store_coldef passages[] = {
      .since = 7, .shipped = 5, .meaning = "the fit's R²"},
     REAL("gvw_comp_kg", gvw_comp_kg, AMFI_NULL_ZERO, 1, 0, KG, "kg", 8, 5,
          "the weight the STD and mean rules were fed; NULL did not feed them"),
+    TEXT("class", vclass, AMFI_NULL_PTR, AMFI_TEXT_UTF8, 1, 15, 10, 7,
+         "vehicle class from axles and spacings (classes: scheme), 'unknown'; NULL before v10"),
+    TEXT("axle_groups", axle_groups, AMFI_NULL_PTR, AMFI_TEXT_UTF8, 1, 31, 10, 7,
+         "axles per group front to back, e.g. 1-1-3; NULL before v10"),
+    {.name = "overload", .sql_type = 'i', .ctype = AMFI_C_INT, .off = O(overload),
+     .null_rule = AMFI_NULL_FLAG, .flag_off = O(has_overload), .null_ok = 1, .ilo = 0, .ihi = 1,
+     .unit = "", .since = 10, .shipped = 7,
+     .meaning = "1: GVW or a group above its class's legal limit; NULL not solved"},
 };
 #undef ROW
 

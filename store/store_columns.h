@@ -50,7 +50,7 @@ enum amfi_store_null {
     AMFI_NULL_ZERO,      /* double: NaN or 0 is NULL */
     AMFI_NULL_PTR,       /* text: a NULL pointer is NULL */
     AMFI_NULL_EMPTY,     /* NOT NULL text: a NULL pointer is stored as '' */
-    AMFI_NULL_FLAG,      /* double: NULL when the int field at flag_off is 0,
+    AMFI_NULL_FLAG,      /* double or int: NULL when the int field at flag_off is 0,
                             else a value is needed */
     AMFI_NULL_ZERO_AS,   /* NOT NULL int: 0 is stored as `zero_as` */
     AMFI_NULL_OPTIONAL,  /* integer: NULL when the value is <= 0 */

@@ -288,6 +288,18 @@ static const char schema_v9[] =
     ") STRICT;\n"
     "CREATE INDEX refusals_period ON refusals (period_start);\n";
 
+/* Version 10: the vehicle class and axle groups amfid finds from the axle
+ * count and spacings (classify/, the site file's classes:), and whether
+ * the GVW or a group is above its legal limit (NULL when not solved). NULL
+ * in rows written before. */
+static const char schema_v10[] =
+    "ALTER TABLE passages ADD COLUMN class TEXT\n"
+    "  CHECK (length(class) BETWEEN 1 AND 15);\n"
+    "ALTER TABLE passages ADD COLUMN axle_groups TEXT\n"
+    "  CHECK (length(axle_groups) BETWEEN 1 AND 31);\n"
+    "ALTER TABLE passages ADD COLUMN overload INTEGER\n"
+    "  CHECK (overload IN (0, 1));\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
@@ -300,6 +312,7 @@ const st_migration st_migrations[] = {
     {7, "passages: f1_hz, f1_comp_hz, f1_zeta, f1_r2 (natural frequency)", schema_v7},
     {8, "passages: gvw_comp_kg (the weight the STD and mean rules were fed)", schema_v8},
     {9, "refusals: refused bus messages summarised per period, channel and reason", schema_v9},
+    {10, "passages: class, axle_groups and overload (classify/)", schema_v10},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

@@ -6,12 +6,16 @@
  * message is checked before it is decoded. With --site, one line
  * "CHANNEL SITE_ID" per passage, indicator, alert and status message instead
  * (tests/daemon/daemon_site.sh). With --f1, "PASSAGE_ID VEHICLE_ID STATUS F1_HZ
- * F1_COMP_HZ" (%.6f, nan when none; tests/daemon/daemon_natfreq.sh). With --site
+ * F1_COMP_HZ" (%.6f, nan when none; tests/daemon/daemon_natfreq.sh). With --class,
+ * "PASSAGE_ID VEHICLE_ID STATUS CLASS GROUPS GROUP_LOADS_KG OVERLOAD" (CLASS
+ * "-" when empty, GROUPS the groups' axles joined by '-', GROUP_LOADS_KG the
+ * sum of the groups' loads, %.3f, nan when not solved;
+ * tests/daemon/daemon_classes.sh). With --site
  * and the test's bus key ($CREDENTIALS_DIRECTORY/amfi-bus-key), every
  * message must also carry amfid's valid signature (the trailer verified, each
  * producer's sequence increasing; docs/messages.md).
  *
- *   lcm_passages [--site | --f1] LOG
+ *   lcm_passages [--site | --f1 | --class] LOG
  */
 #include <lcm/eventlog.h>
 #include <stdio.h>
@@ -94,8 +98,9 @@ int main(int argc, char **argv)
 {
     int sites = argc == 3 && strcmp(argv[1], "--site") == 0;
     int f1 = argc == 3 && strcmp(argv[1], "--f1") == 0;
-    if (argc != 2 && !sites && !f1) {
-        fprintf(stderr, "usage: lcm_passages [--site | --f1] LOG\n");
+    int cls = argc == 3 && strcmp(argv[1], "--class") == 0;
+    if (argc != 2 && !sites && !f1 && !cls) {
+        fprintf(stderr, "usage: lcm_passages [--site | --f1 | --class] LOG\n");
         return 2;
     }
     lcm_eventlog_t *in = lcm_eventlog_create(argv[argc - 1], "r");
@@ -124,6 +129,15 @@ int main(int argc, char **argv)
                        m.status);
                 if (f1)
                     printf(" %.6f %.6f", m.f1_hz, m.f1_comp_hz);
+                if (cls) {
+                    double sum = 0.0;
+                    printf(" %s ", m.vehicle_class[0] ? m.vehicle_class : "-");
+                    for (int g = 0; g < m.n_groups; g++) {
+                        printf("%s%d", g ? "-" : "", m.group_axles[g]);
+                        sum += m.group_load_kg[g];
+                    }
+                    printf("%s %.3f %d", m.n_groups ? "" : "-", sum, m.overload);
+                }
                 printf("\n");
                 amfi_passage_t_decode_cleanup(&m);
             }

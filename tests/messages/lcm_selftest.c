@@ -85,6 +85,8 @@ struct round {
     double truth_force_N[AMFI_MAX_AXLES];
     amfi_passage_t passage;      /* solved */
     double passage_axle_kg[AMFI_MAX_AXLES];
+    int16_t passage_group_axles[AMFI_MAX_AXLES];
+    double passage_group_kg[AMFI_MAX_AXLES];
     amfi_passage_t unsolved;     /* status gap: NaN weights, no axles */
     amfi_indicator_t indicator;
     amfi_alert_t alert;
@@ -166,6 +168,16 @@ static void round_make(struct round *r, int i)
     r->passage.reference_gvw_kg = i % 4 == 0 ? 14829.0 : NAN;
     r->passage.f1_hz = 5.7338 - 0.001 * (i % 5); /* paper-20m's first frequency */
     r->passage.f1_comp_hz = i % 4 ? 5.7201 : NAN; /* before the baseline: NaN */
+    /* the class and groups: a two-axle R2 (1-1), or the front axle and the rest */
+    r->passage.vehicle_class = n_axles == 2 ? "R2" : "unknown";
+    r->passage.n_groups = (int8_t)(n_axles > 1 ? 2 : 1);
+    r->passage_group_axles[0] = 1;
+    r->passage_group_axles[1] = (int16_t)(n_axles - 1);
+    r->passage_group_kg[0] = r->passage_axle_kg[0];
+    r->passage_group_kg[1] = r->passage.gvw_kg - r->passage_axle_kg[0];
+    r->passage.group_axles = r->passage_group_axles;
+    r->passage.group_load_kg = r->passage_group_kg;
+    r->passage.overload = (int8_t)(i % 2);
 
     r->unsolved = r->passage;
     r->unsolved.passage_id = 100000 + i;
@@ -179,6 +191,11 @@ static void round_make(struct round *r, int i)
     r->unsolved.residual_rms = NAN;
     r->unsolved.formulation = "";
     r->unsolved.solve_ms = 0;
+    r->unsolved.vehicle_class = "";
+    r->unsolved.n_groups = 0;
+    r->unsolved.group_axles = NULL;
+    r->unsolved.group_load_kg = NULL;
+    r->unsolved.overload = -1;
 
     r->indicator.utime = r->vehicle.utime;
     r->indicator.indicator_id = 700 + i;
@@ -500,7 +517,14 @@ static int same_passage(const char *c, const amfi_passage_t *a, const amfi_passa
             same_d(c, "residual_rms", a->residual_rms, b->residual_rms) +
             same_s(c, "formulation", a->formulation, b->formulation) +
             same_d(c, "solve_ms", a->solve_ms, b->solve_ms) +
-            same_d(c, "reference_gvw_kg", a->reference_gvw_kg, b->reference_gvw_kg);
+            same_d(c, "reference_gvw_kg", a->reference_gvw_kg, b->reference_gvw_kg) +
+            same_s(c, "vehicle_class", a->vehicle_class, b->vehicle_class) +
+            same_i(c, "n_groups", a->n_groups, b->n_groups) +
+            same_i(c, "overload", a->overload, b->overload);
+    for (int k = 0; !e && k < a->n_groups; k++)
+        e += same_i(c, "group_axles", a->group_axles[k], b->group_axles[k]);
+    if (!e && a->n_groups)
+        e += same_da(c, "group_load_kg", a->group_load_kg, b->group_load_kg, a->n_groups);
     return e ? e : same_da(c, "axle_kg", a->axle_kg, b->axle_kg, a->n_axles);
 }
 

@@ -145,7 +145,7 @@ static enc random_message(amfi_msg_type t, int big)
                             rnd_double(), NULL, NULL, rnd_double(), 0, NULL, rnd_double(),
                             rnd_double(), NULL, rnd_double(), NULL, rnd_double(),
                             (int8_t)rnd(), (int16_t)rnd(), rnd_double(), rnd_double(),
-                            rnd_double(), rnd_double()};
+                            rnd_double(), rnd_double(), NULL, 0, NULL, NULL, 0};
         m.status = rnd_string(AMFI_MSG_MAX_PASSAGE_STATUS);
         m.site_id = rnd_string(AMFI_MSG_MAX_PASSAGE_SITE_ID);
         m.reason = rnd_string(AMFI_MSG_MAX_PASSAGE_REASON);
@@ -153,11 +153,22 @@ static enc random_message(amfi_msg_type t, int big)
                                   : rnd_int(0, AMFI_MSG_MAX_PASSAGE_N_AXLES));
         m.axle_kg = rnd_doubles(m.n_axles);
         m.formulation = rnd_string(AMFI_MSG_MAX_PASSAGE_FORMULATION);
+        m.vehicle_class = rnd_string(AMFI_MSG_MAX_PASSAGE_VEHICLE_CLASS);
+        m.n_groups = (int8_t)(big ? AMFI_MSG_MAX_PASSAGE_N_GROUPS
+                                  : rnd_int(0, AMFI_MSG_MAX_PASSAGE_N_GROUPS));
+        int16_t ga[AMFI_MSG_MAX_PASSAGE_N_GROUPS];
+        for (int k = 0; k < m.n_groups; k++)
+            ga[k] = (int16_t)rnd();
+        m.group_axles = ga;
+        m.group_load_kg = rnd_doubles(m.n_groups);
+        m.overload = (int8_t)rnd();
         ENCODE(passage_t, m);
         free(m.site_id);
         free(m.status);
         free(m.reason);
         free(m.axle_kg);
+        free(m.vehicle_class);
+        free(m.group_load_kg);
         free(m.formulation);
         break;
     }
@@ -473,7 +484,7 @@ static enc empty_arrays(amfi_msg_type t)
     case AMFI_MSG_PASSAGE_T: {
         amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
                             1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0,
-                            5.73, 5.70};
+                            5.73, 5.70, (char *)"A23", 0, NULL, NULL, 0};
         ENCODE(passage_t, m);
         break;
     }
@@ -539,6 +550,60 @@ static void test_counts(void **state)
         free(b);
         free(e.buf);
     }
+}
+
+/* passage_t's class and groups: n_groups up to its limit, one over refused
+ * (over_limit, naming the array), a negative count refused, a class name
+ * over its 15 bytes refused. */
+static enc passage_with(const char *vclass, int n_groups)
+{
+    enc e = {0};
+    double none[1] = {0}, kg[AMFI_MSG_MAX_PASSAGE_N_GROUPS + 1];
+    int16_t ax[AMFI_MSG_MAX_PASSAGE_N_GROUPS + 1];
+    for (int k = 0; k <= AMFI_MSG_MAX_PASSAGE_N_GROUPS; k++) {
+        ax[k] = 1;
+        kg[k] = 1000.0 * (k + 1);
+    }
+    amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
+                        1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0,
+                        5.73, 5.70, (char *)vclass, (int8_t)n_groups, ax, kg, 1};
+    ENCODE(passage_t, m);
+    return e;
+}
+
+static void test_passage_groups(void **state)
+{
+    (void)state;
+    char why[256], big[AMFI_MSG_MAX_PASSAGE_VEHICLE_CLASS + 2];
+    for (int n = 0; n <= AMFI_MSG_MAX_PASSAGE_N_GROUPS + 1; n++) {
+        enc e = passage_with("A23", n);
+        int want = n <= AMFI_MSG_MAX_PASSAGE_N_GROUPS ? AMFI_MSG_OK : AMFI_MSG_OVER_LIMIT;
+        expect_reason(AMFI_MSG_PASSAGE_T, e.buf, e.len, want);
+        if (want != AMFI_MSG_OK) {
+            assert_int_equal(amfi_msg_check(AMFI_MSG_PASSAGE_T, e.buf, e.len, why, sizeof why),
+                             AMFI_MSG_OVER_LIMIT);
+            assert_non_null(strstr(why, "passage_t.group_axles"));
+        }
+        free(e.buf);
+    }
+    /* n_groups is the last message's second-to-last byte (then overload) */
+    enc e = passage_with("A23", 0);
+    e.buf[e.len - 2] = 0xff; /* -1 */
+    assert_int_equal(amfi_msg_check(AMFI_MSG_PASSAGE_T, e.buf, e.len, why, sizeof why),
+                     AMFI_MSG_NEGATIVE_COUNT);
+    assert_non_null(strstr(why, "passage_t.group_axles"));
+    free(e.buf);
+    memset(big, 'X', sizeof big - 1);
+    big[sizeof big - 1] = '\0';
+    e = passage_with(big, 0);
+    assert_int_equal(amfi_msg_check(AMFI_MSG_PASSAGE_T, e.buf, e.len, why, sizeof why),
+                     AMFI_MSG_OVER_LIMIT);
+    assert_non_null(strstr(why, "passage_t.vehicle_class"));
+    free(e.buf);
+    big[sizeof big - 2] = '\0'; /* 15 bytes: the limit */
+    e = passage_with(big, 0);
+    expect_reason(AMFI_MSG_PASSAGE_T, e.buf, e.len, AMFI_MSG_OK);
+    free(e.buf);
 }
 
 /* The labels are the documented ones and every type has a name. */
@@ -627,6 +692,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_issue9_negative_string_length),
         cmocka_unit_test(test_bad_strings),
         cmocka_unit_test(test_counts),
+        cmocka_unit_test(test_passage_groups),
         cmocka_unit_test(test_names),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

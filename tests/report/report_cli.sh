@@ -232,27 +232,28 @@ if ok passages-csv --db "$ex" --passages --format csv --status gap; then
     n=$(($(wc -l < "$tmp/out") - 1))
     [ "$n" -eq 4 ] || problem "$n CSV rows of gap passages, expected 4"
     hdr=$(head -1 "$tmp/out")
-    [ "$(echo "$hdr" | awk -F, '{print NF}')" -eq 37 ] || problem "CSV header has $(echo "$hdr" | awk -F, '{print NF}') columns"
-    echo "$hdr" | grep -q ',status,reason,speed_given_mps,speed_estimated,n_vehicles,quality$' || problem "CSV header: $hdr"
-    bad_rows=$(awk -F, 'NR > 1 && NF != 37' "$tmp/out" | wc -l)
-    [ "$bad_rows" -eq 0 ] || problem "$bad_rows CSV rows without 37 columns"
+    [ "$(echo "$hdr" | awk -F, '{print NF}')" -eq 38 ] || problem "CSV header has $(echo "$hdr" | awk -F, '{print NF}') columns"
+    echo "$hdr" | grep -q ',status,reason,speed_given_mps,speed_estimated,n_vehicles,quality,class$' || problem "CSV header: $hdr"
+    bad_rows=$(awk -F, 'NR > 1 && NF != 38' "$tmp/out" | wc -l)
+    [ "$bad_rows" -eq 0 ] || problem "$bad_rows CSV rows without 38 columns"
     has '^2025-11-22T10:00:00Z,1763805600000000,10,10,1,25\.000,2,,,,'
-    has ',gap,12 samples missing in the window,25\.000,0,1,$'
+    has ',gap,12 samples missing in the window,25\.000,0,1,,$'
 fi
 if ok passages-csv-values --db "$ex" --passages --format csv --from 2025-11-22T03:00:00Z --to 2025-11-22T03:00:00Z; then
     row=$(sed -n 2p "$tmp/out")
     [ "$(echo "$row" | cut -d, -f8,9,10)" = "18000.0,7200.0,10800.0" ] || problem "passage 3: '$row'"
     [ "$(echo "$row" | cut -d, -f21)" = "4.500" ] || problem "passage 3 spacing: '$row'"
 fi
-# a vehicle weighed in an event of two (issue 13): n_vehicles and quality exported
+# a vehicle weighed in an event of two (issue 13): n_vehicles and quality
+# exported; its class (store version 10) as stored
 cp "$ex" "$tmp/event.db"
-sqlite3 "$tmp/event.db" "UPDATE passages SET n_vehicles = 2, quality = 1.25 WHERE utime = 1763780400000000"
+sqlite3 "$tmp/event.db" "UPDATE passages SET n_vehicles = 2, quality = 1.25, class = 'A23' WHERE utime = 1763780400000000"
 if ok passages-event-csv --db "$tmp/event.db" --passages --format csv --from 2025-11-22T03:00:00Z --to 2025-11-22T03:00:00Z; then
     row=$(sed -n 2p "$tmp/out")
-    [ "$(echo "$row" | cut -d, -f36,37)" = "2,1.25" ] || problem "event passage: '$row'"
+    [ "$(echo "$row" | cut -d, -f36,37,38)" = "2,1.25,A23" ] || problem "event passage: '$row'"
 fi
 if ok passages-event-json --db "$tmp/event.db" --passages --format json --from 2025-11-22T03:00:00Z --to 2025-11-22T03:00:00Z; then
-    has '"n_vehicles":2,"quality":1\.25\}'
+    has '"n_vehicles":2,"quality":1\.25,"class":"A23"\}'
 fi
 if ok passages-json --db "$ex" --passages --format json --lane 1; then
     n=$(grep -o '"passage_id":' "$tmp/out" | wc -l)
@@ -334,7 +335,7 @@ if ok passages-json-mixed --db "$ex" --summary --overloads --passages --format j
     [ "$n" -eq "$want" ] || problem "$n passage objects, expected $want (gap passages + overloads at the 96/53/EC defaults)"
     has '"by_status":\{"ok":36,"gap":4,'
     has '"natural_frequency":\{"n":36,"mean_hz":5\.7[0-9]*,"sd_hz":0\.0[0-9]*,"compensated_n":18,"compensated_mean_hz":5\.72111'
-    has ',"passages":\[\{"time_utc":"2025-11-22T10:00:00Z",.*"reason":"12 samples missing in the window","speed_given_mps":25\.0,"speed_estimated":false,"n_vehicles":1,"quality":null\}.*\]\}$'
+    has ',"passages":\[\{"time_utc":"2025-11-22T10:00:00Z",.*"reason":"12 samples missing in the window","speed_given_mps":25\.0,"speed_estimated":false,"n_vehicles":1,"quality":null,"class":null\}.*\]\}$'
 fi
 if ok passages-json-none --db "$ex" --passages --format json --lane 7; then
     [ -z "$jcheck" ] || "$jcheck" site_id=fixture-1 < "$tmp/out" || problem "JSON does not parse"

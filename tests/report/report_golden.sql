@@ -24,6 +24,11 @@ UPDATE passages SET f1_hz = 5.5 + 0.125 * (vehicle_id % 3), f1_zeta = 0.03125, f
        f1_comp_hz = CASE WHEN vehicle_id > 120 THEN 5.75 END
 WHERE status = 'ok';
 UPDATE passages SET gvw_comp_kg = gvw_kg + 250 WHERE status = 'ok' AND lane = 2;
+-- the class and groups of version 10 (the three-axle rows: a rigid steer + tandem), one
+-- hostile class text; rows before the migration keep NULL
+UPDATE passages SET class = 'R3', axle_groups = '1-2',
+  overload = CASE WHEN gvw_kg IS NULL THEN NULL ELSE gvw_kg > 26000 END WHERE n_axles = 3;
+UPDATE passages SET class = '=cmd|"x",y' WHERE id = (SELECT max(id) FROM passages WHERE n_axles = 3);
 INSERT INTO axles (passage_id, idx, spacing_m, load_kg)
 SELECT id, 1, NULL, 0.25 * gvw_kg FROM passages WHERE n_axles = 3;
 INSERT INTO axles (passage_id, idx, spacing_m, load_kg)

@@ -1282,6 +1282,70 @@ static void test_f1_and_migration_from_v6(void **state)
     free(a);
 }
 
+/* ---- version 10: class, axle groups, overload; a version-9 file migrates ----- */
+
+static void test_class_and_migration_from_v9(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN], buf[64];
+    amfi_passage_row r;
+    raw_db *db;
+
+    ok_row(&r, 1, DAY_US, 18000.0); /* memset: no class, groups, overload (NULL) */
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    ok_row(&r, 2, DAY_US + 1000, 41000.0);
+    r.vclass = "A23";
+    r.axle_groups = "1-1-3";
+    r.has_overload = 1;
+    r.overload = 1;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    r.has_overload = 1;
+    r.overload = 0; /* decided: not over (0, not NULL) */
+    r.vehicle_id = 3;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    /* refused, naming the field */
+    r.overload = 2;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.overload"));
+    r.overload = 0;
+    r.vclass = "A-class-name-too-long";
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.class"));
+    r.vclass = "";
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.class"));
+    r.vclass = "A23";
+    r.axle_groups = "1-1\n3";
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.axle_groups"));
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    db = raw_open(f->path);
+    assert_int_equal(1, raw_int(db, "SELECT count(*) FROM passages WHERE vehicle_id = 1 AND "
+                                    "class IS NULL AND axle_groups IS NULL AND overload IS NULL"));
+    assert_string_equal("A23 1-1-3 1",
+                        raw_text(db, "SELECT class || ' ' || axle_groups || ' ' || overload "
+                                     "FROM passages WHERE vehicle_id = 2", buf, sizeof buf));
+    assert_int_equal(0, raw_int(db, "SELECT overload FROM passages WHERE vehicle_id = 3"));
+    /* the schema refuses what the checks refuse */
+    assert_int_not_equal(0, raw_try(db, "UPDATE passages SET overload = 2 WHERE vehicle_id = 2"));
+    assert_int_not_equal(0, raw_try(db, "UPDATE passages SET class = '' WHERE vehicle_id = 2"));
+    /* make it a version-9 file, as amfid before the classes left it */
+    raw_downgrade(db, 9);
+    raw_close(db);
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE class IS NULL AND "
+                                    "axle_groups IS NULL AND overload IS NULL"));
+    raw_close(db);
+    ok_row(&r, 4, 2 * DAY_US, 18000.0);
+    r.vclass = "R2";
+    r.axle_groups = "1-1";
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+}
+
 /* ---- version 8: the weight the STD and mean rules were fed; a version-7 file --- */
 
 static void test_gvw_comp_and_migration_from_v7(void **state)
@@ -1786,6 +1850,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_speed_given_and_migration_from_v2, setup, teardown),
         cmocka_unit_test_setup_teardown(test_f1_and_migration_from_v6, setup, teardown),
         cmocka_unit_test_setup_teardown(test_gvw_comp_and_migration_from_v7, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_class_and_migration_from_v9, setup, teardown),
         cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
         cmocka_unit_test_setup_teardown(test_many_passages, setup, teardown),

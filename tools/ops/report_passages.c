@@ -59,6 +59,11 @@ static void p_given(const void *w, report_val *v) { v->x = R(w)->speed_given_mps
 static void p_estimated(const void *w, report_val *v) { v->i = R(w)->speed_estimated; }
 static void p_vehicles(const void *w, report_val *v) { v->i = R(w)->n_vehicles; }
 static void p_quality(const void *w, report_val *v) { v->x = R(w)->quality; }
+static void p_class(const void *w, report_val *v)
+{
+    v->s = R(w)->vclass;
+    v->null = !v->s;
+}
 
 static const report_col passage_cols[] = {
     REPORT_COL("time_utc", COL_WORD, "", NULL, COL_BOTH, p_time),
@@ -79,6 +84,7 @@ static const report_col passage_cols[] = {
     REPORT_COL("speed_estimated", COL_BOOL, "", NULL, COL_BOTH, p_estimated),
     REPORT_COL("n_vehicles", COL_INT, "", NULL, COL_BOTH, p_vehicles),
     REPORT_COL("quality", COL_NUM, "", "%.4g", COL_BOTH, p_quality),
+    REPORT_COL("class", COL_TEXT, "", NULL, COL_BOTH, p_class),
 };
 #undef R
 

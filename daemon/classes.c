@@ -1,0 +1,73 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * classes.c: the vehicle class and axle groups of every stored passage
+ * (classify/, the site file's classes: section, docs/classes.md). A module
+ * (ctx.h) with one hook: row fills the passage's class, its groups (the
+ * axles per group front to back, "1-1-3") and, when it was solved, whether
+ * its GVW or a group is above the legal limit. Classification needs only
+ * the axle count and the detector's spacings, so passages that were not
+ * solved get their class and groups too (their overload stays NULL); a
+ * passage without axles or with a spacing the classifier refuses gets none
+ * (NULL), which the detector's checks make rare (intake validates the
+ * spacings before a vehicle becomes a passage).
+ *
+ * Thread: the main thread only. The row's strings point into this file's
+ * state, valid until the next passage's row hook (the pipeline stores and
+ * publishes one passage before it fills the next one's row).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "amfi_classify.h"
+#include "ctx.h"
+
+static struct {
+    char name[AMFI_CLASS_NAME_LEN];
+    char groups[32];
+} C;
+
+/* "1-1-3": the axles per group, front to back; 0 when it does not fit. */
+static int groups_text(const amfi_classification *k, char *buf, size_t len)
+{
+    size_t n = 0;
+    buf[0] = '\0';
+    for (int g = 0; g < k->n_groups; g++) {
+        int w = snprintf(buf + n, len - n, "%s%d", g ? "-" : "", k->group[g].n_axles);
+        if (w < 0 || (size_t)w >= len - n)
+            return 0;
+        n += (size_t)w;
+    }
+    return n > 0;
+}
+
+static void classes_row(amfid_ctx *c, const amfid_passage *p, amfi_passage_row *r)
+{
+    (void)p;
+    r->vclass = r->axle_groups = NULL;
+    r->has_overload = r->overload = 0;
+    if (r->n_axles < 1 || r->n_axles > AMFI_MAX_AXLES)
+        return;
+    int loads = !isnan(r->gvw_kg);
+    for (int a = 0; loads && a < r->n_axles; a++)
+        loads = isfinite(r->axle_kg[a]) && r->axle_kg[a] >= 0;
+    amfi_classification k;
+    char err[160];
+    if (amfi_classify(&c->cfg->classes, r->n_axles, r->spacing_m, loads ? r->axle_kg : NULL, &k,
+                      err, sizeof err) != 0 &&
+        (!loads || amfi_classify(&c->cfg->classes, r->n_axles, r->spacing_m, NULL, &k, err,
+                                 sizeof err) != 0))
+        return;
+    snprintf(C.name, sizeof C.name, "%s", k.name);
+    r->vclass = C.name;
+    if (groups_text(&k, C.groups, sizeof C.groups))
+        r->axle_groups = C.groups;
+    if (loads) {
+        r->has_overload = 1;
+        r->overload = k.over != 0;
+    }
+}
+
+const amfid_module classes_module = {
+    .name = "classes", .section = "classes", .row = classes_row,
+};
