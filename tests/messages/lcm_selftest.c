@@ -263,6 +263,14 @@ static void put_da(const char *name, const double *v, int n, const char *sep)
     printf("]%s", sep);
 }
 
+static void put_i16a(const char *name, const int16_t *v, int n, const char *sep)
+{
+    printf("%s=[", name);
+    for (int k = 0; k < n; k++)
+        printf("%s%d", k ? "," : "", v[k]);
+    printf("]%s", sep);
+}
+
 static void put_i(const char *name, long long v, const char *sep)
 {
     printf("%s=%lld%s", name, v, sep);
@@ -329,7 +337,12 @@ static void print_round(const struct round *r)
     put_d("quality", p->quality, ";");
     put_d("reference_gvw_kg", p->reference_gvw_kg, ";");
     put_d("f1_hz", p->f1_hz, ";");
-    put_d("f1_comp_hz", p->f1_comp_hz, "\n");
+    put_d("f1_comp_hz", p->f1_comp_hz, ";");
+    put_s("vehicle_class", p->vehicle_class, ";");
+    put_i("n_groups", p->n_groups, ";");
+    put_i16a("group_axles", p->group_axles, p->n_groups, ";");
+    put_da("group_load_kg", p->group_load_kg, p->n_groups, ";");
+    put_i("overload", p->overload, "\n");
 
     const amfi_indicator_t *d = &r->indicator;
     printf("%s\tamfi.indicator_t\t", AMFI_CHANNEL_INDICATOR);

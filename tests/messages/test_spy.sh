@@ -133,6 +133,12 @@ public class AmfiSpyProbe {
                 b.append(i > 0 ? "," : "").append(String.format("0x%016x", Double.doubleToRawLongBits(a[i])));
             return b.append("]").toString();
         }
+        if (v != null && v.getClass().isArray()) { // short[], byte[], int[], long[]: decimal
+            StringBuilder b = new StringBuilder("[");
+            for (int i = 0; i < java.lang.reflect.Array.getLength(v); i++)
+                b.append(i > 0 ? "," : "").append(String.valueOf(java.lang.reflect.Array.get(v, i)));
+            return b.append("]").toString();
+        }
         return String.valueOf(v);
     }
 
