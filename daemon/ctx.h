@@ -3,7 +3,7 @@
  * ctx.h: the inside of amfid: the context of shared services every module
  * is handed, the module interface, the timers, and what the daemon's files
  * offer each other (functions only: every module's state is private to its
- * own file). docs/architecture.md draws it; tests/daemon/daemon_calls.sh
+ * own file). docs/architecture.md draws it; tests/common/call_graph.sh
  * checks, on the built objects, that no two files call each other in a
  * circle (the services a module is handed go through this context's
  * function pointers, the table of modules through ctx->modules).
@@ -18,7 +18,7 @@
  * environment.c, freevib.c, drift.c, stdmean.c, scaleind.c (the
  * indicators), classes.c (class and axle groups of each passage), notify.c, metrics.c, status.c (heartbeat, intake record).
  *
- * Who calls whom (from the built objects; tests/daemon/daemon_calls.sh
+ * Who calls whom (from the built objects; tests/common/call_graph.sh
  * fails when this list differs from the library, or when it has a circle):
  *   admit.c -> reject.c
  *   alert.c -> log.c metrics.c notify.c

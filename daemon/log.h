@@ -2,7 +2,7 @@
 /*
  * log.h: amfid's log: lines on stderr with the <N> priority prefixes that
  * journald reads. log.c calls nothing of amfid's: every daemon file may
- * log without making a circle of calls (tests/daemon_calls.sh).
+ * log without making a circle of calls (tests/common/call_graph.sh).
  */
 #ifndef AMFID_LOG_H
 #define AMFID_LOG_H

@@ -3,7 +3,7 @@
  * internal.h: helpers shared by libamfi's sources; not part of the API.
  *
  * Call graph between libamfi's files (file -> files it calls). No file calls
- * back into one that calls it; tests/libamfi/libamfi_calls.sh (ctest libamfi_calls)
+ * back into one that calls it; tests/common/call_graph.sh (ctest libamfi_calls)
  * reads the library with nm, fails on a cycle and fails when this list
  * differs from the code:
  *   speed.c -> solver.c status.c sweep.c

@@ -23,7 +23,7 @@
  *   report_plot.c        gnuplot helpers and the plot frame (report_plot.h)
  *   report_util.c        statistics, times, the failure message
  *
- * Who calls whom (tests/report/report_calls.sh reads it from the objects
+ * Who calls whom (tests/common/call_graph.sh reads it from the objects
  * with nm, fails on a circle and when this list differs; report_cols.c,
  * report_plot.c, report_util.c and report_pg.c call no report file):
  *   amfi-report.c -> report_indicators.c report_natfreq.c report_passages.c report_pg.c
