@@ -15,6 +15,9 @@ pkgs=(
   libglib2.0-dev                 # lcm.pc requires glib-2.0; liblcm-dev does not pull it in
   libsodium-dev                  # HMAC-SHA-512-256 of the signed bus (messages/amfi_auth.c)
   libmseed-dev                   # MiniSEED 2 records (libmseed 2.19): amfi-ingest reads data loggers (tools/ingest/)
+  libmicrohttpd-dev              # HTTP server of amfi-web (tools/web/): the read-only dashboard and JSON API
+  libjs-chart.js                 # Chart.js, served locally by amfi-web (no CDN: sites have no internet)
+  chromium                       # headless browser: the web_* tests load amfi-web's pages and check what they draw
   liblcm-bin                     # lcm-gen, lcm-logger, lcm-logplayer
   liblcm-java                    # lcm.jar: lcm-spy (tools/ops/amfi-spy)
   default-jdk-headless           # javac, jar: amfi_types.jar for lcm-spy
