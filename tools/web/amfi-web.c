@@ -175,7 +175,8 @@ static enum MHD_Result send_bytes(struct MHD_Connection *c, const void *data, si
 
 typedef struct params {
     web_param p[MAX_PARAMS];
-    int n, too_many;
+    int n;
+    const char *too_many; /* the first parameter beyond MAX_PARAMS */
 } params;
 
 static enum MHD_Result collect(void *cls, enum MHD_ValueKind kind, const char *key,
@@ -184,7 +185,7 @@ static enum MHD_Result collect(void *cls, enum MHD_ValueKind kind, const char *k
     (void)kind;
     params *ps = cls;
     if (ps->n == MAX_PARAMS) {
-        ps->too_many = 1;
+        ps->too_many = key;
         return MHD_NO;
     }
     ps->p[ps->n].name = key;
@@ -211,7 +212,7 @@ static enum MHD_Result answer(void *cls, struct MHD_Connection *c, const char *u
         if (ps.too_many) {
             char msg[64];
             snprintf(msg, sizeof msg, "more than %d parameters", MAX_PARAMS);
-            return send_json(c, 400, web_error(msg, ps.p[MAX_PARAMS - 1].name));
+            return send_json(c, 400, web_error(msg, ps.too_many));
         }
         maybe_refresh(sv);
         web_reply r = web_api(&sv->src, url, ps.p, ps.n);
@@ -324,6 +325,34 @@ static unsigned char *read_file(const char *path, size_t *len)
     }
     fclose(f);
     return buf;
+}
+
+static int hexval(char c)
+{
+    return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10
+           : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+}
+
+/* libmicrohttpd's unescaping of the path and the parameters, except that
+   %00 stays as it is: a NUL would cut the text short ("/static/app.js%00.png"
+   would be served as "/static/app.js"), so it reaches no comparison. */
+static size_t unescape(void *cls, struct MHD_Connection *c, char *s)
+{
+    (void)cls;
+    (void)c;
+    char *w = s;
+    for (const char *r = s; *r;) {
+        int hi, lo;
+        if (r[0] == '%' && r[1] && r[2] && (hi = hexval(r[1])) >= 0 && (lo = hexval(r[2])) >= 0
+            && (hi | lo) != 0) {
+            *w++ = (char)(hi * 16 + lo);
+            r += 3;
+        } else {
+            *w++ = *r++;
+        }
+    }
+    *w = 0;
+    return (size_t)(w - s);
 }
 
 static void mhd_log(void *cls, const char *fmt, va_list ap)
@@ -452,7 +481,8 @@ int main(int argc, char **argv)
         MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
         MHD_OPTION_CONNECTION_LIMIT, (unsigned)maxc, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
         (unsigned)(maxc > 16 ? maxc / 2 : maxc), MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)timeout,
-        MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)64 * 1024, MHD_OPTION_END);
+        MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)64 * 1024, MHD_OPTION_UNESCAPE_CALLBACK,
+        unescape, NULL, MHD_OPTION_STRICT_FOR_CLIENT, 1, MHD_OPTION_END);
     int rc = 0;
     if (!d) {
         logf_("cannot listen on %s: %s", listen, strerror(errno));

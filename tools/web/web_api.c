@@ -518,7 +518,7 @@ static web_reply api_trends(const web_source *src, const web_param *p, int np)
     int64_t from, to;
     long points = DEFAULT_POINTS;
     if (only(p, np, allowed, &r) || range_params(p, np, &from, &to, &r)
-        || int_param(p, np, "points", 1, AMFI_WEB_MAX_BUCKETS, 1, &points, &r))
+        || int_param(p, np, "points", 1, AMFI_WEB_MAX_BUCKETS, 0, &points, &r))
         return r;
     const char *name = get(p, np, "series");
     if (!name)
