@@ -326,6 +326,19 @@ int main(int argc, char **argv)
     j = get_json("/api/trends?series=gvw&from=2026-01-11&to=2026-01-11T23:59:59Z", 200);
     CHECK(sum_n(at(j, "points")) == 16, "gvw of 2026-01-11: %lld", sum_n(at(j, "points")));
     json_decref(j);
+    /* without from: the 30 days before `to` (or the newest passage) */
+    j = get_json("/api/trends?series=gvw&to=2026-01-10T10:00:00Z", 200);
+    CHECK(sum_n(at(j, "points")) == 8
+              && strcmp(sval(j, "from_utc"), "2025-12-11T10:00:00.000000Z") == 0,
+          "gvw up to 10:00: %lld from %s", sum_n(at(j, "points")), sval(j, "from_utc"));
+    json_decref(j);
+    j = get_json("/api/classes?to=2026-01-10T10:00:00Z", 200);
+    CHECK(sum_n(at(j, "classes")) == 10, "classes up to 10:00: %lld", sum_n(at(j, "classes")));
+    json_decref(j);
+    j = get_json("/api/trends?series=gvw", 200);
+    CHECK(strcmp(sval(j, "from_utc"), "2025-12-12T16:00:00.000000Z") == 0,
+          "default window from %s", sval(j, "from_utc"));
+    json_decref(j);
     j = get_json("/api/trends?series=gvw&from=2030-01-01", 200);
     CHECK(json_array_size(at(j, "points")) == 0, "trend of an empty range");
     json_decref(j);

@@ -21,6 +21,10 @@
 #define MAX_CLASSES 256
 #define MAX_ALERTS 500
 #define DAY_US INT64_C(86400000000)
+/* /api/trends and /api/classes without `from`: the 30 days before `to`, or
+   before the newest passage (a whole store's year of passages costs about
+   a second per million rows scanned: docs/results/web.md) */
+#define DEFAULT_DAYS 30
 
 /* At most 64 bytes of s, bytes outside printable ASCII as '?': for messages
    about what a client sent (which need not be UTF-8). */
@@ -128,6 +132,29 @@ static int range_params(const web_param *p, int np, int64_t *from, int64_t *to, 
         *r = reply(400, web_error("from is after to", "from"));
         return -1;
     }
+    return 0;
+}
+
+/* range_params, and without `from` the DEFAULT_DAYS days before `to` or, without
+   `to` either, before the newest passage (its end inclusive). */
+static int window_params(amfi_store *s, const web_param *p, int np, int64_t *from, int64_t *to,
+                         web_reply *r)
+{
+    if (range_params(p, np, from, to, r))
+        return -1;
+    if (get(p, np, "from"))
+        return 0;
+    int64_t end = *to;
+    if (!get(p, np, "to")) {
+        amfi_web_status st;
+        char err[512];
+        if (amfi_store_web_status(s, AMFI_STORE_MAX_UTIME, &st, err, sizeof err)) {
+            *r = store_failed(err);
+            return -1;
+        }
+        end = st.last_id > 0 ? st.last_utime : web_now_us();
+    }
+    *from = end > DEFAULT_DAYS * DAY_US ? end - DEFAULT_DAYS * DAY_US : 0;
     return 0;
 }
 
@@ -517,7 +544,7 @@ static web_reply api_trends(const web_source *src, const web_param *p, int np)
     web_reply r;
     int64_t from, to;
     long points = DEFAULT_POINTS;
-    if (only(p, np, allowed, &r) || range_params(p, np, &from, &to, &r)
+    if (only(p, np, allowed, &r) || window_params(src->store, p, np, &from, &to, &r)
         || int_param(p, np, "points", 1, AMFI_WEB_MAX_BUCKETS, 0, &points, &r))
         return r;
     const char *name = get(p, np, "series");
@@ -543,6 +570,8 @@ static web_reply api_trends(const web_source *src, const web_param *p, int np)
     }
     json_t *o = json_object(), *arr = json_array();
     json_object_set_new(o, "series", json_string(name));
+    set_time(o, "from", from);
+    set_time(o, "to", to);
     json_object_set_new(o, "unit", json_string(series_units[which]));
     json_object_set_new(o, "bucket_s", json_real((double)width / 1e6));
     for (int k = 0; k < n; k++) {
@@ -567,7 +596,7 @@ static web_reply api_classes(const web_source *src, const web_param *p, int np)
     static const char *const allowed[] = {"from", "to", NULL};
     web_reply r;
     int64_t from, to;
-    if (only(p, np, allowed, &r) || range_params(p, np, &from, &to, &r))
+    if (only(p, np, allowed, &r) || window_params(src->store, p, np, &from, &to, &r))
         return r;
     amfi_web_class *c = malloc(MAX_CLASSES * sizeof *c);
     int n = 0;

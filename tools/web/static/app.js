@@ -195,13 +195,29 @@ const seriesList = [['gvw', 'GVW of ok passages', 'kg'], ['indicator', 'STD indi
   ['natfreq', 'first natural frequency', 'Hz'], ['residual', 'fit residual RMS', 'm/s²'],
   ['temperature', 'deck temperature', '°C']];
 
+// a from/to form for the pages whose API defaults to the last 30 days
+function rangeForm(action, q, shown) {
+  const input = name => {
+    const i = el('input', {name: name, size: '20'});
+    i.value = q.get(name) || '';
+    return i;
+  };
+  return el('form', {method: 'get', action: action},
+    el('label', {}, 'from ', input('from')), el('label', {}, 'to ', input('to')),
+    el('button', {type: 'submit'}, 'show'),
+    el('span', {class: 'muted', id: 'range'}, ' ' + when(shown.from_utc) + ' to ' +
+       when(shown.to_utc) + (q.get('from') ? '' : ' (default: the 30 days before the newest passage)')));
+}
+
 async function pageTrends() {
   const q = new URLSearchParams(location.search);
   const range = new URLSearchParams();
   for (const k of ['from', 'to']) if (q.get(k)) range.set(k, q.get(k));
   const parts = [];
+  let shown = null;
   for (const [name, title, unit] of seriesList) {
     const t = await api('/api/trends?series=' + name + (range.toString() ? '&' + range : ''));
+    shown = shown || t;
     const labels = t.points.map(p => when(p.t_utc));
     parts.push(el('h2', {}, title + (unit ? ' (' + unit + ')' : '') + ': ' + t.count +
                   ' points, ' + Math.round(t.bucket_s) + ' s each'));
@@ -210,7 +226,7 @@ async function pageTrends() {
       {label: 'min', data: t.points.map(p => p.min), borderColor: '#9ab', pointRadius: 0},
       {label: 'max', data: t.points.map(p => p.max), borderColor: '#c96', pointRadius: 0}], unit));
   }
-  main.replaceChildren(...parts);
+  main.replaceChildren(rangeForm('/trends', q, shown), ...parts);
 }
 
 // ---- alerts ----------------------------------------------------------------------
@@ -228,9 +244,12 @@ async function pageAlerts() {
 
 // ---- classes ----------------------------------------------------------------------
 async function pageClasses() {
-  const c = await api('/api/classes');
+  const q = new URLSearchParams(location.search);
+  const range = new URLSearchParams();
+  for (const k of ['from', 'to']) if (q.get(k)) range.set(k, q.get(k));
+  const c = await api('/api/classes' + (range.toString() ? '?' + range : ''));
   const name = x => x.class === null ? '(none)' : x.class;
-  main.replaceChildren(el('h2', {}, 'Passages per class'),
+  main.replaceChildren(rangeForm('/classes', q, c), el('h2', {}, 'Passages per class'),
     table('classes', ['class', 'passages', 'ok', 'overloaded', 'mean GVW kg', 'max GVW kg'],
       c.classes.map(x => el('tr', {}, cell(name(x)), cell(x.n, 'num'), cell(x.n_ok, 'num'),
         cell(x.n_overload, 'num'), cell(num(x.gvw_mean_kg, 0), 'num'),
