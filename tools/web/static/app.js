@@ -260,4 +260,7 @@ async function pageClasses() {
 
 const pages = {'/': pageStatus, '/passages': pagePassages, '/vehicle': pageVehicle,
                '/trends': pageTrends, '/alerts': pageAlerts, '/classes': pageClasses};
-(pages[location.pathname] || (async () => { throw new Error('no such page'); }))().catch(fail);
+// data-drawn-ms on <body>: milliseconds from navigation to the first drawing
+// (tools/bench/amfi-web-bench reads it)
+(pages[location.pathname] || (async () => { throw new Error('no such page'); }))().catch(fail)
+  .finally(() => document.body.setAttribute('data-drawn-ms', String(Math.round(performance.now()))));
