@@ -79,7 +79,17 @@ const passageHead = ['id', 'time (UTC)', 'lane', 'class', 'axles', 'groups', 'GV
                      'speed m/s', 'status', 'reason'];
 
 // ---- status (live) ---------------------------------------------------------
+// live: drawn again every 5 s, and tried again 5 s after a failure (amfid or
+// the store restarting)
 async function pageStatus() {
+  try {
+    await drawStatus();
+  } finally {
+    setTimeout(() => pageStatus().catch(fail), 5000);
+  }
+}
+
+async function drawStatus() {
   const s = await api('/api/status');
   const last = await api('/api/passages?limit=10');
   const counts = c => table('', ['status', 'passages'],
@@ -115,7 +125,6 @@ async function pageStatus() {
                 ', every 5 s'));
   document.getElementById('site').textContent = 'amfi: ' + (s.site_name || s.site || '');
   main.replaceChildren(...parts);
-  setTimeout(() => pageStatus().catch(fail), 5000);
 }
 
 // ---- passages ----------------------------------------------------------------
