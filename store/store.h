@@ -17,6 +17,7 @@
  * store_read.c (what amfid reads back, maintenance), store_report.c (the
  * queries of reports), store_export.c (the passage listing), store_speed.c
  * (the estimated speeds), store_environment.c (the environment readings),
+ * store_web.c (amfi-web's reads),
  * store_natfreq.c (the natural frequencies), store_columns.c (the column
  * table, store_columns.h: every stored column once), store_rows.c (the
  * INSERTs, bindings and checks of the tables written from a row struct, from
@@ -502,6 +503,91 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
 int amfi_store_each_passage(amfi_store *s, int64_t from, int64_t to,
                             const char *status, amfi_store_passage_fn fn,
                             void *ctx, char *err, size_t errlen);
+
+/* ---- the web dashboard's reads (store_web.c, amfi-web) -------------------- */
+
+/* The newest passage and the counts by status since a time. */
+typedef struct amfi_web_status {
+    int64_t total;        /* passages */
+    int64_t last_id;      /* the newest (by utime, then id); 0: none */
+    int64_t last_utime;   /* its data time, µs; 0: none */
+    int64_t since_total;  /* passages with utime >= since */
+    int64_t since_by_status[AMFI_STORE_N_STATUS]; /* amfi_store_status_name order */
+} amfi_web_status;
+
+int amfi_store_web_status(amfi_store *s, int64_t since, amfi_web_status *out, char *err,
+                          size_t errlen);
+
+/* One passage as stored: row's strings point into the buffers here. */
+typedef struct amfi_web_passage {
+    int64_t id;
+    amfi_passage_row row;
+    char status[16];
+    char reason[AMFI_STORE_REASON_MAX + 1];
+    char formulation[64];
+    char vclass[16];
+    char groups[32];
+} amfi_web_passage;
+
+/* Called once per passage (valid during the call only); nonzero stops. */
+typedef int (*amfi_web_passage_fn)(void *ctx, const amfi_web_passage *p);
+
+#define AMFI_WEB_MAX_LIMIT 1000 /* passages in one listing */
+typedef struct amfi_web_query {
+    int64_t from, to;     /* from <= utime <= to, µs */
+    const char *status;   /* NULL: any; else one of AMFI_STORE_STATUSES */
+    const char *vclass;   /* NULL: any; else the class (1 .. 15 bytes) */
+    int limit;            /* 1 .. AMFI_WEB_MAX_LIMIT */
+} amfi_web_query;
+
+/* The newest `limit` passages the query selects, newest first (utime, id),
+   without their axle rows (spacing_m, axle_kg NaN). */
+int amfi_store_web_passages(amfi_store *s, const amfi_web_query *q, amfi_web_passage_fn fn,
+                            void *ctx, char *err, size_t errlen);
+
+/* Passage id with its axle rows: *found 1, or 0 when there is none. */
+int amfi_store_web_passage(amfi_store *s, int64_t id, amfi_web_passage *out, int *found,
+                           char *err, size_t errlen);
+
+/* The trend series: ok GVW (passages.gvw_kg), the STD indicator's ratio
+   (indicators.std_ratio), the natural frequency (passages.f1_hz), the fit
+   residual (passages.residual_rms), the deck temperature (environment.deck_c). */
+enum { AMFI_WEB_GVW, AMFI_WEB_INDICATOR, AMFI_WEB_NATFREQ, AMFI_WEB_RESIDUAL,
+       AMFI_WEB_TEMPERATURE, AMFI_WEB_N_SERIES };
+#define AMFI_WEB_MAX_BUCKETS 2000
+/* "gvw", "indicator", "natfreq", "residual", "temperature"; NULL outside. */
+const char *amfi_store_web_series_name(int k);
+
+typedef struct amfi_web_bucket {
+    int64_t t0;             /* start of the bucket, µs */
+    int64_t n;              /* values in it, >= 1 */
+    double mean, min, max;  /* of those values */
+} amfi_web_bucket;
+
+/* Series `which` between from and to, narrowed to where it has values, in
+   at most nbuckets (1 .. AMFI_WEB_MAX_BUCKETS) buckets of *width µs each,
+   grouped in SQL: out (nbuckets entries) gets the non-empty ones, oldest
+   first, *n of them (0: no values). */
+int amfi_store_web_trend(amfi_store *s, int which, int64_t from, int64_t to, int nbuckets,
+                         amfi_web_bucket *out, int *n, int64_t *width, char *err, size_t errlen);
+
+/* One vehicle class's passages in a time range. */
+typedef struct amfi_web_class {
+    char vclass[16];        /* "" : none recorded (rows before version 10) */
+    int64_t n, n_ok, n_overload;
+    double gvw_mean_kg, gvw_max_kg; /* of the ok ones; NaN: none */
+} amfi_web_class;
+
+/* The classes of the passages with from <= utime <= to, most passages first,
+   at most max of them into out. */
+int amfi_store_web_classes(amfi_store *s, int64_t from, int64_t to, amfi_web_class *out, int max,
+                           int *n, char *err, size_t errlen);
+
+/* Every meta key starting with prefix (0 .. 63 bytes; "" all), by key;
+   key and value valid during the call only; nonzero stops. */
+typedef int (*amfi_web_meta_fn)(void *ctx, const char *key, const char *value);
+int amfi_store_web_meta(amfi_store *s, const char *prefix, amfi_web_meta_fn fn, void *ctx,
+                        char *err, size_t errlen);
 
 /* ---- estimated speeds (store_speed.c) ----------------------------------- */
 

@@ -23,7 +23,8 @@ for f in "$bindir/amfid" "$bindir/amfi-solve" "$bindir/amfi-report" "$bindir/amf
          "$sysusersdir/amfid.conf" "$tmpfilesdir/amfid.conf" "$mandir/man8/amfid.8.gz" \
          "$mandir/man5/amfid.yaml.5.gz" "$mandir/man1/amfi-solve.1.gz" "$mandir/man1/amfi-report.1.gz" \
          "$mandir/man1/sim_publisher.1.gz" "$datadir/amfi/population.csv" "$datadir/amfi/amfi-alert-mail" \
-         "$docdir/README.md" "$docdir/LICENSE" "$docdir/docs/daemon.md" "$datadir/java/amfi_types.jar"; do
+         "$docdir/README.md" "$docdir/LICENSE" "$docdir/docs/daemon.md" "$datadir/java/amfi_types.jar" \
+         "$bindir/amfi-web" "$unitdir/amfi-web.service" "$mandir/man1/amfi-web.1.gz" "$docdir/docs/web.md"; do
   [ -e "$stage$f" ] || fail "not installed: $f"
 done
 echo "installed files: ok"
@@ -32,7 +33,7 @@ echo "installed files: ok"
 out=$("$stage$bindir/amfid" --check-config --config "$stage$sysconfdir/amfid/amfid.yaml" 2>&1) ||
   { echo "$out"; fail "installed amfid --check-config on the installed amfid.yaml"; }
 echo "installed amfid --check-config: ok"
-for p in amfid amfi-solve amfi-report sim_publisher amfi-mkcase amfi-bench amfi-population amfi-fleet-bench amfi-sync; do
+for p in amfid amfi-solve amfi-report sim_publisher amfi-mkcase amfi-bench amfi-population amfi-fleet-bench amfi-sync amfi-web; do
   v=$("$stage$bindir/$p" --version 2>&1) || fail "installed $p --version exited non-zero"
   case "$v" in "$p "[0-9]*) ;; *) fail "installed $p --version said: $v" ;; esac
 done
