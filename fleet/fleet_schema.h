@@ -15,9 +15,14 @@ struct fleet_migration {
     int version;
     const char *description;
     const char *sql;
+    int roles; /* 1: then fleet_roles_sql (roles.sql), the rights of what it added */
 };
 extern const struct fleet_migration fleet_migrations[];
 extern const int fleet_n_migrations;
+/* roles.sql: the roles and row-level security of the current version, one
+ * source (installed as share/amfi/roles.sql; docs/fleet.md, Roles). Runs
+ * again without change. */
+extern const char *const fleet_roles_sql;
 
 /* One shipped site table: its name and the child table shipped in the same
  * transaction (axles for passages). The columns shipped are those of the

@@ -206,7 +206,8 @@ static const option_row option_rows[] = {
     OPT("status", 1, 'S', 1, "S", "only passages of status S (--passages)"),
     OPT("lane", 1, 'l', 1, "N", "only lane N (--passages, --histogram, --overloads, --speed)"),
     OPT("bin-kg", 1, 'w', 1, "W", "histogram bin width, kg (default report.histogram_bin_kg)"),
-    OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document)"),
+    OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document);\n"
+                                "with --pg and no --site: the fleet summary so"),
     OPT("plot", 1, 'p', 1, "DIR", "draw PNGs into DIR (gnuplot): GVW, trend, histogram, per hour, "
                                "speed"),
     OPT("config", 1, 'c', 1, "FILE", "the site's amfid.yaml: alert thresholds, site name, legal "
@@ -490,9 +491,10 @@ static int check_args(options *o)
         return usage_error("--pg", "the central database is read only here: --set-baseline* and "
                            "--check work on a site's store (--db)");
     if (o->pg && !o->site) {
-        if (asked || o->plot_dir || o->format != FMT_TABLE)
+        if (asked || o->plot_dir)
             return usage_error("--site", "the report sections need one site: without --site, "
-                               "--pg prints the fleet summary only");
+                               "--pg prints the fleet summary only (--format csv or json: "
+                               "exported)");
         return 0;
     }
     if (o->baseline_last && o->baseline_given)
@@ -839,7 +841,9 @@ int main(int argc, char **argv)
     if (parse_args(argc, argv, &o) != 0)
         return EXIT_USAGE;
     if (o.pg && !o.site) {
-        rc = report_pg_fleet(o.pg, o.allow_plaintext, stdout, err, sizeof err);
+        rc = report_pg_fleet(o.pg, o.allow_plaintext,
+                             o.format == FMT_CSV ? "csv" : o.format == FMT_JSON ? "json" : NULL,
+                             stdout, err, sizeof err);
         if (rc)
             fprintf(stderr, PROG ": --pg: %s\n", err);
         return rc == 2 ? EXIT_USAGE : rc ? EXIT_DATA : 0;
