@@ -206,8 +206,7 @@ static const option_row option_rows[] = {
     OPT("status", 1, 'S', 1, "S", "only passages of status S (--passages)"),
     OPT("lane", 1, 'l', 1, "N", "only lane N (--passages, --histogram, --overloads, --speed)"),
     OPT("bin-kg", 1, 'w', 1, "W", "histogram bin width, kg (default report.histogram_bin_kg)"),
-    OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document);\n"
-                                "with --pg and no --site: the fleet summary so"),
+    OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document)"),
     OPT("plot", 1, 'p', 1, "DIR", "draw PNGs into DIR (gnuplot): GVW, trend, histogram, per hour, "
                                "speed"),
     OPT("config", 1, 'c', 1, "FILE", "the site's amfid.yaml: alert thresholds, site name, legal "
@@ -493,8 +492,7 @@ static int check_args(options *o)
     if (o->pg && !o->site) {
         if (asked || o->plot_dir)
             return usage_error("--site", "the report sections need one site: without --site, "
-                               "--pg prints the fleet summary only (--format csv or json: "
-                               "exported)");
+                               "--pg prints the fleet summary only");
         return 0;
     }
     if (o->baseline_last && o->baseline_given)
