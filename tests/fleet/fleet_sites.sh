@@ -8,6 +8,8 @@
 # - a second store claiming the same site id refused with a message that
 #   says so, since when and what to do (exit 3, nothing shipped); a copy of
 #   the site's own store restored from an older backup still told so;
+# - a central database of version 7 migrated: each site's row made from its
+#   first run, the second store still refused;
 # - the views give times as timestamptz, exact to the µs;
 # - amfi-report --pg: the fleet summary with the site's name, exported as
 #   CSV and JSON (parsed), and one site's plots titled by its name;
@@ -101,6 +103,26 @@ pg_q "DELETE FROM fleet_sites WHERE site_id = 'a1-km12'"
     fail "without a fleet_sites row: $(cat "$tmp/other2.log")"
 "$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --once --quiet || fail "a after its row was lost: exit $?"
 [ "$(pg_q "SELECT name FROM fleet_sites WHERE site_id = 'a1-km12'")" = "Sava bridge, km 12" ] || fail "the row not made again"
+
+case=migration-7-8
+# a central database of version 7 with sites shipped: the migration gives
+# each its fleet_sites row from its first run (claimed since that run's
+# start), and the second store is still refused after it
+pg_q "CREATE DATABASE up7"
+U="host=$PG_DIR dbname=up7 user=postgres"
+"$sync" --pg "$U" --init-schema --quiet || fail "up7: --init-schema"
+"$sync" --db "$tmp/a.db" --pg "$U" --once --quiet || fail "up7: a: exit $?"
+psql -X -q -v ON_ERROR_STOP=1 "$U" -c "DROP VIEW fleet_summary; DROP TABLE fleet_sites;
+    DELETE FROM fleet_migrations WHERE version = 8" > "$tmp/up7.log" 2>&1 || fail "down to 7: $(cat "$tmp/up7.log")"
+"$sync" --db "$tmp/a.db" --pg "$U" --once 2> "$tmp/up7.log"
+[ $? = 0 ] || fail "up7: the owner's pass did not migrate: $(cat "$tmp/up7.log")"
+started=$(sqlite3 "$tmp/a.db" "SELECT started_at FROM runs WHERE id = 1")
+[ "$(psql -X -At "$U" -c "SELECT store_started_at || ' ' || (claimed_at = '$started'::timestamptz) || ' ' || name
+     FROM fleet_sites WHERE site_id = 'a1-km12'")" = "$started true Sava bridge, km 12" ] ||
+    fail "up7: fleet_sites after the migration: $(psql -X -At "$U" -c "SELECT * FROM fleet_sites")"
+"$sync" --db "$tmp/a-other.db" --pg "$U" --once 2> "$tmp/up7.log"
+[ $? = 3 ] && grep -q "another store already claims site id 'a1-km12'" "$tmp/up7.log" ||
+    fail "up7: the second store after the migration: $(cat "$tmp/up7.log")"
 
 case=timestamptz
 for v in fleet_latest_state fleet_open_alerts fleet_window_trend fleet_latest_scale; do
