@@ -39,6 +39,28 @@ grep -q '^  lcm_url: "udpm://239.255.76.99:7670' "$dir/site.yaml" || fail "the t
 refused "the configuration's daemon.lcm_url" --config "$dir/site.yaml" --lcm-url 'udpm://239.255.76.99:7670'
 grep -q "$dir/site.yaml: daemon.lcm_url" "$dir/err" || fail "the file not named: $(cat "$dir/err")"
 
+# the installed amfid.yaml's daemon.lcm_url (the path --help names), in a
+# private mount namespace over a tmpfs: the real one is never touched
+inst=$("$sim" --help | sed -n 's|^ *\(/[^ ]*/amfid/amfid\.yaml\)'"'"'s or the configuration'"'"'s$|\1|p')
+[ -n "$inst" ] || fail "--help does not name the installed amfid.yaml"
+etc=$(dirname "$(dirname "$inst")")
+sed -e 's|^  lcm_url: "" .*|  lcm_url: "udpm://239.255.76.97:7671?ttl=0"|' \
+  "$(dirname "$0")/../../config/amfid.yaml" > "$dir/installed.yaml"
+cat > "$dir/inst.sh" <<EOS
+mkdir -p "$etc" && mount -t tmpfs none "$etc" && mkdir "$etc/amfid" && cp "$dir/installed.yaml" "$inst" &&
+  exec "$sim" --vehicles 1 --headway 2 --speedup max --seed 3 --lcm-url 'udpm://239.255.76.97:7671'
+EOS
+if unshare --mount true 2> /dev/null; then
+    unshare --mount sh "$dir/inst.sh" > "$dir/out" 2> "$dir/err"
+    rc=$?
+    [ $rc = 2 ] && grep -q "the bus of the installed amfid ($inst: daemon.lcm_url)" "$dir/err" ||
+        fail "the installed amfid.yaml's bus: exit $rc: $(cat "$dir/err")"
+    [ -f "$inst" ] && grep -q '239.255.76.97:7671' "$inst" && fail "the test wrote the real $inst"
+    echo "installed amfid.yaml: $(cat "$dir/err" | cut -c1-120)"
+else
+    echo "no mount namespace: the installed amfid.yaml's case skipped"
+fi
+
 # allowed: the flag, a private bus, no bus, files
 allowed "--allow-production-bus" --allow-production-bus
 grep -q "refusing" "$dir/err" && fail "--allow-production-bus still refused"
