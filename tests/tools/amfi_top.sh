@@ -7,10 +7,13 @@
 # amfid's next status; with another key nothing is shown (every message
 # refused) and --once times out, exit 1; on a terminal (script(1)) the
 # screen is redrawn with ANSI escapes; bad options exit 2.
-#   amfi_top.sh AMFI_TOP AMFID SIM_PUBLISHER CONFIG
+# A hostile producer (top_inject): an alert with terminal escapes is shown
+# with them replaced; unsigned, wrongly signed and lying passages are
+# counted as refused and never shown.
+#   amfi_top.sh AMFI_TOP AMFID SIM_PUBLISHER CONFIG TOP_INJECT
 set -u
 . "$(dirname "$0")/../common/bus_prologue.sh"
-top=$1 amfid=$2 sim=$3 config=$4
+top=$1 amfid=$2 sim=$3 config=$4 inject=$5
 fail() { echo "FAIL: $*"; [ -f "$dir/top.out" ] && tail -20 "$dir/top.out"; exit 1; }
 N=6
 sed -e "s/^  id: local .*/  id: top-1/" -e "s/^  status_period_s: 1 /  status_period_s: 0.2 /" \
@@ -55,6 +58,23 @@ timeout -s INT 3 script -qfec "$top --config $dir/a.yaml --interval 0.3" /dev/nu
 [ "$(grep -c "$(printf '\033\\[H\033\\[2J')" "$dir/tty.out")" -ge 2 ] || fail "no redrawn screen on a terminal: $(head -c 300 "$dir/tty.out" | od -c | head)"
 grep -q "amfid top-1: running" "$dir/tty.out" || fail "the terminal view lacks amfid's status"
 grep -q "^passage " "$dir/tty.out" && fail "plain lines on a terminal"
+# a hostile producer: escapes replaced, bad passages refused and counted
+"$top" --config "$dir/a.yaml" --plain > "$dir/hostile.out" 2> "$dir/hostile.err" &
+hpid=$!; pids="$pids $hpid"
+wait_for "^# amfi-top on udpm://" "$dir/hostile.out" $hpid 60 || fail "amfi-top --plain did not start"
+"$inject" > "$dir/inject.log" 2>&1 || fail "top_inject: $(cat "$dir/inject.log")"
+wait_for "^alert " "$dir/hostile.out" $hpid 30 || fail "the injected alert was not shown: $(cat "$dir/hostile.out")"
+sleep 1
+kill -INT $hpid; wait $hpid || fail "amfi-top --plain on SIGINT: exit $?"
+cat "$dir/hostile.out"
+grep -q "$(printf '\033')" "$dir/hostile.out" && fail "an escape from the bus reached the terminal"
+grep -q "$(printf '\a')" "$dir/hostile.out" && fail "a bell from the bus reached the terminal"
+grep -q "^alert   2026-01-01T00:00:00Z RAISED  warning std_?]0;owned? evil?\[2J??more$" "$dir/hostile.out" ||
+    fail "the alert not shown with its control characters replaced"
+grep -q "^passage " "$dir/hostile.out" && fail "a refused passage was shown"
+grep -q "^refused here: 3 (unsigned 1, bad_mac 1, malformed 1); last: AMFI_PASSAGE: passage_t.status" "$dir/hostile.out" ||
+    fail "the refusals not counted: $(tail -2 "$dir/hostile.out")"
+
 # bad command lines
 "$top" --rows 0 > /dev/null 2> "$dir/bad.err"; [ $? = 2 ] || fail "--rows 0 accepted"
 "$top" --once --count 3 > /dev/null 2> "$dir/bad.err"; [ $? = 2 ] || fail "--once --count accepted"

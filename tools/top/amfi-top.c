@@ -10,7 +10,7 @@
  * and amfid's status. No curses: on a terminal the screen is redrawn every
  * --interval with ANSI escapes; with --count N, --once, --plain or when
  * stdout is not a terminal it prints plain lines (one per passage, alert or
- * status change) and, at the end, the counts.
+ * status change) and, at the end, the counts and what was refused.
  *
  *   amfi-top [--config FILE] [--lcm-url URL] [--bus-key FILE] [--rows N]
  *            [--interval S] [--count N | --once] [--plain] [--timeout S]
@@ -497,7 +497,8 @@ int main(int argc, char **argv)
         }
         int wait_ms = T.plain ? 200 : (int)((next_draw - now) * 1000) + 1;
         if (wait_ms > 200) wait_ms = 200;
-        if (lcm_handle_timeout(lcm, wait_ms) < 0) {
+        errno = 0;
+        if (lcm_handle_timeout(lcm, wait_ms) < 0 && !stop && errno != EINTR) {
             fprintf(stderr, PROG ": the LCM bus failed\n");
             rc = 1;
             break;
@@ -505,8 +506,10 @@ int main(int argc, char **argv)
     }
     if (T.once && rc == 0)
         draw(stdout, 0);
-    else if (T.plain)
+    else if (T.plain) {
         print_counts(stdout);
+        print_refused(stdout);
+    }
     else
         draw(stdout, 1);
     lcm_destroy(lcm);
