@@ -194,19 +194,24 @@ static int apply_schema(PGconn *pg)
     }
     int have = atoi(PQgetvalue(r, 0, 0));
     PQclear(r);
-    for (int i = have; i < fleet_n_migrations; i++) {
+    /* roles.sql describes the current schema: once, after the last
+     * migration, when one from FLEET_ROLES_SQL_FROM on was applied */
+    int roles = 0, failed = 0;
+    for (int i = have; i < fleet_n_migrations && !failed; i++) {
         char ins[256];
         snprintf(ins, sizeof ins, "INSERT INTO fleet_migrations (version, description) VALUES (%d, '%s')",
                  fleet_migrations[i].version, fleet_migrations[i].description);
-        if (pg_exec(pg, fleet_migrations[i].sql, "migration")
-            || (fleet_migrations[i].roles && pg_exec(pg, fleet_roles_sql, "roles.sql"))
-            || pg_exec(pg, ins, "migration record")) {
-            fprintf(stderr, "amfi-sync: the central schema is at version %d, this program needs %d: "
-                            "run 'amfi-sync --init-schema' as the database owner (docs/fleet.md)\n",
-                    have, fleet_n_migrations);
-            pg_exec(pg, "ROLLBACK", "ROLLBACK");
-            return EX_RETRY;
-        }
+        roles |= fleet_migrations[i].version >= FLEET_ROLES_SQL_FROM;
+        failed = pg_exec(pg, fleet_migrations[i].sql, "migration") || pg_exec(pg, ins, "migration record");
+    }
+    if (!failed && roles)
+        failed = pg_exec(pg, fleet_roles_sql, "roles.sql");
+    if (failed) {
+        fprintf(stderr, "amfi-sync: the central schema is at version %d, this program needs %d: "
+                        "run 'amfi-sync --init-schema' as the database owner (docs/fleet.md)\n",
+                have, fleet_n_migrations);
+        pg_exec(pg, "ROLLBACK", "ROLLBACK");
+        return EX_RETRY;
     }
     return pg_exec(pg, "COMMIT", "COMMIT") ? EX_RETRY : 0;
 }

@@ -225,8 +225,9 @@ static const char fleet_v7[] =
  * run's start). The views give times as timestamptz (column `time`), exact
  * to the µs, instead of µs integers; fleet_summary is the fleet summary of
  * amfi-report --pg, one row per site. Then roles.sql (fleet_roles_sql.h:
- * the one source of the roles and row-level security) gives fleet_sites and
- * the views their rights. */
+ * the one source of the roles and row-level security, run by amfi-sync
+ * after the last migration from this version on) gives fleet_sites and the
+ * views their rights. */
 static const char fleet_v8[] =
     "CREATE TABLE fleet_sites (\n"
     "  site_id text PRIMARY KEY,\n"
@@ -287,21 +288,22 @@ static const char fleet_v8[] =
 /* A later version that adds a site table or a view adds it to roles.sql
  * (its row-level security with the two policies fleet_site and
  * fleet_reader, amfi_site's and amfi_reader's rights, the view revoked from
- * PUBLIC and granted to amfi_reader only) and sets .roles, so that the
- * migration runs roles.sql after its own SQL (tests/fleet/fleet_security.sh
- * fails on a table with a site_id and no policy). */
+ * PUBLIC and granted to amfi_reader only); amfi-sync runs roles.sql after
+ * the last migration it applies (FLEET_ROLES_SQL_FROM;
+ * tests/fleet/fleet_security.sh fails on a table with a site_id and no
+ * policy). */
 const struct fleet_migration fleet_migrations[] = {
-    {1, "site tables with site_id, fleet_sync_state, fleet views", fleet_v1, 0},
-    {2, "fleet_window_trend: indicators with their alerts, per site", fleet_v2, 0},
-    {3, "passages: speed_given_mps and speed_estimated", fleet_v3, 0},
-    {4, "passages: n_vehicles and quality", fleet_v4, 0},
+    {1, "site tables with site_id, fleet_sync_state, fleet views", fleet_v1},
+    {2, "fleet_window_trend: indicators with their alerts, per site", fleet_v2},
+    {3, "passages: speed_given_mps and speed_estimated", fleet_v3},
+    {4, "passages: n_vehicles and quality", fleet_v4},
     {5, "passages: reference_gvw_kg, deck_c, f1_hz, f1_comp_hz, f1_zeta, f1_r2, gvw_comp_kg; "
-        "environment, scale_evals, fleet_latest_scale", fleet_v5, 0},
+        "environment, scale_evals, fleet_latest_scale", fleet_v5},
     {6, "one role per site: fleet_site_roles, row-level security on every site table, "
-        "fleet_migrations written by the owner only", fleet_v6, 0},
-    {7, "passages: class, axle_groups and overload", fleet_v7, 0},
+        "fleet_migrations written by the owner only", fleet_v6},
+    {7, "passages: class, axle_groups and overload", fleet_v7},
     {8, "fleet_sites: name, position, bridge type and store of each site; fleet_summary; "
-        "times in the views as timestamptz", fleet_v8, 1},
+        "times in the views as timestamptz", fleet_v8},
 };
 const char *const fleet_roles_sql = fleet_roles_sql_text;
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);

@@ -2,8 +2,10 @@
 -- roles.sql: the roles and row-level security of the fleet's central
 -- PostgreSQL (docs/fleet.md, "Roles"), as they stand at the current central
 -- schema version. One source: amfi-sync applies this file (compiled in)
--- with every migration that adds a table (version 8 and later), and it is
--- installed as share/amfi/roles.sql for the owner to read or run again:
+-- once after the last migration it applies, when one of version 8 or later
+-- is among them (a migration that adds a table or a view adds their rights
+-- here), and it is installed as share/amfi/roles.sql for the owner to read
+-- or run again:
 --
 --     psql -v ON_ERROR_STOP=1 -d fleet -f /usr/share/amfi/roles.sql
 --
