@@ -227,6 +227,8 @@ typedef struct amfi_site_identity {
     char name[128];   /* site.name: 1 .. 127 bytes; default bridge.name */
     double latitude;  /* site.latitude, degrees WGS 84, [-90, 90]; NaN unknown */
     double longitude; /* site.longitude, degrees, [-180, 180]; NaN unknown */
+    char bridge_type[64]; /* site.bridge_type: 1 .. 63 bytes for people and the
+                         fleet ("steel girder", "box girder", ...); "" unknown */
 } amfi_site_identity;
 
 /* 1 when s is a valid site.id ([A-Za-z0-9_.-], 1 .. 63 bytes), else 0. */
@@ -340,6 +342,17 @@ void amfi_config_defaults(amfi_site_config *c);
  * amfi_config_keys() (amfi_config_keys.h) and amfid.yaml(5). */
 int amfi_config_load(const char *path, amfi_site_config *c, char *err,
                      size_t errlen);
+
+/* The file `path` (already loaded without error) read again for what is
+ * still the shipped example's (config/amfid.yaml, site_example.c): the
+ * example's site.id 'local', the paper's 20 m bridge (bridge.name
+ * paper-20m, or its span, stiffness, section and density unchanged), no
+ * site.name of its own. Each finding is one line "FILE:LINE: key:
+ * WARNING: ..." (":LINE" left out for a key not in the file) given to
+ * warn(line, arg); returns their number (0: none), or −1 when the file
+ * cannot be read again (a line through warn says so). */
+int amfi_config_example_warnings(const char *path, void (*warn)(const char *line, void *arg),
+                                 void *arg);
 
 #ifdef __cplusplus
 }

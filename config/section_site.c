@@ -15,6 +15,7 @@
 
 #define ID_CAP sizeof(((amfi_site_identity *)0)->id)
 #define NAME_CAP sizeof(((amfi_site_identity *)0)->name)
+#define TYPE_CAP sizeof(((amfi_site_identity *)0)->bridge_type)
 
 int amfi_config_site_id_valid(const char *s)
 {
@@ -87,6 +88,36 @@ static void v_sname(const field *f, const void *base, char *buf)
     snprintf(buf, DOC_LEN, "bridge.name");
 }
 
+/* site.bridge_type: free text for people and the fleet; absent: unknown */
+static int p_btype(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
+{
+    amfi_site_config *c = base;
+
+    (void)f;
+    return amfi_cfg_get_name(x, v, path, c->site.bridge_type, TYPE_CAP);
+}
+
+static void d_btype(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "1 .. %zu bytes, no control characters", TYPE_CAP - 1);
+}
+
+static void v_btype(const field *f, const void *base, char *buf)
+{
+    (void)f;
+    (void)base;
+    snprintf(buf, DOC_LEN, "none");
+}
+
+static int s_btype(const field *f, span *out)
+{
+    (void)f;
+    out[0] = (span){SC(site.bridge_type), TYPE_CAP};
+    return 1;
+}
+
 /* site.latitude / site.longitude: degrees (WGS 84); absent: unknown (NaN) */
 static int p_coord(ctx *x, yaml_node_t *v, const char *path, const field *f, void *base)
 {
@@ -126,6 +157,7 @@ static int s_sname(const field *f, span *out)
 
 static const kind K_SITE_ID = {"string", p_id, d_id, v_id, NEST_NONE, s_id};
 static const kind K_SITE_NAME = {"string", p_sname, d_sname, v_sname, NEST_NONE, s_sname};
+static const kind K_BRIDGE_TYPE = {"string", p_btype, d_btype, v_btype, NEST_NONE, s_btype};
 static const kind K_COORD = {"number", p_coord, d_coord, v_coord, NEST_NONE,
                              amfi_cfg_spans_double};
 
@@ -135,6 +167,7 @@ const field amfi_cfg_site_fields[] = {
     {.key = "latitude", .kind = &K_COORD, .off = SC(site.latitude), .lo = -90, .hi = 90},
     {.key = "longitude", .kind = &K_COORD, .off = SC(site.longitude), .lo = -180,
      .hi = 180},
+    {.key = "bridge_type", .kind = &K_BRIDGE_TYPE},
     {.key = NULL}};
 
 /* site.name follows bridge.name when not given (bridge_check runs first);

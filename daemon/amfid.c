@@ -169,8 +169,15 @@ static int start_config(amfid *h, const amfid_options *o)
     return 0;
 }
 
+/* --check-config's warnings: "amfid: FILE:LINE: key: WARNING: ..." */
+static void print_warning(const char *line, void *arg)
+{
+    (void)arg;
+    printf("amfid: %s\n", line);
+}
+
 /* The store belongs to one bridge: at its first start amfid writes the
- * configuration's site.id (and name, position) into the store's meta table;
+ * configuration's site.id (and name, position, bridge type) into the store's meta table;
  * later starts refuse a store that holds another site.id, so two bridges'
  * passages never mix in one store (or in a fleet's central database, which
  * keys rows by site). A changed site.name or position is written over the
@@ -198,15 +205,19 @@ static int claim_site(amfid *h)
                  site->name);
     struct {
         const char *key, *val;
-    } kv[4] = {{"site.id", site->id}, {"site.name", site->name}, {NULL, NULL}, {NULL, NULL}};
+    } kv[5] = {{"site.id", site->id}, {"site.name", site->name}, {NULL, NULL}, {NULL, NULL},
+               {NULL, NULL}};
     char lat[32], lon[32];
+    int nkv = 2;
     if (!isnan(site->latitude)) {
         snprintf(lat, sizeof lat, "%.7f", site->latitude);
         snprintf(lon, sizeof lon, "%.7f", site->longitude);
-        kv[2].key = "site.latitude", kv[2].val = lat;
-        kv[3].key = "site.longitude", kv[3].val = lon;
+        kv[nkv].key = "site.latitude", kv[nkv++].val = lat;
+        kv[nkv].key = "site.longitude", kv[nkv++].val = lon;
     }
-    for (int i = 0; i < 4 && kv[i].key; i++) {
+    if (site->bridge_type[0])
+        kv[nkv].key = "site.bridge_type", kv[nkv++].val = site->bridge_type;
+    for (int i = 0; i < nkv; i++) {
         if (amfi_store_meta_get(st, kv[i].key, stored, sizeof stored, &found, err,
                                 sizeof err) ||
             ((!found || strcmp(stored, kv[i].val)) &&
@@ -294,11 +305,19 @@ int amfid_start(amfid **out, const amfid_options *o)
     }
     h->bus_key_option = o->bus_key;
     int rc = start_config(h, o);
-    if (rc == 0 && o->check_only)
-        printf("amfid: %s: ok (site %s, bridge %s, %d sensor(s), %d worker(s), store %s)\n",
+    if (rc == 0 && o->check_only) {
+        /* what is still the shipped example's: a WARNING line each (stdout,
+         * with the verdict), exit 2 with --strict */
+        int nw = amfi_config_example_warnings(o->config, print_warning, NULL);
+        printf("amfid: %s: ok (site %s, bridge %s, %d sensor(s), %d worker(s), store %s)",
                o->config, h->cfg.site.id, h->cfg.name, h->cfg.solver.n_sensors,
                h->cfg.daemon.workers, h->cfg.daemon.db_path);
-    else if (rc == 0)
+        if (nw > 0)
+            printf(" with %d warning(s)%s", nw, o->strict ? ": refused (--strict)" : "");
+        printf("\n");
+        if (nw != 0 && o->strict)
+            rc = 2;
+    } else if (rc == 0)
         rc = start_runtime(h);
     return rc;
 }

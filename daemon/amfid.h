@@ -29,6 +29,7 @@ typedef struct amfid_options {
     const char *db;       /* --db, NULL: the file's */
     const char *lcm_url;  /* --lcm-url, NULL: the file's */
     int check_only;       /* --check-config */
+    int strict;           /* --strict: --check-config's warnings fail it (exit 2) */
     const char *bus_key;  /* --bus-key FILE, NULL: daemon.bus.key_file, then the
                              systemd credential */
     const char *make_bus_key; /* --make-bus-key FILE: create a site key and exit */

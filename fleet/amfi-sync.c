@@ -20,6 +20,7 @@
 #include <inttypes.h>
 #include <libpq-fe.h>
 #include <signal.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -193,17 +194,24 @@ static int apply_schema(PGconn *pg)
     }
     int have = atoi(PQgetvalue(r, 0, 0));
     PQclear(r);
-    for (int i = have; i < fleet_n_migrations; i++) {
+    /* roles.sql describes the current schema: once, after the last
+     * migration, when one from FLEET_ROLES_SQL_FROM on was applied */
+    int roles = 0, failed = 0;
+    for (int i = have; i < fleet_n_migrations && !failed; i++) {
         char ins[256];
         snprintf(ins, sizeof ins, "INSERT INTO fleet_migrations (version, description) VALUES (%d, '%s')",
                  fleet_migrations[i].version, fleet_migrations[i].description);
-        if (pg_exec(pg, fleet_migrations[i].sql, "migration") || pg_exec(pg, ins, "migration record")) {
-            fprintf(stderr, "amfi-sync: the central schema is at version %d, this program needs %d: "
-                            "run 'amfi-sync --init-schema' as the database owner (docs/fleet.md)\n",
-                    have, fleet_n_migrations);
-            pg_exec(pg, "ROLLBACK", "ROLLBACK");
-            return EX_RETRY;
-        }
+        roles |= fleet_migrations[i].version >= FLEET_ROLES_SQL_FROM;
+        failed = pg_exec(pg, fleet_migrations[i].sql, "migration") || pg_exec(pg, ins, "migration record");
+    }
+    if (!failed && roles)
+        failed = pg_exec(pg, fleet_roles_sql, "roles.sql");
+    if (failed) {
+        fprintf(stderr, "amfi-sync: the central schema is at version %d, this program needs %d: "
+                        "run 'amfi-sync --init-schema' as the database owner (docs/fleet.md)\n",
+                have, fleet_n_migrations);
+        pg_exec(pg, "ROLLBACK", "ROLLBACK");
+        return EX_RETRY;
     }
     return pg_exec(pg, "COMMIT", "COMMIT") ? EX_RETRY : 0;
 }
@@ -482,6 +490,148 @@ static int store_site_id(amfi_store *db, char out[SITE_ID_MAX + 1])
     return found;
 }
 
+/* What the store says of its site (the meta amfid writes from site.* of
+ * amfid.yaml) and of itself (the started_at of its first run, written once
+ * at its first start: the store's identity), each value checked as the
+ * configuration loader checks it; "" where the store has none. */
+struct site_facts {
+    char name[128], lat[32], lon[32], bridge_type[64];
+    char started[64]; /* runs id 1: started_at */
+};
+static int text_ok(const char *s)
+{
+    /* UTF-8, no control characters (amfid.yaml(5): site.name, site.bridge_type) */
+    const unsigned char *p = (const unsigned char *)s;
+    while (*p) {
+        int n = *p < 0x80 ? 1 : (*p & 0xe0) == 0xc0 && *p >= 0xc2 ? 2 : (*p & 0xf0) == 0xe0 ? 3
+              : (*p & 0xf8) == 0xf0 && *p <= 0xf4 ? 4 : 0;
+        if (!n || (n == 1 && (*p < 0x20 || *p == 0x7f))) return 0;
+        for (int k = 1; k < n; k++)
+            if ((p[k] & 0xc0) != 0x80) return 0;
+        p += n;
+    }
+    return 1;
+}
+static int coord_ok(const char *s, double lim)
+{
+    char *end;
+    errno = 0;
+    double x = strtod(s, &end);
+    return *s && !*end && errno == 0 && x >= -lim && x <= lim;
+}
+static int first_run(void *ctx, const amfi_store_value *v, int n)
+{
+    char tmp[40];
+    const char *t = n > 1 ? amfi_store_value_text(&v[1], tmp, sizeof tmp) : NULL;
+    snprintf(ctx, 64, "%s", t ? t : "");
+    return 0;
+}
+static int site_facts_read(amfi_store *db, const char *site, const char *store, struct site_facts *f)
+{
+    static const struct { const char *key; size_t off, cap; double lim; } keys[] = {
+        {"site.name", offsetof(struct site_facts, name), sizeof ((struct site_facts *)0)->name, 0},
+        {"site.latitude", offsetof(struct site_facts, lat), sizeof ((struct site_facts *)0)->lat, 90},
+        {"site.longitude", offsetof(struct site_facts, lon), sizeof ((struct site_facts *)0)->lon, 180},
+        {"site.bridge_type", offsetof(struct site_facts, bridge_type),
+         sizeof ((struct site_facts *)0)->bridge_type, 0},
+    };
+    char err[512], val[AMFI_STORE_META_VALUE_MAX + 1];
+    memset(f, 0, sizeof *f);
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
+        int found = 0, grc = amfi_store_meta_get(db, keys[i].key, val, sizeof val, &found, err,
+                                                  sizeof err);
+        if (grc == AMFI_STORE_ECORRUPT) { /* a value the store's rules refuse */
+            fprintf(stderr, "amfi-sync: refused: site '%s' store %s: meta '%s': %s. Nothing shipped "
+                            "(see docs/fleet.md, 'Bad values')\n", site, store, keys[i].key, err);
+            return EX_REFUSED;
+        }
+        if (grc != 0) {
+            fprintf(stderr, "amfi-sync: store: %s\n", err);
+            return EX_RETRY;
+        }
+        if (!found) continue;
+        int ok = strlen(val) > 0 && strlen(val) < keys[i].cap
+                 && (keys[i].lim > 0 ? coord_ok(val, keys[i].lim) : text_ok(val));
+        if (!ok) {
+            fprintf(stderr, "amfi-sync: refused: site '%s' store %s: meta '%s': %s (amfid.yaml(5)). "
+                            "Nothing shipped (see docs/fleet.md, 'Bad values')\n",
+                    site, store, keys[i].key,
+                    keys[i].lim > 0 ? "not a number of degrees in range"
+                                    : "not 1 .. the key's bytes of UTF-8 text without control characters");
+            return EX_REFUSED;
+        }
+        memcpy((char *)f + keys[i].off, val, strlen(val) + 1);
+    }
+    if (!f->lat[0] != !f->lon[0]) {
+        fprintf(stderr, "amfi-sync: refused: site '%s' store %s: meta '%s' without '%s' "
+                        "(amfid.yaml(5): both or neither). Nothing shipped\n",
+                site, store, f->lat[0] ? "site.latitude" : "site.longitude",
+                f->lat[0] ? "site.longitude" : "site.latitude");
+        return EX_REFUSED;
+    }
+    static const char *const cols[] = {"id", "started_at"};
+    if (amfi_store_scan(db, "runs", cols, 2, 0, 1, 1, first_run, f->started, err, sizeof err) != 0) {
+        fprintf(stderr, "amfi-sync: store: %s\n", err);
+        return EX_RETRY;
+    }
+    return 0;
+}
+
+/* A site is shipped by one store (fleet_sites.store_started_at, else the
+ * site's central runs row 1): another store claiming the same site id is
+ * refused (exit 3) saying so, since when, and what to do, before the marks
+ * would take it for a restored backup. A store without a first run (not
+ * written by amfid) is not checked. */
+static int check_claim(PGconn *pg, const char *site, const char *store, const struct site_facts *f)
+{
+    if (!f->started[0]) return 0;
+    const char *pv[1] = {site};
+    PGresult *r = PQexecParams(pg,
+        "SELECT store_started_at, to_char(claimed_at AT TIME ZONE 'UTC', "
+        "'YYYY-MM-DD\"T\"HH24:MI:SS\"Z\"'), 'fleet_sites' FROM fleet_sites "
+        "WHERE site_id = $1 AND store_started_at IS NOT NULL "
+        "UNION ALL SELECT started_at, started_at, 'runs' FROM runs WHERE site_id = $1 AND id = 1 "
+        "LIMIT 1", 1, NULL, pv, NULL, NULL, 0);
+    if (pg_ok(r, "fleet_sites")) { PQclear(r); return EX_RETRY; }
+    int rc = 0;
+    if (PQntuples(r) == 1 && strcmp(PQgetvalue(r, 0, 0), f->started) != 0) {
+        fprintf(stderr,
+                "amfi-sync: refused: another store already claims site id '%s': the central database "
+                "has shipped it since %s from a store first started at %s, but this store %s "
+                "was first started at %s. Two stores cannot ship one site id. Give this store's "
+                "site its own site.id (a new site: before amfid's first start); or, if this store "
+                "replaces the other for good, the owner first deletes the site's central rows "
+                "(docs/fleet.md, 'Two stores, one site id'). Nothing shipped\n",
+                site, PQgetvalue(r, 0, 1), PQgetvalue(r, 0, 0), store, f->started);
+        rc = EX_REFUSED;
+    }
+    PQclear(r);
+    return rc;
+}
+
+/* The site's row of fleet_sites: its name, position and bridge type as the
+ * store says now, and the store that ships it (kept from the first pass:
+ * a different one is refused by check_claim). One statement. */
+static int ship_site(PGconn *pg, const char *site, const struct site_facts *f)
+{
+    const char *pv[7] = {site, f->started[0] ? f->started : NULL, f->name[0] ? f->name : NULL,
+                         f->lat[0] ? f->lat : NULL, f->lon[0] ? f->lon : NULL,
+                         f->bridge_type[0] ? f->bridge_type : NULL};
+    PGresult *r = PQexecParams(pg,
+        "INSERT INTO fleet_sites AS s (site_id, store_started_at, name, latitude, longitude, bridge_type) "
+        "VALUES ($1, $2, $3, $4, $5, $6) ON CONFLICT (site_id) DO UPDATE SET "
+        "store_started_at = coalesce(s.store_started_at, EXCLUDED.store_started_at), "
+        "name = EXCLUDED.name, latitude = EXCLUDED.latitude, longitude = EXCLUDED.longitude, "
+        "bridge_type = EXCLUDED.bridge_type, updated_at = now() "
+        "WHERE (s.name, s.latitude, s.longitude, s.bridge_type, s.store_started_at) IS DISTINCT FROM "
+        "(EXCLUDED.name, EXCLUDED.latitude, EXCLUDED.longitude, EXCLUDED.bridge_type, "
+        "coalesce(s.store_started_at, EXCLUDED.store_started_at))",
+        6, NULL, pv, NULL, NULL, 0);
+    int rc = pg_ok(r, "fleet_sites") ? EX_RETRY : 0;
+    PQclear(r);
+    return rc;
+}
+
 /* The connection as the options say (fleet_pg_connect: TLS for a server
  * not on this machine, the password file checked). */
 static const char *opt_passfile;
@@ -634,12 +784,16 @@ static int sync_once(const char *conninfo, const char *store, const char *site_o
         rc = EX_RETRY;
         goto out;
     }
-    rc = check_backwards(pg, db, site);
+    struct site_facts facts;
+    rc = site_facts_read(db, site, store, &facts);
+    if (!rc) rc = check_claim(pg, site, store, &facts);
+    if (!rc) rc = check_backwards(pg, db, site);
     long total = 0;
     /* every table checked (its mark, then its new rows' values) before any
      * is shipped */
     for (int i = 0; !rc && i < fleet_n_tables; i++)
         rc = sync_table(pg, db, site, store, &fleet_tables[i], 1, &total);
+    if (!rc && !stop_requested) rc = ship_site(pg, site, &facts);
     for (int i = 0; !rc && i < fleet_n_tables && !stop_requested; i++)
         rc = sync_table(pg, db, site, store, &fleet_tables[i], 0, &total);
     amfi_store_transaction(db, AMFI_STORE_TX_COMMIT, NULL, 0);

@@ -214,11 +214,84 @@ static const char fleet_v7[] =
     "ALTER TABLE passages ADD COLUMN class text, ADD COLUMN axle_groups text,\n"
     "  ADD COLUMN overload integer;\n";
 
-/* A later version that adds a site table enables row-level security on it
- * with the two policies of version 6 (fleet_site, fleet_reader), grants
- * amfi_site SELECT, INSERT and amfi_reader SELECT on it, and revokes a new
- * view from PUBLIC and grants it to amfi_reader only (tests/fleet/fleet_security.sh
- * fails on a table with a site_id and no policy). */
+/* Version 8: the sites themselves and times people read. fleet_sites holds
+ * each site's name, position and bridge type (the store's meta, written by
+ * amfid from site.* of amfid.yaml, shipped by amfi-sync at every pass) and
+ * which store ships it: the started_at of the store's first run (runs id 1,
+ * written once at the store's first start), so that a second store claiming
+ * the same site id is told so (amfi-sync, docs/fleet.md "Two stores, one
+ * site id") instead of being taken for a restored backup. Sites shipped
+ * before get their row from their central runs row 1 (claimed_at: that
+ * run's start). The views give times as timestamptz (column `time`), exact
+ * to the µs, instead of µs integers; fleet_summary is the fleet summary of
+ * amfi-report --pg, one row per site. Then roles.sql (fleet_roles_sql.h:
+ * the one source of the roles and row-level security, run by amfi-sync
+ * after the last migration from this version on) gives fleet_sites and the
+ * views their rights. */
+static const char fleet_v8[] =
+    "CREATE TABLE fleet_sites (\n"
+    "  site_id text PRIMARY KEY,\n"
+    "  store_started_at text,  -- the shipping store's first run (runs id 1): its identity\n"
+    "  name text, latitude double precision CHECK (latitude BETWEEN -90 AND 90),\n"
+    "  longitude double precision CHECK (longitude BETWEEN -180 AND 180),\n"
+    "  bridge_type text,\n"
+    "  claimed_at timestamptz NOT NULL DEFAULT now(),  -- first shipped by that store\n"
+    "  updated_at timestamptz NOT NULL DEFAULT now(),\n"
+    "  CHECK ((latitude IS NULL) = (longitude IS NULL)));\n"
+    "INSERT INTO fleet_sites (site_id, store_started_at, claimed_at)\n"
+    "  SELECT site_id, started_at,\n"
+    "         CASE WHEN started_at ~ '^[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:.]+Z$'\n"
+    "              THEN started_at::timestamptz ELSE now() END\n"
+    "  FROM runs WHERE id = 1;\n"
+    "DROP VIEW fleet_latest_state, fleet_open_alerts, fleet_window_trend, fleet_latest_scale;\n"
+    "CREATE VIEW fleet_latest_state AS\n"
+    "  SELECT DISTINCT ON (site_id) site_id, id AS indicator_id,\n"
+    "         timestamptz 'epoch' + utime * interval '1 microsecond' AS time, n, mean_kg, std_kg,\n"
+    "         std_ratio, p_value, state\n"
+    "  FROM indicators ORDER BY site_id, utime DESC, id DESC;\n"
+    "CREATE VIEW fleet_open_alerts AS\n"
+    "  SELECT * FROM (SELECT DISTINCT ON (site_id, kind) site_id, id AS alert_id,\n"
+    "                        timestamptz 'epoch' + utime * interval '1 microsecond' AS time,\n"
+    "                        level, kind, message, indicator_id, raised\n"
+    "                 FROM alerts ORDER BY site_id, kind, utime DESC, id DESC) AS last\n"
+    "  WHERE raised = 1;\n"
+    "CREATE VIEW fleet_window_trend AS\n"
+    "  SELECT i.site_id, i.id AS indicator_id,\n"
+    "         timestamptz 'epoch' + i.utime * interval '1 microsecond' AS time, i.n, i.mean_kg,\n"
+    "         i.std_kg, i.baseline_mean_kg, i.baseline_std_kg, i.std_ratio, i.p_value, i.state,\n"
+    "         a.id AS alert_id, a.level AS alert_level, a.kind AS alert_kind,\n"
+    "         a.raised AS alert_raised, a.message AS alert_message\n"
+    "  FROM indicators AS i\n"
+    "  LEFT JOIN alerts AS a ON a.site_id = i.site_id AND a.indicator_id = i.id;\n"
+    "CREATE VIEW fleet_latest_scale AS\n"
+    "  SELECT DISTINCT ON (site_id, kind) site_id, kind, id AS scale_eval_id,\n"
+    "         timestamptz 'epoch' + utime * interval '1 microsecond' AS time, n, value, raw,\n"
+    "         deck_c, z, cusum, h, state\n"
+    "  FROM scale_evals ORDER BY site_id, kind, utime DESC, id DESC;\n"
+    "CREATE VIEW fleet_summary AS\n"
+    "  SELECT s.site_id, f.name, f.latitude, f.longitude, f.bridge_type, s.hwm AS passages,\n"
+    "         (SELECT timestamptz 'epoch' + max(p.utime) * interval '1 microsecond'\n"
+    "          FROM passages AS p WHERE p.site_id = s.site_id) AS last_passage,\n"
+    "         coalesce(l.state, '-') AS state, l.std_ratio,\n"
+    "         (SELECT count(*) FROM fleet_open_alerts AS a WHERE a.site_id = s.site_id) AS open_alerts,\n"
+    "         (SELECT max(g.synced_at) FROM fleet_sync_state AS g WHERE g.site_id = s.site_id)\n"
+    "           AS last_shipped\n"
+    "  FROM fleet_sync_state AS s\n"
+    "  LEFT JOIN fleet_sites AS f ON f.site_id = s.site_id\n"
+    "  LEFT JOIN fleet_latest_state AS l ON l.site_id = s.site_id\n"
+    "  WHERE s.tbl = 'passages';\n";
+
+/* roles.sql (the roles and row-level security as they stand now), compiled
+ * in by fleet/CMakeLists.txt */
+#include "fleet_roles_sql.h"
+
+/* A later version that adds a site table or a view adds it to roles.sql
+ * (its row-level security with the two policies fleet_site and
+ * fleet_reader, amfi_site's and amfi_reader's rights, the view revoked from
+ * PUBLIC and granted to amfi_reader only); amfi-sync runs roles.sql after
+ * the last migration it applies (FLEET_ROLES_SQL_FROM;
+ * tests/fleet/fleet_security.sh fails on a table with a site_id and no
+ * policy). */
 const struct fleet_migration fleet_migrations[] = {
     {1, "site tables with site_id, fleet_sync_state, fleet views", fleet_v1},
     {2, "fleet_window_trend: indicators with their alerts, per site", fleet_v2},
@@ -229,7 +302,10 @@ const struct fleet_migration fleet_migrations[] = {
     {6, "one role per site: fleet_site_roles, row-level security on every site table, "
         "fleet_migrations written by the owner only", fleet_v6},
     {7, "passages: class, axle_groups and overload", fleet_v7},
+    {8, "fleet_sites: name, position, bridge type and store of each site; fleet_summary; "
+        "times in the views as timestamptz", fleet_v8},
 };
+const char *const fleet_roles_sql = fleet_roles_sql_text;
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
 
 const struct fleet_table fleet_tables[] = {

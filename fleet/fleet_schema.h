@@ -18,6 +18,15 @@ struct fleet_migration {
 };
 extern const struct fleet_migration fleet_migrations[];
 extern const int fleet_n_migrations;
+/* roles.sql: the roles and row-level security of the current version, one
+ * source (installed as share/amfi/roles.sql; docs/fleet.md, Roles). Runs
+ * again without change. amfi-sync runs it once, in the same transaction,
+ * after the last of the migrations it applies when one of them is of
+ * version FLEET_ROLES_SQL_FROM or later: it describes the current schema,
+ * so it cannot run between two migrations. A migration that adds a table
+ * or a view adds its rights and policies to roles.sql. */
+extern const char *const fleet_roles_sql;
+#define FLEET_ROLES_SQL_FROM 8
 
 /* One shipped site table: its name and the child table shipped in the same
  * transaction (axles for passages). The columns shipped are those of the

@@ -42,6 +42,9 @@ pkgs=(
   libpq-dev                      # libpq: amfi-sync ships site stores to the central PostgreSQL (fleet/)
   postgresql                     # initdb, pg_ctl: the fleet_* tests start a throwaway server
   openssl                        # openssl req: fleet_security's self-signed server certificate (TLS)
+  prometheus                     # promtool: the contrib_monitoring test checks and unit-tests
+                                 #   contrib/prometheus/amfi-alerts.yml (the server itself is not used)
+  python3-yaml                   # the contrib_monitoring test reads the alert rules' YAML
   python3-numpy                  # tools/research/multi-r5: the offline analysis behind
                                  #   docs/results/multi-vehicle.md round five (nothing built needs it)
 )

@@ -29,7 +29,7 @@ OPENBLAS_NUM_THREADS=1 unshare --net bash -c '
   "$1/daemon/amfid" --config "$2" --db "$3/demo.db" --bus-key "$3/bus.key" 2> "$3/amfid.log" &
   pid=$!
   for i in $(seq 100); do grep -q running "$3/amfid.log" && break; sleep 0.1; done
-  "$1/sim_publisher/sim_publisher" --config "$2" --bus-key "$3/bus.key" --vehicles 500 --headway 2 --speedup 25 \
+  "$1/sim_publisher/sim_publisher" --allow-production-bus --config "$2" --bus-key "$3/bus.key" --vehicles 500 --headway 2 --speedup 25 \
     --damage 0.2 --damage-step-at 250 --seed 1 2> "$3/sim_publisher.log"
   sleep 1
   kill -TERM "$pid"

@@ -122,6 +122,15 @@
 
 #define PROG "sim_publisher"
 
+/* amfid's configuration where it is installed (daemon/amfid.h, set by CMake
+ * alike): the bus it names is amfid's production bus. */
+#ifndef AMFID_DEFAULT_CONFIG
+#define AMFID_DEFAULT_CONFIG "/etc/amfid/amfid.yaml"
+#endif
+#define AMFID_INSTALLED_CONFIG AMFID_DEFAULT_CONFIG
+/* amfid's bus when daemon.lcm_url is "" (daemon/bus.c) */
+#define AMFID_BUILTIN_URL "udpm://239.255.76.67:7667?ttl=0"
+
 /* The shipped files looked for when none is named (common/amfi_datafile.h). */
 #define DEFAULT_CONFIG_NAME "sim_publisher.yaml"
 #define DEFAULT_POPULATION_NAME "population.csv"
@@ -142,6 +151,7 @@ typedef struct opts {
     const char *lcm_url, *log; /* NULL: LCM's default URL / no log */
     const char *bus_key;  /* --bus-key FILE; NULL: the configuration's, the credential */
     int lcm_url_flag;     /* lcm_url came from --lcm-url (for messages) */
+    int allow_production_bus; /* --allow-production-bus: amfid's bus on purpose */
     double speedup;       /* <= 0: as fast as possible */
     double headway;       /* <= 0: the population's timestamps */
     double flow;          /* > 0: Poisson arrivals, vehicles/h per lane (flow.h) */
@@ -169,7 +179,8 @@ static void usage(FILE *f)
 {
     char places[512];
     fprintf(f,
-            "usage: %s [--out DIR | --lcm-url URL|none] [--log FILE] [--speedup X|max]\n"
+            "usage: %s [--out DIR | --lcm-url URL|none [--allow-production-bus]] [--log FILE]\n"
+            "       [--speedup X|max]\n"
             "       [--headway SEC] [--damage-step-at K|none] [--noise-ms2 STD] [--block N]\n"
             "       [--start-utime US] [--detector-lead SEC]\n"
             "       [--config FILE.yaml] [--population FILE.csv] [--vehicles N]\n"
@@ -203,6 +214,9 @@ static void usage(FILE *f)
             "  -k, --bus-key FILE             the site's bus key: every message signed\n"
             "                                 (else daemon.bus.key_file, else the\n"
             "                                 credential amfi-bus-key)\n"
+            "      --allow-production-bus     publish even on amfid's bus (its default,\n"
+            "                                 %s's or the configuration's\n"
+            "                                 daemon.lcm_url): refused without this\n"
             "      --speedup X|max            pacing: data time / wall time\n"
             "      --headway SEC              time between vehicles\n"
             "      --flow VEH_PER_H           Poisson arrivals per lane (overrides --headway)\n"
@@ -235,7 +249,7 @@ static void usage(FILE *f)
             "Settings: built-in defaults < the configuration file's simulation: section\n"
             "< flags. Without --config: sim_publisher.yaml, and without --population:\n"
             "population.csv, from the first of %s.\n",
-            PROG, amfi_datafile_places(places, sizeof places));
+            PROG, AMFID_INSTALLED_CONFIG, amfi_datafile_places(places, sizeof places));
 }
 
 enum {
@@ -244,7 +258,7 @@ enum {
     O_NOISE_MS2, O_BLOCK, O_START_UTIME, O_DETECTOR_LEAD, O_ENVIRONMENT,
     O_TIME_COMPRESSION, O_ENVIRONMENT_PERIOD, O_CALIBRATION_EVERY, O_FLOW, O_MIN_HEADWAY, O_LANES,
     O_AS_BUILT, O_CALIB_RUNS, O_TRUCK, O_RUNS_PER_TRUCK, O_CALIB_SPEEDS, O_TAIL, O_AMBIENT_OUT,
-    O_AMBIENT_DURATION, O_AMBIENT_FORCE
+    O_AMBIENT_DURATION, O_AMBIENT_FORCE, O_ALLOW_PRODUCTION_BUS
 };
 
 static const struct option longopts[] = {
@@ -267,6 +281,7 @@ static const struct option longopts[] = {
     {"lcm-url", required_argument, NULL, 'u'},
     {"log", required_argument, NULL, 'l'},
     {"bus-key", required_argument, NULL, 'k'},
+    {"allow-production-bus", no_argument, NULL, O_ALLOW_PRODUCTION_BUS},
     {"speedup", required_argument, NULL, O_SPEEDUP},
     {"headway", required_argument, NULL, O_HEADWAY},
     {"flow", required_argument, NULL, O_FLOW},
@@ -438,6 +453,7 @@ static void apply_flags(int argc, char **argv, opts *o)
             break;
         case 'l': o->log = v; break;
         case 'k': o->bus_key = v; break;
+        case O_ALLOW_PRODUCTION_BUS: o->allow_production_bus = 1; break;
         case O_SPEEDUP:
             o->speedup = !strcmp(v, "max") ? 0.0 : amfi_cli_num(&c, v, 0.01, 1e6);
             break;
@@ -507,6 +523,78 @@ static void apply_flags(int argc, char **argv, opts *o)
                     "(stream.log or --log) would produce nothing\n", PROG, o->config ? o->config : "?");
         exit(2);
     }
+}
+
+/* The bus an LCM URL reaches, for comparison: "provider://address:port"
+ * without the options (ttl, recv_buf_size); for udpm, LCM's default group
+ * and port filled in where the URL leaves them out. */
+static void bus_identity(const char *url, char *out, size_t n)
+{
+    const char *q = strchr(url, '?');
+    size_t len = q ? (size_t)(q - url) : strlen(url);
+    snprintf(out, n, "%.*s", (int)len, url);
+    if (strncmp(out, "udpm://", 7) == 0) {
+        char addr[256];
+        snprintf(addr, sizeof addr, "%s", out + 7);
+        if (!addr[0])
+            snprintf(addr, sizeof addr, "239.255.76.67:7667");
+        else if (!strchr(addr, ':'))
+            snprintf(addr + strlen(addr), sizeof addr - strlen(addr), ":7667");
+        snprintf(out, n, "udpm://%s", addr);
+    }
+}
+
+/* Simulated vehicles on amfid's bus would be weighed and stored as real
+ * passages (on a site box: the production store, the fleet's central
+ * database, the alerts). The bus sim_publisher would publish on (the URL
+ * given, else $LCM_DEFAULT_URL, else LCM's default) is refused when it is
+ * the bus amfid uses: its built-in default, the daemon.lcm_url of the
+ * configuration sim_publisher read (the site file amfid reads too), or that
+ * of the installed amfid.yaml. --allow-production-bus lets it through (a
+ * bench, a private network namespace). 0: go on; 2 after a message. */
+static int refuse_production_bus(const opts *o, const amfi_site_config *cfg)
+{
+    if (o->allow_production_bus || o->out || o->calib_dir || o->ambient_out ||
+        (o->lcm_url && !strcmp(o->lcm_url, "none")))
+        return 0;
+    const char *env = getenv("LCM_DEFAULT_URL");
+    const char *url = o->lcm_url ? o->lcm_url : env && env[0] ? env : AMFID_BUILTIN_URL;
+    char mine[300], theirs[300], why[600] = "";
+    bus_identity(url, mine, sizeof mine);
+    bus_identity(AMFID_BUILTIN_URL, theirs, sizeof theirs);
+    if (!strcmp(mine, theirs))
+        snprintf(why, sizeof why, "amfid's default bus (daemon.lcm_url \"\")");
+    if (!why[0] && cfg->daemon.lcm_url[0]) {
+        bus_identity(cfg->daemon.lcm_url, theirs, sizeof theirs);
+        if (!strcmp(mine, theirs))
+            snprintf(why, sizeof why, "the bus amfid uses by %s: daemon.lcm_url",
+                     o->config ? o->config : "the configuration");
+    }
+    if (!why[0] && (!o->config || strcmp(o->config, AMFID_INSTALLED_CONFIG))) {
+        static amfi_site_config inst; /* large */
+        char err[512];
+        if (access(AMFID_INSTALLED_CONFIG, R_OK) == 0 &&
+            amfi_config_load(AMFID_INSTALLED_CONFIG, &inst, err, sizeof err) == 0 &&
+            inst.daemon.lcm_url[0]) {
+            bus_identity(inst.daemon.lcm_url, theirs, sizeof theirs);
+            if (!strcmp(mine, theirs))
+                snprintf(why, sizeof why, "the bus of the installed amfid (%s: daemon.lcm_url)",
+                         AMFID_INSTALLED_CONFIG);
+        }
+    }
+    if (!why[0])
+        return 0;
+    fprintf(stderr,
+            "%s: refusing to publish on %s (%s): it is %s, and a running amfid would weigh "
+            "the simulated vehicles and store them as real passages (and ship them, raise "
+            "alerts). Give a private bus (--lcm-url or simulation.stream.lcm_url, and the same "
+            "daemon.lcm_url to a test amfid), or --allow-production-bus on a bench or in a "
+            "private network namespace\n",
+            PROG, url,
+            o->lcm_url ? (o->lcm_url_flag ? "--lcm-url" : "simulation.stream.lcm_url")
+                       : env && env[0] ? "$LCM_DEFAULT_URL" : "LCM's default",
+            why);
+    return 2;
 }
 
 /* A generator for vehicle i of a run: the same (seed, i), the same draws. */
@@ -1093,6 +1181,8 @@ int main(int argc, char **argv)
         return 1;
     opts_from_config(&o, &cfg.sim, cused);
     apply_flags(argc, argv, &o);
+    if (refuse_production_bus(&o, &cfg))
+        return 2;
     amfi_set_blas_threads(1);
     char err[512];
     cfg.bridge.damage = o.damage;

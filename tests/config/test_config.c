@@ -122,6 +122,9 @@ static void test_site_section(void **state)
                                   "  latitude: 46.05\n  longitude: -14.5\n", &c, err));
     assert_string_equal("Most čez Savo, km 42", c.site.name);
     assert_true(c.site.latitude == 46.05 && c.site.longitude == -14.5);
+    assert_string_equal("", c.site.bridge_type);
+    assert_int_equal(0, load_text("site:\n  bridge_type: prestressed concrete slab\n", &c, err));
+    assert_string_equal("prestressed concrete slab", c.site.bridge_type);
     assert_true(amfi_config_site_id_valid("a-b.c_9"));
     assert_false(amfi_config_site_id_valid(""));
     assert_false(amfi_config_site_id_valid("a b"));
@@ -578,8 +581,13 @@ static const bad_case bad_cases[] = {
      "expected a finite number, got 'east'"},
     {"site_lat_alone", "\nsite:\n  latitude: 46\n", 3, "site.latitude",
      "give both site.latitude and site.longitude"},
+    {"site_bridge_type_control", "site:\n  bridge_type: \"slab\\tgirder\"\n", 2,
+     "site.bridge_type", "must not contain control characters"},
+    {"site_bridge_type_long", "site:\n  bridge_type: "
+     "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\n", 2, "site.bridge_type",
+     "must be 1 .. 63 bytes long"},
     {"site_unknown", "site:\n  idd: x\n", 2, "site.idd",
-     "unknown key (known: id, name, latitude, longitude)"},
+     "unknown key (known: id, name, latitude, longitude, bridge_type)"},
     {"sim_not_map", "simulation: 10\n", 1, "simulation", "expected a mapping"},
     {"sim_unknown_key", "simulation:\n  vehicles: 5\n  vehicle: 5\n", 3,
      "simulation.vehicle", "unknown key (known: population, vehicles, first"},

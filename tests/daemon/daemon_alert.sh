@@ -60,7 +60,7 @@ apid=$!; pids="$pids $apid"
 lcm-logger -c 'AMFI_ALERT' -f "$dir/alerts.lcmlog" > "$dir/logger.log" 2>&1 &
 lpid=$!; pids="$pids $lpid"
 wait_for running "$dir/amfid.log" $lpid 60 || fail "amfid did not start"
-"$sim" --vehicles $N --headway 2 --speedup 40 --damage 0.1 --damage-step-at $HEALTHY \
+"$sim" --allow-production-bus --vehicles $N --headway 2 --speedup 40 --damage 0.1 --damage-step-at $HEALTHY \
   --seed $SEED 2> "$dir/sim.log" &
 spid=$!; pids="$pids $spid"
 t0=$(date +%s)

@@ -47,7 +47,7 @@ amfid_start "$amfid" "$dir/amfid.yaml"
 lcm-logger -f "$dir/passages.log" > "$dir/logger.log" 2>&1 &  # every channel
 lpid=$!; pids="$pids $lpid"
 sleep 0.3
-timeout 240 "$sim" --population "$dir/pop.csv" --vehicles $N --headway 3 --speedup 20 \
+timeout 240 "$sim" --allow-production-bus --population "$dir/pop.csv" --vehicles $N --headway 3 --speedup 20 \
   --dt 2.5e-4 2> "$dir/sim.log" || { cat "$dir/sim.log"; fail "sim_publisher exited $?"; }
 sleep 1
 amfid_stop

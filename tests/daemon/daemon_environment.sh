@@ -27,7 +27,7 @@ apid=$!; pids="$pids $apid"
 wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
 
 # 1. live traffic with the site's climate; sim_publisher logs what it sends
-timeout 120 "$sim" --vehicles $N --headway 3 --speedup 20 --seed 3 --dt 2.5e-4 \
+timeout 120 "$sim" --allow-production-bus --vehicles $N --headway 3 --speedup 20 --seed 3 --dt 2.5e-4 \
   --environment site --time-compression 73000 --environment-period 1 \
   --log "$dir/sent.lcmlog" 2> "$dir/sim.log" || fail "sim_publisher exited $?"
 "$envsum" "$dir/sent.lcmlog" > "$dir/sent.txt" || fail "lcm_environment"

@@ -43,7 +43,7 @@ start_amfid
 lcm-logger -c AMFI_PASSAGE -f "$dir/passages.log" > "$dir/logger.log" 2>&1 &
 lpid=$!; pids="$pids $lpid"
 sleep 0.3
-timeout 120 "$sim" --vehicles $N --headway 4 --speedup 20 --seed 5 --dt 2.5e-4 \
+timeout 120 "$sim" --allow-production-bus --vehicles $N --headway 4 --speedup 20 --seed 5 --dt 2.5e-4 \
   --environment site --time-compression 300 --environment-period 1 2> "$dir/sim.log" ||
   fail "sim_publisher exited $?"
 sleep 1
@@ -92,7 +92,7 @@ wait_for "reload: configuration .* applied" "$dir/amfid.log" "" 60 || fail "no r
 grep -q "reload: daemon.natural_frequency.free_s changed; takes effect at the next start" "$dir/amfid.log" ||
   fail "reload: $(grep reload "$dir/amfid.log")"
 # 3. vehicles 1.5 s apart: 0.5 s of free vibration each, refused as short
-timeout 120 "$sim" --vehicles 4 --headway 1.5 --speedup 20 --seed 6 --dt 2.5e-4 \
+timeout 120 "$sim" --allow-production-bus --vehicles 4 --headway 1.5 --speedup 20 --seed 6 --dt 2.5e-4 \
   --start-utime 1767312000000000 2> "$dir/sim2.log" || fail "sim_publisher exited $?"
 sleep 1
 stop_amfid

@@ -62,7 +62,7 @@ stop() {
 # sim NAME ARGS...: vehicles live on the bus, the site's climate on
 sim() {
   name=$1; shift
-  timeout 300 "$sim" --headway 3 --speedup 60 --seed 3 --dt 2.5e-4 --environment site \
+  timeout 300 "$sim" --allow-production-bus --headway 3 --speedup 60 --seed 3 --dt 2.5e-4 --environment site \
     --time-compression 2000 --environment-period 10 --calibration-every 10 \
     --log "$dir/$name.lcmlog" "$@" 2> "$dir/$name-sim.log" ||
     fail "sim_publisher exited $? ($name)"

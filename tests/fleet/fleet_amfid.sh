@@ -8,7 +8,8 @@
 # ships while the rows arrive, and after both stop the central rows equal
 # the store's: no gap, no duplicate. The simulator's site climate is on:
 # the temperature readings, the passages' deck temperatures and natural
-# frequencies are shipped too.
+# frequencies are shipped too, and the site's name, position and bridge
+# type of amfid.yaml (through amfid's meta) reach fleet_sites.
 # Usage: fleet_amfid.sh AMFI_SYNC AMFID SIM_PUBLISHER CONFIG. Exit 77 without
 # sqlite3/PostgreSQL.
 set -u
@@ -31,8 +32,12 @@ die() { echo "FAIL: $*"; tail -n 5 "$tmp/amfid.log" "$tmp/sync.log" "$tmp/sim.lo
 sed -e "s/^  id: local .*/  id: live-1/" -e "s|^    path: amfi.db .*|    path: $tmp/live.db|" \
     -e "s/^    window: 500/    window: 10/" -e "s/^    every: 100/    every: 5/" \
     -e "s/^    baseline_n: 10000/    baseline_n: 10/" \
-    -e "s/^    deck_max_rate_c_per_min: 2 /    deck_max_rate_c_per_min: 1000000 /" "$config" > "$tmp/live.yaml"
-grep -q "^  id: live-1$" "$tmp/live.yaml" && grep -q "path: $tmp/live.db" "$tmp/live.yaml" ||
+    -e "s/^    deck_max_rate_c_per_min: 2 /    deck_max_rate_c_per_min: 1000000 /" \
+    -e "s/^  # name: .*/  name: \"Live bridge, km 1\"/" -e "s/^  # latitude: .*/  latitude: 46.05/" \
+    -e "s/^  # longitude: .*/  longitude: 14.51/" -e "s/^  # bridge_type: .*/  bridge_type: \"box girder\"/" \
+    "$config" > "$tmp/live.yaml"
+grep -q "^  id: live-1$" "$tmp/live.yaml" && grep -q "path: $tmp/live.db" "$tmp/live.yaml" &&
+    grep -q '^  bridge_type: "box girder"$' "$tmp/live.yaml" ||
     die "the test's site and store did not apply"
 "$amfid" --config "$tmp/live.yaml" 2> "$tmp/amfid.log" &
 apid=$!
@@ -41,7 +46,7 @@ wait_for running "$tmp/amfid.log" $apid 60 || die "amfid did not start"
 spid=$!
 # 120 vehicles 2 s apart, 12 times faster than real time: about 20 s; the
 # site's climate (issue 14) on, time-compressed, a reading every second
-"$sim" --vehicles 120 --headway 2 --speedup 12 --seed 11 \
+"$sim" --allow-production-bus --vehicles 120 --headway 2 --speedup 12 --seed 11 \
     --environment site --time-compression 73000 --environment-period 1 2> "$tmp/sim.log" || die "sim_publisher"
 sleep 2
 mid=$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'live-1'")
@@ -57,6 +62,9 @@ stored=$(sqlite3 "$tmp/live.db" "SELECT count(*) FROM passages")
 passes=$(grep -c "rows shipped" "$tmp/sync.log")
 [ "$passes" -ge 3 ] || fail "amfi-sync shipped in $passes passes while amfid wrote, expected several"
 fleet_same "$tmp/live.db" live-1
+# the site's facts, from amfid.yaml through amfid's meta to fleet_sites
+f=$(pg_q "SELECT name || '|' || latitude || '|' || longitude || '|' || bridge_type FROM fleet_sites WHERE site_id = 'live-1'")
+[ "$f" = "Live bridge, km 1|46.05|14.51|box girder" ] || fail "fleet_sites of live-1: '$f'"
 # issue 14's data as amfid wrote it: temperature readings, the passages'
 # deck temperature and natural frequency, all of it in the central rows
 env=$(sqlite3 "$tmp/live.db" "SELECT count(*) FROM environment")

@@ -115,7 +115,7 @@ as amfi_sync_site-a "INSERT INTO fleet_site_roles VALUES ('amfi_sync_site-a', 's
 [ "$(as amfi_sync_site-a "SELECT count(*) FROM passages WHERE site_id = 'site-b'")" = 0 ] || fail "A reads B's passages"
 [ "$(as amfi_sync_site-a "SELECT count(DISTINCT site_id) FROM alerts")" = 1 ] || fail "A reads other sites' alerts"
 [ "$(as amfi_sync_site-a "SELECT string_agg(site_id, ' ') FROM fleet_site_roles")" = site-a ] || fail "A reads other sites' roles"
-for v in fleet_open_alerts fleet_latest_state fleet_window_trend fleet_daily_trend; do
+for v in fleet_open_alerts fleet_latest_state fleet_window_trend fleet_daily_trend fleet_summary; do
     as amfi_sync_site-a "SELECT count(*) FROM $v" > /dev/null 2>&1 && fail "A reads the view $v (every site)"
 done
 as amfi_sync_site-a "DELETE FROM passages" 2> /dev/null && fail "A deleted passages"
@@ -176,6 +176,8 @@ DO $$ DECLARE t text; BEGIN
     EXECUTE format('ALTER TABLE %I DISABLE ROW LEVEL SECURITY', t);
   END LOOP;
 END $$;
+DROP VIEW fleet_summary;
+DROP TABLE fleet_sites;
 DROP TABLE fleet_site_roles;
 ALTER TABLE passages DROP COLUMN class, DROP COLUMN axle_groups, DROP COLUMN overload;
 DELETE FROM fleet_migrations WHERE version > 5;
@@ -192,8 +194,8 @@ psql -X -q -v ON_ERROR_STOP=1 "$upw" -c "INSERT INTO fleet_migrations VALUES (77
 [ "$(pg_q "SELECT count(*) FROM fleet_open_alerts WHERE site_id = 'site-v'")" = 0 ] ||
     fail "at version 5, the forged cleared alert did not close site-v's alert"
 pg_q "DELETE FROM alerts WHERE site_id = 'site-v' AND id = 9999; DELETE FROM fleet_migrations WHERE version = 77"
-"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 5 -> 7"
-[ "$(psql -X -At "$up" -c 'SELECT max(version) FROM fleet_migrations')" = 7 ] || fail "not migrated to 7"
+"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 5 -> 8"
+[ "$(psql -X -At "$up" -c 'SELECT max(version) FROM fleet_migrations')" = 8 ] || fail "not migrated to 8"
 add_rows "$tmp/u.db" 200
 "$sync" --db "$tmp/u.db" --pg "$upw" --once 2> "$tmp/upw.log"
 [ $? = 2 ] || fail "the shared writer after the migration: not refused"

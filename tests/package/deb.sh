@@ -25,7 +25,8 @@ files=$(dpkg-deb -c "$deb" | awk '{print $6}')
 for f in ./usr/bin/amfid ./usr/bin/amfi-solve ./usr/bin/amfi-report ./usr/bin/amfi-spy ./usr/bin/sim_publisher \
          ./etc/amfid/amfid.yaml ./lib/systemd/system/amfid.service ./usr/lib/sysusers.d/amfid.conf \
          ./usr/lib/tmpfiles.d/amfid.conf ./usr/share/man/man8/amfid.8.gz ./usr/share/man/man5/amfid.yaml.5.gz ./usr/share/doc/amfi/LICENSE \
-         ./usr/share/java/amfi_types.jar; do
+         ./usr/share/java/amfi_types.jar ./usr/share/amfi/roles.sql ./usr/bin/amfi-top \
+         ./usr/share/man/man1/amfi-top.1.gz; do
   echo "$files" | grep -qx "$f" || fail "not in the package: $f"
 done
 echo "$files" | grep -q '^\./usr/local' && fail "files under /usr/local in the package"

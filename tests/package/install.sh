@@ -33,7 +33,7 @@ echo "installed files: ok"
 out=$("$stage$bindir/amfid" --check-config --config "$stage$sysconfdir/amfid/amfid.yaml" 2>&1) ||
   { echo "$out"; fail "installed amfid --check-config on the installed amfid.yaml"; }
 echo "installed amfid --check-config: ok"
-for p in amfid amfi-solve amfi-report sim_publisher amfi-mkcase amfi-bench amfi-population amfi-fleet-bench amfi-sync amfi-web; do
+for p in amfid amfi-solve amfi-report sim_publisher amfi-mkcase amfi-bench amfi-population amfi-fleet-bench amfi-sync amfi-web amfi-top; do
   v=$("$stage$bindir/$p" --version 2>&1) || fail "installed $p --version exited non-zero"
   case "$v" in "$p "[0-9]*) ;; *) fail "installed $p --version said: $v" ;; esac
 done

@@ -490,7 +490,7 @@ static int check_args(options *o)
         return usage_error("--pg", "the central database is read only here: --set-baseline* and "
                            "--check work on a site's store (--db)");
     if (o->pg && !o->site) {
-        if (asked || o->plot_dir || o->format != FMT_TABLE)
+        if (asked || o->plot_dir)
             return usage_error("--site", "the report sections need one site: without --site, "
                                "--pg prints the fleet summary only");
         return 0;
@@ -839,7 +839,9 @@ int main(int argc, char **argv)
     if (parse_args(argc, argv, &o) != 0)
         return EXIT_USAGE;
     if (o.pg && !o.site) {
-        rc = report_pg_fleet(o.pg, o.allow_plaintext, stdout, err, sizeof err);
+        rc = report_pg_fleet(o.pg, o.allow_plaintext,
+                             o.format == FMT_CSV ? "csv" : o.format == FMT_JSON ? "json" : NULL,
+                             stdout, err, sizeof err);
         if (rc)
             fprintf(stderr, PROG ": --pg: %s\n", err);
         return rc == 2 ? EXIT_USAGE : rc ? EXIT_DATA : 0;

@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "amfi_config.h"
+#include "amfi_json.h"
 #include "fleet_pg.h"
 #include "fleet_schema.h"
 #include "store.h"
@@ -83,23 +84,60 @@ static int count_ok(const char *v)
     return errno == 0 && end != v && !*end && x >= 0;
 }
 
+/* text without control characters, valid UTF-8 (site.name, site.bridge_type) */
+static int text_ok(const char *s)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    while (*p) {
+        int n = *p < 0x80 ? 1 : (*p & 0xe0) == 0xc0 && *p >= 0xc2 ? 2 : (*p & 0xf0) == 0xe0 ? 3
+              : (*p & 0xf8) == 0xf0 && *p <= 0xf4 ? 4 : 0;
+        if (!n || (n == 1 && (*p < 0x20 || *p == 0x7f))) return 0;
+        for (int k = 1; k < n; k++)
+            if ((p[k] & 0xc0) != 0x80) return 0;
+        p += n;
+    }
+    return 1;
+}
+
+/* The fleet summary's columns (the view fleet_summary, central version 8):
+ * 0-6 as the table prints them, then the site's facts and the full times. */
+enum { FS_SITE, FS_PASSAGES, FS_LAST, FS_STATE, FS_RATIO, FS_OPEN, FS_SHIPPED, FS_NAME, FS_LAT,
+       FS_LON, FS_TYPE, FS_LAST_FULL, FS_SHIPPED_FULL, FS_N };
+static const char fleet_summary_sql[] =
+    "SELECT site_id, passages,"
+    "  to_char(last_passage AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI\"Z\"'),"
+    "  state, coalesce(to_char(std_ratio, 'FM990.000'), '-'), open_alerts,"
+    "  to_char(last_shipped AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI\"Z\"'),"
+    "  name, latitude, longitude, bridge_type,"
+    "  to_char(last_passage AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.US\"Z\"'),"
+    "  to_char(last_shipped AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.US\"Z\"')"
+    " FROM fleet_summary ORDER BY site_id";
+
+static int coord_ok(const char *v, double lim)
+{
+    char *end;
+    double x = strtod(v, &end);
+    return end != v && !*end && x >= -lim && x <= lim;
+}
+
 /* What is wrong with row i of the fleet summary query, NULL if nothing:
- * site id as amfid's config allows it, counts, a known state, a ratio. */
+ * site id as amfid's config allows it, counts, a known state, a ratio, the
+ * site's name, position and bridge type as amfid.yaml(5) allows them. */
 static const char *fleet_row_problem(PGresult *r, int i)
 {
     static const char *const states[] = {"-", "baseline", "normal", "watch", "alert", NULL};
-    if (PQgetisnull(r, i, 0) || !amfi_config_site_id_valid(PQgetvalue(r, i, 0)))
+    if (PQgetisnull(r, i, FS_SITE) || !amfi_config_site_id_valid(PQgetvalue(r, i, FS_SITE)))
         return "site_id is not a valid site id";
-    if (PQgetisnull(r, i, 1) || !count_ok(PQgetvalue(r, i, 1)))
+    if (PQgetisnull(r, i, FS_PASSAGES) || !count_ok(PQgetvalue(r, i, FS_PASSAGES)))
         return "fleet_sync_state.hwm is not a count";
-    if (PQgetisnull(r, i, 5) || !count_ok(PQgetvalue(r, i, 5)))
+    if (PQgetisnull(r, i, FS_OPEN) || !count_ok(PQgetvalue(r, i, FS_OPEN)))
         return "the open alerts are not a count";
     int k = 0;
-    while (states[k] && strcmp(states[k], PQgetvalue(r, i, 3)) != 0)
+    while (states[k] && strcmp(states[k], PQgetvalue(r, i, FS_STATE)) != 0)
         k++;
     if (!states[k])
         return "fleet_latest_state.state is not baseline, normal, watch or alert";
-    const char *ratio = PQgetvalue(r, i, 4);
+    const char *ratio = PQgetvalue(r, i, FS_RATIO);
     if (strcmp(ratio, "-") != 0) {
         char *end;
         double x = strtod(ratio, &end);
@@ -107,32 +145,129 @@ static const char *fleet_row_problem(PGresult *r, int i)
         if (end == ratio || *end || !(x >= 0))
             return "fleet_latest_state.std_ratio is not a ratio in [0, 999.999]";
     }
+    if (!PQgetisnull(r, i, FS_NAME)
+        && (!text_ok(PQgetvalue(r, i, FS_NAME)) || strlen(PQgetvalue(r, i, FS_NAME)) > 127))
+        return "fleet_sites.name is not 1 .. 127 bytes of UTF-8 text without control characters";
+    if (!PQgetisnull(r, i, FS_TYPE)
+        && (!text_ok(PQgetvalue(r, i, FS_TYPE)) || strlen(PQgetvalue(r, i, FS_TYPE)) > 63))
+        return "fleet_sites.bridge_type is not 1 .. 63 bytes of UTF-8 text without control characters";
+    if ((!PQgetisnull(r, i, FS_LAT) && !coord_ok(PQgetvalue(r, i, FS_LAT), 90))
+        || (!PQgetisnull(r, i, FS_LON) && !coord_ok(PQgetvalue(r, i, FS_LON), 180)))
+        return "fleet_sites.latitude or longitude is not a number of degrees in range";
     return NULL;
 }
 
-int report_pg_fleet(const char *conninfo, int allow_plaintext, FILE *out, char *err, size_t errlen)
+/* A CSV field (RFC 4180): quoted when it holds a comma, a quote or a line
+ * break; NULL is empty. */
+static void csv_field(FILE *out, const PGresult *r, int i, int col, int last)
+{
+    if (!PQgetisnull(r, i, col)) {
+        const char *v = PQgetvalue(r, i, col);
+        if (strpbrk(v, ",\"\r\n")) {
+            fputc('"', out);
+            for (; *v; v++) {
+                if (*v == '"') fputc('"', out);
+                fputc(*v, out);
+            }
+            fputc('"', out);
+        } else {
+            fputs(v, out);
+        }
+    }
+    fputc(last ? '\n' : ',', out);
+}
+
+static json_t *col_text(const PGresult *r, int i, int col)
+{
+    return PQgetisnull(r, i, col) ? json_null() : json_string(PQgetvalue(r, i, col));
+}
+static json_t *col_real(const PGresult *r, int i, int col)
+{
+    return PQgetisnull(r, i, col) ? json_null() : amfi_json_num(strtod(PQgetvalue(r, i, col), NULL));
+}
+static json_t *col_count(const PGresult *r, int i, int col)
+{
+    return json_integer(strtoll(PQgetvalue(r, i, col), NULL, 10));
+}
+
+/* The summary as CSV (a header, one line per site) or one JSON document
+ * ({"fleet": {...}, "sites": [...]}): the site's facts, counts as numbers,
+ * times in ISO 8601 UTC to the µs. 0, or 1 out of memory / write error. */
+static int fleet_export(PGconn *pg, PGresult *r, const char *format, FILE *out)
+{
+    static const int cols[] = {FS_SITE, FS_NAME, FS_LAT, FS_LON, FS_TYPE, FS_PASSAGES, FS_LAST_FULL,
+                               FS_STATE, FS_RATIO, FS_OPEN, FS_SHIPPED_FULL};
+    static const char *const names[] = {"site_id", "name", "latitude", "longitude", "bridge_type",
+                                        "passages", "last_passage", "state", "std_ratio",
+                                        "open_alerts", "last_shipped"};
+    enum { NC = sizeof cols / sizeof cols[0] };
+    if (strcmp(format, "csv") == 0) {
+        for (int c = 0; c < NC; c++)
+            fprintf(out, "%s%c", names[c], c + 1 < NC ? ',' : '\n');
+        for (int i = 0; i < PQntuples(r); i++)
+            for (int c = 0; c < NC; c++) {
+                if (cols[c] == FS_RATIO && strcmp(PQgetvalue(r, i, FS_RATIO), "-") == 0)
+                    fputc(c + 1 < NC ? ',' : '\n', out); /* no indicator yet: empty */
+                else
+                    csv_field(out, r, i, cols[c], c + 1 == NC);
+            }
+        return ferror(out) ? 1 : 0;
+    }
+    json_t *sites = json_array(), *root = json_object(), *fleet = json_object();
+    for (int i = 0; sites && i < PQntuples(r); i++) {
+        json_t *o = json_object();
+        const char *ratio = PQgetvalue(r, i, FS_RATIO);
+        json_object_set_new(o, "site_id", col_text(r, i, FS_SITE));
+        json_object_set_new(o, "name", col_text(r, i, FS_NAME));
+        json_object_set_new(o, "latitude", col_real(r, i, FS_LAT));
+        json_object_set_new(o, "longitude", col_real(r, i, FS_LON));
+        json_object_set_new(o, "bridge_type", col_text(r, i, FS_TYPE));
+        json_object_set_new(o, "passages", col_count(r, i, FS_PASSAGES));
+        json_object_set_new(o, "last_passage", col_text(r, i, FS_LAST_FULL));
+        json_object_set_new(o, "state", col_text(r, i, FS_STATE));
+        json_object_set_new(o, "std_ratio", strcmp(ratio, "-") ? amfi_json_num(strtod(ratio, NULL))
+                                                               : json_null());
+        json_object_set_new(o, "open_alerts", col_count(r, i, FS_OPEN));
+        json_object_set_new(o, "last_shipped", col_text(r, i, FS_SHIPPED_FULL));
+        if (!o || json_array_append_new(sites, o) != 0) {
+            json_decref(sites);
+            sites = NULL;
+        }
+    }
+    if (!sites || !root || !fleet) {
+        json_decref(sites);
+        json_decref(root);
+        json_decref(fleet);
+        return 1;
+    }
+    json_object_set_new(fleet, "host", json_string(PQhost(pg)));
+    json_object_set_new(fleet, "database", json_string(PQdb(pg)));
+    json_object_set_new(fleet, "n_sites", json_integer(PQntuples(r)));
+    json_object_set_new(root, "fleet", fleet);
+    json_object_set_new(root, "sites", sites);
+    return amfi_json_print(out, root) ? 1 : 0;
+}
+
+int report_pg_fleet(const char *conninfo, int allow_plaintext, const char *format, FILE *out,
+                    char *err, size_t errlen)
 {
     int crc;
     PGconn *pg = connect_pg(conninfo, allow_plaintext, &crc, err, errlen);
     if (!pg) return crc;
-    /* Per site: the newest passage id and time shipped (ids are never
-     * reused in a store, so the id counts the passages), the latest
-     * indicator, the open alerts and when the site last shipped. Index
-     * lookups only: instant on a fleet of 36 M passages. */
-    PGresult *r = PQexec(pg,
-        "SELECT s.site_id, s.hwm,"
-        "  to_char(to_timestamp((SELECT max(utime) FROM passages p WHERE p.site_id = s.site_id) / 1e6)"
-        "          AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI\"Z\"'),"
-        "  coalesce(l.state, '-'), coalesce(to_char(l.std_ratio, 'FM990.000'), '-'),"
-        "  (SELECT count(*) FROM fleet_open_alerts a WHERE a.site_id = s.site_id),"
-        "  to_char(g.synced_at AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI\"Z\"')"
-        " FROM fleet_sync_state s"
-        " LEFT JOIN fleet_latest_state l ON l.site_id = s.site_id"
-        " LEFT JOIN (SELECT site_id, max(synced_at) AS synced_at FROM fleet_sync_state GROUP BY 1) g"
-        "   ON g.site_id = s.site_id"
-        " WHERE s.tbl = 'passages' ORDER BY s.site_id");
+    /* Per site (the view fleet_summary, one source with psql's): the
+     * newest passage id and time shipped (ids are never reused in a store,
+     * so the id counts the passages), the latest indicator, the open
+     * alerts, when the site last shipped, its name, position and bridge
+     * type. Index lookups only: instant on a fleet of 36 M passages. */
+    PGresult *r = PQexec(pg, fleet_summary_sql);
     if (PQresultStatus(r) != PGRES_TUPLES_OK) {
-        fail(err, errlen, 1, "fleet summary: %s", PQerrorMessage(pg));
+        const char *state = PQresultErrorField(r, PG_DIAG_SQLSTATE);
+        if (state && strcmp(state, "42P01") == 0) /* undefined table: an older central schema */
+            fail(err, errlen, 1, "fleet summary: the central database has no view fleet_summary "
+                 "(central schema before version %d): its owner runs 'amfi-sync --init-schema' "
+                 "(docs/fleet.md)", fleet_n_migrations);
+        else
+            fail(err, errlen, 1, "fleet summary: %s", PQerrorMessage(pg));
         PQclear(r);
         PQfinish(pg);
         return 1;
@@ -151,13 +286,23 @@ int report_pg_fleet(const char *conninfo, int allow_plaintext, FILE *out, char *
             return 1;
         }
     }
+    int rc = 0;
+    if (format && strcmp(format, "table") != 0) {
+        if (fleet_export(pg, r, format, out) != 0)
+            rc = fail(err, errlen, 1, "fleet summary: --format %s: %s", format,
+                      ferror(out) ? strerror(errno) : "out of memory");
+        PQclear(r);
+        PQfinish(pg);
+        return rc;
+    }
     fprintf(out, "fleet        %d sites on %s/%s\n", PQntuples(r), PQhost(pg), PQdb(pg));
-    fprintf(out, "%-24s %10s  %-17s  %-8s %9s  %5s  %-17s\n", "site", "passages", "last passage",
-            "state", "STD ratio", "open", "last shipped");
+    fprintf(out, "%-24s %10s  %-17s  %-8s %9s  %5s  %-17s  %s\n", "site", "passages", "last passage",
+            "state", "STD ratio", "open", "last shipped", "name");
     for (int i = 0; i < PQntuples(r); i++)
-        fprintf(out, "%-24s %10s  %-17s  %-8s %9s  %5s  %-17s\n", PQgetvalue(r, i, 0),
+        fprintf(out, "%-24s %10s  %-17s  %-8s %9s  %5s  %-17s  %s\n", PQgetvalue(r, i, 0),
                 PQgetvalue(r, i, 1), PQgetisnull(r, i, 2) ? "-" : PQgetvalue(r, i, 2),
-                PQgetvalue(r, i, 3), PQgetvalue(r, i, 4), PQgetvalue(r, i, 5), PQgetvalue(r, i, 6));
+                PQgetvalue(r, i, 3), PQgetvalue(r, i, 4), PQgetvalue(r, i, 5), PQgetvalue(r, i, 6),
+                PQgetisnull(r, i, FS_NAME) ? "-" : PQgetvalue(r, i, FS_NAME));
     PQclear(r);
     PQfinish(pg);
     return 0;
@@ -265,6 +410,41 @@ static int fetch_table(PGconn *pg, amfi_store *s, const char *site_lit, const ch
     return rc;
 }
 
+/* The site's name, position and bridge type (fleet_sites, central version
+ * 8) into the store's meta, as amfid writes them at a site: the report and
+ * its plots are then titled by the site's name, not the temporary file's.
+ * A central database before version 8 has none: nothing written. */
+static int site_meta(PGconn *pg, amfi_store *s, const char *site, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"site.name", "site.latitude", "site.longitude",
+                                       "site.bridge_type"};
+    const char *pv[1] = {site};
+    PGresult *r = PQexecParams(pg, "SELECT name, latitude, longitude, bridge_type FROM fleet_sites "
+                                   "WHERE site_id = $1 AND to_regclass('fleet_sites') IS NOT NULL",
+                               1, NULL, pv, NULL, NULL, 0);
+    int rc = 0;
+    if (PQresultStatus(r) != PGRES_TUPLES_OK) {
+        const char *state = PQresultErrorField(r, PG_DIAG_SQLSTATE);
+        if (!state || strcmp(state, "42P01") != 0)
+            rc = fail(err, errlen, 1, "central fleet_sites: %s", PQerrorMessage(pg));
+        PQclear(r);
+        return rc;
+    }
+    for (int k = 0; rc == 0 && PQntuples(r) == 1 && k < 4; k++) {
+        const char *v = PQgetvalue(r, 0, k);
+        if (PQgetisnull(r, 0, k)) continue;
+        int ok = k == 1 ? coord_ok(v, 90) : k == 2 ? coord_ok(v, 180)
+                        : text_ok(v) && strlen(v) <= (k == 0 ? 127u : 63u);
+        if (!ok)
+            rc = fail(err, errlen, 1, "central fleet_sites (site %s): %s is not what amfid.yaml(5) "
+                      "allows for %s", site, keys[k] + 5, keys[k]);
+        else if (amfi_store_meta_set(s, keys[k], v, err, errlen) != 0)
+            rc = 1;
+    }
+    PQclear(r);
+    return rc;
+}
+
 int report_pg_fetch_site(const char *conninfo, int allow_plaintext, const char *site, const char *path,
                          long *rows, char *err, size_t errlen)
 {
@@ -294,6 +474,7 @@ int report_pg_fetch_site(const char *conninfo, int allow_plaintext, const char *
     }
     if (amfi_store_open(path, 0, &s, err, errlen) != 0
         || amfi_store_meta_set(s, "site.id", site, err, errlen) != 0
+        || site_meta(pg, s, site, err, errlen) != 0
         || amfi_store_transaction(s, AMFI_STORE_TX_WRITE, err, errlen) != 0) {
         rc = 1;
         goto out;

@@ -10,9 +10,12 @@
 
 #include <stdio.h>
 
-/* The fleet summary on out: one line per site. 0, 1 (server away,
- * query failed) or 2 (connection refused: TLS, password file). */
-int report_pg_fleet(const char *conninfo, int allow_plaintext, FILE *out, char *err, size_t errlen);
+/* The fleet summary on out (the central view fleet_summary): format NULL or
+ * "table" one line per site, "csv" a header and one line per site, "json"
+ * one document. 0, 1 (server away, query failed, a central row that is not
+ * what the sites ship) or 2 (connection refused: TLS, password file). */
+int report_pg_fleet(const char *conninfo, int allow_plaintext, const char *format, FILE *out,
+                    char *err, size_t errlen);
 
 /* A new store at path (which must not exist) holding every central row of
  * site; *rows gets their number. 0; 1 server away or a row the store's

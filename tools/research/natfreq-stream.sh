@@ -54,7 +54,7 @@ i=0; until grep -q "running" "$out/amfid.log"; do
   i=$((i + 1)); [ $i -lt 400 ] || { echo "amfid did not start" >&2; kill $apid; exit 1; }
   sleep 0.05; done
 start=$(date +%s)
-"$build/sim_publisher/sim_publisher" --vehicles "$n" --speedup "${SPEEDUP:-20}" "$@" \
+"$build/sim_publisher/sim_publisher" --allow-production-bus --vehicles "$n" --speedup "${SPEEDUP:-20}" "$@" \
   2> "$out/sim.log" || echo "sim_publisher exited $?" >&2
 sleep 2
 kill -TERM $apid; wait $apid
