@@ -29,7 +29,8 @@
 
 #include "store_internal.h"
 
-#define RAW_LEVEL 6 /* zlib's default level: docs/results/raw-passages.md */
+#define RAW_LEVEL 1 /* zlib level: 1 is 0.6 % larger than 6 on float64 samples and many
+                      * times faster (docs/results/raw-passages.md) */
 
 struct st_raw {
     z_stream z;
