@@ -64,6 +64,7 @@ typedef struct amfi_daemon_config {
     int raw_keep;             /* daemon.store.raw.keep: the raw samples of every passage
                                  weighed (AMFI_RAW_KEEP_ALL), of those not stored ok
                                  (AMFI_RAW_KEEP_FAILED) or none (AMFI_RAW_KEEP_NONE) */
+    int raw_float32;          /* daemon.store.raw.precision: float64 (0, exact) | float32 (1) */
     double raw_max_age_days;  /* daemon.store.raw.max_age_days: windows older than this
                                  (data time) are deleted, days, 0 (no limit) .. 36500 */
     double raw_max_mib;       /* daemon.store.raw.max_mib: the oldest windows are deleted

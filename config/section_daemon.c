@@ -41,8 +41,11 @@ static const enum_name raw_keep_names[] = {
     {"none", AMFI_RAW_KEEP_NONE}, {"failed", AMFI_RAW_KEEP_FAILED}, {"all", AMFI_RAW_KEEP_ALL},
     {NULL, 0}};
 
+static const enum_name raw_precision_names[] = {{"float64", 0}, {"float32", 1}, {NULL, 0}};
+
 static const field raw_fields[] = {
     {.key = "keep", .kind = &amfi_cfg_k_enum, .off = DC(raw_keep), .aux = raw_keep_names},
+    {.key = "precision", .kind = &amfi_cfg_k_enum, .off = DC(raw_float32), .aux = raw_precision_names},
     {.key = "max_age_days", .kind = &amfi_cfg_k_double, .off = DC(raw_max_age_days), .lo = 0,
      .hi = 36500},
     {.key = "max_mib", .kind = &amfi_cfg_k_double, .off = DC(raw_max_mib), .lo = 0,

@@ -17,7 +17,8 @@
  * it is stored without.
  *
  * A module (ctx.h): restore reads the store's usage and adds the retention
- * timer (every 60 s; again at the next turn while more is due), row points
+ * timer (every 60 s; again at the next turn while more is due; once more at
+ * the drain, final), row points
  * the row at the window (the store encodes it into the handle's reused
  * buffers: no allocation per passage once they fit), on_passage counts
  * and remembers an event's window for its later vehicles, metrics and final
@@ -105,9 +106,10 @@ static int raw_restore(amfid_ctx *c)
         LOG_ERR("raw samples: %s", err);
         return 1;
     }
-    LOG_INFO("raw samples: keep %s; %" PRId64 " windows, %.1f MiB stored; deleted after %g days "
-             "(0: never) or beyond %g MiB (0: no bound)",
-             keep_names[dc->raw_keep], R.kept_windows, (double)R.kept_bytes / 1048576.0,
+    LOG_INFO("raw samples: keep %s as %s; %" PRId64 " windows, %.1f MiB stored; deleted after %g "
+             "days (0: never) or beyond %g MiB (0: no bound)",
+             keep_names[dc->raw_keep], dc->raw_float32 ? "float32" : "float64", R.kept_windows,
+             (double)R.kept_bytes / 1048576.0,
              dc->raw_max_age_days, dc->raw_max_mib);
     if (timer_add(c->timers, &R.period_s, raw_prune) != 0) {
         LOG_ERR("raw samples: no room for the retention timer");
@@ -171,6 +173,7 @@ static void raw_row(amfid_ctx *c, const amfid_passage *p, amfi_passage_row *r)
         w->speed_prior = j->speed_prior;
         w->samples = j->accel;
         R.put.window = w;
+        R.put.float32 = dc->raw_float32;
         R.put.vehicle = idx;
         R.holder = 1;
     } else if (multi && idx > 0 && R.event_seq == j->w.seq && R.event_window > 0) {
@@ -229,7 +232,10 @@ static void raw_metrics(amfid_ctx *c, amfid_stats *s)
 
 static void raw_final(amfid_ctx *c)
 {
-    (void)c;
+    /* the retention once more at the drain (the last minute's passages):
+     * bounded, a batch a call */
+    for (int k = 0; k < 1000 && raw_prune(c); k++)
+        ;
     LOG_INFO("raw samples: %" PRId64 " windows written (%.1f MiB, %.1f MiB as float64: "
              "ratio %.2f), %" PRId64 " passages linked to their event's, %" PRId64
              " not written; %" PRId64 " deleted by age, %" PRId64 " by size",

@@ -572,8 +572,11 @@ typedef struct amfi_raw_vehicle {
     double spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1, (0, 50] m */
 } amfi_raw_vehicle;
 
-/* The encodings of raw_windows.samples (the one written). */
-#define AMFI_STORE_RAW_ENCODING "f64-xor-shuffle-zlib"
+/* The encodings of raw_windows.samples: the float64 values exactly, or
+ * rounded to float32 (each sample changed by at most 2^-24 of itself,
+ * about half the bytes; daemon.store.raw.precision). */
+#define AMFI_STORE_RAW_F64 "f64-xor-shuffle-zlib"
+#define AMFI_STORE_RAW_F32 "f32-xor-shuffle-zlib"
 /* The largest raw window the store writes or reads, in samples (all
  * sensors): 2^26 (512 MiB of float64). */
 #define AMFI_STORE_RAW_MAX_SAMPLES (INT64_C(1) << 26)
@@ -611,6 +614,8 @@ typedef struct amfi_raw_window {
  * never shrunk: no allocation per passage once they fit). */
 typedef struct amfi_raw_put {
     const amfi_raw_window *window;
+    int float32;         /* 1: the window's samples rounded to float32
+                            (AMFI_STORE_RAW_F32), 0: exact (AMFI_STORE_RAW_F64) */
     int64_t window_id;   /* the window linked to (window NULL) */
     int vehicle;         /* the passage's index in the window's vehicles */
     /* out */
@@ -626,6 +631,8 @@ typedef struct amfi_raw_rec {
     int64_t passage_id, window_id;
     int vehicle;         /* the passage's index in w.vehicle[] */
     int64_t bytes;       /* compressed bytes stored */
+    int float32;         /* 1: stored rounded to float32 (w.samples are those
+                            floats as doubles), 0: the float64 values */
     amfi_raw_window w;   /* w.samples malloc'd */
 } amfi_raw_rec;
 
@@ -669,14 +676,15 @@ typedef struct amfi_raw_pruned {
 int amfi_store_raw_prune(amfi_store *s, int64_t before_utime, int64_t max_bytes, int max_windows,
                          amfi_raw_pruned *out, char *err, size_t errlen);
 
-/* The codec alone (tests, measurements): n float64 values in `sensors`
- * runs of n / sensors into a zlib blob, *out malloc'd (*outlen bytes), at
- * zlib level 1 .. 9; and back (exactly n values, else
- * AMFI_STORE_ECORRUPT). */
-int amfi_store_raw_encode(const double *x, int64_t n, int sensors, int level, unsigned char **out,
-                          size_t *outlen, char *err, size_t errlen);
+/* The codec alone (tests, measurements): n values in `sensors` runs of
+ * n / sensors into a zlib blob, *out malloc'd (*outlen bytes), at zlib
+ * level 1 .. 9, as float64 (float32 0) or rounded to float32 (float32 1: a
+ * value beyond float's range is AMFI_EINVAL); and back (exactly n values,
+ * else AMFI_STORE_ECORRUPT). */
+int amfi_store_raw_encode(const double *x, int64_t n, int sensors, int level, int float32,
+                          unsigned char **out, size_t *outlen, char *err, size_t errlen);
 int amfi_store_raw_decode(const unsigned char *blob, size_t len, int64_t n, int sensors,
-                          double *x, char *err, size_t errlen);
+                          int float32, double *x, char *err, size_t errlen);
 
 /* ---- rows as column values, for other programs (store_scan.c) ----------- */
 /* amfi-sync ships a store's rows, amfi-report --pg and amfi-fleet-bench

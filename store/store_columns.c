@@ -281,7 +281,8 @@ static const amfi_store_coldef refusals[] = {
 #undef ROW
 
 /* ---- raw_windows, passage_raw (written and read by store_raw.c) ----------- */
-static const char *const raw_encodings[] = {"f64-xor-shuffle-zlib", NULL};
+static const char *const raw_encodings[] = {"f64-xor-shuffle-zlib", "f32-xor-shuffle-zlib",
+                                            NULL};
 static const amfi_store_coldef raw_windows[] = {
     ID(11, 0, "one window weighed: a vehicle, or an event of several weighed together"),
     {.name = "utime", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 0, .ihi = UT_MAX,
@@ -302,11 +303,11 @@ static const amfi_store_coldef raw_windows[] = {
      .unit = "", .since = 11, .meaning = "the solver's λ policy and speed settings at release"},
     {.name = "encoding", .sql_type = 't', .null_rule = AMFI_NULL_DB,
      .text_kind = AMFI_TEXT_ENUM, .words = raw_encodings, .unit = "", .since = 11,
-     .meaning = "how samples is encoded"},
+     .meaning = "how samples is encoded: float64 exact, or rounded to float32"},
     {.name = "bytes", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1, .ihi = INT64_MAX,
      .unit = "B", .since = 11, .meaning = "length(samples)"},
     {.name = "samples", .sql_type = 'b', .null_rule = AMFI_NULL_DB, .min_len = 1, .unit = "",
-     .since = 11, .meaning = "every sensor's samples (float64), compressed"},
+     .since = 11, .meaning = "every sensor's samples, compressed (encoding)"},
 };
 static const amfi_store_coldef passage_raw[] = {
     {.name = "passage_id", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1,

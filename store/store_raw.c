@@ -6,19 +6,21 @@
  * written never costs the passage), the read back of one passage's window
  * with every value checked, one stored passage by id, and the retention.
  *
- * The codec is lossless on the float64 values the solver had: each
- * sample's 64-bit pattern XORed with the previous sample's of the same
+ * The codec is lossless on the float64 values the solver had (or on the
+ * samples rounded to float32, daemon.store.raw.precision): each sample's
+ * 64-bit (32-bit) pattern XORed with the previous sample's of the same
  * sensor (a slowly varying signal leaves the sign, the exponent and the
  * high mantissa bits zero), the bytes of the result shuffled into eight
- * planes (the zero high bytes of every sample in a run), then zlib (its
- * Adler-32 checks the decoded bytes). docs/results/raw-passages.md has the
- * ratios measured against plain zlib and float32.
+ * (four) planes (the zero high bytes of every sample in a run), then zlib
+ * (its Adler-32 checks the decoded bytes). docs/results/raw-passages.md has
+ * the ratios measured against plain zlib.
  *
  * The handle's thread; the write's buffers and deflate state live in the
  * handle (st_raw) and are grown, never shrunk: no allocation per passage
  * once they fit.
  */
 #include <errno.h>
+#include <float.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdarg.h>
@@ -59,37 +61,60 @@ void st_raw_free(amfi_store *s)
 
 /* ---- the codec ------------------------------------------------------------ */
 
-/* n values (sensors runs) into 8n bytes of planes: plane p holds byte 7 − p
- * (the most significant first) of every XORed pattern. */
-static void shuffle(const double *x, int64_t n, int sensors, unsigned char *planes)
+/* The bit pattern of sample x as stored: float64, or rounded to float32. */
+static uint64_t pattern(double x, int f32)
+{
+    if (f32) {
+        float f = (float)x;
+        uint32_t b;
+        memcpy(&b, &f, sizeof b);
+        return b;
+    }
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+/* n values (sensors runs) into w·n bytes of planes (w = 8, or 4 for
+ * float32): plane p holds byte w − 1 − p (the most significant first) of
+ * every XORed pattern. */
+static void shuffle(const double *x, int64_t n, int sensors, int f32, unsigned char *planes)
 {
     const int64_t per = n / sensors;
+    const int w = f32 ? 4 : 8;
     for (int s = 0; s < sensors; s++) {
         uint64_t prev = 0;
         for (int64_t k = 0; k < per; k++) {
             const int64_t i = (int64_t)s * per + k;
-            uint64_t b;
-            memcpy(&b, &x[i], sizeof b);
+            const uint64_t b = pattern(x[i], f32);
             const uint64_t d = b ^ prev;
             prev = b;
-            for (int p = 0; p < 8; p++)
-                planes[(int64_t)p * n + i] = (unsigned char)(d >> (8 * (7 - p)));
+            for (int p = 0; p < w; p++)
+                planes[(int64_t)p * n + i] = (unsigned char)(d >> (8 * (w - 1 - p)));
         }
     }
 }
 
-static void unshuffle(const unsigned char *planes, int64_t n, int sensors, double *x)
+static void unshuffle(const unsigned char *planes, int64_t n, int sensors, int f32, double *x)
 {
     const int64_t per = n / sensors;
+    const int w = f32 ? 4 : 8;
     for (int s = 0; s < sensors; s++) {
         uint64_t prev = 0;
         for (int64_t k = 0; k < per; k++) {
             const int64_t i = (int64_t)s * per + k;
             uint64_t d = 0;
-            for (int p = 0; p < 8; p++)
-                d |= (uint64_t)planes[(int64_t)p * n + i] << (8 * (7 - p));
+            for (int p = 0; p < w; p++)
+                d |= (uint64_t)planes[(int64_t)p * n + i] << (8 * (w - 1 - p));
             prev ^= d;
-            memcpy(&x[i], &prev, sizeof prev);
+            if (f32) {
+                const uint32_t b = (uint32_t)prev;
+                float f;
+                memcpy(&f, &b, sizeof f);
+                x[i] = (double)f;
+            } else {
+                memcpy(&x[i], &prev, sizeof prev);
+            }
         }
     }
 }
@@ -135,15 +160,27 @@ static int deflate_all(z_stream *z, const unsigned char *in, size_t len, unsigne
     return 0;
 }
 
-int amfi_store_raw_encode(const double *x, int64_t n, int sensors, int level, unsigned char **out,
-                          size_t *outlen, char *err, size_t errlen)
+/* A sample float32 cannot hold (beyond its range, or not finite). */
+static int64_t beyond_float(const double *x, int64_t n)
+{
+    for (int64_t k = 0; k < n; k++)
+        if (!(fabs(x[k]) <= FLT_MAX))
+            return k;
+    return -1;
+}
+
+int amfi_store_raw_encode(const double *x, int64_t n, int sensors, int level, int float32,
+                          unsigned char **out, size_t *outlen, char *err, size_t errlen)
 {
     int rc = check_shape(n, sensors, err, errlen);
     if (rc == 0 && (!x || !out || !outlen || level < 1 || level > 9))
         rc = st_fail(err, errlen, AMFI_EINVAL, "raw samples: bad argument to encode");
+    if (rc == 0 && float32 && beyond_float(x, n) >= 0)
+        rc = st_fail(err, errlen, AMFI_EINVAL, "raw samples: sample %" PRId64 " is beyond float32",
+                     beyond_float(x, n));
     if (rc != 0)
         return rc;
-    const size_t len = (size_t)n * 8;
+    const size_t len = (size_t)n * (float32 ? 4 : 8);
     unsigned char *planes = malloc(len);
     z_stream z;
     memset(&z, 0, sizeof z);
@@ -156,7 +193,7 @@ int amfi_store_raw_encode(const double *x, int64_t n, int sensors, int level, un
     if (!o)
         rc = st_fail(err, errlen, AMFI_ENOMEM, "raw samples: out of memory");
     if (rc == 0) {
-        shuffle(x, n, sensors, planes);
+        shuffle(x, n, sensors, float32, planes);
         rc = deflate_all(&z, planes, len, o, cap, outlen, err, errlen);
     }
     deflateEnd(&z);
@@ -169,15 +206,15 @@ int amfi_store_raw_encode(const double *x, int64_t n, int sensors, int level, un
     return 0;
 }
 
-int amfi_store_raw_decode(const unsigned char *blob, size_t len, int64_t n, int sensors, double *x,
-                          char *err, size_t errlen)
+int amfi_store_raw_decode(const unsigned char *blob, size_t len, int64_t n, int sensors,
+                          int float32, double *x, char *err, size_t errlen)
 {
     int rc = check_shape(n, sensors, err, errlen);
     if (rc == 0 && (!blob || !x))
         rc = st_fail(err, errlen, AMFI_EINVAL, "raw samples: bad argument to decode");
     if (rc != 0)
         return rc;
-    const size_t want = (size_t)n * 8;
+    const size_t want = (size_t)n * (float32 ? 4 : 8);
     unsigned char *planes = malloc(want);
     if (!planes)
         return st_fail(err, errlen, AMFI_ENOMEM, "raw samples: out of memory for %zu bytes",
@@ -206,7 +243,7 @@ int amfi_store_raw_decode(const unsigned char *blob, size_t len, int64_t n, int 
     }
     inflateEnd(&z);
     if (rc == 0)
-        unshuffle(planes, n, sensors, x);
+        unshuffle(planes, n, sensors, float32, x);
     free(planes);
     return rc;
 }
@@ -531,13 +568,18 @@ static int run_stmt(amfi_store *s, sqlite3_stmt *st, int b, const char *what, ch
     return rc;
 }
 
-static int write_window(amfi_store *s, const amfi_raw_window *w, int64_t *wid, int64_t *bytes,
-                        char *err, size_t errlen)
+static int write_window(amfi_store *s, const amfi_raw_window *w, int f32, int64_t *wid,
+                        int64_t *bytes, char *err, size_t errlen)
 {
     struct st_raw *r = s->raw;
     char sensors[1100], solve[1100];
     const int64_t n = (int64_t)w->n_samples * w->n_sensors;
-    const size_t len = (size_t)n * 8;
+    const size_t len = (size_t)n * (f32 ? 4 : 8);
+    if (f32 && beyond_float(w->samples, n) >= 0)
+        return st_fail(err, errlen, AMFI_EINVAL,
+                       "raw_windows: sample %" PRId64 " of sensor %d is beyond float32",
+                       beyond_float(w->samples, n) % w->n_samples,
+                       (int)(beyond_float(w->samples, n) / w->n_samples));
     int rc = 0;
     if (sensors_text(w, sensors, sizeof sensors) || solve_text(w, solve, sizeof solve))
         return st_fail(err, errlen, AMFI_EINVAL, "raw_windows: sensors or solve text too long");
@@ -550,7 +592,7 @@ static int write_window(amfi_store *s, const amfi_raw_window *w, int64_t *wid, i
     if (grow(&r->planes, &r->planes_cap, len) || grow(&r->out, &r->out_cap, bound))
         return st_fail(err, errlen, AMFI_ENOMEM, "raw samples: out of memory for %zu bytes",
                        len + bound);
-    shuffle(w->samples, n, w->n_sensors, r->planes);
+    shuffle(w->samples, n, w->n_sensors, f32, r->planes);
     size_t olen = 0;
     rc = deflate_all(&r->z, r->planes, len, r->out, r->out_cap, &olen, err, errlen);
     if (rc != 0)
@@ -563,7 +605,7 @@ static int write_window(amfi_store *s, const amfi_raw_window *w, int64_t *wid, i
     if (b == SQLITE_OK) b = st_bind_text(st, 5, sensors);
     if (b == SQLITE_OK) b = st_bind_text(st, 6, r->text);
     if (b == SQLITE_OK) b = st_bind_text(st, 7, solve);
-    if (b == SQLITE_OK) b = st_bind_text(st, 8, AMFI_STORE_RAW_ENCODING);
+    if (b == SQLITE_OK) b = st_bind_text(st, 8, f32 ? AMFI_STORE_RAW_F32 : AMFI_STORE_RAW_F64);
     if (b == SQLITE_OK) b = sqlite3_bind_int64(st, 9, (int64_t)olen);
     if (b == SQLITE_OK) b = sqlite3_bind_blob64(st, 10, r->out, olen, SQLITE_STATIC);
     rc = run_stmt(s, st, b, "raw_windows: insert", err, errlen);
@@ -594,7 +636,7 @@ int st_raw_write(amfi_store *s, int64_t pid, amfi_raw_put *put)
                          "passage_raw.vehicle: %d is not one of the window's %d", put->vehicle,
                          w->n_vehicles);
         if (rc == 0)
-            rc = write_window(s, w, &wid, &bytes, err, errlen);
+            rc = write_window(s, w, put->float32 != 0, &wid, &bytes, err, errlen);
     } else if (rc == 0 && (wid <= 0 || put->vehicle < 0 || put->vehicle > 63)) {
         rc = st_fail(err, errlen, AMFI_EINVAL,
                      "passage_raw: neither a window nor a window id (%" PRId64 ") to link to",
@@ -614,7 +656,7 @@ int st_raw_write(amfi_store *s, int64_t pid, amfi_raw_put *put)
     if (rc == 0) {
         put->stored_window_id = wid;
         put->bytes = bytes;
-        put->raw_bytes = w ? (int64_t)w->n_samples * w->n_sensors * 8 : 0;
+        put->raw_bytes = w ? (int64_t)w->n_samples * w->n_sensors * 8 : 0; /* as float64 */
     }
     return rc;
 }
@@ -718,7 +760,9 @@ int amfi_store_raw_get(amfi_store *s, int64_t passage_id, amfi_raw_rec *out, int
     if (rc == 0 && parse_solve(t[2], w))
         rc = st_fail(err, errlen, AMFI_STORE_ECORRUPT, "%s: solve '%.80s' cannot be read", what,
                      t[2]);
-    if (rc == 0 && strcmp(t[3], AMFI_STORE_RAW_ENCODING) != 0)
+    if (rc == 0 && strcmp(t[3], AMFI_STORE_RAW_F32) == 0)
+        out->float32 = 1;
+    else if (rc == 0 && strcmp(t[3], AMFI_STORE_RAW_F64) != 0)
         rc = st_fail(err, errlen, AMFI_STORE_ECORRUPT, "%s: unknown encoding '%.40s'", what,
                      t[3]);
     if (rc == 0 && out->vehicle >= w->n_vehicles)
@@ -745,7 +789,8 @@ int amfi_store_raw_get(amfi_store *s, int64_t passage_id, amfi_raw_rec *out, int
                      total);
     if (rc == 0) {
         char zerr[200];
-        rc = amfi_store_raw_decode(blob, (size_t)blen, total, w->n_sensors, x, zerr, sizeof zerr);
+        rc = amfi_store_raw_decode(blob, (size_t)blen, total, w->n_sensors, out->float32, x, zerr,
+                                   sizeof zerr);
         if (rc != 0)
             st_fail(err, errlen, rc, "%s: %s", what, zerr);
     }

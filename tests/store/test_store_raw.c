@@ -68,27 +68,51 @@ static void test_codec_exact(void **state)
     unsigned char *blob = NULL;
     size_t len = 0;
     char err[256];
-    for (int level = 1; level <= 9; level += 4) {
-        assert_int_equal(0, amfi_store_raw_encode(x, N * S, S, level, &blob, &len, err,
-                                                  sizeof err));
-        assert_true(len > 0 && len < sizeof x);
-        memset(y, 0xa5, sizeof y);
-        assert_int_equal(0, amfi_store_raw_decode(blob, len, N * S, S, y, err, sizeof err));
-        assert_same_bits(x, y, N * S);
-        /* a count other than the one encoded is refused */
-        assert_int_equal(AMFI_STORE_ECORRUPT,
-                         amfi_store_raw_decode(blob, len, N * S - S, S, y, err, sizeof err));
-        /* truncated: refused, never half a window */
-        assert_int_equal(AMFI_STORE_ECORRUPT,
-                         amfi_store_raw_decode(blob, len - 7, N * S, S, y, err, sizeof err));
-        /* one flipped byte in the middle: zlib's checksum or its stream says so */
-        blob[len / 2] ^= 0x40;
-        assert_int_equal(AMFI_STORE_ECORRUPT,
-                         amfi_store_raw_decode(blob, len, N * S, S, y, err, sizeof err));
-        free(blob);
+    /* float32: the extremes within its range (3e38), the rest as is */
+    static double xs[N * S], xf[N * S];
+    memcpy(xs, x, sizeof xs);
+    xs[4] = 3e38;
+    xs[5] = -3e38;
+    for (int k = 0; k < N * S; k++)
+        xf[k] = (double)(float)xs[k];
+    size_t len64 = 0; /* float64 at level 1: float32 takes fewer bytes */
+    for (int f32 = 0; f32 <= 1; f32++) {
+        /* float32: the samples as floats, exactly (subnormal doubles are 0) */
+        const double *in = f32 ? xs : x, *want = f32 ? xf : x;
+        for (int level = 1; level <= 9; level += 4) {
+            assert_int_equal(0, amfi_store_raw_encode(in, N * S, S, level, f32, &blob, &len, err,
+                                                      sizeof err));
+            assert_true(len > 0 && len < (f32 ? sizeof x / 2 : sizeof x));
+            if (level == 1 && !f32)
+                len64 = len;
+            if (level == 1 && f32)
+                assert_true(len < len64);
+            memset(y, 0xa5, sizeof y);
+            assert_int_equal(0, amfi_store_raw_decode(blob, len, N * S, S, f32, y, err,
+                                                      sizeof err));
+            assert_same_bits(want, y, N * S);
+            /* read as the other width, or a count other than the one encoded: refused */
+            assert_int_equal(AMFI_STORE_ECORRUPT,
+                             amfi_store_raw_decode(blob, len, N * S, S, !f32, y, err, sizeof err));
+            assert_int_equal(AMFI_STORE_ECORRUPT,
+                             amfi_store_raw_decode(blob, len, N * S - S, S, f32, y, err,
+                                                   sizeof err));
+            /* truncated: refused, never half a window */
+            assert_int_equal(AMFI_STORE_ECORRUPT,
+                             amfi_store_raw_decode(blob, len - 7, N * S, S, f32, y, err,
+                                                   sizeof err));
+            /* one flipped byte in the middle: zlib's checksum or its stream says so */
+            blob[len / 2] ^= 0x40;
+            assert_int_equal(AMFI_STORE_ECORRUPT,
+                             amfi_store_raw_decode(blob, len, N * S, S, f32, y, err, sizeof err));
+            free(blob);
+        }
     }
+    /* float32 cannot hold 1.8e308: refused, not made infinite */
+    assert_int_equal(AMFI_EINVAL, amfi_store_raw_encode(x, N * S, S, 1, 1, &blob, &len, err,
+                                                       sizeof err));
     /* not a window: a count that is not a multiple of the sensors */
-    assert_int_equal(AMFI_EINVAL, amfi_store_raw_encode(x, 10, 3, 6, &blob, &len, err,
+    assert_int_equal(AMFI_EINVAL, amfi_store_raw_encode(x, 10, 3, 6, 0, &blob, &len, err,
                                                        sizeof err));
 }
 
@@ -224,6 +248,19 @@ static void test_write_read(void **state)
                                                sizeof err));
         assert_int_equal(0, found);
     }
+    /* the same window kept as float32: read back as the floats, flagged */
+    amfi_raw_put p32 = {.window = &w, .float32 = 1, .vehicle = 0};
+    int64_t id5 = 0;
+    make_row(&r, 45, w.utime + 3000000, &p32);
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, &id5, err, sizeof err));
+    assert_int_equal(0, p32.status);
+    assert_true(p32.bytes < put.bytes);
+    assert_int_equal(0, amfi_store_raw_get(f->s, id5, &rec, &found, err, sizeof err));
+    assert_int_equal(1, found);
+    assert_int_equal(1, rec.float32);
+    for (int k = 0; k < 3000; k++)
+        assert_true(rec.w.samples[k] == (double)(float)samples[k]);
+    amfi_store_raw_free(&rec);
     amfi_stored_passage sp;
     assert_int_equal(0, amfi_store_passage_get(f->s, id1, &sp, &found, err, sizeof err));
     assert_int_equal(1, found);

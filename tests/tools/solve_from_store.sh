@@ -2,8 +2,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # amfi-solve --from-store DB --passage ID on a store amfid wrote from a
 # recorded bus (sim_publisher --log, replayed through file://: no network):
-# the re-weigh is amfid's ("identical"); another sensor position in the
-# site file is named as the difference; and every way of having no samples
+# the re-weigh is amfid's ("identical"); kept as float32 it is within 1e-6
+# of amfid's and says why; another sensor position in the site file is
+# named as the difference; and every way of having no samples
 # is exit 1 with a message saying which: no such passage, not kept (keep
 # none), a store older than version 11, a truncated blob and a damaged one
 # (named by passage, never a crash); the command line's misuses are exit 2.
@@ -46,6 +47,29 @@ grep -q "at_m: 9.5" "$dir/moved.yaml" || fail "the test's sensor position did no
   fail "re-weigh with the sensor moved"
 grep -q '"explained":"the site file puts sensor 0 at 9.5 m, amfid had it at 10 m"' "$dir/moved.json" ||
   fail "moved: $(sed 's/.*"difference"//' "$dir/moved.json")"
+
+# kept as float32: the re-weigh differs from amfid's by the rounding alone,
+# and says so
+sed -e "s/^      precision: float64 /      precision: float32 /" "$dir/site.yaml" > "$dir/f32.yaml"
+grep -q "^      precision: float32 " "$dir/f32.yaml" || fail "the test's precision did not apply"
+"$amfid" --config "$dir/f32.yaml" --db "$dir/f32.db" --lcm-url "file://$dir/bus.log?speed=0" \
+  2> "$dir/amfid.log" || fail "amfid precision float32"
+[ "$(sqlite3 "$dir/f32.db" "SELECT sum(bytes) FROM raw_windows")" -lt \
+  "$(sqlite3 "$dir/s.db" "SELECT sum(bytes) / 2 + 2000 FROM raw_windows")" ] ||
+  fail "float32 does not take about half the bytes"
+: > "$dir/f32-stored.txt"; : > "$dir/f32-reweighed.txt"
+for id in 1 2 3 4; do
+  "$solve" --config "$dir/f32.yaml" --from-store "$dir/f32.db" --passage $id > "$dir/f32.json" ||
+    fail "re-weigh of float32 passage $id"
+  grep -q '"precision":"float32"' "$dir/f32.json" || fail "precision: $(cat "$dir/f32.json")"
+  grep -q '"explained":"identical\|"explained":"the samples were kept rounded to float32' \
+    "$dir/f32.json" || fail "float32: $(sed 's/.*"difference"//' "$dir/f32.json")"
+  sed 's/.*"passage_gvw_kg":\([^,}]*\).*/\1/' "$dir/f32.json" >> "$dir/f32-reweighed.txt"
+  sqlite3 "$dir/f32.db" "SELECT gvw_kg FROM passages WHERE id = $id" >> "$dir/f32-stored.txt"
+done
+sh "$(dirname "$0")/../common/num_cmp.sh" -r 1e-6 "$dir/f32-stored.txt" "$dir/f32-reweighed.txt" ||
+  fail "float32 re-weigh further than 1e-6 from amfid's"
+paste "$dir/f32-stored.txt" "$dir/f32-reweighed.txt"
 
 # the command line
 expect 2 "needs --from-store" --passage 2

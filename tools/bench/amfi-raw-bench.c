@@ -15,6 +15,9 @@
  *                        store's), 6 and 9 (checked: decodes bit for bit)
  *   f32-shuffle-zlib6    rounded to float32 (lossy: the largest relative
  *                        change of a sample is printed), byte planes, zlib 6
+ *   f32-xor-shuffle-zlib1  the store's float32 encoding
+ *                        (daemon.store.raw.precision: float32), checked:
+ *                        decodes to the samples rounded to float32
  * Exit 0, 1 (a store or window error), 2 (command line).
  */
 #include <math.h>
@@ -26,10 +29,11 @@
 
 #include "store.h"
 
-enum { V_PLAIN, V_SHUF, V_X1, V_X6, V_X9, V_F32, NV };
+enum { V_PLAIN, V_SHUF, V_X1, V_X6, V_X9, V_F32, V_F32X1, NV };
 static const char *const names[NV] = {"f64-zlib6",          "f64-shuffle-zlib6",
                                       "f64-xor-shuffle-zlib1 (store)", "f64-xor-shuffle-zlib6",
-                                      "f64-xor-shuffle-zlib9", "f32-shuffle-zlib6 (lossy)"};
+                                      "f64-xor-shuffle-zlib9", "f32-shuffle-zlib6 (lossy)",
+                                      "f32-xor-shuffle-zlib1 (store, float32)"};
 
 static double now_s(void)
 {
@@ -138,7 +142,7 @@ int main(int argc, char **argv)
             unsigned char *blob = NULL;
             size_t blen = 0;
             t = now_s();
-            if (amfi_store_raw_encode(r.w.samples, (int64_t)n, r.w.n_sensors, levels[v - V_X1],
+            if (amfi_store_raw_encode(r.w.samples, (int64_t)n, r.w.n_sensors, levels[v - V_X1], 0,
                                       &blob, &blen, err, sizeof err) != 0) {
                 fprintf(stderr, "amfi-raw-bench: %s\n", err);
                 return 1;
@@ -147,7 +151,7 @@ int main(int argc, char **argv)
             bytes[v] += (double)blen;
             if (v == V_X1) {
                 t = now_s();
-                if (amfi_store_raw_decode(blob, blen, (int64_t)n, r.w.n_sensors, back, err,
+                if (amfi_store_raw_decode(blob, blen, (int64_t)n, r.w.n_sensors, 0, back, err,
                                           sizeof err) != 0 ||
                     memcmp(back, r.w.samples, len) != 0) {
                     fprintf(stderr, "amfi-raw-bench: passage %lld: not decoded bit for bit\n",
@@ -171,6 +175,30 @@ int main(int argc, char **argv)
         planes((const unsigned char *)f, n, 4, pl);
         bytes[V_F32] += (double)deflated(pl, n * 4, 6);
         enc_s[V_F32] += now_s() - t;
+        {
+            unsigned char *blob = NULL;
+            size_t blen = 0;
+            t = now_s();
+            if (amfi_store_raw_encode(r.w.samples, (int64_t)n, r.w.n_sensors, 1, 1, &blob, &blen,
+                                      err, sizeof err) != 0) {
+                fprintf(stderr, "amfi-raw-bench: %s\n", err);
+                return 1;
+            }
+            enc_s[V_F32X1] += now_s() - t;
+            bytes[V_F32X1] += (double)blen;
+            if (amfi_store_raw_decode(blob, blen, (int64_t)n, r.w.n_sensors, 1, back, err,
+                                      sizeof err) != 0) {
+                fprintf(stderr, "amfi-raw-bench: %s\n", err);
+                return 1;
+            }
+            for (size_t i = 0; i < n; i++)
+                if (back[i] != (double)f[i]) {
+                    fprintf(stderr, "amfi-raw-bench: passage %lld: float32 not decoded exactly\n",
+                            (long long)ids[k]);
+                    return 1;
+                }
+            free(blob);
+        }
         raw_bytes += (double)len;
         samples += (long)n;
         windows++;

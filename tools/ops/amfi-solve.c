@@ -777,6 +777,10 @@ static json_t *store_json(const options *o, const amfi_raw_rec *raw,
     else if (same)
         snprintf(why, sizeof why,
                  "identical: the same samples, detector records and settings as amfid's");
+    else if (raw->float32 && !o->lambda && !o->formulation && !position_note[0])
+        snprintf(why, sizeof why,
+                 "the samples were kept rounded to float32 (daemon.store.raw.precision), each "
+                 "changed by at most 6e-8 of itself; amfid weighed the float64 values");
     else if (o->lambda || o->formulation)
         snprintf(why, sizeof why, "the %s given here is not the one amfid weighed it with",
                  o->lambda && o->formulation ? "lambda and formulation"
@@ -799,10 +803,10 @@ static json_t *store_json(const options *o, const amfi_raw_rec *raw,
                            "gvw_rel",
                            amfi_json_num(r->gvw_kg != 0 ? (gvw_kg - r->gvw_kg) / r->gvw_kg : NAN),
                            "axle_kg", dax, "explained", why);
-    json_t *fs = json_pack("{s:s, s:I, s:I, s:i, s:I, s:s}", "db", o->store, "passage_id",
+    json_t *fs = json_pack("{s:s, s:I, s:I, s:i, s:I, s:s, s:s}", "db", o->store, "passage_id",
                            (json_int_t)o->passage_id, "window_id", (json_int_t)raw->window_id,
                            "vehicle", raw->vehicle, "raw_bytes", (json_int_t)raw->bytes,
-                           "config", site);
+                           "precision", raw->float32 ? "float32" : "float64", "config", site);
     return json_pack("{s:o, s:o, s:o, s:o}", "from_store", fs, "passage_gvw_kg",
                      amfi_json_num(gvw_kg), "stored", st, "difference", df);
 }
