@@ -572,6 +572,10 @@ typedef struct amfi_raw_vehicle {
     double spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1, (0, 50] m */
 } amfi_raw_vehicle;
 
+/* The schema version whose migration added raw_windows and passage_raw
+ * (store_schema.c): older stores have no raw samples. */
+#define AMFI_STORE_RAW_VERSION 11
+
 /* The encodings of raw_windows.samples: the float64 values exactly, or
  * rounded to float32 (each sample changed by at most 2^-24 of itself,
  * about half the bytes; daemon.store.raw.precision). */

@@ -281,42 +281,44 @@ static const amfi_store_coldef refusals[] = {
 #undef ROW
 
 /* ---- raw_windows, passage_raw (written and read by store_raw.c) ----------- */
+#define RAWV AMFI_STORE_RAW_VERSION
 static const char *const raw_encodings[] = {"f64-xor-shuffle-zlib", "f32-xor-shuffle-zlib",
                                             NULL};
 static const amfi_store_coldef raw_windows[] = {
-    ID(11, 0, "one window weighed: a vehicle, or an event of several weighed together"),
+    ID(RAWV, 0, "one window weighed: a vehicle, or an event of several weighed together"),
     {.name = "utime", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 0, .ihi = UT_MAX,
-     .unit = "µs", .since = 11, .meaning = "data time of the first vehicle's entry (t = 0)"},
+     .unit = "µs", .since = RAWV, .meaning = "data time of the first vehicle's entry (t = 0)"},
     {.name = "rate_hz", .sql_type = 'r', .null_rule = AMFI_NULL_DB, .open = 1, .lo = 0,
-     .hi = 100000, .unit = "Hz", .since = 11, .meaning = "sample rate"},
+     .hi = 100000, .unit = "Hz", .since = RAWV, .meaning = "sample rate"},
     {.name = "t_first_s", .sql_type = 'r', .null_rule = AMFI_NULL_DB, .lo = -3600, .hi = 3600,
-     .unit = "s", .since = 11, .meaning = "time of the first sample after utime"},
+     .unit = "s", .since = RAWV, .meaning = "time of the first sample after utime"},
     {.name = "n_samples", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1, .ihi = INT32_MAX,
-     .unit = "", .since = 11, .meaning = "samples per sensor"},
+     .unit = "", .since = RAWV, .meaning = "samples per sensor"},
     {.name = "sensors", .sql_type = 't', .null_rule = AMFI_NULL_DB, .min_len = 3,
-     .max_len = 1024, .unit = "", .since = 11,
+     .max_len = 1024, .unit = "", .since = RAWV,
      .meaning = "ID@AT_M of each sensor, comma-separated, in the samples' order"},
     {.name = "vehicles", .sql_type = 't', .null_rule = AMFI_NULL_DB, .min_len = 7,
-     .max_len = 32768, .unit = "", .since = 11,
+     .max_len = 32768, .unit = "", .since = RAWV,
      .meaning = "the detector records weighed, ';'-separated (docs/schema.md)"},
     {.name = "solve", .sql_type = 't', .null_rule = AMFI_NULL_DB, .min_len = 1, .max_len = 1024,
-     .unit = "", .since = 11, .meaning = "the solver's λ policy and speed settings at release"},
+     .unit = "", .since = RAWV, .meaning = "the solver's λ policy and speed settings at release"},
     {.name = "encoding", .sql_type = 't', .null_rule = AMFI_NULL_DB,
-     .text_kind = AMFI_TEXT_ENUM, .words = raw_encodings, .unit = "", .since = 11,
+     .text_kind = AMFI_TEXT_ENUM, .words = raw_encodings, .unit = "", .since = RAWV,
      .meaning = "how samples is encoded: float64 exact, or rounded to float32"},
     {.name = "bytes", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1, .ihi = INT64_MAX,
-     .unit = "B", .since = 11, .meaning = "length(samples)"},
+     .unit = "B", .since = RAWV, .meaning = "length(samples)"},
     {.name = "samples", .sql_type = 'b', .null_rule = AMFI_NULL_DB, .min_len = 1, .unit = "",
-     .since = 11, .meaning = "every sensor's samples, compressed (encoding)"},
+     .since = RAWV, .meaning = "every sensor's samples, compressed (encoding)"},
 };
 static const amfi_store_coldef passage_raw[] = {
     {.name = "passage_id", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1,
-     .ihi = INT64_MAX, .unit = "", .since = 11, .meaning = "passages.id"},
+     .ihi = INT64_MAX, .unit = "", .since = RAWV, .meaning = "passages.id"},
     {.name = "window_id", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1,
-     .ihi = INT64_MAX, .unit = "", .since = 11, .meaning = "raw_windows.id"},
+     .ihi = INT64_MAX, .unit = "", .since = RAWV, .meaning = "raw_windows.id"},
     {.name = "vehicle", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 0, .ihi = 63,
-     .unit = "", .since = 11, .meaning = "its place in the window's vehicles (0: the first)"},
+     .unit = "", .since = RAWV, .meaning = "its place in the window's vehicles (0: the first)"},
 };
+#undef RAWV
 
 const amfi_store_tabledef amfi_store_tabledefs[] = {
     {"passages", passages, N(passages), "id", sizeof(amfi_passage_row)},

@@ -415,7 +415,7 @@ static void test_from_v10(void **state)
     fixture *f = *state;
     char path[160], err[512];
     snprintf(path, sizeof path, "%s/v10.db", f->dir);
-    assert_int_equal(0, amfi_store_test_create(path, 10, err, sizeof err));
+    assert_int_equal(0, amfi_store_test_create(path, AMFI_STORE_RAW_VERSION - 1, err, sizeof err));
     amfi_store_test_db *db = amfi_store_test_open(path, 0, err, sizeof err);
     assert_non_null(db);
     assert_int_equal(0, amfi_store_test_exec(db,
@@ -429,7 +429,7 @@ static void test_from_v10(void **state)
     int version = 0, immutable = 0, found = -1;
     assert_int_equal(0, amfi_store_open_reader(path, 0, &rd, &version, &immutable, err,
                                                sizeof err));
-    assert_int_equal(10, version);
+    assert_int_equal(AMFI_STORE_RAW_VERSION - 1, version);
     amfi_raw_rec rec;
     assert_int_equal(0, amfi_store_raw_get(rd, 1, &rec, &found, err, sizeof err));
     assert_int_equal(0, found);

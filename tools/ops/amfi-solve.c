@@ -675,11 +675,11 @@ static int load_from_store(options *o, amfi_site_config *cfg, amfi_raw_rec *raw,
                 o->store, version, AMFI_STORE_SCHEMA_VERSION);
         goto out;
     }
-    if (version < 11) {
+    if (version < AMFI_STORE_RAW_VERSION) {
         fprintf(stderr,
                 PROG ": %s: passage %lld has no raw samples: the store is at version %d, older "
-                "than raw samples (version 11; amfid migrates it at its next start)\n",
-                o->store, id, version);
+                "than raw samples (version %d; amfid migrates it at its next start)\n",
+                o->store, id, version, AMFI_STORE_RAW_VERSION);
         goto out;
     }
     if (amfi_store_passage_get(s, o->passage_id, stored, &found, err, sizeof err) != 0) {
