@@ -111,6 +111,12 @@ void amfi_config_defaults(amfi_site_config *c)
     d->bus_max_skew_s = 300.0;
     d->sync_full = 1;
     d->held_max_bytes = 101760000; /* 20 000 held passages of 5 088 bytes (x86-64) */
+    /* every passage's samples, 90 days or 4 GiB of them, whichever is
+     * less (docs/results/raw-passages.md: the sizes behind it) */
+    d->raw_keep = AMFI_RAW_KEEP_ALL;
+    d->raw_float32 = 0; /* exact: a re-weigh is amfid's to the last bit */
+    d->raw_max_age_days = 90.0;
+    d->raw_max_mib = 4096.0;
     d->workers = 2;
     d->queue_size = 256;
     d->recv_buf_bytes = 4194304;

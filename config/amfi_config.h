@@ -39,6 +39,9 @@ extern "C" {
  * shipped files and the simulator's default stream agree. */
 #define AMFI_CONFIG_DEFAULT_RATE_HZ 1000.0
 
+/* daemon.store.raw.keep */
+enum { AMFI_RAW_KEEP_NONE = 0, AMFI_RAW_KEEP_FAILED = 1, AMFI_RAW_KEEP_ALL = 2 };
+
 /* The monitoring daemon's section (daemon: in the site file). */
 typedef struct amfi_daemon_config {
     char lcm_url[256];        /* daemon.lcm_url; "" = LCM's default */
@@ -58,6 +61,14 @@ typedef struct amfi_daemon_config {
     int sync_full;            /* daemon.store.sync: full (1) | normal (0) */
     long long held_max_bytes; /* daemon.store.held_max_bytes: passages held while the
                                  store cannot write, bytes, 1 MiB .. 64 GiB */
+    int raw_keep;             /* daemon.store.raw.keep: the raw samples of every passage
+                                 weighed (AMFI_RAW_KEEP_ALL), of those not stored ok
+                                 (AMFI_RAW_KEEP_FAILED) or none (AMFI_RAW_KEEP_NONE) */
+    int raw_float32;          /* daemon.store.raw.precision: float64 (0, exact) | float32 (1) */
+    double raw_max_age_days;  /* daemon.store.raw.max_age_days: windows older than this
+                                 (data time) are deleted, days, 0 (no limit) .. 36500 */
+    double raw_max_mib;       /* daemon.store.raw.max_mib: the oldest windows are deleted
+                                 beyond this many MiB of samples, 0 (no limit) .. 1e6 */
     int workers;              /* daemon.workers: solver threads, 1 .. 64 */
     int queue_size;           /* daemon.queue_size: passages waiting, 1 .. 100000 */
     int recv_buf_bytes;       /* daemon.recv_buf_bytes: UDP receive buffer asked of LCM

@@ -37,11 +37,27 @@ static const field bus_fields[] = {
 
 static const enum_name sync_names[] = {{"normal", 0}, {"full", 1}, {NULL, 0}};
 
+static const enum_name raw_keep_names[] = {
+    {"none", AMFI_RAW_KEEP_NONE}, {"failed", AMFI_RAW_KEEP_FAILED}, {"all", AMFI_RAW_KEEP_ALL},
+    {NULL, 0}};
+
+static const enum_name raw_precision_names[] = {{"float64", 0}, {"float32", 1}, {NULL, 0}};
+
+static const field raw_fields[] = {
+    {.key = "keep", .kind = &amfi_cfg_k_enum, .off = DC(raw_keep), .aux = raw_keep_names},
+    {.key = "precision", .kind = &amfi_cfg_k_enum, .off = DC(raw_float32), .aux = raw_precision_names},
+    {.key = "max_age_days", .kind = &amfi_cfg_k_double, .off = DC(raw_max_age_days), .lo = 0,
+     .hi = 36500},
+    {.key = "max_mib", .kind = &amfi_cfg_k_double, .off = DC(raw_max_mib), .lo = 0,
+     .hi = 1e6},
+    {.key = NULL}};
+
 static const field store_fields[] = {
     STR("path", db_path, 1),
     {.key = "sync", .kind = &amfi_cfg_k_enum, .off = DC(sync_full), .aux = sync_names},
     {.key = "held_max_bytes", .kind = &amfi_cfg_k_llong, .off = DC(held_max_bytes),
      .lo = 1048576, .hi = 68719476736.0},
+    {.key = "raw", .kind = &amfi_cfg_k_map, .aux = raw_fields},
     {.key = NULL}};
 
 /* Offsets of the engine's amfi_indicator_params inside the site config. */

@@ -65,6 +65,7 @@ static const amfid_module *const modules[] = {
     &notify_module,      /* alerts.command */
     &freevib_module,     /* the natural frequency */
     &classes_module,     /* row: the class, axle groups and overload */
+    &raw_module,         /* row: the passage's raw samples; timer: their retention */
     &pipeline_module,    /* reorder → sink; tick: results stored; on_passage: published */
     &drift_module,       /* the speed-drift alert */
     &stdmean_module,     /* the STD and mean rules */

@@ -78,6 +78,12 @@ typedef struct amfid_stats {
     /* alert notices (notify.c) */
     int64_t notices_ok, notices_failed, notices_timeouts, notices_dropped;
     int notices_running, notices_queued;
+    /* the passages' raw samples (raw.c) */
+    int64_t raw_windows, raw_links;      /* windows written, passages linked to one */
+    int64_t raw_bytes, raw_bytes_in;     /* their bytes compressed, and as float64 */
+    int64_t raw_failed;                  /* not written (the passages stored without) */
+    int64_t raw_pruned_age, raw_pruned_size, raw_pruned_bytes; /* deleted by retention */
+    int64_t raw_kept_windows, raw_kept_bytes; /* in the store now */
     /* kernel drops on amfid's sockets (status.c, as of the last heartbeat) */
     int64_t udp_drops;
 } amfid_stats;

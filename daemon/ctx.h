@@ -16,13 +16,15 @@
  * windows to jobs), pool.c (solver threads), pipeline.c (reorder.c → sink.c
  * → the fan-out of a stored passage), alert.c (one alert out),
  * environment.c, freevib.c, drift.c, stdmean.c, scaleind.c (the
- * indicators), classes.c (class and axle groups of each passage), notify.c, metrics.c, status.c (heartbeat, intake record).
+ * indicators), classes.c (class and axle groups of each passage), raw.c
+ * (the passages' raw samples and their retention), notify.c, metrics.c,
+ * status.c (heartbeat, intake record).
  *
  * Who calls whom (from the built objects; tests/common/call_graph.sh
  * fails when this list differs from the library, or when it has a circle):
  *   admit.c -> reject.c
  *   alert.c -> log.c metrics.c notify.c
- *   amfid.c -> alert.c bus.c classes.c drift.c environment.c freevib.c intake.c log.c metrics.c notify.c pipeline.c pool.c reject.c scaleind.c status.c stdmean.c timer.c
+ *   amfid.c -> alert.c bus.c classes.c drift.c environment.c freevib.c intake.c log.c metrics.c notify.c pipeline.c pool.c raw.c reject.c scaleind.c status.c stdmean.c timer.c
  *   bus.c -> admit.c log.c reject.c
  *   drift.c -> log.c metrics.c
  *   environment.c -> admit.c bus.c log.c reject.c
@@ -31,6 +33,7 @@
  *   metrics.c -> log.c reject.c timer.c
  *   notify.c -> log.c
  *   pipeline.c -> log.c metrics.c notify.c pool.c reorder.c sink.c
+ *   raw.c -> log.c timer.c
  *   reject.c -> log.c timer.c
  *   reorder.c -> pool.c
  *   scaleind.c -> environment.c log.c metrics.c
@@ -147,7 +150,8 @@ struct amfid_module {
 /* The modules (amfid.c's table holds them, in order). */
 extern const amfid_module environment_lost_module, intake_module, environment_module,
     record_module, metrics_module, notify_module, freevib_module, classes_module,
-    pipeline_module, drift_module, stdmean_module, scaleind_module, reject_module, status_module;
+    pipeline_module, drift_module, stdmean_module, scaleind_module, reject_module, status_module,
+    raw_module;
 
 /* ---- timers (timer.c) ------------------------------------------------------- */
 

@@ -171,6 +171,28 @@ static void write_all(amfid_ctx *d, const amfid_stats *st, FILE *f)
     head(f, "amfi_queue_depth", "gauge", "Passages waiting for a solver thread.");
     fprintf(f, "amfi_queue_depth %d\n", st->queue_depth);
 
+    head(f, "amfi_raw_windows_total", "counter",
+         "Raw sample windows written since start (daemon.store.raw.keep), and passages linked "
+         "to the window of their event.");
+    fprintf(f, "amfi_raw_windows_total{kind=\"window\"} %lld\n", (long long)st->raw_windows);
+    fprintf(f, "amfi_raw_windows_total{kind=\"link\"} %lld\n", (long long)st->raw_links);
+    fprintf(f, "amfi_raw_windows_total{kind=\"failed\"} %lld\n", (long long)st->raw_failed);
+    head(f, "amfi_raw_bytes_total", "counter",
+         "Bytes of the raw windows written since start, compressed and as float64.");
+    fprintf(f, "amfi_raw_bytes_total{form=\"compressed\"} %lld\n", (long long)st->raw_bytes);
+    fprintf(f, "amfi_raw_bytes_total{form=\"float64\"} %lld\n", (long long)st->raw_bytes_in);
+    head(f, "amfi_raw_deleted_total", "counter",
+         "Raw sample windows deleted by retention since start, by rule.");
+    fprintf(f, "amfi_raw_deleted_total{rule=\"age\"} %lld\n", (long long)st->raw_pruned_age);
+    fprintf(f, "amfi_raw_deleted_total{rule=\"size\"} %lld\n", (long long)st->raw_pruned_size);
+    head(f, "amfi_raw_deleted_bytes_total", "counter",
+         "Compressed bytes of the raw windows deleted by retention since start.");
+    fprintf(f, "amfi_raw_deleted_bytes_total %lld\n", (long long)st->raw_pruned_bytes);
+    head(f, "amfi_raw_stored_windows", "gauge", "Raw sample windows in the store.");
+    fprintf(f, "amfi_raw_stored_windows %lld\n", (long long)st->raw_kept_windows);
+    head(f, "amfi_raw_stored_bytes", "gauge", "Compressed bytes of the raw windows in the store.");
+    fprintf(f, "amfi_raw_stored_bytes %lld\n", (long long)st->raw_kept_bytes);
+
     head(f, "amfi_messages_received_total", "counter",
          "Bus messages the input channels handed to amfid.");
     fprintf(f, "amfi_messages_received_total %lld\n", (long long)st->messages_in);

@@ -254,15 +254,20 @@ static int write_passage(void *arg, job *j)
 }
 
 /* The job of vehicle i of an event: its own vehicle, result and status
- * (the event's when the event was not solved), no samples. NULL: out of
- * memory. */
-static job *vehicle_job(const job *e, int i)
+ * (the event's when the event was not solved); the first vehicle's takes
+ * the event's samples (its passage holds the event's raw window, raw.c),
+ * the others none. NULL: out of memory. */
+static job *vehicle_job(job *e, int i)
 {
     job *j = malloc(sizeof *j);
     if (!j)
         return NULL;
     *j = *e;
     j->accel = NULL;
+    if (i == 0) {
+        j->accel = e->accel;
+        e->accel = NULL;
+    }
     j->w.v = e->w.ev[i];
     j->quality = NAN;
     if (!e->solved)
@@ -364,11 +369,16 @@ static int store_job(amfid_ctx *d, job *e)
         mark_inseparable(d, e, 0, e);
         return sink_put(P.sink, e);
     }
-    int rc = 0;
+    int rc = 0, not_ok = 0;
+    job *vj[AMFI_MAX_VEHICLES];
     for (int i = 0; i < e->w.n_vehicles; i++) {
-        job *j = vehicle_job(e, i);
-        if (j)
-            mark_inseparable(d, e, i, j);
+        vj[i] = vehicle_job(e, i);
+        if (vj[i])
+            mark_inseparable(d, e, i, vj[i]);
+        not_ok |= !vj[i] || !vj[i]->solved || strcmp(vj[i]->status, "ok") != 0;
+    }
+    for (int i = 0; i < e->w.n_vehicles; i++) {
+        job *j = vj[i];
         if (!j) {
             sink_lost(P.sink, 1);
             ctx_error(d, "out of memory: passage of vehicle %lld at utime %lld LOST",
@@ -376,6 +386,7 @@ static int store_job(amfid_ctx *d, job *e)
             rc = -1;
             continue;
         }
+        j->event_not_ok = not_ok;
         if (sink_put(P.sink, j))
             rc = -1;
     }

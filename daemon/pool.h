@@ -53,6 +53,9 @@ typedef struct job {
     /* the natural frequency (freevib.c), set by the main thread at release */
     double f1_hz, f1_zeta, f1_r2; /* NaN: none */
     int64_t f1_vehicle_id;   /* the event's vehicle that carries it (left last) */
+    /* a vehicle's job of an event (pipeline.c): 1 when some vehicle of the
+     * event is not stored ok (raw.c keeps the window's samples: failed) */
+    int event_not_ok;
 } job;
 
 void job_free(job *j);

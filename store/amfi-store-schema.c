@@ -21,6 +21,7 @@ int main(int argc, char **argv)
                 printf("%s\t%s\t%s\t%d\t%d\t%d\n", t->name, c->name,
                        c->sql_type == AMFI_SQL_INTEGER ? "INTEGER"
                        : c->sql_type == AMFI_SQL_REAL  ? "REAL"
+                       : c->sql_type == AMFI_SQL_BLOB  ? "BLOB"
                                                        : "TEXT",
                        c->null_ok, c->since, c->shipped);
             }

@@ -18,7 +18,8 @@
  * queries of reports), store_export.c (the passage listing), store_speed.c
  * (the estimated speeds), store_environment.c (the environment readings),
  * store_web.c (amfi-web's reads),
- * store_natfreq.c (the natural frequencies), store_columns.c (the column
+ * store_natfreq.c (the natural frequencies), store_raw.c (the passages' raw
+ * samples), store_columns.c (the column
  * table, store_columns.h: every stored column once), store_rows.c (the
  * INSERTs, bindings and checks of the tables written from a row struct, from
  * the column table), store_scan.c (rows as column values for amfi-sync,
@@ -73,7 +74,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 10
+#define AMFI_STORE_SCHEMA_VERSION 11
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -188,6 +189,9 @@ typedef struct amfi_passage_row {
     int has_overload;    /* 1: overload holds the legal-limit check; 0: not
                             decided (not solved), NULL */
     int overload;        /* 1: the GVW or a group above its limit, else 0 */
+    /* Not a column: the passage's raw samples, written in its transaction
+     * (raw_windows, passage_raw; amfi_raw_put below), or NULL: none. */
+    struct amfi_raw_put *raw;
 } amfi_passage_row;
 /* The range of a reference GVW (a calibration truck), kg. */
 #define AMFI_STORE_MIN_REF_KG 1000.0
@@ -630,6 +634,147 @@ typedef struct amfi_f1_rec {
    value outside the schema's range is AMFI_STORE_ECORRUPT. */
 int amfi_store_f1_series(amfi_store *s, int64_t from, int64_t to, int max, amfi_f1_rec **out,
                          size_t *n, char *err, size_t errlen);
+
+
+/* ---- raw samples of the passages (store_raw.c; schema version 11) ------- */
+/* amfid keeps the samples it weighed each passage with (daemon.store.raw):
+ * one raw window per solve (a vehicle, or an event of several weighed
+ * together), every sensor's samples exactly as the solver had them (the
+ * float64 values, losslessly compressed: each sample's bit pattern XORed
+ * with the previous one's, the bytes shuffled into planes, zlib), with the
+ * time base, the sensors, the detector records and the solver's live
+ * settings; each passage of the window links to it. amfi-solve
+ * --from-store re-weighs a passage from it; retention deletes whole
+ * windows, oldest first, never the passages. */
+
+/* One vehicle of a raw window: its detector record as the solver took it
+ * (amfid's detector.* corrections applied). */
+typedef struct amfi_raw_vehicle {
+    int64_t vehicle_id;
+    int64_t utime;       /* entry of its first axle, data time, µs */
+    int lane;            /* −32768 .. 32767 */
+    double speed_mps;    /* the detector's (corrected) speed, (0, 150] m/s */
+    int n_axles;         /* 1 .. AMFI_MAX_AXLES */
+    double spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1, (0, 50] m */
+} amfi_raw_vehicle;
+
+/* The schema version whose migration added raw_windows and passage_raw
+ * (store_schema.c): older stores have no raw samples. */
+#define AMFI_STORE_RAW_VERSION 11
+
+/* The encodings of raw_windows.samples: the float64 values exactly, or
+ * rounded to float32 (each sample changed by at most 2^-24 of itself,
+ * about half the bytes; daemon.store.raw.precision). */
+#define AMFI_STORE_RAW_F64 "f64-xor-shuffle-zlib"
+#define AMFI_STORE_RAW_F32 "f32-xor-shuffle-zlib"
+/* The largest raw window the store writes or reads, in samples (all
+ * sensors): 2^26 (512 MiB of float64). */
+#define AMFI_STORE_RAW_MAX_SAMPLES (INT64_C(1) << 26)
+
+/* A window's raw samples: written from it (samples given), read into it
+ * (samples malloc'd by amfi_store_raw_get: free with amfi_store_raw_free). */
+typedef struct amfi_raw_window {
+    int64_t utime;       /* data time of vehicle[0]'s entry: t = 0 of the
+                            samples, µs, 0 .. AMFI_STORE_MAX_UTIME */
+    double rate_hz;      /* sample rate, (0, 100000] Hz */
+    double t_first_s;    /* time of sample 0 after utime, s, [-3600, 3600] */
+    int n_samples;       /* per sensor, >= 1 */
+    int n_sensors;       /* 1 .. AMFI_MAX_SENSORS */
+    int sensor_id[AMFI_MAX_SENSORS];        /* 0 .. 255, in the samples' order */
+    double sensor_at_m[AMFI_MAX_SENSORS];   /* position on the span, m, finite */
+    int n_vehicles;      /* 1 .. AMFI_MAX_VEHICLES, by entry time */
+    amfi_raw_vehicle vehicle[AMFI_MAX_VEHICLES];
+    /* the solver's settings the window was weighed with (a reload changes
+     * the λ policy between passages) */
+    amfi_lambda lambda;
+    int speed_estimate;  /* 1: amfi_solve_speed with speed_prior (one vehicle) */
+    amfi_speed_prior speed_prior;
+    /* sample k of sensor i (at t_first_s + k / rate_hz) is
+     * samples[i * n_samples + k], m/s² */
+    const double *samples;
+} amfi_raw_window;
+
+/* The raw part of a passage written with it (amfi_passage_row.raw): either
+ * a new window (window != NULL, the passage is its vehicle `vehicle`) or a
+ * link to a window stored before (window NULL, window_id > 0: a later
+ * vehicle of the same event). Written in the passage's transaction, under
+ * a savepoint: when the raw rows cannot be written (a bad window, the link's
+ * window deleted, out of memory) the passage is stored without them and
+ * status says why. The handle keeps the buffers the encoding needs (grown,
+ * never shrunk: no allocation per passage once they fit). */
+typedef struct amfi_raw_put {
+    const amfi_raw_window *window;
+    int float32;         /* 1: the window's samples rounded to float32
+                            (AMFI_STORE_RAW_F32), 0: exact (AMFI_STORE_RAW_F64) */
+    int64_t window_id;   /* the window linked to (window NULL) */
+    int vehicle;         /* the passage's index in the window's vehicles */
+    /* out */
+    int status;          /* 0: written; else a status (message in err) */
+    char err[256];
+    int64_t stored_window_id; /* the window written or linked */
+    int64_t bytes;       /* compressed bytes written (0 for a link) */
+    int64_t raw_bytes;   /* their float64 bytes (0 for a link) */
+} amfi_raw_put;
+
+/* A passage's raw samples read back. */
+typedef struct amfi_raw_rec {
+    int64_t passage_id, window_id;
+    int vehicle;         /* the passage's index in w.vehicle[] */
+    int64_t bytes;       /* compressed bytes stored */
+    int float32;         /* 1: stored rounded to float32 (w.samples are those
+                            floats as doubles), 0: the float64 values */
+    amfi_raw_window w;   /* w.samples malloc'd */
+} amfi_raw_rec;
+
+/* The raw samples of passage `passage_id`: *found = 0 when it has none
+ * (never kept, deleted by retention, a store older than version 11: then 0
+ * is returned too, with nothing read); else *found = 1 and *out filled,
+ * every value checked and the samples decoded and verified (zlib's
+ * checksum, their count): a damaged row or blob is AMFI_STORE_ECORRUPT
+ * with a message naming the passage and its window. Works on any handle
+ * (amfi_store_open_readonly too). Free with amfi_store_raw_free. */
+int amfi_store_raw_get(amfi_store *s, int64_t passage_id, amfi_raw_rec *out, int *found,
+                       char *err, size_t errlen);
+void amfi_store_raw_free(amfi_raw_rec *r); /* NULL-safe; zeroes it */
+
+/* One stored passage by id (amfi-solve --from-store; a page per passage):
+ * vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason,
+ * lambda, residual_rms, n_vehicles and the axles' spacing_m and axle_kg
+ * (NaN where NULL; the other fields 0). row.status and row.reason point
+ * into the struct. *found = 0 when there is no such passage. Any handle. */
+typedef struct amfi_stored_passage {
+    amfi_passage_row row;
+    char status[16];
+    char reason[AMFI_STORE_REASON_MAX + 1];
+} amfi_stored_passage;
+int amfi_store_passage_get(amfi_store *s, int64_t id, amfi_stored_passage *out, int *found,
+                           char *err, size_t errlen);
+
+/* The raw windows stored: count and compressed bytes. */
+int amfi_store_raw_usage(amfi_store *s, int64_t *windows, int64_t *bytes, char *err,
+                         size_t errlen);
+
+/* Retention, oldest first (by utime, then id), in one transaction, at most
+ * max_windows windows (>= 1) a call: the windows whose utime is before
+ * before_utime (0: none by age), then the oldest while the windows' bytes
+ * are above max_bytes (< 0: no bound). The passages stay. */
+typedef struct amfi_raw_pruned {
+    int64_t by_age, by_size;     /* windows deleted */
+    int64_t bytes;               /* their compressed bytes */
+    int more;                    /* 1: max_windows reached with more to delete */
+} amfi_raw_pruned;
+int amfi_store_raw_prune(amfi_store *s, int64_t before_utime, int64_t max_bytes, int max_windows,
+                         amfi_raw_pruned *out, char *err, size_t errlen);
+
+/* The codec alone (tests, measurements): n values in `sensors` runs of
+ * n / sensors into a zlib blob, *out malloc'd (*outlen bytes), at zlib
+ * level 1 .. 9, as float64 (float32 0) or rounded to float32 (float32 1: a
+ * value beyond float's range is AMFI_EINVAL); and back (exactly n values,
+ * else AMFI_STORE_ECORRUPT). */
+int amfi_store_raw_encode(const double *x, int64_t n, int sensors, int level, int float32,
+                          unsigned char **out, size_t *outlen, char *err, size_t errlen);
+int amfi_store_raw_decode(const unsigned char *blob, size_t len, int64_t n, int sensors,
+                          int float32, double *x, char *err, size_t errlen);
 
 /* ---- rows as column values, for other programs (store_scan.c) ----------- */
 /* amfi-sync ships a store's rows, amfi-report --pg and amfi-fleet-bench

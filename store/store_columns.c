@@ -280,6 +280,46 @@ static const amfi_store_coldef refusals[] = {
 };
 #undef ROW
 
+/* ---- raw_windows, passage_raw (written and read by store_raw.c) ----------- */
+#define RAWV AMFI_STORE_RAW_VERSION
+static const char *const raw_encodings[] = {"f64-xor-shuffle-zlib", "f32-xor-shuffle-zlib",
+                                            NULL};
+static const amfi_store_coldef raw_windows[] = {
+    ID(RAWV, 0, "one window weighed: a vehicle, or an event of several weighed together"),
+    {.name = "utime", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 0, .ihi = UT_MAX,
+     .unit = "µs", .since = RAWV, .meaning = "data time of the first vehicle's entry (t = 0)"},
+    {.name = "rate_hz", .sql_type = 'r', .null_rule = AMFI_NULL_DB, .open = 1, .lo = 0,
+     .hi = 100000, .unit = "Hz", .since = RAWV, .meaning = "sample rate"},
+    {.name = "t_first_s", .sql_type = 'r', .null_rule = AMFI_NULL_DB, .lo = -3600, .hi = 3600,
+     .unit = "s", .since = RAWV, .meaning = "time of the first sample after utime"},
+    {.name = "n_samples", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1, .ihi = INT32_MAX,
+     .unit = "", .since = RAWV, .meaning = "samples per sensor"},
+    {.name = "sensors", .sql_type = 't', .null_rule = AMFI_NULL_DB, .min_len = 3,
+     .max_len = 1024, .unit = "", .since = RAWV,
+     .meaning = "ID@AT_M of each sensor, comma-separated, in the samples' order"},
+    {.name = "vehicles", .sql_type = 't', .null_rule = AMFI_NULL_DB, .min_len = 7,
+     .max_len = 32768, .unit = "", .since = RAWV,
+     .meaning = "the detector records weighed, ';'-separated (docs/schema.md)"},
+    {.name = "solve", .sql_type = 't', .null_rule = AMFI_NULL_DB, .min_len = 1, .max_len = 1024,
+     .unit = "", .since = RAWV, .meaning = "the solver's λ policy and speed settings at release"},
+    {.name = "encoding", .sql_type = 't', .null_rule = AMFI_NULL_DB,
+     .text_kind = AMFI_TEXT_ENUM, .words = raw_encodings, .unit = "", .since = RAWV,
+     .meaning = "how samples is encoded: float64 exact, or rounded to float32"},
+    {.name = "bytes", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1, .ihi = INT64_MAX,
+     .unit = "B", .since = RAWV, .meaning = "length(samples)"},
+    {.name = "samples", .sql_type = 'b', .null_rule = AMFI_NULL_DB, .min_len = 1, .unit = "",
+     .since = RAWV, .meaning = "every sensor's samples, compressed (encoding)"},
+};
+static const amfi_store_coldef passage_raw[] = {
+    {.name = "passage_id", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1,
+     .ihi = INT64_MAX, .unit = "", .since = RAWV, .meaning = "passages.id"},
+    {.name = "window_id", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 1,
+     .ihi = INT64_MAX, .unit = "", .since = RAWV, .meaning = "raw_windows.id"},
+    {.name = "vehicle", .sql_type = 'i', .null_rule = AMFI_NULL_DB, .ilo = 0, .ihi = 63,
+     .unit = "", .since = RAWV, .meaning = "its place in the window's vehicles (0: the first)"},
+};
+#undef RAWV
+
 const amfi_store_tabledef amfi_store_tabledefs[] = {
     {"passages", passages, N(passages), "id", sizeof(amfi_passage_row)},
     {"axles", axles, N(axles), "passage_id", 0},
@@ -293,6 +333,8 @@ const amfi_store_tabledef amfi_store_tabledefs[] = {
     {"environment", environment, N(environment), "id", sizeof(amfi_environment_row)},
     {"scale_evals", scale_evals, N(scale_evals), "id", sizeof(amfi_scale_eval_row)},
     {"refusals", refusals, N(refusals), "id", sizeof(amfi_refusal_row)},
+    {"raw_windows", raw_windows, N(raw_windows), "id", 0},
+    {"passage_raw", passage_raw, N(passage_raw), "passage_id", 0},
 };
 const int amfi_store_n_tabledefs = N(amfi_store_tabledefs);
 
@@ -337,7 +379,10 @@ const char *amfi_store_value_problem(const amfi_store_coldef *c, const amfi_stor
                                      char *msg, size_t msglen)
 {
     static const char *const names[] = {"?", "an integer", "a real", "text", "a blob", "NULL"};
-    const char *want = c->sql_type == 'i' ? "an integer" : c->sql_type == 'r' ? "a number" : "text";
+    const char *want = c->sql_type == 'i'   ? "an integer"
+                       : c->sql_type == 'r' ? "a number"
+                       : c->sql_type == 'b' ? "a blob"
+                                            : "text";
     int type = v->type == 'i' ? 1 : v->type == 'r' ? 2 : v->type == 't' ? 3 : v->type == 'b' ? 4
                                                                                           : 5;
     if (type == 5) {
@@ -345,8 +390,10 @@ const char *amfi_store_value_problem(const amfi_store_coldef *c, const amfi_stor
         snprintf(msg, msglen, "NULL, but it must be %s", want);
         return msg;
     }
-    int ok_type = c->sql_type == 'i' ? type == 1 : c->sql_type == 'r' ? type == 1 || type == 2
-                                                                       : type == 3;
+    int ok_type = c->sql_type == 'i'   ? type == 1
+                  : c->sql_type == 'r' ? type == 1 || type == 2
+                  : c->sql_type == 'b' ? type == 4
+                                       : type == 3;
     if (!ok_type) {
         snprintf(msg, msglen, "%s, but it must be %s", names[type], want);
         return msg;
@@ -371,10 +418,12 @@ const char *amfi_store_value_problem(const amfi_store_coldef *c, const amfi_stor
     }
     int len = v->len;
     if (len < c->min_len || (c->max_len && len > c->max_len)) {
-        snprintf(msg, msglen, "text of %d bytes, not %d..%d", len, c->min_len,
-                 c->max_len ? c->max_len : INT32_MAX);
+        snprintf(msg, msglen, "%s of %d bytes, not %d..%d", type == 4 ? "a blob" : "text", len,
+                 c->min_len, c->max_len ? c->max_len : INT32_MAX);
         return msg;
     }
+    if (type == 4) /* a blob: only its length is the column table's */
+        return NULL;
     if (!utf8_ok((const unsigned char *)v->text, len)) {
         snprintf(msg, msglen, "text that is not valid UTF-8 (or holds a NUL byte)");
         return msg;
@@ -437,7 +486,10 @@ static void range_text(const amfi_store_coldef *c, char *buf, size_t len)
         amfi_store_coldef_words(c, "/", buf, len);
     } else if (c->max_len || c->min_len || c->wmax) {
         int mn = c->wmax ? c->wmin : c->min_len, mx = c->wmax ? c->wmax : c->max_len;
-        snprintf(buf, len, "%d .. %d bytes", mn, mx);
+        if (mx)
+            snprintf(buf, len, "%d .. %d bytes", mn, mx);
+        else
+            snprintf(buf, len, ">= %d bytes", mn);
     }
 }
 
@@ -472,7 +524,10 @@ int amfi_store_columns_markdown(FILE *f)
             char ship[8] = "-";
             if (c->shipped) snprintf(ship, sizeof ship, "v%d", c->shipped);
             fprintf(f, "| %s | %s | %s | %s | %s%s | %d | %s | %s |\n", c->name,
-                    c->sql_type == 'i' ? "INTEGER" : c->sql_type == 'r' ? "REAL" : "TEXT",
+                    c->sql_type == 'i'   ? "INTEGER"
+                    : c->sql_type == 'r' ? "REAL"
+                    : c->sql_type == 'b' ? "BLOB"
+                                         : "TEXT",
                     c->unit && c->unit[0] ? c->unit : "", rtext, null_text(c), with, c->since,
                     ship, c->meaning ? c->meaning : "");
         }

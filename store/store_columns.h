@@ -29,7 +29,12 @@ extern "C" {
 #endif
 
 /* SQL type of a column (STRICT tables: exactly these). */
-enum amfi_store_sqltype { AMFI_SQL_INTEGER = 'i', AMFI_SQL_REAL = 'r', AMFI_SQL_TEXT = 't' };
+enum amfi_store_sqltype {
+    AMFI_SQL_INTEGER = 'i',
+    AMFI_SQL_REAL = 'r',
+    AMFI_SQL_TEXT = 't',
+    AMFI_SQL_BLOB = 'b' /* raw_windows.samples only (written and read by store_raw.c) */
+};
 
 /* C type of the column's field in its table's row struct. */
 enum amfi_store_ctype {
@@ -77,7 +82,7 @@ typedef struct amfi_store_coldef {
     double lo, hi;       /* REAL: the range (hi may be HUGE_VAL) */
     char open;           /* REAL: bit 1 lo excluded, bit 2 hi excluded */
     char text_kind;      /* TEXT: enum amfi_store_textkind */
-    int min_len, max_len;/* TEXT: bytes the table holds (max_len 0: no limit) */
+    int min_len, max_len;/* TEXT, BLOB: bytes the table holds (max_len 0: no limit) */
     int wmin, wmax;      /* TEXT: bytes the store writes, when stricter
                             (wmax 0: min_len .. max_len) */
     int cut;             /* TEXT: stored cut to this many characters (0: not) */
@@ -109,7 +114,7 @@ int amfi_store_coldef_index(const amfi_store_tabledef *t, const char *name);
 /* One value of a stored column, as SQLite holds it. */
 typedef struct amfi_store_value {
     int type;            /* AMFI_SQL_INTEGER, AMFI_SQL_REAL, AMFI_SQL_TEXT,
-                            0 NULL, 'b' a blob (never in an amfi store) */
+                            0 NULL, AMFI_SQL_BLOB a blob (raw_windows.samples) */
     int64_t i;
     double r;
     const char *text;    /* TEXT: its bytes (NUL-terminated), len of them */

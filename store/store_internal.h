@@ -69,6 +69,8 @@ struct amfi_store {
     int readonly;                /* opened with amfi_store_open_readonly */
     sqlite3_stmt *st[N_STMT];    /* prepared at open, reset after each use */
     char path[256];              /* for messages (truncated) */
+    struct st_raw *raw;          /* the raw samples' buffers and statements
+                                    (store_raw.c), NULL until the first write */
 };
 
 /* ---- messages (store_open.c) --------------------------------------------- */
@@ -216,5 +218,13 @@ int st_select_list(const amfi_store_tabledef *t, char *buf, size_t len);
  * AMFI_EINVAL). */
 int st_read_row(sqlite3_stmt *st, int first, const amfi_store_tabledef *t, void *row,
                 const origin *o, char *err, size_t errlen);
+
+/* ---- raw samples (store_raw.c) ------------------------------------------ */
+
+/* The raw rows of passage pid, in its open transaction, under a savepoint
+ * (rolled back alone on failure): 0, or the status also in put. */
+int st_raw_write(amfi_store *s, int64_t pid, amfi_raw_put *put);
+/* The handle's raw buffers and statements freed (close). */
+void st_raw_free(amfi_store *s);
 
 #endif /* AMFI_STORE_INTERNAL_H */

@@ -177,6 +177,7 @@ static void destroy(amfi_store *s, int tidy)
         return;
     for (int k = 0; k < N_STMT; k++)
         sqlite3_finalize(s->st[k]);
+    st_raw_free(s);
     if (s->db && tidy && !s->readonly) {
         sqlite3_exec(s->db, "PRAGMA optimize", NULL, NULL, NULL);
         sqlite3_wal_checkpoint_v2(s->db, NULL, SQLITE_CHECKPOINT_TRUNCATE,

@@ -300,6 +300,38 @@ static const char schema_v10[] =
     "ALTER TABLE passages ADD COLUMN overload INTEGER\n"
     "  CHECK (overload IN (0, 1));\n";
 
+/* Version 11: the raw samples of each passage's window (amfid's
+ * daemon.store.raw): one raw_windows row per window weighed (one vehicle,
+ * or an event of several weighed together) with the samples of every
+ * sensor exactly as the solver had them (float64, compressed: encoding),
+ * the time base, the sensors, the detector records and the solver's
+ * settings it was weighed with; one passage_raw row per passage linking it
+ * to its window. Retention deletes raw_windows rows (their links go with
+ * them); the passages stay. */
+static const char schema_v11[] =
+    "CREATE TABLE raw_windows (\n"
+    "  id         INTEGER PRIMARY KEY,\n"
+    "  utime      INTEGER NOT NULL  -- data time of the first vehicle's entry (t = 0), µs\n"
+    "             CHECK (utime BETWEEN 0 AND 253402300799999999),\n"
+    "  rate_hz    REAL NOT NULL CHECK (rate_hz > 0 AND rate_hz <= 100000),  -- sample rate, Hz\n"
+    "  t_first_s  REAL NOT NULL CHECK (t_first_s BETWEEN -3600 AND 3600),  -- first sample's time, s\n"
+    "  n_samples  INTEGER NOT NULL CHECK (n_samples BETWEEN 1 AND 2147483647),  -- per sensor\n"
+    "  sensors    TEXT NOT NULL CHECK (length(sensors) BETWEEN 3 AND 1024),  -- ID@AT_M,... in the samples' order\n"
+    "  vehicles   TEXT NOT NULL CHECK (length(vehicles) BETWEEN 7 AND 32768),  -- the detector records weighed\n"
+    "  solve      TEXT NOT NULL CHECK (length(solve) BETWEEN 1 AND 1024),  -- the solver's settings\n"
+    "  encoding   TEXT NOT NULL  -- how samples is encoded (float64 exact, or rounded to float32)\n"
+    "             CHECK (encoding IN ('f64-xor-shuffle-zlib', 'f32-xor-shuffle-zlib')),\n"
+    "  bytes      INTEGER NOT NULL CHECK (bytes >= 1),  -- length(samples)\n"
+    "  samples    BLOB NOT NULL CHECK (length(samples) = bytes)  -- every sensor's samples, compressed\n"
+    ") STRICT;\n"
+    "CREATE INDEX raw_windows_utime ON raw_windows (utime, bytes);\n"
+    "CREATE TABLE passage_raw (\n"
+    "  passage_id INTEGER PRIMARY KEY REFERENCES passages (id) ON DELETE CASCADE,\n"
+    "  window_id  INTEGER NOT NULL REFERENCES raw_windows (id) ON DELETE CASCADE,\n"
+    "  vehicle    INTEGER NOT NULL CHECK (vehicle BETWEEN 0 AND 63)  -- its place in the window's vehicles\n"
+    ") STRICT;\n"
+    "CREATE INDEX passage_raw_window ON passage_raw (window_id);\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
@@ -313,6 +345,8 @@ const st_migration st_migrations[] = {
     {8, "passages: gvw_comp_kg (the weight the STD and mean rules were fed)", schema_v8},
     {9, "refusals: refused bus messages summarised per period, channel and reason", schema_v9},
     {10, "passages: class, axle_groups and overload (classify/)", schema_v10},
+    {11, "raw_windows, passage_raw: each passage's raw samples (retention by age and size)",
+     schema_v11},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

@@ -77,10 +77,18 @@ int amfi_store_add_passage(amfi_store *s, const amfi_passage_row *r,
         if (b == SQLITE_OK) b = st_bind_real(st, 4, r->axle_kg[k]);
         rc = st_run(s, ST_INS_AXLE, b, "axles: insert", err, errlen);
     }
+    /* the raw samples: under a savepoint, never the passage's failure */
+    if (rc == 0 && r->raw)
+        st_raw_write(s, pid, r->raw);
     if (rc == 0)
         rc = st_commit(s, err, errlen);
     if (rc != 0 && s)
         st_rollback(s);
+    if (rc != 0 && r && r->raw && r->raw->status == 0) {
+        r->raw->status = rc; /* rolled back with the passage */
+        r->raw->stored_window_id = r->raw->bytes = r->raw->raw_bytes = 0;
+        snprintf(r->raw->err, sizeof r->raw->err, "the passage was not stored");
+    }
     if (rc == 0 && id)
         *id = pid;
     return rc;

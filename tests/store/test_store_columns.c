@@ -35,7 +35,7 @@ static int setup(void **state) { return store_fixture_setup(state, "amfi_test_co
 static int teardown(void **state)
 {
     static const char *const extra[] = {"v1.db", "v2.db", "v3.db", "v4.db", "v5.db", "v6.db",
-                                        "v7.db", "v8.db", "v9.db", NULL};
+                                        "v7.db", "v8.db", "v9.db", "v10.db", "v11.db", NULL};
     return store_fixture_teardown(state, extra);
 }
 
@@ -95,6 +95,7 @@ static void test_fresh_store_matches(void **state)
             const amfi_store_coldef *c = &t->cols[j];
             const char *type = c->sql_type == AMFI_SQL_INTEGER ? "INTEGER"
                                : c->sql_type == AMFI_SQL_REAL  ? "REAL"
+                               : c->sql_type == AMFI_SQL_BLOB  ? "BLOB"
                                                                : "TEXT";
             if (strcmp(in.name[j], c->name) != 0)
                 fail_msg("%s column %d: the store has %s, the column table %s", t->name, j,

@@ -9,6 +9,8 @@
  *              [--lambda auto|VALUE] [--formulation NAME]
  *              [--forces OUT.csv] [--lcurve OUT.csv]
  *              [--estimate-speed [--speed-sd FRACTION]]
+ *   amfi-solve [--config FILE.yaml] --from-store DB --passage ID
+ *              [--lambda auto|VALUE] [--formulation NAME] [--forces OUT.csv] [--lcurve OUT.csv]
  *
  * Reads a passage CSV (tools/accel_csv.h): 't,accel' for a site of one
  * sensor, or 't,accel_ID,...' with a column for every sensor of the site
@@ -21,6 +23,18 @@
  * detector's value, the prior of amfi_solve_speed, and the passage is
  * weighed at the estimated speed (JSON speed_mps, speed_given_mps,
  * speed_estimated; the axle spacings are always the given ones).
+ *
+ * With --from-store, the passage's raw samples kept by amfid
+ * (daemon.store.raw; store.h, "raw samples") are re-weighed: the samples,
+ * time base, detector records (as amfid corrected them: detector.* is not
+ * applied again), the λ policy and the speed settings are the store's, the
+ * bridge, sensors and the rest of solver: the site file's (--config; the
+ * store does not record them). The JSON line then also holds "stored"
+ * (amfid's row) and "difference" (re-weighed − stored, and why: "identical",
+ * the λ or formulation given, the passage not solved by amfid, or the site
+ * file / libamfi differing from amfid's). A passage without raw samples
+ * (not kept, deleted by retention, a store older than version 11) is exit 1
+ * with a message saying which.
  *
  * Exit status: 0 solved; 1 bad data, configuration, solver failure or an
  * output file that cannot be written; 2 bad command line. Every error is one
@@ -41,6 +55,7 @@
 
 #include "accel_csv.h"
 #include "amfi/amfi.h"
+#include "store.h"
 #include "amfi_cli.h"
 #include "amfi_config.h"
 #include "amfi_datafile.h"
@@ -73,6 +88,9 @@ typedef struct options {
     int entry_given;         /* --entry-time seen (not with --vehicle) */
     int n_vehicles;          /* --vehicle count, 0: the one-vehicle form */
     amfi_vehicle vehicle[AMFI_MAX_VEHICLES]; /* entry on the file's clock */
+    const char *store;       /* --from-store DB; NULL: --accel */
+    int64_t passage_id;      /* --passage */
+    int passage_given;
 } options;
 
 static void usage(FILE *f)
@@ -87,6 +105,8 @@ static void usage(FILE *f)
             "       [--estimate-speed [--speed-sd FRACTION]]\n"
             "   or: " PROG " ... --vehicle ENTRY_S:SPEED_MPS:S1[,S2,...] "
             "[--vehicle ...] (instead of --speed/--axle-spacing/--entry-time)\n"
+            "   or: " PROG " [--config FILE.yaml] --from-store DB --passage ID [--lambda ...]\n"
+            "       [--formulation NAME] [--forces OUT.csv] [--lcurve OUT.csv]\n"
             "\n"
             "Solves one recorded passage (CSV 't,accel', or 't,accel_ID,...' with a column\n"
             "per sensor of the site by its id; plain or gzip) and prints a JSON line.\n"
@@ -113,6 +133,12 @@ static void usage(FILE *f)
             "      --speed-sd FRACTION  the detector's relative SD, 0 < f < 1 (default: the\n"
             "                           config's solver.speed_sd)\n"
             "      --speed-trace FILE   write the speed search's grid: speed_mps,J,dip\n"
+            "      --from-store DB      re-weigh a passage from the raw samples amfid kept in\n"
+            "                           its store (daemon.store.raw), with the store's detector\n"
+            "                           records, lambda and speed settings and this site file's\n"
+            "                           bridge and solver; prints the stored result and the\n"
+            "                           difference too\n"
+            "      --passage ID         the passage (passages.id) to re-weigh\n"
             "  -h, --help               this help\n"
             "  -V, --version            print the version\n"
             "Exit status: 0 ok, 1 data or solver error, 2 usage error.\n",
@@ -223,6 +249,8 @@ static int parse_args(int argc, char **argv, options *o)
         {"speed-sd", required_argument, NULL, 'S'},
         {"speed-trace", required_argument, NULL, 'T'},
         {"vehicle", required_argument, NULL, 'v'},
+        {"from-store", required_argument, NULL, 'D'},
+        {"passage", required_argument, NULL, 'P'},
         AMFI_CLI_END};
     memset(o, 0, sizeof *o);
     o->speed_mps = NAN;
@@ -270,6 +298,18 @@ static int parse_args(int argc, char **argv, options *o)
         case 'F': o->forces = val; break;
         case 'L': o->lcurve = val; break;
         case 'T': o->speed_trace = val; break;
+        case 'D': o->store = val; break;
+        case 'P': {
+            char *e;
+            errno = 0;
+            long long id = strtoll(val, &e, 10);
+            if (*e || errno || id < 1)
+                return usage_error(opt, "'%s' is not a passage id (an integer >= 1)",
+                                   amfi_cli_shown(val));
+            o->passage_id = id;
+            o->passage_given = 1;
+            break;
+        }
         case 'S':
             if (amfi_cli_double(val, &x) != 0 || !(x > 0 && x < 1))
                 return usage_error(opt, "'%s' must be a fraction in (0, 1)",
@@ -277,6 +317,20 @@ static int parse_args(int argc, char **argv, options *o)
             o->speed_sd = x;
             break;
         }
+    }
+    if (o->store || o->passage_given) {
+        if (!o->store)
+            return usage_error("--passage", "needs --from-store DB");
+        if (!o->passage_given)
+            return usage_error("--from-store", "needs --passage ID");
+        if (o->accel || o->n_vehicles || !isnan(o->speed_mps) || o->n_spacings ||
+            o->entry_given || o->estimate_speed || !isnan(o->speed_sd) || o->speed_trace)
+            return usage_error("--from-store",
+                               "not with --accel, --vehicle, --speed, --axle-spacing, "
+                               "--entry-time, --estimate-speed, --speed-sd or --speed-trace "
+                               "(the store has the samples, the detector records and the "
+                               "speed settings)");
+        return 0;
     }
     if (!o->accel)
         return usage_error("--accel", "missing (see --help)");
@@ -520,7 +574,8 @@ static int class_json(const amfi_class_params *cp, int n_axles, const double *sp
 static int print_json(const amfi_site_config *c, const amfi_result *r,
                       const amfi_speed_result *sr, int estimated,
                       const amfi_multi_result *m, const double *spacing_m,
-                      const amfi_multi_passage *mp, double scan_rate_hz, double solve_ms)
+                      const amfi_multi_passage *mp, double scan_rate_hz, double solve_ms,
+                      json_t *extra)
 {
     json_t *axle = json_array(), *force = json_array();
     for (int a = 0; a < r->n_axles; a++) {
@@ -590,7 +645,170 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
         }
         json_object_set_new(o, "vehicles", vs);
     }
+    if (o && extra && json_object_update(o, extra) != 0) {
+        json_decref(o);
+        o = NULL;
+    }
+    json_decref(extra);
     return amfi_json_print(stdout, o);
+}
+
+/* --from-store: the passage's raw samples and its stored row into *raw and
+ * *stored, and what the solve takes from them into o and cfg (the samples'
+ * time base and channels into csv, which then does not own them). 0, or
+ * −1 with the message on stderr. */
+static int load_from_store(options *o, amfi_site_config *cfg, amfi_raw_rec *raw,
+                           amfi_stored_passage *stored, accel_csv *csv, char *name,
+                           size_t namelen)
+{
+    char err[512];
+    amfi_store *s = NULL;
+    int version = 0, immutable = 0, found = 0, rc = -1;
+    const long long id = (long long)o->passage_id;
+    snprintf(name, namelen, "%s: passage %lld", o->store, id);
+    if (amfi_store_open_reader(o->store, 1, &s, &version, &immutable, err, sizeof err) != 0) {
+        fprintf(stderr, PROG ": --from-store: %s\n", err);
+        return -1;
+    }
+    if (version > AMFI_STORE_SCHEMA_VERSION) {
+        fprintf(stderr, PROG ": %s: store version %d is newer than this program's (%d)\n",
+                o->store, version, AMFI_STORE_SCHEMA_VERSION);
+        goto out;
+    }
+    if (version < AMFI_STORE_RAW_VERSION) {
+        fprintf(stderr,
+                PROG ": %s: passage %lld has no raw samples: the store is at version %d, older "
+                "than raw samples (version %d; amfid migrates it at its next start)\n",
+                o->store, id, version, AMFI_STORE_RAW_VERSION);
+        goto out;
+    }
+    if (amfi_store_passage_get(s, o->passage_id, stored, &found, err, sizeof err) != 0) {
+        fprintf(stderr, PROG ": %s: %s\n", o->store, err);
+        goto out;
+    }
+    if (!found) {
+        fprintf(stderr, PROG ": %s: there is no passage %lld\n", o->store, id);
+        goto out;
+    }
+    if (amfi_store_raw_get(s, o->passage_id, raw, &found, err, sizeof err) != 0) {
+        fprintf(stderr, PROG ": %s: %s\n", o->store, err);
+        goto out;
+    }
+    if (!found) {
+        fprintf(stderr,
+                PROG ": %s: passage %lld (vehicle %lld, status %s) has no raw samples: not "
+                "kept (daemon.store.raw.keep, or its window was not complete: status gap, "
+                "late, multiple, invalid) or deleted by retention (max_age_days, max_mib)\n",
+                o->store, id, (long long)stored->row.vehicle_id, stored->status);
+        goto out;
+    }
+    const amfi_raw_window *w = &raw->w;
+    /* the detector records as the solver took them: the entries relative to
+     * the first vehicle's, as pool.c computes them */
+    if (w->n_vehicles > 1) {
+        int axles = 0;
+        o->n_vehicles = w->n_vehicles;
+        for (int v = 0; v < w->n_vehicles; v++) {
+            const amfi_raw_vehicle *e = &w->vehicle[v];
+            amfi_vehicle *ve = &o->vehicle[v];
+            memset(ve, 0, sizeof *ve);
+            ve->entry_s = 1e-6 * (double)(e->utime - w->utime);
+            ve->speed_mps = e->speed_mps;
+            ve->n_axles = e->n_axles;
+            for (int a = 0; a + 1 < e->n_axles; a++)
+                ve->axle_spacing_m[a] = e->spacing_m[a];
+            axles += e->n_axles;
+        }
+        if (axles > AMFI_MAX_AXLES) {
+            fprintf(stderr, PROG ": %s: %d axles in the event (at most %d)\n", name, axles,
+                    AMFI_MAX_AXLES);
+            goto out;
+        }
+        cfg->speed_estimate = 0; /* the joint solve takes the detector's speeds */
+    } else {
+        const amfi_raw_vehicle *e = &w->vehicle[0];
+        o->speed_mps = e->speed_mps;
+        o->n_spacings = e->n_axles - 1;
+        for (int a = 0; a + 1 < e->n_axles; a++)
+            o->spacing_m[a] = e->spacing_m[a];
+        o->entry_time_s = 1e-6 * (double)(e->utime - w->utime);
+        cfg->speed_estimate = w->speed_estimate;
+    }
+    cfg->lambda = w->lambda;
+    cfg->speed_prior = w->speed_prior;
+    memset(csv, 0, sizeof *csv);
+    csv->n = w->n_samples;
+    csv->t0_s = w->t_first_s;
+    csv->rate_hz = w->rate_hz;
+    csv->n_channels = w->n_sensors;
+    for (int k = 0; k < w->n_sensors; k++) {
+        csv->channel_id[k] = w->sensor_id[k];
+        csv->channel[k] = (double *)w->samples + (size_t)k * (size_t)w->n_samples;
+    }
+    csv->accel = csv->channel[0];
+    if (cfg->solver.max_duration_s < (double)w->n_samples / w->rate_hz)
+        cfg->solver.max_duration_s = (double)w->n_samples / w->rate_hz;
+    rc = 0;
+out:
+    amfi_store_close(s);
+    return rc;
+}
+
+/* The stored row and the difference of the re-weighed passage from it. */
+static json_t *store_json(const options *o, const amfi_raw_rec *raw,
+                          const amfi_stored_passage *sp, const char *site, double gvw_kg,
+                          const double *axle_kg, int n_axles, double lambda_ref,
+                          const char *position_note)
+{
+    const amfi_passage_row *r = &sp->row;
+    json_t *ax = json_array(), *dax = json_array();
+    int same = r->gvw_kg == gvw_kg;
+    for (int a = 0; a < r->n_axles; a++) {
+        json_array_append_new(ax, amfi_json_num(r->axle_kg[a]));
+        double d = a < n_axles ? axle_kg[a] - r->axle_kg[a] : NAN;
+        same &= d == 0;
+        json_array_append_new(dax, amfi_json_num(d));
+    }
+    same &= r->n_axles == n_axles;
+    char why[700];
+    if (isnan(r->gvw_kg))
+        snprintf(why, sizeof why, "amfid stored it as %s without a weight: %.500s", sp->status,
+                 sp->reason);
+    else if (same)
+        snprintf(why, sizeof why,
+                 "identical: the same samples, detector records and settings as amfid's");
+    else if (raw->float32 && !o->lambda && !o->formulation && !position_note[0])
+        snprintf(why, sizeof why,
+                 "the samples were kept rounded to float32 (daemon.store.raw.precision), each "
+                 "changed by at most 6e-8 of itself; amfid weighed the float64 values");
+    else if (o->lambda || o->formulation)
+        snprintf(why, sizeof why, "the %s given here is not the one amfid weighed it with",
+                 o->lambda && o->formulation ? "lambda and formulation"
+                 : o->lambda                 ? "lambda"
+                                             : "formulation");
+    else if (position_note[0])
+        snprintf(why, sizeof why, "%s", position_note);
+    else
+        snprintf(why, sizeof why,
+                 "the site file (%.300s) or this libamfi is not what amfid ran with: the store "
+                 "records the samples, detector records, lambda policy and speed settings, not "
+                 "the bridge model or the rest of solver:%s",
+                 site,
+                 !isnan(r->lambda) && r->lambda != lambda_ref ? " (lambda differs too)" : "");
+    json_t *st = json_pack("{s:s, s:s, s:o, s:o, s:o, s:o, s:i}", "status", sp->status, "reason",
+                           sp->reason, "gvw_kg", amfi_json_num(r->gvw_kg), "axle_kg", ax,
+                           "lambda_ref", amfi_json_num(r->lambda), "speed_mps",
+                           amfi_json_num(r->speed_mps), "n_vehicles", r->n_vehicles);
+    json_t *df = json_pack("{s:o, s:o, s:o, s:s}", "gvw_kg", amfi_json_num(gvw_kg - r->gvw_kg),
+                           "gvw_rel",
+                           amfi_json_num(r->gvw_kg != 0 ? (gvw_kg - r->gvw_kg) / r->gvw_kg : NAN),
+                           "axle_kg", dax, "explained", why);
+    json_t *fs = json_pack("{s:s, s:I, s:I, s:i, s:I, s:s, s:s}", "db", o->store, "passage_id",
+                           (json_int_t)o->passage_id, "window_id", (json_int_t)raw->window_id,
+                           "vehicle", raw->vehicle, "raw_bytes", (json_int_t)raw->bytes,
+                           "precision", raw->float32 ? "float32" : "float64", "config", site);
+    return json_pack("{s:o, s:o, s:o, s:o}", "from_store", fs, "passage_gvw_kg",
+                     amfi_json_num(gvw_kg), "stored", st, "difference", df);
 }
 
 int main(int argc, char **argv)
@@ -604,6 +822,14 @@ int main(int argc, char **argv)
     char site[4096];
     if (load_config(&o, &cfg, site, sizeof site) != 0)
         return EXIT_DATA;
+    static amfi_raw_rec raw;
+    static amfi_stored_passage stored;
+    accel_csv csv = {0};
+    char from[4200] = "";
+    if (o.store && load_from_store(&o, &cfg, &raw, &stored, &csv, from, sizeof from) != 0) {
+        amfi_store_raw_free(&raw);
+        return EXIT_DATA;
+    }
     if (o.lambda) {
         if (strcmp(o.lambda, "auto") == 0) {
             cfg.lambda.automatic = 1;
@@ -657,9 +883,10 @@ int main(int argc, char **argv)
     /* the detector as commissioning found it (detector.*): true entry =
      * reported − clock offset, true speed and spacings = reported / scale,
      * as amfid corrects every vehicle (amfi_config_detector_correct) */
-    amfi_config_detector_correct(&cfg.detector, &o.entry_time_s, NULL, &o.speed_mps, o.spacing_m,
-                          o.n_spacings);
-    for (int v = 0; v < o.n_vehicles; v++)
+    if (!o.store) /* the store's records are corrected already */
+        amfi_config_detector_correct(&cfg.detector, &o.entry_time_s, NULL, &o.speed_mps,
+                                     o.spacing_m, o.n_spacings);
+    for (int v = 0; v < o.n_vehicles && !o.store; v++)
         amfi_config_detector_correct(&cfg.detector, &o.vehicle[v].entry_s, NULL,
                               &o.vehicle[v].speed_mps, o.vehicle[v].axle_spacing_m,
                               o.vehicle[v].n_axles - 1);
@@ -700,17 +927,23 @@ int main(int argc, char **argv)
 
     int status = EXIT_DATA;
     char err[512];
-    accel_csv csv = {0};
     amfi_bridge *bridge = NULL;
     amfi_solver *solver = NULL;
 
-    if (accel_csv_read(o.accel, &csv, err, sizeof err) != 0) {
+    if (!o.store && accel_csv_read(o.accel, &csv, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
         goto done;
     }
+    const char *data_name = o.store ? from : o.accel;
     int col[AMFI_MAX_SENSORS]; /* the CSV column of each site sensor */
-    if (map_sensors(o.accel, site, &cfg, &csv, col) != 0)
+    if (map_sensors(data_name, site, &cfg, &csv, col) != 0)
         goto done;
+    char position_note[400] = "";
+    for (int i = 0; o.store && i < cfg.solver.n_sensors; i++)
+        if (cfg.solver.sensor_x_m[i] != raw.w.sensor_at_m[col[i]])
+            snprintf(position_note, sizeof position_note,
+                     "the site file puts sensor %d at %.6g m, amfid had it at %.6g m",
+                     cfg.sensor_id[i], cfg.solver.sensor_x_m[i], raw.w.sensor_at_m[col[i]]);
     if (amfi_bridge_create(&cfg.bridge, &bridge, err, sizeof err) != 0) {
         fprintf(stderr, PROG ": bridge model: %s\n", err);
         goto done;
@@ -765,11 +998,11 @@ int main(int argc, char **argv)
         fprintf(stderr,
                 "%s: passage not covered: the data spans [%.6g, %.6g] s but "
                 "the window needs [%.6g, %.6g] s\n",
-                o.accel, lo, hi, win_lo, win_hi);
+                data_name, lo, hi, win_lo, win_hi);
         goto done;
     }
     if (rc != 0) {
-        fprintf(stderr, PROG ": %s: solve failed: %s\n", o.accel,
+        fprintf(stderr, PROG ": %s: solve failed: %s\n", data_name,
                 err[0] ? err : amfi_strerror(rc));
         goto done;
     }
@@ -781,9 +1014,18 @@ int main(int argc, char **argv)
         goto done;
     if (o.speed_trace && write_speed_trace(o.speed_trace, &sres, &cfg.speed_prior) != 0)
         goto done;
+    json_t *extra = NULL;
+    if (o.store) {
+        const int k = raw.vehicle; /* this passage's vehicle in the event */
+        const int multi = o.n_vehicles > 0;
+        extra = store_json(&o, &raw, &stored, site, multi ? mres.vehicle[k].gvw_kg : res.gvw_kg,
+                           multi ? mres.vehicle[k].axle_kg : res.axle_kg,
+                           multi ? mres.vehicle[k].n_axles : res.n_axles, res.lambda_ref,
+                           position_note);
+    }
     if (print_json(&cfg, &res, &sres, cfg.speed_estimate, o.n_vehicles ? &mres : NULL,
                    o.spacing_m, &mp, csv.rate_hz,
-                   elapsed_ms(&t_a, &t_b)) != 0
+                   elapsed_ms(&t_a, &t_b), extra) != 0
         || fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, PROG ": stdout: %s\n", strerror(errno));
         goto done;
@@ -792,6 +1034,8 @@ int main(int argc, char **argv)
 done:
     amfi_solver_destroy(solver);
     amfi_bridge_destroy(bridge);
-    accel_csv_free(&csv);
+    if (!o.store)
+        accel_csv_free(&csv);
+    amfi_store_raw_free(&raw);
     return status;
 }
