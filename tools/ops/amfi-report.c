@@ -85,9 +85,13 @@ typedef struct plot_def {
     report_plot_fn draw;
 } plot_def;
 
-/* The filters a section honours; the others see every passage. */
-#define F_RANGE 1u  /* --from, --to, --lane */
+/* The filters a section honours; the others see every passage. A section
+ * without F_TIME refuses --from/--to (check_args), and --help says which
+ * honour it, both from this table. */
+#define F_TIME 1u   /* --from, --to */
 #define F_STATUS 2u /* --status */
+#define F_LANE 4u   /* --lane */
+#define F_RANGE (F_TIME | F_LANE)
 
 typedef struct section {
     const char *name;                /* --name */
@@ -129,11 +133,12 @@ static const section sections[N_SECTIONS] = {
         .table = trend_table, .export = trend_export,
         .plots = {{2, "trend.png", "indicator trend, thresholds, alerts raised and cleared",
                    indicators_plot_trend}},
-        .by_default = 1},
+        .filters = F_TIME, .by_default = 1},
     [SEC_ALERTS] = {
         .name = "alerts", .key = 'a',
-        .help = "the last " STR(REPORT_ALERT_ROWS) " alerts and those open now",
-        .table = alerts_table, .export = alerts_export, .by_default = 1},
+        .help = "the last " STR(REPORT_ALERT_ROWS) " alerts and those open now (open\n"
+                "now whatever the range)",
+        .table = alerts_table, .export = alerts_export, .filters = F_TIME, .by_default = 1},
     [SEC_ERRORS] = {
         .name = "errors", .key = 'e', .help = "inferred GVW against the truth (simulations)",
         .table = errors_table, .export = errors_export},
@@ -208,7 +213,7 @@ static const option_row option_rows[] = {
     OPT("bin-kg", 1, 'w', 1, "W", "histogram bin width, kg (default report.histogram_bin_kg)"),
     OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document)"),
     OPT("plot", 1, 'p', 1, "DIR", "draw PNGs into DIR (gnuplot): GVW, trend, histogram, per hour, "
-                               "speed"),
+                               "speed\n[honours --from --to]"),
     OPT("config", 1, 'c', 1, "FILE", "the site's amfid.yaml: alert thresholds, site name, legal "
                                   "limits"),
     OPT("help", 0, 'h', 1, NULL, "this help", .builtin = 1),
@@ -233,6 +238,7 @@ typedef struct options {
     int format;             /* FMT_* */
     export_opts ex;         /* --from --to --status --lane --bin-kg, limits */
     int bin_given;
+    const char *range_opt;  /* "--from" or "--to" when one was given, else NULL */
 } options;
 
 /* --help: "  -k, --name ARG" in 31 columns, then its text */
@@ -252,6 +258,17 @@ static void help_line(FILE *f, int key, int show_short, const char *name, const 
     fputc('\n', f);
 }
 
+/* A section's --help text and, from its filters, what it honours. */
+static void section_help(int k, char *text, size_t len)
+{
+    const unsigned fl = sections[k].filters;
+    if (fl & F_TIME)
+        snprintf(text, len, "%s\n[honours --from --to%s%s]", sections[k].help,
+                 fl & F_LANE ? " --lane" : "", fl & F_STATUS ? " --status" : "");
+    else
+        snprintf(text, len, "%s\n[the whole store: refuses --from and --to]", sections[k].help);
+}
+
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -268,8 +285,11 @@ static void usage(FILE *f)
     for (size_t i = 0; i < N_OPTION_ROWS; i++) {
         const option_row *r = &option_rows[i];
         if (r->last > 0) {
-            for (int k = r->first; k <= r->last; k++)
-                help_line(f, sections[k].key, 1, sections[k].name, NULL, sections[k].help);
+            for (int k = r->first; k <= r->last; k++) {
+                char text[512];
+                section_help(k, text, sizeof text);
+                help_line(f, sections[k].key, 1, sections[k].name, NULL, text);
+            }
         } else if (r->help) {
             help_line(f, r->key, r->show_short, r->name, r->arg, r->help);
         }
@@ -412,6 +432,8 @@ static int parse_args(int argc, char **argv, options *o)
                     return usage_error(opt, "'%s' is not a UTC time (%s): use YYYY-MM-DD, "
                                        "YYYY-MM-DDTHH:MM[:SS[.ffffff]][Z]",
                                        amfi_cli_shown(val), why);
+                if (!o->range_opt)
+                    o->range_opt = k == 'f' ? "--from" : "--to";
             }
             break;
         case 'S': {
@@ -503,9 +525,27 @@ static int check_args(options *o)
                            "--set-baseline");
     if (o->ex.from > o->ex.to)
         return usage_error("--from", "after --to");
+    if (o->range_opt && (o->check || o->baseline_last || o->baseline_given))
+        return usage_error(o->range_opt, "%s works on the whole store and does not honour "
+                           "--from/--to", o->check ? "--check" : o->baseline_last
+                           ? "--set-baseline-last" : "--set-baseline");
     if (!asked && !o->check && !o->plot_dir && !o->baseline_last && !o->baseline_given)
         for (int k = 0; k < N_SECTIONS; k++)
             o->sel[k] = sections[k].by_default ? (sections[k].default_if ? 2 : 1) : 0;
+    /* every section asked for (or shown by default) honours the range, or
+     * it is refused: never silently the whole store */
+    for (int k = 0; o->range_opt && k < N_SECTIONS; k++)
+        if (o->sel[k] && !(sections[k].filters & F_TIME)) {
+            char with[256] = "";
+            size_t at = 0;
+            for (int j = 0; j < N_SECTIONS; j++)
+                if ((sections[j].filters & F_TIME) && at < sizeof with)
+                    at += (size_t)snprintf(with + at, sizeof with - at, "--%s ",
+                                           sections[j].name);
+            return usage_error(o->range_opt, "--%s%s reports the whole store and does not honour "
+                               "--from/--to; these do: %s--plot", sections[k].name,
+                               asked ? "" : " (shown with no section asked for)", with);
+        }
     for (int k = 0; k < N_SECTIONS; k++)
         n_status += o->sel[k] && (sections[k].filters & F_STATUS);
     if (o->ex.status && !n_status) {
@@ -660,9 +700,11 @@ static void print_next(const options *o)
 static void context_for(report_ctx *c, const options *o, int k)
 {
     c->ex = o->ex;
-    if (!(sections[k].filters & F_RANGE)) {
+    if (!(sections[k].filters & F_TIME)) {
         c->ex.from = 0;
         c->ex.to = AMFI_STORE_MAX_UTIME;
+    }
+    if (!(sections[k].filters & F_LANE)) {
         c->ex.lane_given = 0;
         c->ex.lane = 0;
     }
@@ -808,7 +850,7 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
             order[i] = &sections[k].plots[j];
         }
     report_plot_frame p;
-    rc = report_plot_begin(&p, s, o->plot_dir, site, &ip, err, sizeof err);
+    rc = report_plot_begin(&p, s, o->plot_dir, site, &ip, o->ex.from, o->ex.to, err, sizeof err);
     for (int i = 0; rc == 0 && i < n_plots; i++) {
         int drawn = 0;
         rc = order[i]->draw(&p, &drawn, err, sizeof err);

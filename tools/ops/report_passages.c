@@ -583,17 +583,12 @@ int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t e
 }
 
 /* passages_per_hour.png: passages per hour by status, cumulative columns so
- * the boxes stack; the bucket adapts to the span. Writes hourly.dat. */
+ * the boxes stack. A bucket is one hour (what the axis says), or one day
+ * over more than 400 hours (then its mean per hour). Writes hourly.dat. */
 int passages_plot_per_hour(report_plot_frame *p, int *made, char *err, size_t errlen)
 {
-    static const double buckets[] = {60, 300, 900, 3600, 86400};
     const double t0 = p->t0, t1 = p->t1;
-    double bw = 86400;
-    for (int k = 0; k < 5; k++)
-        if ((t1 - t0) / buckets[k] <= 200) {
-            bw = buckets[k];
-            break;
-        }
+    const double bw = (t1 - t0) / 3600 <= 400 ? 3600 : 86400;
     int nbk = (int)floor((t1 - t0) / bw) + 1;
     if (nbk > 100000)
         nbk = 100000;
@@ -629,11 +624,11 @@ int passages_plot_per_hour(report_plot_frame *p, int *made, char *err, size_t er
     fprintf(p->gp,
         "set output o.'passages_per_hour.png'\n"
         "set xdata time\nset format x \"%%H:%%M\\n%%d %%b\"\nset xrange [%.3f:%.3f]\n"
-        "set title \"Passages per hour by status (buckets of %.0f min)\\n%s\"\n"
+        "set title \"Passages per hour by status (buckets of %s)\\n%s\"\n"
         "set xlabel 'time (UTC, data time)'\nset ylabel 'passages per hour'\n"
         "set style fill solid 0.8 border lc rgb 'black'\nset boxwidth %.0f\nset yrange [0:*]\n"
         "plot ",
-        tb0, tb0 + nbk * bw, bw / 60, p->sub, bw * 0.9);
+        tb0, tb0 + nbk * bw, bw == 3600 ? "1 h" : "1 day, mean per hour", p->sub, bw * 0.9);
     for (int k = AMFI_STORE_N_STATUS - 1; k >= 0; k--)
         fprintf(p->gp, "d.'hourly.dat' using 1:%d with boxes lc rgb '%s' title '%s'%s", k + 2,
                 status_colour[k], amfi_store_status_name(k), k ? ", \\\n     " : "\n");

@@ -1,0 +1,150 @@
+#!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
+# report_range.sh: amfi-report's --from/--to in every section (honoured, or
+# refused with a message naming the section), --help saying which honour
+# it, and --plot's gnuplot script (the threshold lines inside each panel's
+# y range, hourly buckets on the per-hour plot, no legend entry for a
+# series without a point, the range honoured by the data files). The
+# fixture is report_golden's (docs/schema.md's DDL and report_golden.sql).
+#
+# usage: report_range.sh AMFI_REPORT SCHEMA_MD DIR_OF_report_golden.sql
+# Exit 77 (skipped) without the sqlite3 program or gnuplot.
+set -u
+bin=${1:?usage: report_range.sh AMFI_REPORT SCHEMA_MD DIR}
+doc=${2:?usage: report_range.sh AMFI_REPORT SCHEMA_MD DIR}
+dir=${3:?usage: report_range.sh AMFI_REPORT SCHEMA_MD DIR}
+command -v sqlite3 > /dev/null || { echo "report_range.sh: no sqlite3 program: skipped"; exit 77; }
+command -v gnuplot > /dev/null || { echo "report_range.sh: no gnuplot: skipped"; exit 77; }
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/report_range.XXXXXX") || exit 1
+trap 'rm -rf "$tmp"' EXIT INT TERM
+
+awk '/^<!-- ddl:begin -->/ { on = 1; next } /^<!-- ddl:end -->/ { on = 0 }
+     on && !/^```/' "$doc" > "$tmp/ddl.sql"
+v=$(sed -n 's/.*PRAGMA user_version` (this document: version \([0-9]*\)).*/\1/p' "$doc")
+[ -n "$v" ] || { echo "report_range.sh: no schema version in $doc" >&2; exit 1; }
+db=$tmp/golden.db
+{
+    cat "$tmp/ddl.sql"
+    echo "PRAGMA user_version = $v;
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < $v)
+INSERT INTO schema_migrations (version, description) SELECT i, 'golden' FROM k;"
+    cat "$dir/report_golden.sql"
+} > "$tmp/fixture.sql"
+sqlite3 "$db" < "$tmp/fixture.sql" > "$tmp/fixture.log" 2>&1 ||
+    { echo "report_range.sh: building the fixture failed:" >&2; cat "$tmp/fixture.log" >&2; exit 1; }
+
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+# run ARGS...: stdout in $tmp/out, stderr in $tmp/err, status in $rc
+run() { "$bin" "$@" > "$tmp/out" 2> "$tmp/err"; rc=$?; }
+
+# ---- sections that report the whole store refuse the range ------------------
+for s in summary errors; do
+    for opt in "--from 2025-11-22" "--to 2025-11-22T12:00"; do
+        # shellcheck disable=SC2086
+        run --db "$db" --$s $opt
+        [ "$rc" = 2 ] || fail "--$s $opt: status $rc, want 2 (refused)"
+        grep -q -- "--$s reports the whole store and does not honour --from/--to" "$tmp/err" ||
+            fail "--$s $opt: no message naming --$s: $(cat "$tmp/err")"
+    done
+done
+run --db "$db" --from 2025-11-22
+[ "$rc" = 2 ] || fail "no section, --from: status $rc, want 2"
+grep -q -- "--from: --summary (shown with no section asked for) reports the whole store" "$tmp/err" ||
+    fail "no section, --from: $(cat "$tmp/err")"
+run --db "$db" --set-baseline-last 3 --to 2025-11-22
+[ "$rc" = 2 ] && grep -q -- "--set-baseline-last works on the whole store" "$tmp/err" ||
+    fail "--set-baseline-last --to: status $rc: $(cat "$tmp/err")"
+
+# ---- --trend and --alerts honour it ------------------------------------------
+# indicators hourly from 01:00 to 24:00; alerts at 10:00, 12:00, 20:00, 21:00
+for f in csv json table; do
+    run --db "$db" --trend --from 2025-11-22T20:00 --to 2025-11-22T22:00 --format $f
+    [ "$rc" = 0 ] || fail "--trend range $f: status $rc: $(cat "$tmp/err")"
+    case $f in
+    csv) n=$(($(wc -l < "$tmp/out") - 1)) ;;
+    json) n=$(grep -o '"indicator_id"' "$tmp/out" | wc -l) ;;
+    table) n=$(grep -c '^2025-11-2' "$tmp/out") ;;
+    esac
+    [ "$n" = 3 ] || fail "--trend 20:00 .. 22:00 --format $f: $n rows, want 3"
+    run --db "$db" --alerts --from 2025-11-22T11:00 --to 2025-11-22T20:30 --format $f
+    [ "$rc" = 0 ] || fail "--alerts range $f: status $rc: $(cat "$tmp/err")"
+    case $f in
+    csv) n=$(grep -c '^[0-9]' "$tmp/out") ;;
+    json) n=$(grep -o '"alert_id"' "$tmp/out" | wc -l) ;;
+    table) n=$(grep -c '^2025-11-2' "$tmp/out") ;;
+    esac
+    [ "$n" = 2 ] || fail "--alerts 11:00 .. 20:30 --format $f: $n rows, want 2"
+done
+run --db "$db" --trend --format csv
+[ "$(($(wc -l < "$tmp/out") - 1))" = 24 ] || fail "--trend without a range: not every row"
+run --db "$db" --trend --from 2025-11-22T20:00 --to 2025-11-22T22:00
+grep -q '^== indicators (last 3 of 3 from 2025-11-22 20:00:00 to 2025-11-22 22:00:59 UTC)' "$tmp/out" ||
+    fail "--trend range: header: $(head -1 "$tmp/out")"
+
+# ---- --help says, per section, whether it honours the range --------------------
+run --help
+awk '/^  -[a-zA-Z], --[a-z]/ { sec = $2 } /honours --from --to/ { print sec, "honours" }
+     /refuses --from and --to/ { print sec, "refuses" }' "$tmp/out" > "$tmp/help"
+for s in summary:refuses errors:refuses trend:honours alerts:honours passages:honours \
+         histogram:honours overloads:honours speed:honours plot:honours; do
+    grep -q "^--${s%%:*} ${s#*:}\$" "$tmp/help" || fail "--help: --${s%%:*} does not say it ${s#*:} --from/--to"
+done
+
+# ---- --plot honours the range ------------------------------------------------
+run --db "$db" --plot "$tmp/p1" --from 2025-11-22T06:00 --to 2025-11-22T11:59
+[ "$rc" = 0 ] || fail "--plot range: status $rc: $(cat "$tmp/err")"
+# passages every 30 min from 00:30: 06:00 .. 11:30 is 12 of them
+n=$(grep -vc '^#' "$tmp/p1/data/passages.dat")
+[ "$n" = 12 ] || fail "--plot 06:00 .. 11:59: passages.dat has $n rows, want 12"
+n=$(grep -vc '^#' "$tmp/p1/data/indicators.dat")
+[ "$n" = 6 ] || fail "--plot 06:00 .. 11:59: indicators.dat has $n rows, want 6"
+n=$(grep -vc '^#' "$tmp/p1/data/alerts.dat")
+[ "$n" = 1 ] || fail "--plot 06:00 .. 11:59: alerts.dat has $n rows, want 1"
+awk 'NR > 1 && ($1 < 1763791200 || $1 > 1763812799) { bad = 1 } END { exit bad }' \
+    "$tmp/p1/data/temperature.dat" || fail "--plot range: temperature.dat outside the range"
+
+# ---- the gnuplot script --------------------------------------------------------
+run --db "$db" --plot "$tmp/p2"
+[ "$rc" = 0 ] || fail "--plot: status $rc: $(cat "$tmp/err")"
+gp=$tmp/p2/data/plots.gp
+# the y range set for the panel of each ylabel: "LO HI"
+yr() { awk -v l="$1" 'index($0, "set ylabel '\''" l) == 1 { on = 1; next }
+       on && /^set yrange \[/ { s = $3; gsub(/[][]/, "", s); split(s, a, ":"); print a[1], a[2]; exit }
+       on && /^plot/ { exit }' "$gp"; }
+# the thresholds, read from the legend titles
+read -r raise clear <<EOT
+$(sed -n "s/.*title 'raise at >= \([0-9.e+-]*\)'.*title 'clear below \([0-9.e+-]*\)'.*/\1 \2/p" "$gp")
+EOT
+read -r mean_r <<EOT
+$(sed -n "s/.*title 'mean alert \([0-9.e+-]*\) and 1\/.*/\1/p" "$gp")
+EOT
+[ -n "$raise" ] && [ -n "$clear" ] && [ -n "$mean_r" ] || fail "plots.gp: no threshold titles"
+read -r lo hi <<EOT
+$(yr 'STD ratio')
+EOT
+[ -n "$lo" ] || fail "plots.gp: no y range on the STD ratio panel"
+awk -v lo="${lo:-0}" -v hi="${hi:-0}" -v a="$raise" -v c="$clear" \
+    'BEGIN { m = 0.02 * (a - c); exit !(lo < c - m && lo < a - m && hi > a + m && hi > c + m) }' ||
+    fail "STD ratio panel: y range [$lo:$hi] does not hold $clear and $raise inside the frame"
+read -r lo hi <<EOT
+$(yr 'mean ratio')
+EOT
+[ -n "$lo" ] || fail "plots.gp: no y range on the mean ratio panel"
+awk -v lo="${lo:-0}" -v hi="${hi:-0}" -v r="$mean_r" \
+    'BEGIN { m = 0.02 * (r - 1 / r); exit !(lo < 1 / r - m && hi > r + m) }' ||
+    fail "mean ratio panel: y range [$lo:$hi] does not hold 1/$mean_r and $mean_r inside the frame"
+# passages per hour: one-hour buckets
+grep -q '(bucket 3600 s)' "$tmp/p2/data/hourly.dat" || fail "hourly.dat: $(head -1 "$tmp/p2/data/hourly.dat")"
+grep -A8 "passages_per_hour.png" "$gp" | grep -q 'set boxwidth 3240$' ||
+    fail "passages_per_hour.png: boxes not one hour wide"
+# natural frequency without a compensated value: no 'compensated' legend entry
+sqlite3 "$db" "UPDATE passages SET f1_comp_hz = NULL" || exit 1
+run --db "$db" --plot "$tmp/p3"
+[ "$rc" = 0 ] || fail "--plot (no compensated f1): status $rc: $(cat "$tmp/err")"
+awk '/natfreq.png/ { on = 1 } on && /^plot/ { p = 1 } p && /^set output/ { exit } p' \
+    "$tmp/p3/data/plots.gp" | grep -q "title 'compensated'" &&
+    fail "natfreq.png: a 'compensated' legend entry with no compensated value"
+
+[ "$fails" = 0 ] && echo "ok: report_range"
+exit $((fails > 0))
