@@ -36,7 +36,7 @@
  *   scaleind.c -> environment.c log.c metrics.c
  *   sink.c -> log.c pool.c
  *   status.c -> bus.c environment.c log.c pipeline.c timer.c
- *   stdmean.c -> log.c metrics.c
+ *   stdmean.c -> log.c metrics.c timer.c
  * log.c and timer.c call nothing of amfid's; a module reaches the core only
  * through the context.
  *

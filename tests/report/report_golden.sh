@@ -137,9 +137,11 @@ run usage-unknown --db "$db" --bogus
 run usage-ambiguous --db "$db" --s
 run missing-db --db "$db.missing"
 cp "$db" "$tmp/copy.db"
-run baseline-last --db "$tmp/copy.db" --set-baseline-last 5 --note 'after "work"'
-run baseline-given --db "$tmp/copy.db" --set-baseline 18000,1500,30 --summary
-run baseline-too-many --db "$tmp/copy.db" --set-baseline-last 1000
+run baseline-open-alert --db "$tmp/copy.db" --set-baseline-last 5
+run usage-force --db "$db" --force
+run baseline-last --db "$tmp/copy.db" --set-baseline-last 5 --note 'after "work"' --force
+run baseline-given --db "$tmp/copy.db" --set-baseline 18000,1500,30 --summary --force
+run baseline-too-many --db "$tmp/copy.db" --set-baseline-last 1000 --force
 
 # --plot: the listing, every data file and the script (not the PNGs, nor
 # gnuplot's log)

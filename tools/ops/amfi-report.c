@@ -203,6 +203,8 @@ static const option_row option_rows[] = {
                                           "N >= 2"),
     OPT("set-baseline", 1, 'b', 1, "M,S,N", "baseline mean M kg, STD S kg, from N passages"),
     OPT("note", 1, 'n', 1, "TEXT", "note stored with the baseline (<= 127 bytes)"),
+    OPT("force", 0, 'K', 0, NULL, "with --set-baseline*: set it even while an alert is open\n"
+                                 "(refused by default: a baseline from damaged data)"),
     OPT("check", 0, 'k', 1, NULL, "PRAGMA integrity_check and foreign_key_check"),
     {.first = SEC_PASSAGES, .last = SEC_SPEED},
     OPT("from", 1, 'f', 1, "T, -T, --to T", "only passages in [T, T]: YYYY-MM-DD or "
@@ -233,6 +235,7 @@ typedef struct options {
     double mean_kg, std_kg;
     int n;
     const char *note;    /* NULL: empty */
+    int force;           /* --force: a baseline even while an alert is open */
     const char *plot_dir;   /* --plot DIR, NULL: none */
     const char *config;     /* --config FILE, NULL: none */
     int format;             /* FMT_* */
@@ -423,6 +426,7 @@ static int parse_args(int argc, char **argv, options *o)
                                    amfi_cli_shown(val));
             break;
         case 'X': o->allow_plaintext = 1; break;
+        case 'K': o->force = 1; break;
         case 'f':
         case 'T':
             {
@@ -523,6 +527,8 @@ static int check_args(options *o)
     if (o->note && !o->baseline_last && !o->baseline_given)
         return usage_error("--note", "only with --set-baseline-last or "
                            "--set-baseline");
+    if (o->force && !o->baseline_last && !o->baseline_given)
+        return usage_error("--force", "only with --set-baseline-last or --set-baseline");
     if (o->ex.from > o->ex.to)
         return usage_error("--from", "after --to");
     if (o->range_opt && (o->check || o->baseline_last || o->baseline_given))
@@ -582,7 +588,29 @@ static int set_baseline(const options *o, const report_ctx *c)
         fprintf(stderr, PROG ": %s\n", err); /* starts with the path */
         return -1;
     }
-    if (o->baseline_last) {
+    /* an open alert: the recent passages may come from a damaged bridge,
+     * and a baseline taken from them would hide the damage */
+    amfi_alert_rec *open = NULL;
+    int n_open = 0;
+    if (amfi_store_open_alerts(s, &open, &n_open, err, sizeof err) != 0)
+        rc = data_error(c, "%s", err);
+    if (rc == 0 && n_open > 0) {
+        char t[32], names[512] = "";
+        size_t at = 0;
+        for (int k = 0; k < n_open && at < sizeof names; k++)
+            at += (size_t)snprintf(names + at, sizeof names - at, "%s%s %s (since %s UTC)",
+                                   k ? ", " : "", amfi_cli_shown(open[k].level),
+                                   amfi_cli_shown(open[k].kind), report_utc(open[k].utime, t));
+        if (o->force)
+            fprintf(stderr, PROG ": %s: warning: --force: baseline set while %d alert%s open: %s\n",
+                    c->name, n_open, n_open > 1 ? "s are" : " is", names);
+        else
+            rc = data_error(c, "%d alert%s open: %s; a baseline now may be taken from damaged "
+                            "data: clear the cause first, or give --force", n_open,
+                            n_open > 1 ? "s are" : " is", names);
+    }
+    free(open);
+    if (rc == 0 && o->baseline_last) {
         g = malloc((size_t)o->baseline_last * sizeof *g);
         if (!g)
             rc = data_error(c, "out of memory");
@@ -597,7 +625,7 @@ static int set_baseline(const options *o, const report_ctx *c)
             report_mean_std(g, (size_t)n, &b.mean_kg, &b.std_kg);
             b.n = n;
         }
-    } else {
+    } else if (rc == 0) {
         b.mean_kg = o->mean_kg;
         b.std_kg = o->std_kg;
         b.n = o->n;
@@ -620,8 +648,7 @@ static int set_baseline(const options *o, const report_ctx *c)
         char t[32];
         printf("baseline set: mean %.0f kg, STD %.0f kg, n %d, manual, from "
                "%s UTC\n", b.mean_kg, b.std_kg, b.n, report_utc(b.utime_set, t));
-        printf("(amfid reads the newest baseline row when it starts: restart "
-               "it to use this one)\n");
+        printf("(a running amfid applies the newest baseline row within a few seconds)\n");
     }
     free(g);
     amfi_store_close(s);
