@@ -182,7 +182,7 @@ name="read-only modes"
 cases=$((cases + 1))
 [ "$sum0" = "$sum1" ] || problem "the printing modes changed the file"
 
-if ok baseline-last --db "$db" --set-baseline-last 10 --note "after the bearing repair"; then
+if ok baseline-last --db "$db" --set-baseline-last 10 --note "after the bearing repair" --force; then
     has '^baseline set: mean [0-9]+ kg, STD [0-9]+ kg, n 10, manual, from 2025-11-23 16:00:00 UTC$'
     got=$(q "$db" "SELECT n, source, note, utime_set FROM baseline ORDER BY id DESC LIMIT 1")
     [ "$got" = "10|manual|after the bearing repair|1763913600000000" ] || problem "newest baseline row '$got'"
@@ -193,7 +193,7 @@ if ok baseline-last --db "$db" --set-baseline-last 10 --note "after the bearing 
     has 'SELECT \* FROM baseline'
 fi
 
-if ok baseline-explicit --db "$db" --set-baseline 18000,2000.5,500 --summary; then
+if ok baseline-explicit --db "$db" --set-baseline 18000,2000.5,500 --summary --force; then
     got=$(q "$db" "SELECT mean_kg, std_kg, n, source, note FROM baseline ORDER BY id DESC LIMIT 1")
     [ "$got" = "18000.0|2000.5|500|manual|" ] || problem "newest baseline row '$got'"
     has '^baseline +mean 18000 kg, STD 2000 kg, n 500, manual, from 2025-11-23 16:00:00 UTC$'
@@ -433,6 +433,12 @@ cp "$tmp/pristine.db" "$tmp/newer.db"
 sqlite3 "$tmp/newer.db" "PRAGMA user_version = 99"
 bad newer 1 'schema version 99 is newer than this program.s [0-9]' --db "$tmp/newer.db"
 
+# the fixture's std_increase alert is open: refused without --force, and
+# the store unchanged
+n0=$(q "$db" "SELECT count(*) FROM baseline")
+bad baseline-open-alert 1 "^amfi-report: $tmp/fixture\\.db: 1 alert is open: warning std_increase \\(since 2025-11-23 09:00:00 UTC\\); .* give --force\$" \
+    --db "$db" --set-baseline-last 10
+[ "$(q "$db" "SELECT count(*) FROM baseline")" = "$n0" ] || problem "a refused baseline was stored"
 cp "$tmp/pristine.db" "$tmp/damaged.db"
 sqlite3 "$tmp/damaged.db" "PRAGMA ignore_check_constraints = ON; UPDATE passages SET gvw_kg = -1 WHERE id = 3"
 bad damaged-row 1 "^amfi-report: $tmp/damaged\\.db: passages row 3: gvw_kg is out of range" --db "$tmp/damaged.db" --summary
@@ -440,7 +446,7 @@ cp "$tmp/pristine.db" "$tmp/damaged2.db"
 sqlite3 "$tmp/damaged2.db" "PRAGMA ignore_check_constraints = ON; UPDATE baseline SET std_kg = -5 WHERE id = 1"
 bad damaged-baseline 1 'baseline row 1: std_kg: -5 kg is out of range \(0, 1e\+06\] kg$' --db "$tmp/damaged2.db" --summary
 # the damaged row is not read to set a new baseline, which then is in force
-ok baseline-over-damaged --db "$tmp/damaged2.db" --set-baseline 18000,2000,100 --summary
+ok baseline-over-damaged --db "$tmp/damaged2.db" --set-baseline 18000,2000,100 --summary --force
 cp "$tmp/pristine.db" "$tmp/damaged3.db"
 sqlite3 "$tmp/damaged3.db" "PRAGMA ignore_check_constraints = ON; UPDATE indicators SET state = 'panic' WHERE id = 24"
 bad damaged-indicator 1 'indicators row 24: state is not a known state' --db "$tmp/damaged3.db" --trend

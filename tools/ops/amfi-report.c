@@ -602,8 +602,8 @@ static int set_baseline(const options *o, const report_ctx *c)
                                    k ? ", " : "", amfi_cli_shown(open[k].level),
                                    amfi_cli_shown(open[k].kind), report_utc(open[k].utime, t));
         if (o->force)
-            fprintf(stderr, PROG ": %s: warning: --force: baseline set while %d alert%s open: %s\n",
-                    c->name, n_open, n_open > 1 ? "s are" : " is", names);
+            printf("warning: --force: a baseline while %d alert%s open: %s\n", n_open,
+                   n_open > 1 ? "s are" : " is", names);
         else
             rc = data_error(c, "%d alert%s open: %s; a baseline now may be taken from damaged "
                             "data: clear the cause first, or give --force", n_open,
