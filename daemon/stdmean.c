@@ -9,7 +9,8 @@
  * the context's emit_alert) and the newest evaluation goes to the metrics.
  * At start the baseline, the window's GVWs and the open alerts come back
  * from the store (an alert open before a restart stays open, not raised
- * twice). A baseline written into the store while amfid runs (amfi-report
+ * twice), and the parameters in force are recorded in meta
+ * (daemon.indicators) for the reports. A baseline written into the store while amfid runs (amfi-report
  * --set-baseline*) is applied without a restart: a timer compares the
  * store's newest baseline row with the one in force every
  * BASELINE_POLL_S seconds.
@@ -97,6 +98,13 @@ static int stdmean_restore(amfid_ctx *c)
     char err[512];
     if (timer_add(c->timers, &baseline_poll_s, baseline_tick) != 0)
         return 1;
+    /* what this run's rules use, for the reports (meta daemon.indicators;
+     * a reload does not change them: they apply at the next start) */
+    char params[1024];
+    snprintf(err, sizeof err, "the text is longer than %zu bytes", sizeof params);
+    if (amfi_indicator_params_format(&M.params, params, sizeof params) != 0
+        || amfi_store_meta_set(c->store, "daemon.indicators", params, err, sizeof err) != 0)
+        LOG_WARN("store: the indicator parameters not recorded: %s", err);
     if (amfi_store_get_baseline(c->store, &b, &found, err, sizeof err) != 0) {
         LOG_WARN("store: %s", err);
         return 0;

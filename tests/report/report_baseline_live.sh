@@ -46,4 +46,9 @@ echo "evaluations after the new baseline: $after, of them against it: $new (befo
 [ "$new" -eq "$after" ] || fail "$((after - new)) evaluations after the new baseline not against it"
 [ "$before" -eq 0 ] || fail "evaluations before the new baseline against it"
 [ "$(grep -c 'running: amfid' "$dir/amfid.log")" -eq 1 ] || fail "amfid restarted"
+rec=$(q "SELECT value FROM meta WHERE key = 'daemon.indicators'")
+case "$rec" in
+"window=50 every=10 baseline_n=100 std_alert_ratio="*) ;;
+*) fail "amfid did not record its indicator parameters in meta daemon.indicators: '$rec'" ;;
+esac
 echo "baseline applied without a restart: ok"

@@ -138,6 +138,29 @@ awk -v lo="${lo:-0}" -v hi="${hi:-0}" -v r="$mean_r" \
 grep -q '(bucket 3600 s)' "$tmp/p2/data/hourly.dat" || fail "hourly.dat: $(head -1 "$tmp/p2/data/hourly.dat")"
 grep -A8 "passages_per_hour.png" "$gp" | grep -q 'set boxwidth 3240$' ||
     fail "passages_per_hour.png: boxes not one hour wide"
+# the thresholds amfid ran with (meta daemon.indicators), not the defaults
+# nor --config's
+cp "$db" "$tmp/rec.db"
+sqlite3 "$tmp/rec.db" "INSERT INTO meta (key, value) VALUES ('daemon.indicators',
+  'window=500 every=100 baseline_n=10000 std_alert_ratio=1.5 std_alert_p=0.05 std_clear_ratio=1.25 raise_after=6 clear_after=6 mean_shift=1 mean_alert_ratio=1.125 mean_alert_p=0.01 mean_clear_ratio=1.0625')" || exit 1
+printf 'daemon:\n  indicators:\n    std_alert_ratio: 1.75\n    std_clear_ratio: 1.5\n' > "$tmp/other.yaml"
+run --db "$tmp/rec.db" --plot "$tmp/p4" --config "$tmp/other.yaml"
+[ "$rc" = 0 ] || fail "--plot (recorded thresholds): status $rc: $(cat "$tmp/err")"
+gp4=$tmp/p4/data/plots.gp
+grep -q "title 'raise at >= 1.5', .* title 'clear below 1.25'" "$gp4" ||
+    fail "trend.png: not the recorded STD thresholds 1.5 / 1.25: $(grep -o "title 'raise at[^,]*" "$gp4")"
+grep -q "title 'mean alert 1.125 and 1/1.125'" "$gp4" || fail "trend.png: not the recorded mean threshold 1.125"
+grep -q "thresholds: amfid's, from the store" "$gp4" || fail "trend.png: the title does not say where the thresholds come from"
+read -r lo hi <<EOT
+$(gp=$gp4; yr 'STD ratio')
+EOT
+awk -v lo="${lo:-0}" -v hi="${hi:-0}" 'BEGIN { exit !(lo < 1.24 && hi > 1.51) }' ||
+    fail "STD ratio panel: y range [$lo:$hi] does not hold the recorded 1.25 and 1.5"
+sqlite3 "$tmp/rec.db" "UPDATE meta SET value = 'window=500 std_alert_ratio=x' WHERE key = 'daemon.indicators'" || exit 1
+run --db "$tmp/rec.db" --plot "$tmp/p5"
+[ "$rc" = 1 ] && grep -q "rec.db: meta daemon.indicators: std_alert_ratio: not a number" "$tmp/err" ||
+    fail "a damaged daemon.indicators: status $rc: $(cat "$tmp/err")"
+
 # natural frequency without a compensated value: no 'compensated' legend entry
 sqlite3 "$db" "UPDATE passages SET f1_comp_hz = NULL" || exit 1
 run --db "$db" --plot "$tmp/p3"

@@ -842,8 +842,9 @@ static int run_section(const options *o, report_ctx *c, int k, int *printed)
 }
 
 /* --plot: site name from the store's meta (site.name), else the config's
- * bridge.name, else the database's file name; thresholds from --config or
- * the indicator defaults. Every section's plots, in their places. */
+ * bridge.name, else the database's file name; thresholds from what amfid
+ * recorded in the store (meta daemon.indicators), else --config, else the
+ * indicator defaults. Every section's plots, in their places. */
 static int plot(const options *o, const amfi_site_config *cfg, const report_ctx *c)
 {
     amfi_store *s = c->s;
@@ -851,11 +852,26 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
     int found = 0;
     amfi_indicator_params ip;
     amfi_indicator_params_default(&ip);
+    const char *ip_from = "built-in defaults";
     if (amfi_store_meta_get(s, "site.name", site, sizeof site, &found, err,
                             sizeof err) != 0)
         return data_error(c, "%s", err);
-    if (cfg) {
+    /* the thresholds: what amfid ran with (meta daemon.indicators), else
+     * --config's, else the defaults */
+    char rec[4097], why[256];
+    int have_rec = 0;
+    if (amfi_store_meta_get(s, "daemon.indicators", rec, sizeof rec, &have_rec, err,
+                            sizeof err) != 0)
+        return data_error(c, "%s", err);
+    if (have_rec) {
+        if (amfi_indicator_params_parse(rec, &ip, why, sizeof why) != 0)
+            return data_error(c, "meta daemon.indicators: %s", why);
+        ip_from = "amfid's, from the store";
+    } else if (cfg) {
         ip = cfg->daemon.indicators;
+        ip_from = "--config";
+    }
+    if (cfg) {
         if (!found) {
             snprintf(site, sizeof site, "%s", cfg->site.name);
             found = 1;
@@ -878,6 +894,7 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
         }
     report_plot_frame p;
     rc = report_plot_begin(&p, s, o->plot_dir, site, &ip, o->ex.from, o->ex.to, err, sizeof err);
+    p.ip_from = ip_from;
     for (int i = 0; rc == 0 && i < n_plots; i++) {
         int drawn = 0;
         rc = order[i]->draw(&p, &drawn, err, sizeof err);

@@ -349,7 +349,7 @@ int indicators_plot_trend(report_plot_frame *p, int *made, char *err, size_t err
                 (double)p->al[k].utime / 1e6, (double)p->al[k].utime / 1e6,
                 p->al[k].raised ? "#d62728" : "#2ca02c", p->al[k].raised ? 1 : 2);
     fprintf(gp,
-        "set multiplot layout 3,1 title \"Damage indicator trend (%s)\\n%d indicator rows, %d alerts: red solid = raised, green dashed = cleared\"\n"
+        "set multiplot layout 3,1 title \"Damage indicator trend (%s)\\n%d indicator rows, %d alerts: red solid = raised, green dashed = cleared; thresholds: %s\"\n"
         "unset title\nset format x ''\nunset xlabel\n"
         "set lmargin at screen 0.09\nset rmargin at screen 0.72\n"
         "set ylabel 'STD ratio (window / baseline)'\nset yrange [%.6g:%.6g]\n"
@@ -367,7 +367,7 @@ int indicators_plot_trend(report_plot_frame *p, int *made, char *err, size_t err
         "     %.4g with lines dt 1 lc rgb '#d62728' title 'mean alert %.4g and 1/%.4g', %.4g with lines dt 1 lc rgb '#d62728' notitle\n"
         "unset multiplot\nunset arrow\nset lmargin\nset rmargin\nset autoscale y\n"
         "set terminal pngcairo size 960,540\n",
-        p->sub, p->n_ind, p->n_al, slo - sm, shi + sm, ip->std_alert_ratio, ip->std_alert_ratio,
+        p->sub, p->n_ind, p->n_al, p->ip_from ? p->ip_from : "built-in defaults", slo - sm, shi + sm, ip->std_alert_ratio, ip->std_alert_ratio,
         ip->std_clear_ratio, ip->std_clear_ratio, plo / 4, phi * 2, ip->std_alert_p,
         ip->std_alert_p, mlo - mm, mhi + mm, ip->mean_alert_ratio, ip->mean_alert_ratio,
         ip->mean_alert_ratio, 1.0 / ip->mean_alert_ratio);

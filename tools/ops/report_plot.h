@@ -32,6 +32,7 @@ typedef struct report_plot_frame {
     amfi_store *s;
     const char *dir;                 /* --plot DIR */
     const amfi_indicator_params *ip; /* the alert thresholds */
+    const char *ip_from;             /* where they come from, for the titles */
     int64_t from, to;                /* --from .. --to, µs: every plot draws only these */
     FILE *gp;                        /* DIR/data/plots.gp, being written */
     char gdir[8200];                 /* dir in a gnuplot single-quoted string */
