@@ -477,8 +477,10 @@ int amfi_store_gvw_errors(amfi_store *s, double **pct, size_t *n,
 
 /* ---- passage listing (store_export.c) ------------------------------------ */
 
-/* Called once per passage; row->status and row->reason are valid during the
-   call only. A nonzero return stops the listing and is returned. */
+/* Called once per passage; row->status, row->reason, row->vclass and
+   row->axle_groups (NULL where the column is NULL; has_overload 0 where
+   overload is) are valid during the call only. A nonzero return stops the
+   listing and is returned. */
 typedef int (*amfi_store_passage_fn)(void *ctx, int64_t id,
                                      const amfi_passage_row *row);
 

@@ -89,7 +89,7 @@ run() {
     n=$((n + 1))
 }
 for f in table csv json; do
-    for s in summary trend alerts errors passages histogram overloads speed; do
+    for s in summary trend alerts errors passages histogram overloads speed classes class-histogram; do
         run "$s.$f" --db "$db" --$s --format $f
         run "empty-$s.$f" --db "$empty" --$s --format $f
         run "bare-$s.$f" --db "$bare" --$s --format $f

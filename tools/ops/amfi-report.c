@@ -51,6 +51,7 @@
 #include "amfi_config.h"
 #include "amfi_json.h"
 #include "report.h"
+#include "report_classes.h"
 #include "report_indicators.h"
 #include "report_natfreq.h"
 #include "report_passages.h"
@@ -113,7 +114,7 @@ typedef struct section {
 } section;
 
 enum { SEC_SUMMARY, SEC_TREND, SEC_ALERTS, SEC_ERRORS, SEC_PASSAGES, SEC_HISTOGRAM, SEC_OVERLOADS,
-       SEC_SPEED, N_SECTIONS };
+       SEC_SPEED, SEC_CLASSES, SEC_CLASS_HISTOGRAM, N_SECTIONS };
 
 static const section sections[N_SECTIONS] = {
     [SEC_SUMMARY] = {
@@ -161,7 +162,8 @@ static const section sections[N_SECTIONS] = {
         .filters = F_RANGE},
     [SEC_OVERLOADS] = {
         .name = "overloads", .key = 'O',
-        .help = "ok passages over the legal GVW or axle limit (--config)",
+        .help = "ok passages over their class's legal GVW or an axle group\n"
+                "over its limit (classes: of --config), by class",
         .table = overloads_table, .export = overloads_export, .filters = F_RANGE},
     [SEC_SPEED] = {
         .name = "speed", .key = 'C',
@@ -172,6 +174,15 @@ static const section sections[N_SECTIONS] = {
                    speed_plot_correction}},
         .filters = F_RANGE, .by_default = 1, .default_if = amfi_store_has_estimated,
         .default_when = "when the store has estimated speeds"},
+    [SEC_CLASSES] = {
+        .name = "classes", .key = 'L',
+        .help = "ok passages per vehicle class, all lanes and per lane:\n"
+                "count, share, GVW mean, STD, p5, p50, p95, max, overloaded",
+        .table = classes_table, .export = classes_export, .filters = F_RANGE},
+    [SEC_CLASS_HISTOGRAM] = {
+        .name = "class-histogram", .key = 'Y',
+        .help = "GVW histogram of the ok passages per vehicle class",
+        .table = class_histogram_table, .export = class_histogram_export, .filters = F_RANGE},
 };
 
 /* ---- the other options ------------------------------------------------------- */
@@ -206,12 +217,12 @@ static const option_row option_rows[] = {
     OPT("force", 0, 'K', 0, NULL, "with --set-baseline*: set it even while an alert is open\n"
                                  "(refused by default: a baseline from damaged data)"),
     OPT("check", 0, 'k', 1, NULL, "PRAGMA integrity_check and foreign_key_check"),
-    {.first = SEC_PASSAGES, .last = SEC_SPEED},
+    {.first = SEC_PASSAGES, .last = SEC_CLASS_HISTOGRAM},
     OPT("from", 1, 'f', 1, "T, -T, --to T", "only passages in [T, T]: YYYY-MM-DD or "
                                          "YYYY-MM-DDTHH:MM[:SS], UTC"),
     OPT("to", 1, 'T', 1, NULL, NULL),
     OPT("status", 1, 'S', 1, "S", "only passages of status S (--passages)"),
-    OPT("lane", 1, 'l', 1, "N", "only lane N (--passages, --histogram, --overloads, --speed)"),
+    OPT("lane", 1, 'l', 1, "N", "only lane N (the sections marked --lane above)"),
     OPT("bin-kg", 1, 'w', 1, "W", "histogram bin width, kg (default report.histogram_bin_kg)"),
     OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document)"),
     OPT("plot", 1, 'p', 1, "DIR", "draw PNGs into DIR (gnuplot): GVW, trend, histogram, per hour, "
@@ -281,8 +292,8 @@ static void usage(FILE *f)
             "[--note TEXT] [--check]\n"
             "       [--passages] [--histogram] [--overloads] [--from T] [--to T] "
             "[--status S]\n"
-            "       [--speed] [--lane N] [--bin-kg W] [--format table|csv|json] [--plot DIR] "
-            "[--config FILE]\n"
+            "       [--speed] [--classes] [--class-histogram] [--lane N] [--bin-kg W]\n"
+            "       [--format table|csv|json] [--plot DIR] [--config FILE] [--force]\n"
             "\n"
             "Reports on amfid's SQLite store (schema: docs/schema.md).\n");
     for (size_t i = 0; i < N_OPTION_ROWS; i++) {
@@ -999,6 +1010,7 @@ static int report_main(options *op)
     c.site = o.site;
     c.format = o.format;
     c.cfg = o.config ? cfg : NULL;
+    c.classes = &cfg->classes;
     c.out = stdout;
     /* the sections shown by default only when the store has their data */
     for (int k = 0; k < N_SECTIONS; k++) {

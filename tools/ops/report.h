@@ -15,6 +15,7 @@
  *   report_passages.c    --passages, --histogram, --overloads; gvw.png,
  *                        gvw_histogram.png, passages_per_hour.png, speed.png
  *   report_speed.c       --speed; speed_correction.png
+ *   report_classes.c     --classes and --class-histogram
  *   report_scale.c       the scale and known-truck lines; scale.png,
  *                        known_truck.png, temperature.png
  *   report_natfreq.c     the natural-frequency lines; natfreq.png
@@ -26,9 +27,10 @@
  * Who calls whom (tests/common/call_graph.sh reads it from the objects
  * with nm, fails on a circle and when this list differs; report_cols.c,
  * report_plot.c, report_util.c and report_pg.c call no report file):
- *   amfi-report.c -> report_indicators.c report_natfreq.c report_passages.c report_pg.c
+ *   amfi-report.c -> report_classes.c report_indicators.c report_natfreq.c report_passages.c report_pg.c
  *   amfi-report.c -> report_plot.c report_scale.c report_speed.c report_summary.c
  *   amfi-report.c -> report_util.c
+ *   report_classes.c -> report_cols.c report_util.c
  *   report_indicators.c -> report_cols.c report_plot.c report_util.c
  *   report_natfreq.c -> report_plot.c
  *   report_passages.c -> report_cols.c report_plot.c report_util.c
@@ -76,6 +78,7 @@ typedef struct report_ctx {
     FILE *out;
     json_t *root;                 /* FMT_JSON: the document */
     const amfi_site_config *cfg;  /* --config, or NULL */
+    const amfi_class_params *classes; /* classes: of --config, else the defaults */
     char err[512];
 } report_ctx;
 

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amfi_classify.h"
 #include "report_cols.h"
 
 #define MAX_LANES 64 /* distinct lanes a histogram keeps apart */
@@ -350,12 +351,21 @@ int histogram_export(report_ctx *c)
 
 /* ---- overloads -------------------------------------------------------------------- */
 
+/* What a passage exceeded: its class's GVW limit, or a group's (a single
+ * axle outside groups is a group of one). */
+typedef struct over_item {
+    int group;             /* 0: the gross weight; 1: an axle group */
+    int first, n_axles;    /* the group's axles, 0-based (group) */
+    const char *kind;      /* "gross", or the group's kind */
+    double load_kg, limit_kg;
+} over_item;
+
 typedef struct over_row {
     int64_t id;
     const amfi_passage_row *r;
-    char t[32], what[16];
-    double gvw_pct, max_axle_kg, axle_pct;
-    int max_axle;
+    char t[32], cls[AMFI_CLASS_NAME_LEN], axles[64];
+    double gvw_limit_kg;
+    const over_item *it; /* the CSV line's item */
 } over_row;
 
 #define O(row) ((const over_row *)(row))
@@ -364,101 +374,246 @@ static void o_utime(const void *w, report_val *v) { v->i = O(w)->r->utime; }
 static void o_id(const void *w, report_val *v) { v->i = O(w)->id; }
 static void o_vehicle(const void *w, report_val *v) { v->i = O(w)->r->vehicle_id; }
 static void o_lane(const void *w, report_val *v) { v->i = O(w)->r->lane; }
+static void o_class(const void *w, report_val *v) { v->s = O(w)->cls; }
 static void o_gvw(const void *w, report_val *v) { v->x = O(w)->r->gvw_kg; }
-static void o_gvw_pct(const void *w, report_val *v) { v->x = O(w)->gvw_pct; }
-static void o_max_axle_kg(const void *w, report_val *v) { v->x = O(w)->max_axle_kg; }
-static void o_max_axle(const void *w, report_val *v) { v->i = O(w)->max_axle; }
-static void o_axle_pct(const void *w, report_val *v) { v->x = O(w)->axle_pct; }
-static void o_what(const void *w, report_val *v) { v->s = O(w)->what; }
+static void o_gvw_limit(const void *w, report_val *v) { v->x = O(w)->gvw_limit_kg; }
+static void o_limit(const void *w, report_val *v) { v->s = O(w)->it->group ? "group" : "gvw"; }
+static void o_axles(const void *w, report_val *v)
+{
+    v->s = O(w)->axles;
+    v->null = !O(w)->it->group;
+}
+static void o_kind(const void *w, report_val *v) { v->s = O(w)->it->kind; }
+static void o_load(const void *w, report_val *v) { v->x = O(w)->it->load_kg; }
+static void o_limit_kg(const void *w, report_val *v) { v->x = O(w)->it->limit_kg; }
+static void o_pct(const void *w, report_val *v)
+{
+    v->x = 100.0 * (O(w)->it->load_kg / O(w)->it->limit_kg - 1);
+}
 #undef O
 
+/* CSV: one line per limit exceeded; JSON: these inside each passage's
+ * "exceeded" array (over_item_cols) after its columns (over_cols). */
 static const report_col over_cols[] = {
     REPORT_COL("time_utc", COL_WORD, "", NULL, COL_BOTH, o_time),
     REPORT_COL("utime", COL_INT, "us", NULL, COL_BOTH, o_utime),
     REPORT_COL("passage_id", COL_INT, "", NULL, COL_BOTH, o_id),
     REPORT_COL("vehicle_id", COL_INT, "", NULL, COL_BOTH, o_vehicle),
     REPORT_COL("lane", COL_INT, "", NULL, COL_BOTH, o_lane),
+    REPORT_COL("class", COL_TEXT, "", NULL, COL_BOTH, o_class),
     REPORT_COL("gvw_kg", COL_NUM, "kg", "%.1f", COL_BOTH, o_gvw),
-    REPORT_COL("gvw_over_pct", COL_NUM, "%", "%.3f", COL_CSV, o_gvw_pct),
-    REPORT_COL("max_axle_kg", COL_NUM, "kg", "%.1f", COL_BOTH, o_max_axle_kg),
-    REPORT_COL("max_axle", COL_INT, "", NULL, COL_BOTH, o_max_axle),
-    REPORT_COL("axle_over_pct", COL_NUM, "%", "%.3f", COL_CSV, o_axle_pct),
-    REPORT_COL("over", COL_WORD, "", NULL, COL_BOTH, o_what),
+    REPORT_COL("gvw_limit_kg", COL_NUM, "kg", "%.1f", COL_BOTH, o_gvw_limit),
+    REPORT_COL("limit", COL_WORD, "", NULL, COL_CSV, o_limit),
+    REPORT_COL("axles", COL_WORD, "", NULL, COL_CSV, o_axles),
+    REPORT_COL("kind", COL_WORD, "", NULL, COL_CSV, o_kind),
+    REPORT_COL("load_kg", COL_NUM, "kg", "%.1f", COL_CSV, o_load),
+    REPORT_COL("limit_kg", COL_NUM, "kg", "%.1f", COL_CSV, o_limit_kg),
+    REPORT_COL("over_pct", COL_NUM, "%", "%.3f", COL_CSV, o_pct),
 };
+static const report_col over_item_cols[] = {
+    REPORT_COL("limit", COL_WORD, "", NULL, COL_JSON, o_limit),
+    REPORT_COL("axles", COL_WORD, "", NULL, COL_JSON, o_axles),
+    REPORT_COL("kind", COL_WORD, "", NULL, COL_JSON, o_kind),
+    REPORT_COL("load_kg", COL_NUM, "kg", "%.1f", COL_JSON, o_load),
+    REPORT_COL("limit_kg", COL_NUM, "kg", "%.1f", COL_JSON, o_limit_kg),
+    REPORT_COL("over_pct", COL_NUM, "%", "%.3f", COL_JSON, o_pct),
+};
+
+#define MAX_OVER_CLASSES 32
+
+/* The counts of one class. */
+typedef struct over_class {
+    char name[AMFI_CLASS_NAME_LEN];
+    int64_t checked, over_gvw, over_group, over_any;
+} over_class;
 
 typedef struct over_ctx {
     const export_opts *o;
+    const amfi_class_params *cp;
     int fmt;
     FILE *f;
     json_t *arr;
-    int64_t checked, over_gvw, over_axle, over_any;
+    int64_t checked, over_gvw, over_group, over_any, unclassified;
+    over_class cls[MAX_OVER_CLASSES + 1]; /* the last: every further class */
+    int n_cls;
 } over_ctx;
+
+static over_class *class_counts(over_ctx *c, const char *name)
+{
+    for (int i = 0; i < c->n_cls; i++)
+        if (strcmp(c->cls[i].name, name) == 0)
+            return &c->cls[i];
+    if (c->n_cls == MAX_OVER_CLASSES + 1)
+        return &c->cls[MAX_OVER_CLASSES];
+    over_class *k = &c->cls[c->n_cls++];
+    snprintf(k->name, sizeof k->name, "%s", c->n_cls == MAX_OVER_CLASSES + 1 ? "other" : name);
+    return k;
+}
+
+/* "2-3": the 1-based axles first .. first + n − 1 */
+static void axle_words(int first, int n, char *buf, size_t len)
+{
+    if (n == 1)
+        snprintf(buf, len, "%d", first + 1);
+    else
+        snprintf(buf, len, "%d-%d", first + 1, first + n);
+}
 
 static int over_one(void *vctx, int64_t id, const amfi_passage_row *r)
 {
     over_ctx *c = vctx;
+    amfi_classification cl;
+    char why[256];
+    over_row w = {.id = id, .r = r};
+    over_item it[AMFI_MAX_AXLES + 1];
+    int n_it = 0;
     c->checked++;
-    over_row w = {.id = id, .r = r, .max_axle_kg = -INFINITY};
-    for (int a = 0; a < r->n_axles; a++)
-        if (r->axle_kg[a] > w.max_axle_kg)
-            w.max_axle_kg = r->axle_kg[a], w.max_axle = a + 1;
-    int og = r->gvw_kg > c->o->gvw_limit_kg, oa = w.max_axle_kg > c->o->axle_limit_kg;
+    /* the class, its groups and their limits (classes: of --config, else
+     * the defaults); the report.limits where no class limit is known */
+    if (amfi_classify(c->cp, r->n_axles, r->spacing_m, r->axle_kg, &cl, why, sizeof why) != 0) {
+        c->unclassified++;
+        memset(&cl, 0, sizeof cl);
+        snprintf(cl.name, sizeof cl.name, "unknown");
+        cl.gvw_limit_kg = NAN;
+        cl.n_groups = r->n_axles;
+        for (int a = 0; a < r->n_axles; a++)
+            cl.group[a] = (amfi_axle_group){.first = a, .n_axles = 1, .load_kg = r->axle_kg[a],
+                                            .kind = AMFI_GROUP_SINGLE, .limit_kg = NAN};
+    }
+    snprintf(w.cls, sizeof w.cls, "%s", cl.name);
+    w.gvw_limit_kg = isfinite(cl.gvw_limit_kg) && cl.gvw_limit_kg > 0 ? cl.gvw_limit_kg
+                                                                      : c->o->gvw_limit_kg;
+    if (r->gvw_kg > w.gvw_limit_kg)
+        it[n_it++] = (over_item){0, 0, 0, "gross", r->gvw_kg, w.gvw_limit_kg};
+    int og = n_it > 0, ogr = 0;
+    for (int g = 0; g < cl.n_groups; g++) {
+        const amfi_axle_group *gr = &cl.group[g];
+        double lim = gr->limit_kg;
+        if (!(isfinite(lim) && lim > 0) && gr->n_axles == 1)
+            lim = c->o->axle_limit_kg; /* a single axle without a class limit */
+        if (isfinite(lim) && lim > 0 && gr->load_kg > lim) {
+            it[n_it++] = (over_item){1, gr->first, gr->n_axles, amfi_group_kind_name(gr->kind),
+                                     gr->load_kg, lim};
+            ogr = 1;
+        }
+    }
+    over_class *k = class_counts(c, cl.name);
+    k->checked++;
+    k->over_gvw += og;
+    k->over_group += ogr;
+    k->over_any += og || ogr;
     c->over_gvw += og;
-    c->over_axle += oa;
-    if (!og && !oa)
+    c->over_group += ogr;
+    if (!og && !ogr)
         return 0;
     c->over_any++;
-    snprintf(w.what, sizeof w.what, "%s%s%s", og ? "gvw" : "", og && oa ? "+" : "",
-             oa ? "axle" : "");
     report_iso(r->utime, w.t);
-    w.gvw_pct = 100.0 * (r->gvw_kg / c->o->gvw_limit_kg - 1);
-    w.axle_pct = 100.0 * (w.max_axle_kg / c->o->axle_limit_kg - 1);
-    if (c->fmt == FMT_TABLE)
-        fprintf(c->f, "%-20s  %8lld  %10lld  %4d  %8.0f  %+6.1f %%  %8.0f (axle %d)  %+6.1f %%  %s\n",
-                w.t, (long long)id, (long long)r->vehicle_id, r->lane, r->gvw_kg, w.gvw_pct,
-                w.max_axle_kg, w.max_axle, w.axle_pct, w.what);
-    else if (c->fmt == FMT_CSV)
-        report_cols_csv_row(c->f, over_cols, REPORT_NCOLS(over_cols), &w);
-    else
-        json_array_append_new(c->arr,
-                              report_cols_json_row(over_cols, REPORT_NCOLS(over_cols), &w, COL_JSON));
+    if (c->fmt == FMT_TABLE) {
+        fprintf(c->f, "%-20s  %8lld  %10lld  %4d  %-7.7s  %8.0f  %8.0f ", w.t, (long long)id,
+                (long long)r->vehicle_id, r->lane, w.cls, r->gvw_kg, w.gvw_limit_kg);
+        for (int i = 0; i < n_it; i++) {
+            char ax[64];
+            axle_words(it[i].first, it[i].n_axles, ax, sizeof ax);
+            if (it[i].group)
+                fprintf(c->f, "%s axle%s %s %s %.0f > %.0f kg (%+.1f %%)", i ? ";" : "",
+                        it[i].n_axles > 1 ? "s" : "", ax, it[i].kind, it[i].load_kg,
+                        it[i].limit_kg, 100.0 * (it[i].load_kg / it[i].limit_kg - 1));
+            else
+                fprintf(c->f, " GVW %+.1f %%", 100.0 * (it[i].load_kg / it[i].limit_kg - 1));
+        }
+        fputc('\n', c->f);
+    } else if (c->fmt == FMT_CSV) {
+        for (int i = 0; i < n_it; i++) {
+            w.it = &it[i];
+            axle_words(it[i].first, it[i].n_axles, w.axles, sizeof w.axles);
+            report_cols_csv_row(c->f, over_cols, REPORT_NCOLS(over_cols), &w);
+        }
+    } else {
+        json_t *o = report_cols_json_row(over_cols, REPORT_NCOLS(over_cols), &w, COL_JSON);
+        json_t *ex = json_array();
+        for (int i = 0; i < n_it; i++) {
+            w.it = &it[i];
+            axle_words(it[i].first, it[i].n_axles, w.axles, sizeof w.axles);
+            json_array_append_new(ex, report_cols_json_row(over_item_cols,
+                                                           REPORT_NCOLS(over_item_cols), &w,
+                                                           COL_JSON));
+        }
+        json_object_set_new(o, "exceeded", ex);
+        json_array_append_new(c->arr, o);
+    }
     return 0;
+}
+
+static int cmp_class(const void *a, const void *b)
+{
+    return strcmp(((const over_class *)a)->name, ((const over_class *)b)->name);
 }
 
 static int overloads(report_ctx *rc, int fmt)
 {
     const export_opts *o = &rc->ex;
-    over_ctx c = {o, fmt, rc->out, NULL, 0, 0, 0, 0};
+    over_ctx *c = calloc(1, sizeof *c);
+    if (!c)
+        return report_fail(rc, "out of memory");
+    *c = (over_ctx){.o = o, .cp = rc->classes, .fmt = fmt, .f = rc->out};
+    const char *scheme = amfi_class_scheme_name(rc->classes->scheme);
     if (fmt == FMT_TABLE)
-        fprintf(c.f, "== overloads (ok passages; limits: GVW %.0f kg, axle %.0f kg)\n"
-                     "%-20s  %8s  %10s  %4s  %8s  %8s  %-19s  %8s  %s\n",
-                o->gvw_limit_kg, o->axle_limit_kg, "time (UTC)", "id", "vehicle", "lane",
-                "GVW kg", "over", "heaviest axle kg", "over", "limit");
+        fprintf(c->f, "== overloads (ok passages; limits by class and axle group, scheme %s; "
+                      "report.limits GVW %.0f kg, axle %.0f kg where no class limit applies)\n"
+                      "%-20s  %8s  %10s  %4s  %-7s  %8s  %8s  %s\n",
+                scheme, o->gvw_limit_kg, o->axle_limit_kg, "time (UTC)", "id", "vehicle",
+                "lane", "class", "GVW kg", "limit kg", "exceeded");
     else if (fmt == FMT_CSV)
-        report_cols_csv_header(c.f, over_cols, REPORT_NCOLS(over_cols), NULL, 0);
+        report_cols_csv_header(c->f, over_cols, REPORT_NCOLS(over_cols), NULL, 0);
     else
-        c.arr = json_array();
-    if (each(rc, "ok", over_one, &c) != 0) {
-        json_decref(c.arr);
+        c->arr = json_array();
+    if (each(rc, "ok", over_one, c) != 0) {
+        json_decref(c->arr);
+        free(c);
         return -1;
     }
-    if (fmt == FMT_TABLE)
-        fprintf(c.f, "checked %lld ok passages: %lld over the GVW limit, %lld with an axle over "
-                     "the axle limit, %lld overloaded in all (%.2f %%)\n",
-                (long long)c.checked, (long long)c.over_gvw, (long long)c.over_axle,
-                (long long)c.over_any,
-                c.checked ? 100.0 * (double)c.over_any / (double)c.checked : 0.0);
-    else if (fmt == FMT_JSON) {
-        json_t *ob = json_object();
+    qsort(c->cls, (size_t)c->n_cls, sizeof *c->cls, cmp_class);
+    if (fmt == FMT_TABLE) {
+        fprintf(c->f, "checked %lld ok passages: %lld over their class's GVW limit, %lld with an "
+                      "axle group over its limit, %lld overloaded in all (%.2f %%)\n",
+                (long long)c->checked, (long long)c->over_gvw, (long long)c->over_group,
+                (long long)c->over_any,
+                c->checked ? 100.0 * (double)c->over_any / (double)c->checked : 0.0);
+        if (c->unclassified)
+            fprintf(c->f, "(%lld passages could not be classified: their limits are "
+                          "report.limits')\n", (long long)c->unclassified);
+        if (c->n_cls > 0)
+            fprintf(c->f, "%-8s  %8s  %8s  %10s  %10s  %7s\n", "class", "checked", "over GVW",
+                    "over group", "overloaded", "%");
+        for (int i = 0; i < c->n_cls; i++)
+            fprintf(c->f, "%-8s  %8lld  %8lld  %10lld  %10lld  %7.2f\n", c->cls[i].name,
+                    (long long)c->cls[i].checked, (long long)c->cls[i].over_gvw,
+                    (long long)c->cls[i].over_group, (long long)c->cls[i].over_any,
+                    100.0 * (double)c->cls[i].over_any / (double)c->cls[i].checked);
+    } else if (fmt == FMT_JSON) {
+        json_t *ob = json_object(), *bc = json_array();
+        json_object_set_new(ob, "scheme", json_string(scheme));
         json_object_set_new(ob, "gvw_limit_kg", json_real(o->gvw_limit_kg));
         json_object_set_new(ob, "axle_limit_kg", json_real(o->axle_limit_kg));
-        json_object_set_new(ob, "checked", json_integer(c.checked));
-        json_object_set_new(ob, "over_gvw", json_integer(c.over_gvw));
-        json_object_set_new(ob, "over_axle", json_integer(c.over_axle));
-        json_object_set_new(ob, "overloaded", json_integer(c.over_any));
-        json_object_set_new(ob, "passages", c.arr);
+        json_object_set_new(ob, "checked", json_integer(c->checked));
+        json_object_set_new(ob, "over_gvw", json_integer(c->over_gvw));
+        json_object_set_new(ob, "over_group", json_integer(c->over_group));
+        json_object_set_new(ob, "overloaded", json_integer(c->over_any));
+        json_object_set_new(ob, "unclassified", json_integer(c->unclassified));
+        for (int i = 0; i < c->n_cls; i++) {
+            json_t *k = json_object();
+            json_object_set_new(k, "class", json_string(c->cls[i].name));
+            json_object_set_new(k, "checked", json_integer(c->cls[i].checked));
+            json_object_set_new(k, "over_gvw", json_integer(c->cls[i].over_gvw));
+            json_object_set_new(k, "over_group", json_integer(c->cls[i].over_group));
+            json_object_set_new(k, "overloaded", json_integer(c->cls[i].over_any));
+            json_array_append_new(bc, k);
+        }
+        json_object_set_new(ob, "by_class", bc);
+        json_object_set_new(ob, "passages", c->arr);
         json_object_set_new(rc->root, "overloads", ob);
     }
+    free(c);
     return 0;
 }
 
