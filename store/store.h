@@ -530,6 +530,22 @@ int amfi_store_speed_pairs(amfi_store *s, const amfi_passage_filter *f, amfi_spe
 int amfi_store_recent_speed_pairs(amfi_store *s, int max, amfi_speed_pair **out, size_t *n,
                                   char *err, size_t errlen);
 
+/* ---- the solver's fit per passage (store_residual.c) --------------------- */
+
+/* One ok passage's fit: passages.residual_rms (not NULL) and quality. */
+typedef struct amfi_residual_rec {
+    int64_t passage_id;
+    int64_t utime;       /* data time, µs */
+    double residual_rms; /* RMS of the fit's residual, m/s², >= 0 */
+    double quality;      /* separability from the event's other vehicles, 1 ..; NaN: NULL */
+} amfi_residual_rec;
+
+/* The ok passages with a residual and from <= utime <= to, oldest first
+   (utime, id): *out is malloc'd (free it; NULL when *n is 0). A value
+   outside the schema's range is AMFI_STORE_ECORRUPT. */
+int amfi_store_residual_series(amfi_store *s, int64_t from, int64_t to, amfi_residual_rec **out,
+                               size_t *n, char *err, size_t errlen);
+
 /* ---- natural frequencies (store_natfreq.c) ------------------------------ */
 
 /* One passage's natural frequency (f1_hz not NULL). */

@@ -169,5 +169,33 @@ awk '/natfreq.png/ { on = 1 } on && /^plot/ { p = 1 } p && /^set output/ { exit 
     "$tmp/p3/data/plots.gp" | grep -q "title 'compensated'" &&
     fail "natfreq.png: a 'compensated' legend entry with no compensated value"
 
+# ---- the solver's residual: a summary line and residual.png ---------------------
+# the fixture's 41 ok passages at 0.001 m/s², then 100 more at 0.01 (tenfold)
+cp "$tmp/golden.db" "$tmp/res.db" 2> /dev/null || sqlite3 "$tmp/res.db" < "$tmp/fixture.sql"
+sqlite3 "$tmp/res.db" "UPDATE passages SET f1_comp_hz = 5.75 WHERE status = 'ok';
+WITH RECURSIVE k(i) AS (SELECT 1 UNION ALL SELECT i + 1 FROM k WHERE i < 100)
+INSERT INTO passages (id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason,
+                      lambda, residual_rms, formulation, solve_ms, speed_given_mps,
+                      speed_estimated, n_vehicles, quality)
+SELECT 1000 + i, 5000 + i, 1763856000000000 + i * 60000000, 1, 24.0, 2, 18000.0, 'ok', '',
+       1e-8, 0.01, 'paper', 10.0, 24.0, 0, 1, 2.5 FROM k;
+INSERT INTO axles (passage_id, idx, spacing_m, load_kg) SELECT id, 1, NULL, 7200 FROM passages WHERE id > 1000;
+INSERT INTO axles (passage_id, idx, spacing_m, load_kg) SELECT id, 2, 4.5, 10800 FROM passages WHERE id > 1000;" || exit 1
+run --db "$tmp/res.db" --summary
+grep -q '^residual     n 141, median 0.01 m/s², p95 0.01 m/s²; oldest 50 median 0.001, newest 50 median 0.01 (x 10.00); quality median 2.5$' "$tmp/out" ||
+    fail "--summary: no residual line showing the tenfold rise: $(grep '^residual' "$tmp/out")"
+run --db "$tmp/res.db" --summary --format csv
+grep -q '^residual_growth,10$' "$tmp/out" || fail "--summary csv: residual_growth: $(grep residual_growth "$tmp/out")"
+run --db "$tmp/res.db" --summary --format json
+grep -q '"residual":{"n":141,"median_mps2":0.01,"p95_mps2":0.01,"oldest_median_mps2":0.001,"newest_median_mps2":0.01,"newest_over_oldest":10' "$tmp/out" ||
+    fail "--summary json: no residual object"
+run --db "$tmp/res.db" --plot "$tmp/p6"
+[ "$rc" = 0 ] || fail "--plot (residual): status $rc: $(cat "$tmp/err")"
+grep -q 'residual.png  solver residual' "$tmp/out" || fail "--plot: residual.png not listed: $(cat "$tmp/out")"
+[ "$(grep -vc '^#' "$tmp/p6/data/residual.dat")" = 141 ] || fail "residual.dat: not one row per ok passage"
+tail -1 "$tmp/p6/data/residual.dat" | awk '{ exit !($4 == 0.01) }' || fail "residual.dat: running median at the end not 0.01"
+run --db "$tmp/res.db" --plot "$tmp/p7" --from 2025-11-23T00:01
+[ "$(grep -vc '^#' "$tmp/p7/data/residual.dat")" = 100 ] || fail "residual.dat with --from: not the range's 100 passages"
+
 [ "$fails" = 0 ] && echo "ok: report_range"
 exit $((fails > 0))

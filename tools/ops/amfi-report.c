@@ -57,6 +57,7 @@
 #include "report_passages.h"
 #include "report_pg.h"
 #include "report_plot.h"
+#include "report_residual.h"
 #include "report_scale.h"
 #include "report_speed.h"
 #include "report_summary.h"
@@ -94,13 +95,15 @@ typedef struct plot_def {
 #define F_LANE 4u   /* --lane */
 #define F_RANGE (F_TIME | F_LANE)
 
+#define MAX_SECTION_PLOTS 5
+
 typedef struct section {
     const char *name;                /* --name */
     int key;                         /* -k */
     const char *help;                /* --help's text; "\n" continues it indented */
     int (*table)(report_ctx *);      /* --format table */
     int (*export)(report_ctx *);     /* --format csv (to c->out) and json (into c->root) */
-    plot_def plots[4];               /* what it draws with --plot */
+    plot_def plots[MAX_SECTION_PLOTS]; /* what it draws with --plot */
     unsigned filters;                /* F_* */
     /* with no section asked for: 1 shown; and then only when default_if
      * says yes, when that is set */
@@ -119,7 +122,8 @@ enum { SEC_SUMMARY, SEC_TREND, SEC_ALERTS, SEC_ERRORS, SEC_PASSAGES, SEC_HISTOGR
 static const section sections[N_SECTIONS] = {
     [SEC_SUMMARY] = {
         .name = "summary", .key = 's',
-        .help = "passages by status, GVW of the ok ones, time span, baseline",
+        .help = "passages by status, GVW of the ok ones, time span, baseline,\n"
+                "the solver's residual",
         .table = summary_table, .export = summary_export,
         .plots = {{7, "scale.png", "scale indicator: raw and temperature-compensated scale, "
                    "CUSUM and threshold", scale_plot_scale},
@@ -127,7 +131,9 @@ static const section sections[N_SECTIONS] = {
                    "compensated", scale_plot_known_truck},
                   {9, "temperature.png", "deck and air temperature", scale_plot_temperature},
                   {10, "natfreq.png", "natural frequency per passage, raw and "
-                   "temperature-compensated", natfreq_plot}},
+                   "temperature-compensated", natfreq_plot},
+                  {11, "residual.png", "solver residual per ok passage and its running median",
+                   residual_plot}},
         .by_default = 1},
     [SEC_TREND] = {
         .name = "trend", .key = 't', .help = "the last " STR(REPORT_TREND_ROWS) " indicators",
@@ -226,7 +232,7 @@ static const option_row option_rows[] = {
     OPT("bin-kg", 1, 'w', 1, "W", "histogram bin width, kg (default report.histogram_bin_kg)"),
     OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document)"),
     OPT("plot", 1, 'p', 1, "DIR", "draw PNGs into DIR (gnuplot): GVW, trend, histogram, per hour, "
-                               "speed\n[honours --from --to]"),
+                               "speed,\nresidual, ... [honours --from --to]"),
     OPT("config", 1, 'c', 1, "FILE", "the site's amfid.yaml: alert thresholds, site name, legal "
                                   "limits"),
     OPT("help", 0, 'h', 1, NULL, "this help", .builtin = 1),
@@ -893,11 +899,11 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
         snprintf(site, sizeof site, "%s", b ? b + 1 : o->db);
     }
     /* every section's plots in their places */
-    enum { MAX_PLOTS = N_SECTIONS * 4 };
+    enum { MAX_PLOTS = N_SECTIONS * MAX_SECTION_PLOTS };
     const plot_def *order[MAX_PLOTS], *made[MAX_PLOTS];
     int n_plots = 0, n_made = 0, rc = 0;
     for (int k = 0; k < N_SECTIONS; k++)
-        for (int j = 0; j < 4 && sections[k].plots[j].place > 0; j++) {
+        for (int j = 0; j < MAX_SECTION_PLOTS && sections[k].plots[j].place > 0; j++) {
             int i = n_plots++;
             for (; i > 0 && order[i - 1]->place > sections[k].plots[j].place; i--)
                 order[i] = order[i - 1];

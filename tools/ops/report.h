@@ -19,6 +19,7 @@
  *   report_scale.c       the scale and known-truck lines; scale.png,
  *                        known_truck.png, temperature.png
  *   report_natfreq.c     the natural-frequency lines; natfreq.png
+ *   report_residual.c    the solver's residual line; residual.png
  *   report_pg.c          --pg: the fleet and one site from PostgreSQL
  *   report_cols.c        CSV and JSON of a column list (report_cols.h)
  *   report_plot.c        gnuplot helpers and the plot frame (report_plot.h)
@@ -28,15 +29,16 @@
  * with nm, fails on a circle and when this list differs; report_cols.c,
  * report_plot.c, report_util.c and report_pg.c call no report file):
  *   amfi-report.c -> report_classes.c report_indicators.c report_natfreq.c report_passages.c report_pg.c
- *   amfi-report.c -> report_plot.c report_scale.c report_speed.c report_summary.c
+ *   amfi-report.c -> report_plot.c report_residual.c report_scale.c report_speed.c report_summary.c
  *   amfi-report.c -> report_util.c
  *   report_classes.c -> report_cols.c report_util.c
  *   report_indicators.c -> report_cols.c report_plot.c report_util.c
  *   report_natfreq.c -> report_plot.c
  *   report_passages.c -> report_cols.c report_plot.c report_util.c
+ *   report_residual.c -> report_plot.c report_util.c
  *   report_scale.c -> report_plot.c
  *   report_speed.c -> report_cols.c report_plot.c report_util.c
- *   report_summary.c -> report_cols.c report_natfreq.c report_scale.c report_util.c
+ *   report_summary.c -> report_cols.c report_natfreq.c report_residual.c report_scale.c report_util.c
  *
  * Single-threaded, the caller's thread; the store is read through store/.
  */

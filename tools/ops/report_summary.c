@@ -11,6 +11,7 @@
 
 #include "report_cols.h"
 #include "report_natfreq.h"
+#include "report_residual.h"
 #include "report_scale.h"
 
 /* amfid's intake counters of its newest run (meta intake.*), if any. */
@@ -143,6 +144,9 @@ int summary_table(report_ctx *c)
     if (natfreq_summary(s, f1line, sizeof f1line, c->err, sizeof c->err) != 0)
         return -1;
     fprintf(f, "%s", f1line);
+    if (residual_summary(s, f1line, sizeof f1line, c->err, sizeof c->err) != 0)
+        return -1;
+    fprintf(f, "%s", f1line);
     return print_baseline(c);
 }
 
@@ -158,6 +162,7 @@ typedef struct sum_row {
     char from[32];
     report_intake in;
     natfreq_stats nf;
+    residual_stats rs;
 } sum_row;
 
 #define S(w) ((const sum_row *)(w))
@@ -191,6 +196,13 @@ static void s_f1_sd(const void *w, report_val *v) { v->x = S(w)->nf.sd_hz; }
 static void s_f1c_n(const void *w, report_val *v) { v->i = (int64_t)S(w)->nf.n_comp; }
 static void s_f1c_mean(const void *w, report_val *v) { v->x = S(w)->nf.comp_mean_hz; }
 static void s_f1c_sd(const void *w, report_val *v) { v->x = S(w)->nf.comp_sd_hz; }
+static void s_res_n(const void *w, report_val *v) { v->i = (int64_t)S(w)->rs.n; }
+static void s_res_median(const void *w, report_val *v) { v->x = S(w)->rs.median; }
+static void s_res_p95(const void *w, report_val *v) { v->x = S(w)->rs.p95; }
+static void s_res_first(const void *w, report_val *v) { v->x = S(w)->rs.first_median; }
+static void s_res_last(const void *w, report_val *v) { v->x = S(w)->rs.last_median; }
+static void s_res_growth(const void *w, report_val *v) { v->x = S(w)->rs.growth; }
+static void s_res_quality(const void *w, report_val *v) { v->x = S(w)->rs.quality_median; }
 #undef S
 
 /* CSV items and JSON members in one list: name (CSV item), type, unit,
@@ -249,6 +261,21 @@ static const report_col summary_items[] = {
                .json = "compensated_mean_hz", .group = "natural_frequency"),
     REPORT_COL("f1_comp_sd_hz", COL_NUM, "Hz", "%.6f", COL_BOTH, s_f1c_sd,
                .json = "compensated_sd_hz", .group = "natural_frequency"),
+    /* the solver's residual of the ok passages (report_residual.h) */
+    REPORT_COL("residual_n", COL_INT, "", NULL, COL_BOTH, s_res_n, .json = "n",
+               .group = "residual"),
+    REPORT_COL("residual_median_mps2", COL_NUM, "m/s2", "%.6g", COL_BOTH, s_res_median,
+               .json = "median_mps2", .group = "residual"),
+    REPORT_COL("residual_p95_mps2", COL_NUM, "m/s2", "%.6g", COL_BOTH, s_res_p95,
+               .json = "p95_mps2", .group = "residual"),
+    REPORT_COL("residual_oldest_median_mps2", COL_NUM, "m/s2", "%.6g", COL_BOTH, s_res_first,
+               .json = "oldest_median_mps2", .group = "residual"),
+    REPORT_COL("residual_newest_median_mps2", COL_NUM, "m/s2", "%.6g", COL_BOTH, s_res_last,
+               .json = "newest_median_mps2", .group = "residual"),
+    REPORT_COL("residual_growth", COL_NUM, "", "%.6g", COL_BOTH, s_res_growth,
+               .json = "newest_over_oldest", .group = "residual"),
+    REPORT_COL("quality_median", COL_NUM, "", "%.6g", COL_BOTH, s_res_quality,
+               .json = "quality_median", .group = "residual"),
 };
 
 int summary_export(report_ctx *c)
@@ -261,7 +288,8 @@ int summary_export(report_ctx *c)
     if (amfi_store_passage_summary(c->s, &r.sum, err, errlen) ||
         amfi_store_all_ok_gvw(c->s, &g, &r.ng, err, errlen) ||
         amfi_store_get_baseline(c->s, &r.b, &r.found, err, errlen) ||
-        read_intake(c->s, &r.in, err, errlen) || natfreq_read_stats(c->s, &r.nf, err, errlen)) {
+        read_intake(c->s, &r.in, err, errlen) || natfreq_read_stats(c->s, &r.nf, err, errlen) ||
+        residual_read_stats(c->s, &r.rs, err, errlen)) {
         free(g);
         return -1;
     }
