@@ -109,6 +109,7 @@ run empty-default --db "$empty"
 run bare-default --db "$bare"
 run all.table --db "$db" -s -t -a -e -P -H -O -C
 run all.json --db "$db" -s -t -a -e -P -H -O -C -F json
+run units-engineering --db "$db" -s -t -P -H -O -L -Y --units engineering
 run check --db "$db" --check
 run check-summary --db "$db" --check --summary --errors
 run help --help

@@ -197,5 +197,36 @@ tail -1 "$tmp/p6/data/residual.dat" | awk '{ exit !($4 == 0.01) }' || fail "resi
 run --db "$tmp/res.db" --plot "$tmp/p7" --from 2025-11-23T00:01
 [ "$(grep -vc '^#' "$tmp/p7/data/residual.dat")" = 100 ] || fail "residual.dat with --from: not the range's 100 passages"
 
+# ---- one unit system per output: --units and report.units ---------------------
+# si (the default): tables and plots in kg and m/s
+run --db "$db" --summary --passages --plot "$tmp/u1"
+[ "$rc" = 0 ] || fail "--plot (si): status $rc: $(cat "$tmp/err")"
+grep -q '^GVW, ok      n 41, mean 18634 kg' "$tmp/out" || fail "si: the summary not in kg"
+grep -q "set ylabel 'GVW (kg)'" "$tmp/u1/data/plots.gp" || fail "si: gvw.png not in kg"
+grep -q "set xlabel 'speed (m/s), bins of 0.5 m/s'" "$tmp/u1/data/plots.gp" || fail "si: speed.png not in m/s"
+grep -q "xlabel 'GVW (kg), bins of" "$tmp/u1/data/plots.gp" || fail "si: gvw_histogram.png not in kg"
+grep -q "(t)\|km/h" "$tmp/u1/data/plots.gp" && fail "si: a plot in t or km/h"
+# engineering, by option and by report.units: tables and plots in t and km/h
+printf 'report:\n  units: engineering\n' > "$tmp/eng.yaml"
+for how in "--units engineering" "--config $tmp/eng.yaml"; do
+    # shellcheck disable=SC2086
+    run --db "$db" --summary --passages --plot "$tmp/u2" $how
+    [ "$rc" = 0 ] || { fail "$how: status $rc: $(cat "$tmp/err")"; continue; }
+    grep -q '^GVW, ok      n 41, mean 18.63 t, STD 4.60 t' "$tmp/out" || fail "$how: the summary not in t"
+    grep -q '^time (UTC) .* km/h  ax     GVW t  axle loads t ' "$tmp/out" || fail "$how: --passages not in t and km/h"
+    grep -q "set ylabel 'GVW (t)'" "$tmp/u2/data/plots.gp" || fail "$how: gvw.png not in t"
+    grep -q "set xlabel 'speed (km/h), bins of 2 km/h'" "$tmp/u2/data/plots.gp" || fail "$how: speed.png not in km/h"
+    grep -q "(kg)\|(m/s)" "$tmp/u2/data/plots.gp" && fail "$how: a plot in kg or m/s"
+    awk '!/^#/ && $2 ~ /^[0-9.]+$/ && $2 > 100 { bad = 1 } END { exit bad }' "$tmp/u2/data/passages.dat" || fail "$how: passages.dat not in t"
+done
+# the exports stay in kg and m/s
+run --db "$db" --passages --format csv --units engineering
+awk -F, 'NR == 2 { exit !($8 > 1000) }' "$tmp/out" || fail "--units engineering changed the CSV's gvw_kg"
+run --db "$db" --summary --units furlongs
+[ "$rc" = 2 ] && grep -q -- "--units: 'furlongs' is not si or engineering" "$tmp/err" || fail "--units furlongs: status $rc: $(cat "$tmp/err")"
+printf 'report:\n  units: imperial\n' > "$tmp/bad.yaml"
+run --db "$db" --summary --config "$tmp/bad.yaml"
+[ "$rc" = 1 ] && grep -q "bad.yaml:2" "$tmp/err" || fail "report.units: imperial: status $rc: $(cat "$tmp/err")"
+
 [ "$fails" = 0 ] && echo "ok: report_range"
 exit $((fails > 0))

@@ -231,6 +231,8 @@ static const option_row option_rows[] = {
     OPT("lane", 1, 'l', 1, "N", "only lane N (the sections marked --lane above)"),
     OPT("bin-kg", 1, 'w', 1, "W", "histogram bin width, kg (default report.histogram_bin_kg)"),
     OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document)"),
+    OPT("units", 1, 'U', 0, "U", "tables and plots in si (kg, m/s) or engineering (t, km/h)\n"
+                              "(default report.units: si); CSV and JSON always kg, m/s"),
     OPT("plot", 1, 'p', 1, "DIR", "draw PNGs into DIR (gnuplot): GVW, trend, histogram, per hour, "
                                "speed,\nresidual, ... [honours --from --to]"),
     OPT("config", 1, 'c', 1, "FILE", "the site's amfid.yaml: alert thresholds, site name, legal "
@@ -258,6 +260,7 @@ typedef struct options {
     int format;             /* FMT_* */
     export_opts ex;         /* --from --to --status --lane --bin-kg, limits */
     int bin_given;
+    int units;              /* --units: AMFI_REPORT_UNITS_*, −1: report.units */
     const char *range_opt;  /* "--from" or "--to" when one was given, else NULL */
 } options;
 
@@ -299,7 +302,8 @@ static void usage(FILE *f)
             "       [--passages] [--histogram] [--overloads] [--from T] [--to T] "
             "[--status S]\n"
             "       [--speed] [--classes] [--class-histogram] [--lane N] [--bin-kg W]\n"
-            "       [--format table|csv|json] [--plot DIR] [--config FILE] [--force]\n"
+            "       [--format table|csv|json] [--units si|engineering] [--plot DIR]\n"
+            "       [--config FILE] [--force]\n"
             "\n"
             "Reports on amfid's SQLite store (schema: docs/schema.md).\n");
     for (size_t i = 0; i < N_OPTION_ROWS; i++) {
@@ -406,6 +410,7 @@ static int parse_args(int argc, char **argv, options *o)
     memcpy(all, longopts, nl * sizeof *all);
     memcpy(all + nl, tail, sizeof tail);
     memset(o, 0, sizeof *o);
+    o->units = -1;
     o->ex.from = 0;
     o->ex.to = AMFI_STORE_MAX_UTIME;
     amfi_cli c;
@@ -444,6 +449,14 @@ static int parse_args(int argc, char **argv, options *o)
             break;
         case 'X': o->allow_plaintext = 1; break;
         case 'K': o->force = 1; break;
+        case 'U':
+            if (strcmp(val, "si") == 0)
+                o->units = AMFI_REPORT_UNITS_SI;
+            else if (strcmp(val, "engineering") == 0)
+                o->units = AMFI_REPORT_UNITS_ENGINEERING;
+            else
+                return usage_error(opt, "'%s' is not si or engineering", amfi_cli_shown(val));
+            break;
         case 'f':
         case 'T':
             {
@@ -663,8 +676,11 @@ static int set_baseline(const options *o, const report_ctx *c)
     }
     if (rc == 0) {
         char t[32];
-        printf("baseline set: mean %.0f kg, STD %.0f kg, n %d, manual, from "
-               "%s UTC\n", b.mean_kg, b.std_kg, b.n, report_utc(b.utime_set, t));
+        char m1[32], m2[32];
+        const char *u = report_mass_unit(c->units);
+        printf("baseline set: mean %s %s, STD %s %s, n %d, manual, from %s UTC\n",
+               report_mass(c->units, b.mean_kg, m1), u, report_mass(c->units, b.std_kg, m2), u,
+               b.n, report_utc(b.utime_set, t));
         printf("(a running amfid applies the newest baseline row within a few seconds)\n");
     }
     free(g);
@@ -912,6 +928,7 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
     report_plot_frame p;
     rc = report_plot_begin(&p, s, o->plot_dir, site, &ip, o->ex.from, o->ex.to, err, sizeof err);
     p.ip_from = ip_from;
+    p.units = c->units;
     for (int i = 0; rc == 0 && i < n_plots; i++) {
         int drawn = 0;
         rc = order[i]->draw(&p, &drawn, err, sizeof err);
@@ -1017,6 +1034,7 @@ static int report_main(options *op)
     c.format = o.format;
     c.cfg = o.config ? cfg : NULL;
     c.classes = &cfg->classes;
+    c.units = o.units >= 0 ? o.units : cfg->report.units;
     c.out = stdout;
     /* the sections shown by default only when the store has their data */
     for (int k = 0; k < N_SECTIONS; k++) {

@@ -81,6 +81,7 @@ typedef struct report_ctx {
     json_t *root;                 /* FMT_JSON: the document */
     const amfi_site_config *cfg;  /* --config, or NULL */
     const amfi_class_params *classes; /* classes: of --config, else the defaults */
+    int units;                    /* AMFI_REPORT_UNITS_*: of the tables (not CSV, JSON) */
     char err[512];
 } report_ctx;
 
@@ -106,6 +107,17 @@ const char *report_utc(long long utime, char buf[32]);
 const char *report_duration(double s, char buf[32]);
 /* "-" for NaN, else printf of fmt into buf. */
 const char *report_num(double x, const char *fmt, char buf[32]);
+
+/* The units of the tables and plots (units: AMFI_REPORT_UNITS_*): a mass in
+ * kg ("%.0f") or t ("%.2f"), a speed in m/s ("%.2f") or km/h ("%.1f"); the
+ * value, its unit, and the number as text ("-" for NaN). CSV and JSON stay
+ * in kg and m/s. */
+double report_mass_val(int units, double kg);
+const char *report_mass_unit(int units);
+const char *report_mass(int units, double kg, char buf[32]);
+double report_speed_val(int units, double mps);
+const char *report_speed_unit(int units);
+const char *report_speed(int units, double mps, char buf[32]);
 
 /* ISO 8601 in UTC: "2025-11-22", "2025-11-22T13:05", "2025-11-22 13:05:09",
  * "2025-11-22T13:05:09.25", each with an optional Z or zero offset (+00:00):

@@ -214,12 +214,12 @@ static void table_row(report_ctx *c, const cls_row *r)
         snprintf(l, sizeof l, "all");
     else
         snprintf(l, sizeof l, "%d", r->lane);
+    const int u = c->units;
     fprintf(c->out, "%-16.16s  %5s  %8lld  %6.2f  %8s  %7s  %8s  %8s  %8s  %8s  %6lld\n",
-            amfi_cli_shown(r->name), l, (long long)r->n, r->share_pct,
-            report_num(r->mean, "%.0f", b[0]), report_num(r->std, "%.0f", b[1]),
-            report_num(r->p5, "%.0f", b[2]), report_num(r->p50, "%.0f", b[3]),
-            report_num(r->p95, "%.0f", b[4]), report_num(r->max, "%.0f", b[5]),
-            (long long)r->over);
+            amfi_cli_shown(r->name), l, (long long)r->n, r->share_pct, report_mass(u, r->mean, b[0]),
+            report_mass(u, r->std, b[1]), report_mass(u, r->p5, b[2]),
+            report_mass(u, r->p50, b[3]), report_mass(u, r->p95, b[4]),
+            report_mass(u, r->max, b[5]), (long long)r->over);
 }
 
 int classes_table(report_ctx *c)
@@ -231,9 +231,16 @@ int classes_table(report_ctx *c)
         if (d.n == 0) {
             fprintf(c->out, "(no ok passage with a GVW in the selection)\n");
         } else {
+            const char *u = report_mass_unit(c->units);
+            char h[6][16];
+            snprintf(h[0], 16, "mean %s", u);
+            snprintf(h[1], 16, "STD %s", u);
+            snprintf(h[2], 16, "p5 %s", u);
+            snprintf(h[3], 16, "p50 %s", u);
+            snprintf(h[4], 16, "p95 %s", u);
+            snprintf(h[5], 16, "max %s", u);
             fprintf(c->out, "%-16s  %5s  %8s  %6s  %8s  %7s  %8s  %8s  %8s  %8s  %6s\n", "class",
-                    "lane", "passages", "%", "mean kg", "STD kg", "p5 kg", "p50 kg", "p95 kg",
-                    "max kg", "over");
+                    "lane", "passages", "%", h[0], h[1], h[2], h[3], h[4], h[5], "over");
             rc = each_row(c, &d, table_row);
         }
     }
@@ -324,8 +331,10 @@ int class_histogram_table(report_ctx *c)
         rc = hist_of(c, &d, &cnt, &nb);
     if (rc == 0) {
         class_order(&d, order);
-        fprintf(f, "== GVW histogram of the ok passages per class, %.0f kg bins\n%-17s",
-                c->ex.bin_kg, "GVW kg");
+        char bw[32], hg[16], lo[32], hi[32];
+        snprintf(hg, sizeof hg, "GVW %s", report_mass_unit(c->units));
+        fprintf(f, "== GVW histogram of the ok passages per class, %s %s bins\n%-17s",
+                report_mass(c->units, c->ex.bin_kg, bw), report_mass_unit(c->units), hg);
         for (int i = 0; i < d.n_names; i++)
             fprintf(f, "  %9.9s", amfi_cli_shown(d.names[order[i]]));
         fprintf(f, "  %9s\n", "all");
@@ -335,7 +344,8 @@ int class_histogram_table(report_ctx *c)
                 all += cnt[(size_t)b * (size_t)d.n_names + (size_t)i];
             if (all == 0)
                 continue;
-            fprintf(f, "%7.0f .. %7.0f", b * c->ex.bin_kg, (b + 1) * c->ex.bin_kg);
+            fprintf(f, "%7s .. %7s", report_mass(c->units, b * c->ex.bin_kg, lo),
+                    report_mass(c->units, (b + 1) * c->ex.bin_kg, hi));
             for (int i = 0; i < d.n_names; i++)
                 fprintf(f, "  %9lld", (long long)cnt[(size_t)b * (size_t)d.n_names
                                                      + (size_t)order[i]]);

@@ -101,14 +101,17 @@ int trend_table(report_ctx *c)
         free(all);
         return 0;
     }
-    fprintf(f, "%-19s  %6s  %9s  %8s  %6s  %8s  %s\n", "time (UTC)", "n", "mean kg", "STD kg",
-            "ratio", "p", "state");
+    char hm[16], hs[16];
+    snprintf(hm, sizeof hm, "mean %s", report_mass_unit(c->units));
+    snprintf(hs, sizeof hs, "STD %s", report_mass_unit(c->units));
+    fprintf(f, "%-19s  %6s  %9s  %8s  %6s  %8s  %s\n", "time (UTC)", "n", hm, hs, "ratio", "p",
+            "state");
     for (int k = nl - 1; k >= 0; k--) { /* oldest first */
         const amfi_indicator_row *r = &rec[k].row;
         char t[32], b1[32], b2[32], b3[32], b4[32];
         fprintf(f, "%-19.19s  %6lld  %9.31s  %8.31s  %6.31s  %8.31s  %.8s\n",
-                report_utc(r->utime, t), (long long)r->n, report_num(r->mean_kg, "%.0f", b1),
-                report_num(r->std_kg, "%.0f", b2), report_num(r->std_ratio, "%.3f", b3),
+                report_utc(r->utime, t), (long long)r->n, report_mass(c->units, r->mean_kg, b1),
+                report_mass(c->units, r->std_kg, b2), report_num(r->std_ratio, "%.3f", b3),
                 report_num(r->p_value, "%.2e", b4), r->state);
     }
     free(all);

@@ -91,27 +91,23 @@ static const report_col passage_cols[] = {
 
 typedef struct list_ctx {
     int fmt;
+    int units;
     FILE *f;
     int64_t n;
     int werr; /* 1: the output refused a write */
 } list_ctx;
 
-static void table_line(FILE *f, int64_t id, const amfi_passage_row *r)
+static void table_line(FILE *f, int units, int64_t id, const amfi_passage_row *r)
 {
-    char t[32], loads[12 * 10 + 1] = "";
+    char t[32], loads[12 * 10 + 1] = "", m[32];
     size_t used = 0;
     for (int a = 0; a < r->n_axles && used < sizeof loads; a++) {
-        int w = isnan(r->axle_kg[a])
-                    ? snprintf(loads + used, sizeof loads - used, "%s-", a ? "/" : "")
-                    : snprintf(loads + used, sizeof loads - used, "%s%.0f", a ? "/" : "",
-                               r->axle_kg[a]);
+        int w = snprintf(loads + used, sizeof loads - used, "%s%s", a ? "/" : "",
+                         report_mass(units, r->axle_kg[a], m));
         used += w > 0 ? (size_t)w : 0;
     }
-    char sp[16] = "-", gvw[16] = "-";
-    if (!isnan(r->speed_mps))
-        snprintf(sp, sizeof sp, "%.2f", r->speed_mps);
-    if (!isnan(r->gvw_kg))
-        snprintf(gvw, sizeof gvw, "%.0f", r->gvw_kg);
+    char spb[32], gvwb[32];
+    const char *sp = report_speed(units, r->speed_mps, spb), *gvw = report_mass(units, r->gvw_kg, gvwb);
     fprintf(f, "%-20s  %8lld  %10lld  %4d  %6s  %2d  %8s  %-28s  %-8s  %.200s\n",
             report_iso(r->utime, t), (long long)id, (long long)r->vehicle_id, r->lane, sp,
             r->n_axles, gvw, loads[0] ? loads : "-", r->status, r->reason);
@@ -122,7 +118,7 @@ static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
     list_ctx *c = vctx;
     c->n++;
     if (c->fmt == FMT_TABLE) {
-        table_line(c->f, id, r);
+        table_line(c->f, c->units, id, r);
         return 0;
     }
     pas_row row = {.id = id, .r = r};
@@ -144,11 +140,14 @@ static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
 
 static int list(report_ctx *c, int fmt)
 {
-    list_ctx l = {fmt, c->out, 0, 0};
+    list_ctx l = {fmt, c->units, c->out, 0, 0};
     FILE *f = c->out;
+    char hg[16], hl[32];
+    snprintf(hg, sizeof hg, "GVW %s", report_mass_unit(c->units));
+    snprintf(hl, sizeof hl, "axle loads %s", report_mass_unit(c->units));
     if (fmt == FMT_TABLE)
         fprintf(f, "== passages\n%-20s  %8s  %10s  %4s  %6s  %2s  %8s  %-28s  %-8s  %s\n",
-                "time (UTC)", "id", "vehicle", "lane", "m/s", "ax", "GVW kg", "axle loads kg",
+                "time (UTC)", "id", "vehicle", "lane", report_speed_unit(c->units), "ax", hg, hl,
                 "status", "reason");
     else if (fmt == FMT_CSV)
         report_cols_csv_header(f, passage_cols, REPORT_NCOLS(passage_cols), NULL, 0);
@@ -289,7 +288,10 @@ int histogram_table(report_ctx *c)
         return -1;
     }
     int64_t lane_total[MAX_LANES] = {0};
-    fprintf(f, "== GVW histogram of ok passages, %.0f kg bins\n%-17s", c->ex.bin_kg, "GVW kg");
+    char bw[32], hg[16], lo[32], hi[32];
+    snprintf(hg, sizeof hg, "GVW %s", report_mass_unit(c->units));
+    fprintf(f, "== GVW histogram of ok passages, %s %s bins\n%-17s",
+            report_mass(c->units, c->ex.bin_kg, bw), report_mass_unit(c->units), hg);
     for (int i = 0; i < h.n_lanes; i++)
         fprintf(f, "  lane %-4d", h.sorted[i]);
     fprintf(f, "  %9s\n", "all");
@@ -298,7 +300,7 @@ int histogram_table(report_ctx *c)
         bin_of(&h, b, &r);
         if (r.all == 0)
             continue;
-        fprintf(f, "%7.0f .. %7.0f", r.lo, r.hi);
+        fprintf(f, "%7s .. %7s", report_mass(c->units, r.lo, lo), report_mass(c->units, r.hi, hi));
         for (int i = 0; i < h.n_lanes; i++) {
             lane_total[i] += r.n[i];
             fprintf(f, "  %9lld", (long long)r.n[i]);
@@ -429,6 +431,7 @@ typedef struct over_class {
 
 typedef struct over_ctx {
     const export_opts *o;
+    int units;
     const amfi_class_params *cp;
     int fmt;
     FILE *f;
@@ -509,15 +512,19 @@ static int over_one(void *vctx, int64_t id, const amfi_passage_row *r)
     c->over_any++;
     report_iso(r->utime, w.t);
     if (c->fmt == FMT_TABLE) {
-        fprintf(c->f, "%-20s  %8lld  %10lld  %4d  %-7.7s  %8.0f  %8.0f ", w.t, (long long)id,
-                (long long)r->vehicle_id, r->lane, w.cls, r->gvw_kg, w.gvw_limit_kg);
+        char m1[32], m2[32];
+        fprintf(c->f, "%-20s  %8lld  %10lld  %4d  %-7.7s  %8s  %8s ", w.t, (long long)id,
+                (long long)r->vehicle_id, r->lane, w.cls, report_mass(c->units, r->gvw_kg, m1),
+                report_mass(c->units, w.gvw_limit_kg, m2));
         for (int i = 0; i < n_it; i++) {
             char ax[64];
             axle_words(it[i].first, it[i].n_axles, ax, sizeof ax);
             if (it[i].group)
-                fprintf(c->f, "%s axle%s %s %s %.0f > %.0f kg (%+.1f %%)", i ? ";" : "",
-                        it[i].n_axles > 1 ? "s" : "", ax, it[i].kind, it[i].load_kg,
-                        it[i].limit_kg, 100.0 * (it[i].load_kg / it[i].limit_kg - 1));
+                fprintf(c->f, "%s axle%s %s %s %s > %s %s (%+.1f %%)", i ? ";" : "",
+                        it[i].n_axles > 1 ? "s" : "", ax, it[i].kind,
+                        report_mass(c->units, it[i].load_kg, m1),
+                        report_mass(c->units, it[i].limit_kg, m2), report_mass_unit(c->units),
+                        100.0 * (it[i].load_kg / it[i].limit_kg - 1));
             else
                 fprintf(c->f, " GVW %+.1f %%", 100.0 * (it[i].load_kg / it[i].limit_kg - 1));
         }
@@ -555,14 +562,18 @@ static int overloads(report_ctx *rc, int fmt)
     over_ctx *c = calloc(1, sizeof *c);
     if (!c)
         return report_fail(rc, "out of memory");
-    *c = (over_ctx){.o = o, .cp = rc->classes, .fmt = fmt, .f = rc->out};
+    *c = (over_ctx){.o = o, .units = rc->units, .cp = rc->classes, .fmt = fmt, .f = rc->out};
+    char hg[16], hl[16], l1[32], l2[32];
+    snprintf(hg, sizeof hg, "GVW %s", report_mass_unit(rc->units));
+    snprintf(hl, sizeof hl, "limit %s", report_mass_unit(rc->units));
     const char *scheme = amfi_class_scheme_name(rc->classes->scheme);
     if (fmt == FMT_TABLE)
         fprintf(c->f, "== overloads (ok passages; limits by class and axle group, scheme %s; "
-                      "report.limits GVW %.0f kg, axle %.0f kg where no class limit applies)\n"
+                      "report.limits GVW %s %s, axle %s %s where no class limit applies)\n"
                       "%-20s  %8s  %10s  %4s  %-7s  %8s  %8s  %s\n",
-                scheme, o->gvw_limit_kg, o->axle_limit_kg, "time (UTC)", "id", "vehicle",
-                "lane", "class", "GVW kg", "limit kg", "exceeded");
+                scheme, report_mass(rc->units, o->gvw_limit_kg, l1), report_mass_unit(rc->units),
+                report_mass(rc->units, o->axle_limit_kg, l2), report_mass_unit(rc->units),
+                "time (UTC)", "id", "vehicle", "lane", "class", hg, hl, "exceeded");
     else if (fmt == FMT_CSV)
         report_cols_csv_header(c->f, over_cols, REPORT_NCOLS(over_cols), NULL, 0);
     else
@@ -626,18 +637,21 @@ static const char *const status_colour[AMFI_STORE_N_STATUS] = {
     "#1f77b4", "#ff7f0e", "#9467bd", "#d62728", "#8c564b", "#7f7f7f", "#000000"};
 
 /* gvw.png: the GVW per passage over time with the baseline band; writes
- * passages.dat (t gvw_t status speed_kmh) and band.dat. */
+ * passages.dat (t gvw status speed, in p->units) and band.dat. */
 int passages_plot_gvw(report_plot_frame *p, int *made, char *err, size_t errlen)
 {
     FILE *f = report_data_open(p->dir, "passages.dat", err, errlen);
     if (!f)
         return -1;
-    fprintf(f, "# time_s gvw_t status(0 ok,1 gap,2 late,3 overload,4 multiple,5 invalid,6 error) speed_kmh\n");
+    const int u = p->units;
+    const char *mu = report_mass_unit(u), *su = report_speed_unit(u);
+    fprintf(f, "# time_s gvw_%s status(0 ok,1 gap,2 late,3 overload,4 multiple,5 invalid,6 error) speed_%s\n",
+            mu, u == AMFI_REPORT_UNITS_ENGINEERING ? "kmh" : "mps");
     size_t n_gvw = 0;
     for (size_t k = 0; k < p->n_pas; k++) {
         const report_pas *a = &p->pas[k];
-        fprintf(f, "%.3f %.4f %d %.3f\n", a->t, isnan(a->gvw) ? NAN : a->gvw / 1000, a->status,
-                isnan(a->speed) ? NAN : a->speed * 3.6);
+        fprintf(f, "%.3f %.4f %d %.3f\n", a->t, isnan(a->gvw) ? NAN : report_mass_val(u, a->gvw),
+                a->status, isnan(a->speed) ? NAN : report_speed_val(u, a->speed));
         n_gvw += !isnan(a->gvw);
     }
     if (report_data_close(f, p->dir, "passages.dat", err, errlen) != 0)
@@ -649,8 +663,9 @@ int passages_plot_gvw(report_plot_frame *p, int *made, char *err, size_t errlen)
         const amfi_baseline *b = &p->b;
         double tb = fmax(p->t0, (double)b->utime_set / 1e6);
         for (int k = 0; k < 2; k++)
-            fprintf(f, "%.3f %.4f %.4f %.4f\n", k ? p->t1 : tb, (b->mean_kg - 2 * b->std_kg) / 1000,
-                    (b->mean_kg + 2 * b->std_kg) / 1000, b->mean_kg / 1000);
+            fprintf(f, "%.3f %.4f %.4f %.4f\n", k ? p->t1 : tb,
+                    report_mass_val(u, b->mean_kg - 2 * b->std_kg),
+                    report_mass_val(u, b->mean_kg + 2 * b->std_kg), report_mass_val(u, b->mean_kg));
     } else {
         fprintf(f, "%.3f NaN NaN NaN\n", p->t0);
     }
@@ -659,16 +674,19 @@ int passages_plot_gvw(report_plot_frame *p, int *made, char *err, size_t errlen)
     fprintf(p->gp,
         "set output o.'gvw.png'\n"
         "set title \"Inferred gross vehicle weight per passage\\n%s\"\n"
-        "set ylabel 'GVW (t)'\n"
+        "set ylabel 'GVW (%s)'\n"
         "%s"
         "plot d.'band.dat' using 1:2:3 with filledcurves fc rgb '#b0d0b0' fs transparent solid 0.5 title 'baseline mean +/- 2 STD', \\\n"
         "     d.'band.dat' using 1:4 with lines lw 2 lc rgb '#2ca02c' title 'baseline mean', \\\n"
         "     d.'passages.dat' using 1:($3==0?$2:NaN) with points pt 7 ps 0.4 lc rgb '#1f77b4' title 'ok', \\\n"
         "     d.'passages.dat' using 1:($3!=0?$2:NaN) with points pt 2 ps 0.6 lc rgb '#d62728' title 'not ok (solved)'\n"
         "unset label 99\nset autoscale y\n",
-        p->sub,
+        p->sub, mu,
         /* gnuplot refuses a plot without one valid point: a fixed range and a word */
-        n_gvw ? "" : "set yrange [0:60]\nset label 99 'no passage with an inferred GVW in this store' at graph 0.5, graph 0.5 center\n");
+        n_gvw ? "" : u == AMFI_REPORT_UNITS_ENGINEERING
+                         ? "set yrange [0:60]\nset label 99 'no passage with an inferred GVW in this store' at graph 0.5, graph 0.5 center\n"
+                         : "set yrange [0:60000]\nset label 99 'no passage with an inferred GVW in this store' at graph 0.5, graph 0.5 center\n");
+    (void)su;
     *made = 1;
     return 0;
 }
@@ -686,7 +704,7 @@ int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t e
     }
     for (size_t k = 0; k < n; k++)
         if (p->pas[k].status == 0 && !isnan(p->pas[k].gvw))
-            ok[n_ok++] = p->pas[k].gvw / 1000;
+            ok[n_ok++] = report_mass_val(p->units, p->pas[k].gvw);
     int win = p->n_ind > 0 && p->ind[0].row.n > 0 ? p->ind[0].row.n : 500;
     size_t nb_end = 0, nb = 0, nla = n_ok < (size_t)win ? n_ok : (size_t)win;
     if (p->found) {
@@ -708,7 +726,7 @@ int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t e
     }
     if (!(hi > lo)) {
         lo = 0;
-        hi = 60;
+        hi = report_mass_val(p->units, 60000);
     }
     int nbins = 30;
     double w = (hi - lo) / nbins, hb[64], hl[64];
@@ -718,8 +736,9 @@ int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t e
     FILE *f = report_data_open(p->dir, "histogram.dat", err, errlen);
     if (!f)
         return -1;
-    fprintf(f, "# gvw_t_bin_centre baseline_fraction latest_fraction (bin %.3f t; baseline n %zu, latest n %zu)\n",
-            w, nb, nla);
+    const char *mu = report_mass_unit(p->units);
+    fprintf(f, "# gvw_%s_bin_centre baseline_fraction latest_fraction (bin %.3f %s; baseline n %zu, latest n %zu)\n",
+            mu, w, mu, nb, nla);
     for (int k = 0; k < nbins; k++)
         fprintf(f, "%.4f %.5f %.5f\n", lo + (k + 0.5) * w, hb[k], hl[k]);
     if (report_data_close(f, p->dir, "histogram.dat", err, errlen) != 0)
@@ -728,11 +747,11 @@ int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t e
         "set output o.'gvw_histogram.png'\n"
         "set xdata\nset format x '%%g'\nset autoscale x\n"
         "set title \"GVW distribution: baseline (%zu ok passages) against the latest window (%zu)\\n%s\"\n"
-        "set xlabel 'GVW (t), bins of %.2f t'\nset ylabel 'fraction of passages'\n"
+        "set xlabel 'GVW (%s), bins of %.*f %s'\nset ylabel 'fraction of passages'\n"
         "set style fill transparent solid 0.45 noborder\nset boxwidth %.4f\n"
         "plot d.'histogram.dat' using 1:2 with boxes lc rgb '#2ca02c' title 'baseline', \\\n"
         "     d.'histogram.dat' using 1:3 with boxes lc rgb '#d62728' title 'latest window'\n",
-        nb, nla, p->sub, w, w);
+        nb, nla, p->sub, mu, p->units == AMFI_REPORT_UNITS_ENGINEERING ? 2 : 0, w, mu, w);
     *made = 1;
     return 0;
 }
@@ -797,7 +816,8 @@ static int cmp_d(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* speed.png: the speed distribution in 2 km/h bins; writes speed.dat. */
+/* speed.png: the speed distribution in bins of 2 km/h (engineering) or
+ * 0.5 m/s (si); writes speed.dat. */
 int passages_plot_speed(report_plot_frame *p, int *made, char *err, size_t errlen)
 {
     size_t n_sp = 0;
@@ -808,22 +828,25 @@ int passages_plot_speed(report_plot_frame *p, int *made, char *err, size_t errle
     }
     for (size_t k = 0; k < p->n_pas; k++)
         if (!isnan(p->pas[k].speed))
-            sp[n_sp++] = p->pas[k].speed * 3.6;
+            sp[n_sp++] = report_speed_val(p->units, p->pas[k].speed);
     FILE *f = report_data_open(p->dir, "speed.dat", err, errlen);
     if (!f) {
         free(sp);
         return -1;
     }
-    fprintf(f, "# speed_kmh_bin_centre passages (bin 2 km/h)\n");
+    const int eng = p->units == AMFI_REPORT_UNITS_ENGINEERING;
+    const double bw = eng ? 2.0 : 0.5;
+    const char *su = report_speed_unit(p->units);
+    fprintf(f, "# speed_%s_bin_centre passages (bin %g %s)\n", eng ? "kmh" : "mps", bw, su);
     qsort(sp, n_sp, sizeof *sp, cmp_d);
     for (size_t k = 0; k < n_sp;) {
-        double b0 = floor(sp[k] / 2) * 2;
+        double b0 = floor(sp[k] / bw) * bw;
         size_t c = 0;
-        while (k < n_sp && sp[k] < b0 + 2) {
+        while (k < n_sp && sp[k] < b0 + bw) {
             c++;
             k++;
         }
-        fprintf(f, "%.1f %zu\n", b0 + 1, c);
+        fprintf(f, "%.2f %zu\n", b0 + bw / 2, c);
     }
     if (n_sp == 0)
         fprintf(f, "NaN 0\n");
@@ -834,13 +857,14 @@ int passages_plot_speed(report_plot_frame *p, int *made, char *err, size_t errle
         "set output o.'speed.png'\n"
         "set xdata\nset format x '%%g'\nset autoscale x\nset yrange [0:*]\n"
         "set title \"Speed distribution (%zu passages with a speed)\\n%s\"\n"
-        "set xlabel 'speed (km/h), bins of 2 km/h'\nset ylabel 'passages'\n"
-        "set style fill solid 0.7 border lc rgb 'black'\nset boxwidth 1.8\n"
+        "set xlabel 'speed (%s), bins of %g %s'\nset ylabel 'passages'\n"
+        "set style fill solid 0.7 border lc rgb 'black'\nset boxwidth %g\n"
         "%s"
         "plot d.'speed.dat' using 1:2 with boxes lc rgb '#1f77b4' title 'passages'\n"
         "set output\n",
-        n_sp, p->sub,
-        n_sp ? "" : "set xrange [0:150]\nset yrange [0:1]\nset label 99 'no passage with a speed in this store' at graph 0.5, graph 0.5 center\n");
+        n_sp, p->sub, su, bw, su, 0.9 * bw,
+        n_sp ? "" : eng ? "set xrange [0:150]\nset yrange [0:1]\nset label 99 'no passage with a speed in this store' at graph 0.5, graph 0.5 center\n"
+                        : "set xrange [0:42]\nset yrange [0:1]\nset label 99 'no passage with a speed in this store' at graph 0.5, graph 0.5 center\n");
     *made = 1;
     return 0;
 }

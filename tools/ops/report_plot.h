@@ -33,6 +33,7 @@ typedef struct report_plot_frame {
     const char *dir;                 /* --plot DIR */
     const amfi_indicator_params *ip; /* the alert thresholds */
     const char *ip_from;             /* where they come from, for the titles */
+    int units;                       /* AMFI_REPORT_UNITS_*: of GVW and speed */
     int64_t from, to;                /* --from .. --to, µs: every plot draws only these */
     FILE *gp;                        /* DIR/data/plots.gp, being written */
     char gdir[8200];                 /* dir in a gnuplot single-quoted string */

@@ -64,8 +64,11 @@ static int print_baseline(report_ctx *c)
                         "passages, or --set-baseline*)\n");
         return 0;
     }
-    fprintf(c->out, "baseline     mean %.0f kg, STD %.0f kg, n %d, %s, from %s UTC%s%s%s\n",
-            b.mean_kg, b.std_kg, b.n, b.source, report_utc(b.utime_set, t),
+    char m1[32], m2[32];
+    const char *u = report_mass_unit(c->units);
+    fprintf(c->out, "baseline     mean %s %s, STD %s %s, n %d, %s, from %s UTC%s%s%s\n",
+            report_mass(c->units, b.mean_kg, m1), u, report_mass(c->units, b.std_kg, m2), u, b.n,
+            b.source, report_utc(b.utime_set, t),
             b.note[0] ? " \"" : "", b.note, b.note[0] ? "\"" : "");
     return 0;
 }
@@ -101,10 +104,13 @@ int summary_table(report_ctx *c)
     } else {
         report_mean_std(g, ng, &mean, &std);
         report_sort(g, ng);
-        fprintf(f, "GVW, ok      n %zu, mean %.0f kg, STD %s kg, min %.0f, "
-                   "median %.0f, max %.0f kg\n",
-                ng, mean, report_num(std, "%.0f", a), g[0], report_percentile(g, ng, 50),
-                g[ng - 1]);
+        char m[4][32];
+        const char *u = report_mass_unit(c->units);
+        fprintf(f, "GVW, ok      n %zu, mean %s %s, STD %s %s, min %s, median %s, max %s %s\n",
+                ng, report_mass(c->units, mean, m[0]), u, report_mass(c->units, std, a), u,
+                report_mass(c->units, g[0], m[1]),
+                report_mass(c->units, report_percentile(g, ng, 50), m[2]),
+                report_mass(c->units, g[ng - 1], m[3]), u);
     }
     free(g);
     /* what the STD and mean rules were fed (at the calibration temperature
@@ -117,10 +123,14 @@ int summary_table(report_ctx *c)
         report_mean_std(g, ng, &mean, &std);
     if (ng > 0 && (ng != n_ok || mean != raw_mean || !(std == raw_std || isnan(std)))) {
         report_sort(g, ng);
-        fprintf(f, "GVW, fed     n %zu, mean %.0f kg, STD %s kg, min %.0f, median %.0f, max %.0f kg "
+        char m[4][32];
+        const char *u = report_mass_unit(c->units);
+        fprintf(f, "GVW, fed     n %zu, mean %s %s, STD %s %s, min %s, median %s, max %s %s "
                    "(the STD and mean rules' input: compensated to the calibration temperature)\n",
-                ng, mean, report_num(std, "%.0f", a), g[0], report_percentile(g, ng, 50),
-                g[ng - 1]);
+                ng, report_mass(c->units, mean, m[0]), u, report_mass(c->units, std, a), u,
+                report_mass(c->units, g[0], m[1]),
+                report_mass(c->units, report_percentile(g, ng, 50), m[2]),
+                report_mass(c->units, g[ng - 1], m[3]), u);
     }
     free(g);
     report_intake in;
