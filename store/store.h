@@ -500,6 +500,24 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
                                   amfi_store_passage_fn fn, void *ctx,
                                   char *err, size_t errlen);
 
+/* ---- class rows (store_classrows.c) --------------------------------------- */
+
+/* An ok passage as the class statistics see it; vclass (NULL where the
+   column is NULL) is valid during the call only. */
+typedef struct amfi_class_row {
+    int lane;
+    double gvw_kg;      /* > 0 */
+    const char *vclass; /* passages.class */
+    int overload;       /* passages.overload; 0 where NULL */
+} amfi_class_row;
+typedef int (*amfi_store_class_fn)(void *ctx, const amfi_class_row *row);
+
+/* Every ok passage with a GVW that the filter's time range and lane select
+   (its status is ignored: ok), oldest first, without its axle rows (one
+   query). A nonzero return of fn stops the listing and is returned. */
+int amfi_store_each_class_row(amfi_store *s, const amfi_passage_filter *f,
+                              amfi_store_class_fn fn, void *ctx, char *err, size_t errlen);
+
 /* amfi_store_each_passage_where with from, to, status and any lane. */
 int amfi_store_each_passage(amfi_store *s, int64_t from, int64_t to,
                             const char *status, amfi_store_passage_fn fn,

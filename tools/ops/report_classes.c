@@ -50,12 +50,9 @@ static int name_index(cls_data *d, const char *name)
     return d->n_names++;
 }
 
-static int collect(void *ctx, int64_t id, const amfi_passage_row *r)
+static int collect(void *ctx, const amfi_class_row *r)
 {
     cls_data *d = ctx;
-    (void)id;
-    if (!(r->gvw_kg > 0))
-        return 0;
     if (d->n == d->cap) {
         size_t cap = d->cap ? 2 * d->cap : 4096;
         cls_pas *v = realloc(d->p, cap * sizeof *v);
@@ -70,7 +67,7 @@ static int collect(void *ctx, int64_t id, const amfi_passage_row *r)
     q->gvw = r->gvw_kg;
     q->cls = name_index(d, r->vclass && *r->vclass ? r->vclass : UNCLASSIFIED);
     q->lane = r->lane;
-    q->over = r->has_overload && r->overload;
+    q->over = r->overload;
     return 0;
 }
 
@@ -81,7 +78,7 @@ static int read_classes(report_ctx *c, cls_data *d)
     d->other = -1;
     amfi_passage_filter f = {.from = c->ex.from, .to = c->ex.to, .status = "ok",
                              .lane_given = c->ex.lane_given, .lane = c->ex.lane};
-    int rc = amfi_store_each_passage_where(c->s, &f, collect, d, c->err, sizeof c->err);
+    int rc = amfi_store_each_class_row(c->s, &f, collect, d, c->err, sizeof c->err);
     if (d->oom)
         return report_fail(c, "out of memory for the passages of the class statistics");
     return rc ? -1 : 0;
