@@ -56,6 +56,18 @@ run --db "$db" --set-baseline-last 3 --to 2025-11-22
 [ "$rc" = 2 ] && grep -q -- "--set-baseline-last works on the whole store" "$tmp/err" ||
     fail "--set-baseline-last --to: status $rc: $(cat "$tmp/err")"
 
+# --lane likewise: the sections that cover every lane refuse it
+for s in summary trend alerts errors; do
+    run --db "$db" --$s --lane 2
+    [ "$rc" = 2 ] && grep -q -- "--lane: --$s covers every lane and does not honour --lane" "$tmp/err" ||
+        fail "--$s --lane 2: status $rc: $(cat "$tmp/err")"
+done
+run --db "$db" --passages --lane 2 --plot "$tmp/pl"
+[ "$rc" = 2 ] && grep -q -- "--lane: --check, --set-baseline\* and --plot cover every lane" "$tmp/err" ||
+    fail "--plot --lane 2: status $rc: $(cat "$tmp/err")"
+run --db "$db" --classes --lane 2
+[ "$rc" = 0 ] || fail "--classes --lane 2: status $rc"
+
 # ---- --trend and --alerts honour it ------------------------------------------
 # indicators hourly from 01:00 to 24:00; alerts at 10:00, 12:00, 20:00, 21:00
 for f in csv json table; do

@@ -582,6 +582,21 @@ static int check_args(options *o)
                                "--from/--to; these do: %s--plot", sections[k].name,
                                asked ? "" : " (shown with no section asked for)", with);
         }
+    /* --lane likewise */
+    for (int k = 0; o->ex.lane_given && k < N_SECTIONS; k++)
+        if (o->sel[k] && !(sections[k].filters & F_LANE)) {
+            char with[256] = "";
+            size_t at = 0;
+            for (int j = 0; j < N_SECTIONS; j++)
+                if ((sections[j].filters & F_LANE) && at < sizeof with)
+                    at += (size_t)snprintf(with + at, sizeof with - at, "%s--%s",
+                                           at ? " " : "", sections[j].name);
+            return usage_error("--lane", "--%s%s covers every lane and does not honour --lane; "
+                               "these do: %s", sections[k].name,
+                               asked ? "" : " (shown with no section asked for)", with);
+        }
+    if (o->ex.lane_given && (o->check || o->baseline_last || o->baseline_given || o->plot_dir))
+        return usage_error("--lane", "--check, --set-baseline* and --plot cover every lane");
     for (int k = 0; k < N_SECTIONS; k++)
         n_status += o->sel[k] && (sections[k].filters & F_STATUS);
     if (o->ex.status && !n_status) {
