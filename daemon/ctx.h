@@ -24,6 +24,7 @@
  *   alert.c -> log.c metrics.c notify.c
  *   amfid.c -> alert.c bus.c classes.c drift.c environment.c freevib.c intake.c log.c metrics.c notify.c pipeline.c pool.c reject.c scaleind.c status.c stdmean.c timer.c
  *   bus.c -> admit.c log.c reject.c
+ *   classes.c -> log.c
  *   drift.c -> log.c metrics.c
  *   environment.c -> admit.c bus.c log.c reject.c
  *   freevib.c -> environment.c log.c pipeline.c timer.c

@@ -51,4 +51,8 @@ case "$rec" in
 "window=50 every=10 baseline_n=100 std_alert_ratio="*) ;;
 *) fail "amfid did not record its indicator parameters in meta daemon.indicators: '$rec'" ;;
 esac
+case "$(q "SELECT value FROM meta WHERE key = 'daemon.classes'")" in
+"scheme=eu group_spacing_m="*) ;;
+*) fail "amfid did not record its classes in meta daemon.classes" ;;
+esac
 echo "baseline applied without a restart: ok"

@@ -130,5 +130,22 @@ grep -q '"by_class":\[{"class":"A23","checked":10,"over_gvw":1,"over_group":1,"o
 grep -q '"exceeded":\[{"limit":"gvw","axles":null,"kind":"gross","load_kg":46000.0,"limit_kg":40000.0' "$tmp/out" ||
     fail "--overloads json: exceeded"
 
+# the classes and limits amfid ran with (meta daemon.classes) rule, not
+# --config's nor the defaults: the A23's 46 t under a recorded 48 t limit
+cp "$db" "$tmp/rec.db"
+sqlite3 "$tmp/rec.db" "INSERT INTO meta (key, value) VALUES ('daemon.classes', 'scheme=eu group_spacing_m=2 light_max_kg=3500 container_44t=0 gvw_limit_kg.CAR=0 gvw_limit_kg.R2=18000 gvw_limit_kg.R3=26000 gvw_limit_kg.R4=32000 gvw_limit_kg.A22=36000 gvw_limit_kg.A23=48000 gvw_limit_kg.A32=40000 gvw_limit_kg.A33=40000 single_axle_kg=10000 driving_axle_kg=11500 motor_tandem_air=1')" || exit 1
+printf 'classes:\n  gvw_limit_kg:\n    A23: 30000\n' > "$tmp/other.yaml"
+run --db "$tmp/rec.db" --overloads --format csv --config "$tmp/other.yaml"
+cut -d, -f3,6,8,9,10,11 "$tmp/out" | tail -n +2 > "$tmp/got"
+printf '%s\n' '8,A23,48000.0,group,3-5,tridem' > "$tmp/want"
+cmp -s "$tmp/want" "$tmp/got" ||
+    { fail "--overloads with daemon.classes: (- want + got):"; diff "$tmp/want" "$tmp/got"; }
+run --db "$tmp/rec.db" --overloads
+grep -q "scheme eu, amfid's, from the store;" "$tmp/out" || fail "--overloads: does not say the limits are amfid's: $(head -1 "$tmp/out")"
+sqlite3 "$tmp/rec.db" "UPDATE meta SET value = 'scheme=xx' WHERE key = 'daemon.classes'" || exit 1
+run --db "$tmp/rec.db" --overloads
+[ "$rc" = 1 ] && grep -q "rec.db: meta daemon.classes: scheme: 'xx' is not eu or fhwa13" "$tmp/err" ||
+    fail "a damaged daemon.classes: status $rc: $(cat "$tmp/err")"
+
 [ "$fails" = 0 ] && echo "ok: report_classes"
 exit $((fails > 0))

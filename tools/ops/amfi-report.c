@@ -47,6 +47,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "amfi_classify.h"
 #include "amfi_cli.h"
 #include "amfi_config.h"
 #include "amfi_json.h"
@@ -1048,7 +1049,31 @@ static int report_main(options *op)
     c.site = o.site;
     c.format = o.format;
     c.cfg = o.config ? cfg : NULL;
+    /* the classes and limits: what amfid ran with (meta daemon.classes),
+     * else --config's, else the defaults */
+    static amfi_class_params recorded;
+    char rec[4097];
+    int have_rec = 0;
     c.classes = &cfg->classes;
+    c.classes_from = o.config ? "--config" : "built-in defaults";
+    if (amfi_store_meta_get(c.s, "daemon.classes", rec, sizeof rec, &have_rec, err,
+                            sizeof err) != 0) {
+        data_error(&c, "%s", err);
+        amfi_store_close(c.s);
+        free(cfg);
+        return EXIT_DATA;
+    }
+    if (have_rec) {
+        char why[256];
+        if (amfi_class_params_parse(rec, &recorded, why, sizeof why) != 0) {
+            data_error(&c, "meta daemon.classes: %s", why);
+            amfi_store_close(c.s);
+            free(cfg);
+            return EXIT_DATA;
+        }
+        c.classes = &recorded;
+        c.classes_from = "amfid's, from the store";
+    }
     c.units = o.units >= 0 ? o.units : cfg->report.units;
     c.out = stdout;
     /* the sections shown by default only when the store has their data */

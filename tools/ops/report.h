@@ -80,7 +80,8 @@ typedef struct report_ctx {
     FILE *out;
     json_t *root;                 /* FMT_JSON: the document */
     const amfi_site_config *cfg;  /* --config, or NULL */
-    const amfi_class_params *classes; /* classes: of --config, else the defaults */
+    const amfi_class_params *classes; /* amfid's (meta daemon.classes), else --config's, else the defaults */
+    const char *classes_from;     /* which of the three, for the output */
     int units;                    /* AMFI_REPORT_UNITS_*: of the tables (not CSV, JSON) */
     char err[512];
 } report_ctx;

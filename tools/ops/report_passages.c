@@ -568,10 +568,10 @@ static int overloads(report_ctx *rc, int fmt)
     snprintf(hl, sizeof hl, "limit %s", report_mass_unit(rc->units));
     const char *scheme = amfi_class_scheme_name(rc->classes->scheme);
     if (fmt == FMT_TABLE)
-        fprintf(c->f, "== overloads (ok passages; limits by class and axle group, scheme %s; "
+        fprintf(c->f, "== overloads (ok passages; limits by class and axle group, scheme %s, %s; "
                       "report.limits GVW %s %s, axle %s %s where no class limit applies)\n"
                       "%-20s  %8s  %10s  %4s  %-7s  %8s  %8s  %s\n",
-                scheme, report_mass(rc->units, o->gvw_limit_kg, l1), report_mass_unit(rc->units),
+                scheme, rc->classes_from ? rc->classes_from : "built-in defaults", report_mass(rc->units, o->gvw_limit_kg, l1), report_mass_unit(rc->units),
                 report_mass(rc->units, o->axle_limit_kg, l2), report_mass_unit(rc->units),
                 "time (UTC)", "id", "vehicle", "lane", "class", hg, hl, "exceeded");
     else if (fmt == FMT_CSV)
@@ -604,6 +604,8 @@ static int overloads(report_ctx *rc, int fmt)
     } else if (fmt == FMT_JSON) {
         json_t *ob = json_object(), *bc = json_array();
         json_object_set_new(ob, "scheme", json_string(scheme));
+        json_object_set_new(ob, "limits_from",
+                            json_string(rc->classes_from ? rc->classes_from : "built-in defaults"));
         json_object_set_new(ob, "gvw_limit_kg", json_real(o->gvw_limit_kg));
         json_object_set_new(ob, "axle_limit_kg", json_real(o->axle_limit_kg));
         json_object_set_new(ob, "checked", json_integer(c->checked));
