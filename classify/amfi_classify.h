@@ -72,6 +72,15 @@ void amfi_class_params_default(amfi_class_params *p);
 int amfi_class_params_check(const amfi_class_params *p, const char **blamed, char *why,
                             size_t whylen);
 
+/* p as one line of "key=value" words ("scheme=eu group_spacing_m=2 ...
+ * gvw_limit_kg.A23=40000 ..."; doubles with 17 significant digits): what
+ * amfid ran with, recorded in the store's meta (daemon.classes) for the
+ * reports. 0, or −1 when buf is too small. */
+int amfi_class_params_format(const amfi_class_params *p, char *buf, size_t len);
+/* The line back: every key once, and amfi_class_params_check passed. 0, or
+ * −1 with why naming the key or the text at fault (*p untouched). */
+int amfi_class_params_parse(const char *s, amfi_class_params *p, char *why, size_t whylen);
+
 /* The kind of a group, for its legal limit. */
 typedef enum amfi_group_kind {
     AMFI_GROUP_SINGLE,       /* a single non-driving axle (steer, trailer) */

@@ -7,6 +7,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* A two-axle front of a four-axle rigid truck (twin steer, 1.7 .. 2.1 m in
@@ -338,4 +339,142 @@ int amfi_classify(const amfi_class_params *p, int n_axles, const double *spacing
             out->over |= AMFI_OVER_GROUP;
     return 0;
 #undef BAD
+}
+
+/* ---- the text form (meta daemon.classes) ------------------------------------------ */
+
+#define N_CLASS_KEYS (7 + AMFI_EU_N)
+
+/* The k-th key of the text form and a pointer to its value in p: *is_int
+ * 1 for an int, 2 for the scheme, 0 for a double. */
+static void *class_key(amfi_class_params *p, int k, char *key, size_t len, int *is_int)
+{
+    static const char *const fixed[] = {"scheme", "group_spacing_m", "light_max_kg",
+                                        "container_44t", "single_axle_kg", "driving_axle_kg",
+                                        "motor_tandem_air"};
+    if (k >= 4 && k < 4 + AMFI_EU_N) {
+        snprintf(key, len, "gvw_limit_kg.%s", amfi_eu_class_name((amfi_eu_class)(k - 4)));
+        *is_int = 0;
+        return &p->gvw_limit_kg[k - 4];
+    }
+    int f = k < 4 ? k : k - AMFI_EU_N;
+    snprintf(key, len, "%s", fixed[f]);
+    switch (f) {
+    case 0: *is_int = 2; return &p->scheme;
+    case 1: *is_int = 0; return &p->group_spacing_m;
+    case 2: *is_int = 0; return &p->light_max_kg;
+    case 3: *is_int = 1; return &p->container_44t;
+    case 4: *is_int = 0; return &p->single_axle_kg;
+    case 5: *is_int = 0; return &p->driving_axle_kg;
+    default: *is_int = 1; return &p->motor_tandem_air;
+    }
+}
+
+int amfi_class_params_format(const amfi_class_params *p, char *buf, size_t len)
+{
+    amfi_class_params q = *p;
+    size_t at = 0;
+    if (!buf || len == 0)
+        return -1;
+    buf[0] = '\0';
+    for (int k = 0; k < N_CLASS_KEYS; k++) {
+        char key[48];
+        int kind = 0;
+        void *v = class_key(&q, k, key, sizeof key, &kind);
+        int n = kind == 2   ? snprintf(buf + at, len - at, "%s%s=%s", k ? " " : "", key,
+                                       amfi_class_scheme_name(*(amfi_class_scheme *)v))
+                : kind == 1 ? snprintf(buf + at, len - at, "%s%s=%d", k ? " " : "", key,
+                                       *(int *)v)
+                            : snprintf(buf + at, len - at, "%s%s=%.17g", k ? " " : "", key,
+                                       *(double *)v);
+        if (n < 0 || (size_t)n >= len - at)
+            return -1;
+        at += (size_t)n;
+    }
+    return 0;
+}
+
+int amfi_class_params_parse(const char *s, amfi_class_params *p, char *why, size_t whylen)
+{
+    amfi_class_params q;
+    int seen[N_CLASS_KEYS] = {0};
+    const char *blamed = NULL;
+    amfi_class_params_default(&q);
+    if (!s || !p) {
+        snprintf(why, whylen, "NULL argument");
+        return -1;
+    }
+    for (const char *c = s; *c;) {
+        while (*c == ' ')
+            c++;
+        if (!*c)
+            break;
+        const char *eq = strchr(c, '='), *end = strchr(c, ' ');
+        if (!end)
+            end = c + strlen(c);
+        int k = 0, kind = 0;
+        char key[48], val[64];
+        void *v = NULL;
+        for (; eq && eq < end && k < N_CLASS_KEYS; k++) {
+            v = class_key(&q, k, key, sizeof key, &kind);
+            if (strlen(key) == (size_t)(eq - c) && strncmp(c, key, (size_t)(eq - c)) == 0)
+                break;
+        }
+        if (!eq || eq >= end || k == N_CLASS_KEYS) {
+            snprintf(why, whylen, "unknown field at '%.40s'", c);
+            return -1;
+        }
+        if (seen[k]++) {
+            snprintf(why, whylen, "%s given twice", key);
+            return -1;
+        }
+        size_t vl = (size_t)(end - eq - 1);
+        if (vl == 0 || vl >= sizeof val) {
+            snprintf(why, whylen, "%s: no value, or too long", key);
+            return -1;
+        }
+        memcpy(val, eq + 1, vl);
+        val[vl] = '\0';
+        char *stop = NULL;
+        if (kind == 2) {
+            if (strcmp(val, "eu") == 0)
+                *(amfi_class_scheme *)v = AMFI_CLASS_SCHEME_EU;
+            else if (strcmp(val, "fhwa13") == 0)
+                *(amfi_class_scheme *)v = AMFI_CLASS_SCHEME_FHWA13;
+            else {
+                snprintf(why, whylen, "%s: '%.20s' is not eu or fhwa13", key, val);
+                return -1;
+            }
+        } else if (kind == 1) {
+            long x = strtol(val, &stop, 10);
+            if (*stop || x < 0 || x > 1) {
+                snprintf(why, whylen, "%s: '%.20s' is not 0 or 1", key, val);
+                return -1;
+            }
+            *(int *)v = (int)x;
+        } else {
+            double x = strtod(val, &stop);
+            if (*stop || !isfinite(x)) {
+                snprintf(why, whylen, "%s: '%.20s' is not a number", key, val);
+                return -1;
+            }
+            *(double *)v = x;
+        }
+        c = end;
+    }
+    for (int k = 0; k < N_CLASS_KEYS; k++)
+        if (!seen[k]) {
+            char key[48];
+            int kind = 0;
+            class_key(&q, k, key, sizeof key, &kind);
+            snprintf(why, whylen, "%s missing", key);
+            return -1;
+        }
+    char w[160];
+    if (amfi_class_params_check(&q, &blamed, w, sizeof w) != 0) {
+        snprintf(why, whylen, "%s", w);
+        return -1;
+    }
+    *p = q;
+    return 0;
 }

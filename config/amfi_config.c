@@ -143,6 +143,7 @@ void amfi_config_defaults(amfi_site_config *c)
     c->report.gvw_limit_kg = 40000.0;
     c->report.axle_limit_kg = 11500.0;
     c->report.bin_kg = 2000.0;
+    c->report.units = AMFI_REPORT_UNITS_SI;
     /* a detector in step with the accelerometers until commissioning says */
     c->detector.clock_offset_s = 0.0;
     c->detector.speed_scale = 1.0;

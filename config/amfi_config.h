@@ -250,7 +250,11 @@ typedef struct amfi_report_config {
     double gvw_limit_kg;   /* report.limits.gvw_kg: legal GVW, (0, 1e6] */
     double axle_limit_kg;  /* report.limits.axle_kg: legal load of any axle, (0, 1e6] */
     double bin_kg;         /* report.histogram_bin_kg: GVW histogram bins, [100, 1e5] */
+    int units;             /* report.units: AMFI_REPORT_UNITS_* of amfi-report's tables and plots */
 } amfi_report_config;
+
+/* report.units: si (kg, m/s) or engineering (t, km/h) */
+enum { AMFI_REPORT_UNITS_SI = 0, AMFI_REPORT_UNITS_ENGINEERING = 1 };
 
 /* detector.*: what commissioning found of the vehicle detector
  * (section_detector.c): its clock runs clock_offset_s ahead of the

@@ -2,7 +2,8 @@
 /*
  * classes.c: the vehicle class and axle groups of every stored passage
  * (classify/, the site file's classes: section, docs/classes.md). A module
- * (ctx.h) with one hook: row fills the passage's class, its groups (the
+ * (ctx.h): restore records the classes and limits in force in the store's
+ * meta (daemon.classes) for the reports; row fills the passage's class, its groups (the
  * axles per group front to back, "1-1-3") and, when it was solved, whether
  * its GVW or a group is above the legal limit. Classification needs only
  * the axle count and the detector's spacings, so passages that were not
@@ -68,6 +69,18 @@ static void classes_row(amfid_ctx *c, const amfid_passage *p, amfi_passage_row *
     }
 }
 
+/* The store is open: the classes and limits this run uses, for the reports
+ * (meta daemon.classes; a reload does not change them). */
+static int classes_restore(amfid_ctx *c)
+{
+    char text[1024], err[512];
+    snprintf(err, sizeof err, "the text is longer than %zu bytes", sizeof text);
+    if (amfi_class_params_format(&c->cfg->classes, text, sizeof text) != 0
+        || amfi_store_meta_set(c->store, "daemon.classes", text, err, sizeof err) != 0)
+        LOG_WARN("store: the classes' parameters not recorded: %s", err);
+    return 0;
+}
+
 const amfid_module classes_module = {
-    .name = "classes", .section = "classes", .row = classes_row,
+    .name = "classes", .section = "classes", .restore = classes_restore, .row = classes_row,
 };

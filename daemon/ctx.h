@@ -26,6 +26,7 @@
  *   alert.c -> log.c metrics.c notify.c
  *   amfid.c -> alert.c bus.c classes.c drift.c environment.c freevib.c intake.c log.c metrics.c notify.c pipeline.c pool.c raw.c reject.c scaleind.c status.c stdmean.c timer.c
  *   bus.c -> admit.c log.c reject.c
+ *   classes.c -> log.c
  *   drift.c -> log.c metrics.c
  *   environment.c -> admit.c bus.c log.c reject.c
  *   freevib.c -> environment.c log.c pipeline.c timer.c
@@ -39,7 +40,7 @@
  *   scaleind.c -> environment.c log.c metrics.c
  *   sink.c -> log.c pool.c
  *   status.c -> bus.c environment.c log.c pipeline.c timer.c
- *   stdmean.c -> log.c metrics.c
+ *   stdmean.c -> log.c metrics.c timer.c
  * log.c and timer.c call nothing of amfid's; a module reaches the core only
  * through the context.
  *

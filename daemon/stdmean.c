@@ -9,7 +9,11 @@
  * the context's emit_alert) and the newest evaluation goes to the metrics.
  * At start the baseline, the window's GVWs and the open alerts come back
  * from the store (an alert open before a restart stays open, not raised
- * twice).
+ * twice), and the parameters in force are recorded in meta
+ * (daemon.indicators) for the reports. A baseline written into the store while amfid runs (amfi-report
+ * --set-baseline*) is applied without a restart: a timer compares the
+ * store's newest baseline row with the one in force every
+ * BASELINE_POLL_S seconds.
  *
  * A module (ctx.h). Thread: the main thread only. Owns the engine and its
  * parameters in force (a reload reports a change, which applies at the
@@ -23,10 +27,48 @@
 #include "amfi_indicator_t.h"
 #include "ctx.h"
 
+/* How often the store's newest baseline is compared with the one in force. */
+#define BASELINE_POLL_S 2.0
+static const double baseline_poll_s = BASELINE_POLL_S;
+
 static struct {
     amfi_indicators *ind;
     amfi_indicator_params params; /* in force */
+    amfi_baseline applied;        /* the store's baseline row in force */
+    int has_applied;
 } M;
+
+static int same_baseline(const amfi_baseline *a, const amfi_baseline *b)
+{
+    return a->utime_set == b->utime_set && a->n == b->n && a->mean_kg == b->mean_kg
+           && a->std_kg == b->std_kg && strcmp(a->source, b->source) == 0
+           && strcmp(a->note, b->note) == 0;
+}
+
+/* The timer: a newer baseline row in the store (amfi-report --set-baseline*)
+ * replaces the one in force; the rules start counting afresh against it. */
+static int baseline_tick(amfid_ctx *c)
+{
+    amfi_baseline b;
+    int found = 0;
+    char err[512];
+    if (amfi_store_get_baseline(c->store, &b, &found, err, sizeof err) != 0) {
+        LOG_WARN("store: %s", err);
+        return 0;
+    }
+    if (!found || (M.has_applied && same_baseline(&b, &M.applied)))
+        return 0;
+    if (amfi_indicators_set_baseline(M.ind, b.mean_kg, b.std_kg, b.n) != 0) {
+        LOG_WARN("store: baseline mean %.0f kg, STD %.0f kg, n %d (%s) refused by the rules",
+                 b.mean_kg, b.std_kg, b.n, b.source);
+    } else {
+        LOG_INFO("baseline changed in the store, applied: mean %.0f kg, STD %.0f kg (%d, %s%s%s)",
+                 b.mean_kg, b.std_kg, b.n, b.source, b.note[0] ? ": " : "", b.note);
+    }
+    M.applied = b;
+    M.has_applied = 1;
+    return 0;
+}
 
 static int stdmean_start(amfid_ctx *c, char *err, size_t errlen)
 {
@@ -47,12 +89,22 @@ static int last_alert_raised(amfi_store *st, const char *kind)
     return open;
 }
 
-/* The baseline, the window's GVWs and the open alerts from the store. */
+/* The baseline, the window's GVWs and the open alerts from the store; the
+ * baseline's timer. */
 static int stdmean_restore(amfid_ctx *c)
 {
     amfi_baseline b;
     int found = 0;
     char err[512];
+    if (timer_add(c->timers, &baseline_poll_s, baseline_tick) != 0)
+        return 1;
+    /* what this run's rules use, for the reports (meta daemon.indicators;
+     * a reload does not change them: they apply at the next start) */
+    char params[1024];
+    snprintf(err, sizeof err, "the text is longer than %zu bytes", sizeof params);
+    if (amfi_indicator_params_format(&M.params, params, sizeof params) != 0
+        || amfi_store_meta_set(c->store, "daemon.indicators", params, err, sizeof err) != 0)
+        LOG_WARN("store: the indicator parameters not recorded: %s", err);
     if (amfi_store_get_baseline(c->store, &b, &found, err, sizeof err) != 0) {
         LOG_WARN("store: %s", err);
         return 0;
@@ -60,6 +112,8 @@ static int stdmean_restore(amfid_ctx *c)
     if (!found)
         return 0;
     amfi_indicators_set_baseline(M.ind, b.mean_kg, b.std_kg, b.n);
+    M.applied = b;
+    M.has_applied = 1;
     LOG_INFO("baseline from the store: mean %.0f kg, STD %.0f kg (%d, %s)", b.mean_kg,
              b.std_kg, b.n, b.source);
     double *g = malloc(sizeof(double) * (size_t)M.params.window);
@@ -107,6 +161,8 @@ static void stdmean_feed(amfid_ctx *c, const amfid_passage *p)
         snprintf(b.note, sizeof b.note, "first %d ok passages", ev.n);
         if (amfi_store_set_baseline(c->store, &b, err, sizeof err))
             ctx_error(c, "store: %s", err);
+        M.applied = b; /* in force already: the timer leaves it be */
+        M.has_applied = 1;
         LOG_INFO("baseline established: mean %.0f kg, STD %.0f kg over %d passages",
                  ev.baseline_mean_kg, ev.baseline_std_kg, ev.n);
     }

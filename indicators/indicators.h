@@ -97,6 +97,18 @@ void amfi_indicator_params_default(amfi_indicator_params *p);
 int amfi_indicator_params_check(const amfi_indicator_params *p, const char **field, char *err,
                                 size_t errlen);
 
+/* The parameters as one line of text, "window=500 every=100 ... " (every
+ * field, its site-file key, doubles with 17 significant digits): what amfid
+ * ran with, recorded in the store's meta (daemon.indicators) for the
+ * reports. 0, or AMFI_IND_EINVAL when buf is too small. */
+int amfi_indicator_params_format(const amfi_indicator_params *p, char *buf, size_t len);
+/* The line back: every field must be there once, as written by
+ * amfi_indicator_params_format, and the whole must pass
+ * amfi_indicator_params_check. 0, or AMFI_IND_EINVAL with err naming the
+ * field or the text at fault. */
+int amfi_indicator_params_parse(const char *s, amfi_indicator_params *p, char *err,
+                                size_t errlen);
+
 /* 1 when every field of a equals the same field of b (compared field by
  * field, not by memory: padding and field order do not matter), else 0. */
 int amfi_indicator_params_equal(const amfi_indicator_params *a, const amfi_indicator_params *b);

@@ -482,8 +482,10 @@ int amfi_store_gvw_errors(amfi_store *s, double **pct, size_t *n,
 
 /* ---- passage listing (store_export.c) ------------------------------------ */
 
-/* Called once per passage; row->status and row->reason are valid during the
-   call only. A nonzero return stops the listing and is returned. */
+/* Called once per passage; row->status, row->reason, row->vclass and
+   row->axle_groups (NULL where the column is NULL; has_overload 0 where
+   overload is) are valid during the call only. A nonzero return stops the
+   listing and is returned. */
 typedef int (*amfi_store_passage_fn)(void *ctx, int64_t id,
                                      const amfi_passage_row *row);
 
@@ -502,6 +504,24 @@ typedef struct amfi_passage_filter {
 int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
                                   amfi_store_passage_fn fn, void *ctx,
                                   char *err, size_t errlen);
+
+/* ---- class rows (store_classrows.c) --------------------------------------- */
+
+/* An ok passage as the class statistics see it; vclass (NULL where the
+   column is NULL) is valid during the call only. */
+typedef struct amfi_class_row {
+    int lane;
+    double gvw_kg;      /* > 0 */
+    const char *vclass; /* passages.class */
+    int overload;       /* passages.overload; 0 where NULL */
+} amfi_class_row;
+typedef int (*amfi_store_class_fn)(void *ctx, const amfi_class_row *row);
+
+/* Every ok passage with a GVW that the filter's time range and lane select
+   (its status is ignored: ok), oldest first, without its axle rows (one
+   query). A nonzero return of fn stops the listing and is returned. */
+int amfi_store_each_class_row(amfi_store *s, const amfi_passage_filter *f,
+                              amfi_store_class_fn fn, void *ctx, char *err, size_t errlen);
 
 /* amfi_store_each_passage_where with from, to, status and any lane. */
 int amfi_store_each_passage(amfi_store *s, int64_t from, int64_t to,
@@ -617,6 +637,22 @@ int amfi_store_speed_pairs(amfi_store *s, const amfi_passage_filter *f, amfi_spe
    first: refills amfid's speed-drift window after a restart. max >= 1. */
 int amfi_store_recent_speed_pairs(amfi_store *s, int max, amfi_speed_pair **out, size_t *n,
                                   char *err, size_t errlen);
+
+/* ---- the solver's fit per passage (store_residual.c) --------------------- */
+
+/* One ok passage's fit: passages.residual_rms (not NULL) and quality. */
+typedef struct amfi_residual_rec {
+    int64_t passage_id;
+    int64_t utime;       /* data time, µs */
+    double residual_rms; /* RMS of the fit's residual, m/s², >= 0 */
+    double quality;      /* separability from the event's other vehicles, 1 ..; NaN: NULL */
+} amfi_residual_rec;
+
+/* The ok passages with a residual and from <= utime <= to, oldest first
+   (utime, id): *out is malloc'd (free it; NULL when *n is 0). A value
+   outside the schema's range is AMFI_STORE_ECORRUPT. */
+int amfi_store_residual_series(amfi_store *s, int64_t from, int64_t to, amfi_residual_rec **out,
+                               size_t *n, char *err, size_t errlen);
 
 /* ---- natural frequencies (store_natfreq.c) ------------------------------ */
 

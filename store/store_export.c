@@ -42,7 +42,8 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
     sqlite3_stmt *p = NULL, *a = NULL;
     src = sqlite3_prepare_v2(s->db,
         "SELECT id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, "
-        "reason, speed_given_mps, speed_estimated, n_vehicles, quality, class FROM passages WHERE utime >= ?1 AND utime <= ?2 "
+        "reason, speed_given_mps, speed_estimated, n_vehicles, quality, class, axle_groups, "
+        "overload FROM passages WHERE utime >= ?1 AND utime <= ?2 "
         "AND (?3 IS NULL OR status = ?3) AND (?4 IS NULL OR lane = ?4) "
         "ORDER BY utime, id", -1, &p, NULL);
     if (src == SQLITE_OK)
@@ -63,7 +64,7 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
         origin o = {"passages", sqlite3_column_int64(p, 0)};
         amfi_passage_row r;
         int64_t v = 0;
-        char st_name[16], reason[AMFI_STORE_REASON_MAX + 1], vclass[16];
+        char st_name[16], reason[AMFI_STORE_REASON_MAX + 1], vclass[16], groups[32];
         memset(&r, 0, sizeof r);
         for (int k = 0; k < AMFI_MAX_AXLES; k++)
             r.spacing_m[k] = r.axle_kg[k] = NAN;
@@ -96,6 +97,15 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
         if (rc == 0 && sqlite3_column_type(p, 13) != SQLITE_NULL) {
             rc = st_read_text(p, 13, sizeof vclass - 1, &o, vclass, sizeof vclass, err, errlen);
             r.vclass = vclass;
+        }
+        if (rc == 0 && sqlite3_column_type(p, 14) != SQLITE_NULL) {
+            rc = st_read_text(p, 14, sizeof groups - 1, &o, groups, sizeof groups, err, errlen);
+            r.axle_groups = groups;
+        }
+        if (rc == 0 && sqlite3_column_type(p, 15) != SQLITE_NULL) {
+            rc = st_read_int(p, 15, 0, 1, &o, &v, err, errlen);
+            r.overload = (int)v;
+            r.has_overload = 1;
         }
         if (rc == 0) {
             int asrc;

@@ -273,12 +273,63 @@ static void refusals(void **state)
     assert_int_equal(amfi_classify(&p, AMFI_MAX_AXLES + 1, sp2, NULL, &c, err, sizeof err), -1);
 }
 
+/* The text form amfid records in the store (meta daemon.classes): every
+ * field round-trips exactly; a damaged text is refused naming the field,
+ * *p untouched. */
+static void params_text(void **state)
+{
+    (void)state;
+    amfi_class_params a, b;
+    char buf[1024], why[256];
+    amfi_class_params_default(&a);
+    a.scheme = AMFI_CLASS_SCHEME_FHWA13;
+    a.group_spacing_m = 1.0 + 1.0 / 3.0;
+    a.gvw_limit_kg[AMFI_EU_A33] = 44000;
+    a.container_44t = 1;
+    assert_int_equal(amfi_class_params_format(&a, buf, sizeof buf), 0);
+    assert_non_null(strstr(buf, "scheme=fhwa13 group_spacing_m="));
+    assert_non_null(strstr(buf, " gvw_limit_kg.A33=44000 "));
+    amfi_class_params_default(&b);
+    assert_int_equal(amfi_class_params_parse(buf, &b, why, sizeof why), 0);
+    assert_memory_equal(&a.gvw_limit_kg, &b.gvw_limit_kg, sizeof a.gvw_limit_kg);
+    assert_true(a.scheme == b.scheme && a.group_spacing_m == b.group_spacing_m &&
+                a.light_max_kg == b.light_max_kg && a.container_44t == b.container_44t &&
+                a.single_axle_kg == b.single_axle_kg && a.driving_axle_kg == b.driving_axle_kg &&
+                a.motor_tandem_air == b.motor_tandem_air);
+    assert_int_equal(amfi_class_params_format(&a, buf, 30), -1);
+    static const struct {
+        const char *text, *why;
+    } bad[] = {
+        {"scheme=eu", "group_spacing_m missing"},
+        {"scheme=eu scheme=eu", "scheme given twice"},
+        {"scheme=mars", "scheme: 'mars' is not eu or fhwa13"},
+        {"gvw_limit_kg.B9=1", "unknown field"},
+        {"container_44t=2", "container_44t: '2' is not 0 or 1"},
+        {"light_max_kg=heavy", "light_max_kg: 'heavy' is not a number"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        amfi_class_params_default(&b);
+        assert_int_equal(amfi_class_params_parse(bad[k].text, &b, why, sizeof why), -1);
+        if (!strstr(why, bad[k].why))
+            fail_msg("'%s': '%s', expected '%s'", bad[k].text, why, bad[k].why);
+        assert_true(b.scheme == AMFI_CLASS_SCHEME_EU && b.group_spacing_m == 2.0);
+    }
+    /* every key there but a value amfi_class_params_check refuses */
+    amfi_class_params_default(&a);
+    assert_int_equal(amfi_class_params_format(&a, buf, sizeof buf), 0);
+    char *gs = strstr(buf, "group_spacing_m=2");
+    assert_non_null(gs);
+    gs[strlen("group_spacing_m=")] = '9';
+    assert_int_equal(amfi_class_params_parse(buf, &b, why, sizeof why), -1);
+    assert_non_null(strstr(why, "group_spacing"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(groups_at_threshold),  cmocka_unit_test(every_eu_class_from_vclass),
         cmocka_unit_test(eu_limits),            cmocka_unit_test(fhwa_typical),
-        cmocka_unit_test(refusals),
+        cmocka_unit_test(refusals),             cmocka_unit_test(params_text),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

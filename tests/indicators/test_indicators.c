@@ -166,6 +166,46 @@ static void test_params_equal(void **state)
     }
 }
 
+/* The text form amfid records in the store (meta daemon.indicators): every
+ * field round-trips exactly, and a damaged text is refused naming the
+ * field. */
+static void test_params_text(void **state)
+{
+    (void)state;
+    amfi_indicator_params a, b;
+    char buf[1024], err[256];
+    amfi_indicator_params_default(&a);
+    a.std_alert_ratio = 1.0 + 1.0 / 3.0;
+    a.mean_alert_p = 0.0123456789;
+    a.window = 777;
+    assert_int_equal(amfi_indicator_params_format(&a, buf, sizeof buf), AMFI_IND_OK);
+    assert_non_null(strstr(buf, "window=777 every="));
+    assert_int_equal(amfi_indicator_params_parse(buf, &b, err, sizeof err), AMFI_IND_OK);
+    assert_true(amfi_indicator_params_equal(&a, &b));
+    assert_int_equal(amfi_indicator_params_format(&a, buf, 20), AMFI_IND_EINVAL);
+    static const struct {
+        const char *text, *why;
+    } bad[] = {
+        {"window=500", "every missing"},
+        {"window=500 window=500", "window given twice"},
+        {"windows=500", "unknown field"},
+        {"window=5x0", "window: trailing text"},
+        {"std_alert_ratio=abc", "std_alert_ratio: not a number"},
+        {"window=500 every=100 baseline_n=10000 std_alert_ratio=1.08 std_alert_p=0.01 "
+         "std_clear_ratio=2 raise_after=6 clear_after=6 mean_shift=1 mean_alert_ratio=1.05 "
+         "mean_alert_p=0.01 mean_clear_ratio=1.03", "std_clear_ratio must be"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        amfi_indicator_params_default(&b);
+        assert_int_equal(amfi_indicator_params_parse(bad[k].text, &b, err, sizeof err),
+                         AMFI_IND_EINVAL);
+        if (!strstr(err, bad[k].why))
+            fail_msg("'%s': '%s', expected '%s'", bad[k].text, err, bad[k].why);
+        amfi_indicator_params_default(&a);
+        assert_true(amfi_indicator_params_equal(&a, &b)); /* untouched */
+    }
+}
+
 static void test_baseline_auto(void **state)
 {
     (void)state;
@@ -692,6 +732,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_params),
         cmocka_unit_test(test_params_equal),
+        cmocka_unit_test(test_params_text),
         cmocka_unit_test(test_baseline_auto),
         cmocka_unit_test(test_baseline_constant_recollects),
         cmocka_unit_test(test_baseline_explicit),

@@ -182,7 +182,7 @@ name="read-only modes"
 cases=$((cases + 1))
 [ "$sum0" = "$sum1" ] || problem "the printing modes changed the file"
 
-if ok baseline-last --db "$db" --set-baseline-last 10 --note "after the bearing repair"; then
+if ok baseline-last --db "$db" --set-baseline-last 10 --note "after the bearing repair" --force; then
     has '^baseline set: mean [0-9]+ kg, STD [0-9]+ kg, n 10, manual, from 2025-11-23 16:00:00 UTC$'
     got=$(q "$db" "SELECT n, source, note, utime_set FROM baseline ORDER BY id DESC LIMIT 1")
     [ "$got" = "10|manual|after the bearing repair|1763913600000000" ] || problem "newest baseline row '$got'"
@@ -193,7 +193,7 @@ if ok baseline-last --db "$db" --set-baseline-last 10 --note "after the bearing 
     has 'SELECT \* FROM baseline'
 fi
 
-if ok baseline-explicit --db "$db" --set-baseline 18000,2000.5,500 --summary; then
+if ok baseline-explicit --db "$db" --set-baseline 18000,2000.5,500 --summary --force; then
     got=$(q "$db" "SELECT mean_kg, std_kg, n, source, note FROM baseline ORDER BY id DESC LIMIT 1")
     [ "$got" = "18000.0|2000.5|500|manual|" ] || problem "newest baseline row '$got'"
     has '^baseline +mean 18000 kg, STD 2000 kg, n 500, manual, from 2025-11-23 16:00:00 UTC$'
@@ -281,20 +281,33 @@ if ok histogram-csv --db "$ex" --histogram --format csv --lane 2; then
     want=$(q "$ex" "SELECT count(*) FROM passages WHERE status = 'ok' AND lane = 2")
     [ "$sum" -eq "$want" ] || problem "lane 2 histogram sums to $sum, expected $want"
 fi
+# overloads by class and axle group: every passage here has two axles and
+# more than 3.5 t, class R2 of the European scheme (96/53/EC: GVW 18 t, the
+# steer axle a single axle of 10 t, the rear a driving axle of 11.5 t);
+# report.limits apply only where no class limit does (not here)
 printf 'report:\n  limits:\n    gvw_kg: 40000\n    axle_kg: 13000\n' > "$tmp/limits.yaml"
+r2_over() { # the SQL of "passage p is over": $1 gvw, $2 steer, $3 driving
+    echo "(gvw_kg > $1 OR EXISTS (SELECT 1 FROM axles a WHERE a.passage_id = p.id AND
+          ((a.idx = 1 AND a.load_kg > $2) OR (a.idx = 2 AND a.load_kg > $3))))"
+}
 if ok overloads --db "$ex" --overloads --config "$tmp/limits.yaml"; then
-    want=$(q "$ex" "SELECT count(*) FROM passages p WHERE status = 'ok' AND (gvw_kg > 40000 OR
-                    EXISTS (SELECT 1 FROM axles a WHERE a.passage_id = p.id AND a.load_kg > 13000))")
-    [ "$want" -eq 3 ] || problem "fixture: $want overloads in sqlite3, expected 3"
-    has "^checked 36 ok passages: 2 over the GVW limit, $want with an axle over the axle limit, $want overloaded in all"
-    has '^2025-11-22T01:00:00Z +1 +1 +1 +45000 +\+12\.5 % +27000 \(axle 2\) +\+107\.7 % +gvw\+axle$'
-    has '^2025-11-22T02:00:00Z +2 +2 +1 +[0-9]+ +-[0-9.]+ % +14000 \(axle 2\) +\+7\.7 % +axle$'
+    og=$(q "$ex" "SELECT count(*) FROM passages p WHERE status = 'ok' AND gvw_kg > 18000")
+    ogr=$(q "$ex" "SELECT count(*) FROM passages p WHERE status = 'ok' AND $(r2_over 1e9 10000 11500)")
+    oa=$(q "$ex" "SELECT count(*) FROM passages p WHERE status = 'ok' AND $(r2_over 18000 10000 11500)")
+    [ "$oa" -gt 3 ] || problem "fixture: $oa overloads in sqlite3, expected more than 3"
+    has "^checked 36 ok passages: $og over their class's GVW limit, $ogr with an axle group over its limit, $oa overloaded in all"
+    has '^2025-11-22T01:00:00Z +1 +1 +1 +R2 +45000 +18000 +GVW \+150\.0 %; axle 2 driving 27000 > 11500 kg \(\+134\.8 %\)$'
+    has '^2025-11-22T02:00:00Z +2 +2 +1 +R2 +17000 +18000 +axle 2 driving 14000 > 11500 kg \(\+21\.7 %\)$'
+    has "^R2 +36 +$og +$ogr +$oa "
 fi
-printf 'report:\n  limits:\n    gvw_kg: 48000\n    axle_kg: 40000\n' > "$tmp/limits2.yaml"
+# the limits of --config's classes: section
+printf 'classes:\n  gvw_limit_kg:\n    R2: 48000\n  single_axle_kg: 30000\n  driving_axle_kg: 30000\n' > "$tmp/limits2.yaml"
 if ok overloads-json --db "$ex" --overloads --format json --config "$tmp/limits2.yaml"; then
     has '"over_gvw":1,'
+    has '"over_group":0,'
     has '"overloaded":1,'
     has '"passage_id":4,'
+    has '"exceeded":\[\{"limit":"gvw","axles":null,"kind":"gross","load_kg":50000\.0,"limit_kg":48000\.0,'
     [ -z "$jcheck" ] || "$jcheck" < "$tmp/out" || problem "JSON does not parse"
 fi
 for sec in summary trend alerts errors; do
@@ -329,8 +342,7 @@ fi
 if ok passages-json-mixed --db "$ex" --summary --overloads --passages --format json --status gap; then
     [ -z "$jcheck" ] || "$jcheck" site_id=fixture-1 < "$tmp/out" || problem "JSON does not parse"
     want=$(q "$ex" "SELECT (SELECT count(*) FROM passages WHERE status = 'gap') + (SELECT count(*)
-                    FROM passages p WHERE status = 'ok' AND (gvw_kg > 40000 OR
-                    EXISTS (SELECT 1 FROM axles a WHERE a.passage_id = p.id AND a.load_kg > 11500)))")
+                    FROM passages p WHERE status = 'ok' AND $(r2_over 18000 10000 11500))")
     n=$(grep -o '"passage_id":' "$tmp/out" | wc -l)
     [ "$n" -eq "$want" ] || problem "$n passage objects, expected $want (gap passages + overloads at the 96/53/EC defaults)"
     has '"by_status":\{"ok":36,"gap":4,'
@@ -433,6 +445,12 @@ cp "$tmp/pristine.db" "$tmp/newer.db"
 sqlite3 "$tmp/newer.db" "PRAGMA user_version = 99"
 bad newer 1 'schema version 99 is newer than this program.s [0-9]' --db "$tmp/newer.db"
 
+# the fixture's std_increase alert is open: refused without --force, and
+# the store unchanged
+n0=$(q "$db" "SELECT count(*) FROM baseline")
+bad baseline-open-alert 1 "^amfi-report: $tmp/fixture\\.db: 1 alert is open: warning std_increase \\(since 2025-11-23 09:00:00 UTC\\); .* give --force\$" \
+    --db "$db" --set-baseline-last 10
+[ "$(q "$db" "SELECT count(*) FROM baseline")" = "$n0" ] || problem "a refused baseline was stored"
 cp "$tmp/pristine.db" "$tmp/damaged.db"
 sqlite3 "$tmp/damaged.db" "PRAGMA ignore_check_constraints = ON; UPDATE passages SET gvw_kg = -1 WHERE id = 3"
 bad damaged-row 1 "^amfi-report: $tmp/damaged\\.db: passages row 3: gvw_kg is out of range" --db "$tmp/damaged.db" --summary
@@ -440,7 +458,7 @@ cp "$tmp/pristine.db" "$tmp/damaged2.db"
 sqlite3 "$tmp/damaged2.db" "PRAGMA ignore_check_constraints = ON; UPDATE baseline SET std_kg = -5 WHERE id = 1"
 bad damaged-baseline 1 'baseline row 1: std_kg: -5 kg is out of range \(0, 1e\+06\] kg$' --db "$tmp/damaged2.db" --summary
 # the damaged row is not read to set a new baseline, which then is in force
-ok baseline-over-damaged --db "$tmp/damaged2.db" --set-baseline 18000,2000,100 --summary
+ok baseline-over-damaged --db "$tmp/damaged2.db" --set-baseline 18000,2000,100 --summary --force
 cp "$tmp/pristine.db" "$tmp/damaged3.db"
 sqlite3 "$tmp/damaged3.db" "PRAGMA ignore_check_constraints = ON; UPDATE indicators SET state = 'panic' WHERE id = 24"
 bad damaged-indicator 1 'indicators row 24: state is not a known state' --db "$tmp/damaged3.db" --trend

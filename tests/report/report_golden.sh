@@ -89,7 +89,7 @@ run() {
     n=$((n + 1))
 }
 for f in table csv json; do
-    for s in summary trend alerts errors passages histogram overloads speed; do
+    for s in summary trend alerts errors passages histogram overloads speed classes class-histogram; do
         run "$s.$f" --db "$db" --$s --format $f
         run "empty-$s.$f" --db "$empty" --$s --format $f
         run "bare-$s.$f" --db "$bare" --$s --format $f
@@ -109,6 +109,7 @@ run empty-default --db "$empty"
 run bare-default --db "$bare"
 run all.table --db "$db" -s -t -a -e -P -H -O -C
 run all.json --db "$db" -s -t -a -e -P -H -O -C -F json
+run units-engineering --db "$db" -s -t -P -H -O -L -Y --units engineering
 run check --db "$db" --check
 run check-summary --db "$db" --check --summary --errors
 run help --help
@@ -137,9 +138,11 @@ run usage-unknown --db "$db" --bogus
 run usage-ambiguous --db "$db" --s
 run missing-db --db "$db.missing"
 cp "$db" "$tmp/copy.db"
-run baseline-last --db "$tmp/copy.db" --set-baseline-last 5 --note 'after "work"'
-run baseline-given --db "$tmp/copy.db" --set-baseline 18000,1500,30 --summary
-run baseline-too-many --db "$tmp/copy.db" --set-baseline-last 1000
+run baseline-open-alert --db "$tmp/copy.db" --set-baseline-last 5
+run usage-force --db "$db" --force
+run baseline-last --db "$tmp/copy.db" --set-baseline-last 5 --note 'after "work"' --force
+run baseline-given --db "$tmp/copy.db" --set-baseline 18000,1500,30 --summary --force
+run baseline-too-many --db "$tmp/copy.db" --set-baseline-last 1000 --force
 
 # --plot: the listing, every data file and the script (not the PNGs, nor
 # gnuplot's log)

@@ -295,7 +295,7 @@ run trigger-reader --db "$tmp/trigger.db" --summary
 grep -q "holds trigger 'wipe'" "$tmp/err" || problem "stderr: $(cat "$tmp/err")"
 # the same store without the trigger: --set-baseline-last works
 cp "$db" "$tmp/clean.db"
-ok clean-set-baseline --db "$tmp/clean.db" --set-baseline-last 5 &&
+ok clean-set-baseline --db "$tmp/clean.db" --set-baseline-last 5 --force &&
     [ "$(sqlite3 "$tmp/clean.db" "SELECT count(*) FROM baseline")" -eq 2 ] ||
     problem "no baseline row added"
 

@@ -47,15 +47,18 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "amfi_classify.h"
 #include "amfi_cli.h"
 #include "amfi_config.h"
 #include "amfi_json.h"
 #include "report.h"
+#include "report_classes.h"
 #include "report_indicators.h"
 #include "report_natfreq.h"
 #include "report_passages.h"
 #include "report_pg.h"
 #include "report_plot.h"
+#include "report_residual.h"
 #include "report_scale.h"
 #include "report_speed.h"
 #include "report_summary.h"
@@ -85,9 +88,15 @@ typedef struct plot_def {
     report_plot_fn draw;
 } plot_def;
 
-/* The filters a section honours; the others see every passage. */
-#define F_RANGE 1u  /* --from, --to, --lane */
+/* The filters a section honours; the others see every passage. A section
+ * without F_TIME refuses --from/--to (check_args), and --help says which
+ * honour it, both from this table. */
+#define F_TIME 1u   /* --from, --to */
 #define F_STATUS 2u /* --status */
+#define F_LANE 4u   /* --lane */
+#define F_RANGE (F_TIME | F_LANE)
+
+#define MAX_SECTION_PLOTS 5
 
 typedef struct section {
     const char *name;                /* --name */
@@ -95,7 +104,7 @@ typedef struct section {
     const char *help;                /* --help's text; "\n" continues it indented */
     int (*table)(report_ctx *);      /* --format table */
     int (*export)(report_ctx *);     /* --format csv (to c->out) and json (into c->root) */
-    plot_def plots[4];               /* what it draws with --plot */
+    plot_def plots[MAX_SECTION_PLOTS]; /* what it draws with --plot */
     unsigned filters;                /* F_* */
     /* with no section asked for: 1 shown; and then only when default_if
      * says yes, when that is set */
@@ -109,12 +118,13 @@ typedef struct section {
 } section;
 
 enum { SEC_SUMMARY, SEC_TREND, SEC_ALERTS, SEC_ERRORS, SEC_PASSAGES, SEC_HISTOGRAM, SEC_OVERLOADS,
-       SEC_SPEED, N_SECTIONS };
+       SEC_SPEED, SEC_CLASSES, SEC_CLASS_HISTOGRAM, N_SECTIONS };
 
 static const section sections[N_SECTIONS] = {
     [SEC_SUMMARY] = {
         .name = "summary", .key = 's',
-        .help = "passages by status, GVW of the ok ones, time span, baseline",
+        .help = "passages by status, GVW of the ok ones, time span, baseline,\n"
+                "the solver's residual",
         .table = summary_table, .export = summary_export,
         .plots = {{7, "scale.png", "scale indicator: raw and temperature-compensated scale, "
                    "CUSUM and threshold", scale_plot_scale},
@@ -122,18 +132,21 @@ static const section sections[N_SECTIONS] = {
                    "compensated", scale_plot_known_truck},
                   {9, "temperature.png", "deck and air temperature", scale_plot_temperature},
                   {10, "natfreq.png", "natural frequency per passage, raw and "
-                   "temperature-compensated", natfreq_plot}},
+                   "temperature-compensated", natfreq_plot},
+                  {11, "residual.png", "solver residual per ok passage and its running median",
+                   residual_plot}},
         .by_default = 1},
     [SEC_TREND] = {
         .name = "trend", .key = 't', .help = "the last " STR(REPORT_TREND_ROWS) " indicators",
         .table = trend_table, .export = trend_export,
         .plots = {{2, "trend.png", "indicator trend, thresholds, alerts raised and cleared",
                    indicators_plot_trend}},
-        .by_default = 1},
+        .filters = F_TIME, .by_default = 1},
     [SEC_ALERTS] = {
         .name = "alerts", .key = 'a',
-        .help = "the last " STR(REPORT_ALERT_ROWS) " alerts and those open now",
-        .table = alerts_table, .export = alerts_export, .by_default = 1},
+        .help = "the last " STR(REPORT_ALERT_ROWS) " alerts and those open now (open\n"
+                "now whatever the range)",
+        .table = alerts_table, .export = alerts_export, .filters = F_TIME, .by_default = 1},
     [SEC_ERRORS] = {
         .name = "errors", .key = 'e', .help = "inferred GVW against the truth (simulations)",
         .table = errors_table, .export = errors_export},
@@ -156,7 +169,8 @@ static const section sections[N_SECTIONS] = {
         .filters = F_RANGE},
     [SEC_OVERLOADS] = {
         .name = "overloads", .key = 'O',
-        .help = "ok passages over the legal GVW or axle limit (--config)",
+        .help = "ok passages over their class's legal GVW or an axle group\n"
+                "over its limit (classes: of --config), by class",
         .table = overloads_table, .export = overloads_export, .filters = F_RANGE},
     [SEC_SPEED] = {
         .name = "speed", .key = 'C',
@@ -167,6 +181,15 @@ static const section sections[N_SECTIONS] = {
                    speed_plot_correction}},
         .filters = F_RANGE, .by_default = 1, .default_if = amfi_store_has_estimated,
         .default_when = "when the store has estimated speeds"},
+    [SEC_CLASSES] = {
+        .name = "classes", .key = 'L',
+        .help = "ok passages per vehicle class, all lanes and per lane:\n"
+                "count, share, GVW mean, STD, p5, p50, p95, max, overloaded",
+        .table = classes_table, .export = classes_export, .filters = F_RANGE},
+    [SEC_CLASS_HISTOGRAM] = {
+        .name = "class-histogram", .key = 'Y',
+        .help = "GVW histogram of the ok passages per vehicle class",
+        .table = class_histogram_table, .export = class_histogram_export, .filters = F_RANGE},
 };
 
 /* ---- the other options ------------------------------------------------------- */
@@ -198,17 +221,21 @@ static const option_row option_rows[] = {
                                           "N >= 2"),
     OPT("set-baseline", 1, 'b', 1, "M,S,N", "baseline mean M kg, STD S kg, from N passages"),
     OPT("note", 1, 'n', 1, "TEXT", "note stored with the baseline (<= 127 bytes)"),
+    OPT("force", 0, 'K', 0, NULL, "with --set-baseline*: set it even while an alert is open\n"
+                                 "(refused by default: a baseline from damaged data)"),
     OPT("check", 0, 'k', 1, NULL, "PRAGMA integrity_check and foreign_key_check"),
-    {.first = SEC_PASSAGES, .last = SEC_SPEED},
+    {.first = SEC_PASSAGES, .last = SEC_CLASS_HISTOGRAM},
     OPT("from", 1, 'f', 1, "T, -T, --to T", "only passages in [T, T]: YYYY-MM-DD or "
                                          "YYYY-MM-DDTHH:MM[:SS], UTC"),
     OPT("to", 1, 'T', 1, NULL, NULL),
     OPT("status", 1, 'S', 1, "S", "only passages of status S (--passages)"),
-    OPT("lane", 1, 'l', 1, "N", "only lane N (--passages, --histogram, --overloads, --speed)"),
+    OPT("lane", 1, 'l', 1, "N", "only lane N (the sections marked --lane above)"),
     OPT("bin-kg", 1, 'w', 1, "W", "histogram bin width, kg (default report.histogram_bin_kg)"),
     OPT("format", 1, 'F', 1, "F", "table (default), csv (one section) or json (one document)"),
+    OPT("units", 1, 'U', 0, "U", "tables and plots in si (kg, m/s) or engineering (t, km/h)\n"
+                              "(default report.units: si); CSV and JSON always kg, m/s"),
     OPT("plot", 1, 'p', 1, "DIR", "draw PNGs into DIR (gnuplot): GVW, trend, histogram, per hour, "
-                               "speed"),
+                               "speed,\nresidual, ... [honours --from --to]"),
     OPT("config", 1, 'c', 1, "FILE", "the site's amfid.yaml: alert thresholds, site name, legal "
                                   "limits"),
     OPT("help", 0, 'h', 1, NULL, "this help", .builtin = 1),
@@ -228,11 +255,14 @@ typedef struct options {
     double mean_kg, std_kg;
     int n;
     const char *note;    /* NULL: empty */
+    int force;           /* --force: a baseline even while an alert is open */
     const char *plot_dir;   /* --plot DIR, NULL: none */
     const char *config;     /* --config FILE, NULL: none */
     int format;             /* FMT_* */
     export_opts ex;         /* --from --to --status --lane --bin-kg, limits */
     int bin_given;
+    int units;              /* --units: AMFI_REPORT_UNITS_*, −1: report.units */
+    const char *range_opt;  /* "--from" or "--to" when one was given, else NULL */
 } options;
 
 /* --help: "  -k, --name ARG" in 31 columns, then its text */
@@ -252,6 +282,17 @@ static void help_line(FILE *f, int key, int show_short, const char *name, const 
     fputc('\n', f);
 }
 
+/* A section's --help text and, from its filters, what it honours. */
+static void section_help(int k, char *text, size_t len)
+{
+    const unsigned fl = sections[k].filters;
+    if (fl & F_TIME)
+        snprintf(text, len, "%s\n[honours --from --to%s%s]", sections[k].help,
+                 fl & F_LANE ? " --lane" : "", fl & F_STATUS ? " --status" : "");
+    else
+        snprintf(text, len, "%s\n[the whole store: refuses --from and --to]", sections[k].help);
+}
+
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -261,15 +302,19 @@ static void usage(FILE *f)
             "[--note TEXT] [--check]\n"
             "       [--passages] [--histogram] [--overloads] [--from T] [--to T] "
             "[--status S]\n"
-            "       [--speed] [--lane N] [--bin-kg W] [--format table|csv|json] [--plot DIR] "
-            "[--config FILE]\n"
+            "       [--speed] [--classes] [--class-histogram] [--lane N] [--bin-kg W]\n"
+            "       [--format table|csv|json] [--units si|engineering] [--plot DIR]\n"
+            "       [--config FILE] [--force]\n"
             "\n"
             "Reports on amfid's SQLite store (schema: docs/schema.md).\n");
     for (size_t i = 0; i < N_OPTION_ROWS; i++) {
         const option_row *r = &option_rows[i];
         if (r->last > 0) {
-            for (int k = r->first; k <= r->last; k++)
-                help_line(f, sections[k].key, 1, sections[k].name, NULL, sections[k].help);
+            for (int k = r->first; k <= r->last; k++) {
+                char text[512];
+                section_help(k, text, sizeof text);
+                help_line(f, sections[k].key, 1, sections[k].name, NULL, text);
+            }
         } else if (r->help) {
             help_line(f, r->key, r->show_short, r->name, r->arg, r->help);
         }
@@ -366,6 +411,7 @@ static int parse_args(int argc, char **argv, options *o)
     memcpy(all, longopts, nl * sizeof *all);
     memcpy(all + nl, tail, sizeof tail);
     memset(o, 0, sizeof *o);
+    o->units = -1;
     o->ex.from = 0;
     o->ex.to = AMFI_STORE_MAX_UTIME;
     amfi_cli c;
@@ -403,6 +449,15 @@ static int parse_args(int argc, char **argv, options *o)
                                    amfi_cli_shown(val));
             break;
         case 'X': o->allow_plaintext = 1; break;
+        case 'K': o->force = 1; break;
+        case 'U':
+            if (strcmp(val, "si") == 0)
+                o->units = AMFI_REPORT_UNITS_SI;
+            else if (strcmp(val, "engineering") == 0)
+                o->units = AMFI_REPORT_UNITS_ENGINEERING;
+            else
+                return usage_error(opt, "'%s' is not si or engineering", amfi_cli_shown(val));
+            break;
         case 'f':
         case 'T':
             {
@@ -412,6 +467,8 @@ static int parse_args(int argc, char **argv, options *o)
                     return usage_error(opt, "'%s' is not a UTC time (%s): use YYYY-MM-DD, "
                                        "YYYY-MM-DDTHH:MM[:SS[.ffffff]][Z]",
                                        amfi_cli_shown(val), why);
+                if (!o->range_opt)
+                    o->range_opt = k == 'f' ? "--from" : "--to";
             }
             break;
         case 'S': {
@@ -501,11 +558,46 @@ static int check_args(options *o)
     if (o->note && !o->baseline_last && !o->baseline_given)
         return usage_error("--note", "only with --set-baseline-last or "
                            "--set-baseline");
+    if (o->force && !o->baseline_last && !o->baseline_given)
+        return usage_error("--force", "only with --set-baseline-last or --set-baseline");
     if (o->ex.from > o->ex.to)
         return usage_error("--from", "after --to");
+    if (o->range_opt && (o->check || o->baseline_last || o->baseline_given))
+        return usage_error(o->range_opt, "%s works on the whole store and does not honour "
+                           "--from/--to", o->check ? "--check" : o->baseline_last
+                           ? "--set-baseline-last" : "--set-baseline");
     if (!asked && !o->check && !o->plot_dir && !o->baseline_last && !o->baseline_given)
         for (int k = 0; k < N_SECTIONS; k++)
             o->sel[k] = sections[k].by_default ? (sections[k].default_if ? 2 : 1) : 0;
+    /* every section asked for (or shown by default) honours the range, or
+     * it is refused: never silently the whole store */
+    for (int k = 0; o->range_opt && k < N_SECTIONS; k++)
+        if (o->sel[k] && !(sections[k].filters & F_TIME)) {
+            char with[256] = "";
+            size_t at = 0;
+            for (int j = 0; j < N_SECTIONS; j++)
+                if ((sections[j].filters & F_TIME) && at < sizeof with)
+                    at += (size_t)snprintf(with + at, sizeof with - at, "--%s ",
+                                           sections[j].name);
+            return usage_error(o->range_opt, "--%s%s reports the whole store and does not honour "
+                               "--from/--to; these do: %s--plot", sections[k].name,
+                               asked ? "" : " (shown with no section asked for)", with);
+        }
+    /* --lane likewise */
+    for (int k = 0; o->ex.lane_given && k < N_SECTIONS; k++)
+        if (o->sel[k] && !(sections[k].filters & F_LANE)) {
+            char with[256] = "";
+            size_t at = 0;
+            for (int j = 0; j < N_SECTIONS; j++)
+                if ((sections[j].filters & F_LANE) && at < sizeof with)
+                    at += (size_t)snprintf(with + at, sizeof with - at, "%s--%s",
+                                           at ? " " : "", sections[j].name);
+            return usage_error("--lane", "--%s%s covers every lane and does not honour --lane; "
+                               "these do: %s", sections[k].name,
+                               asked ? "" : " (shown with no section asked for)", with);
+        }
+    if (o->ex.lane_given && (o->check || o->baseline_last || o->baseline_given || o->plot_dir))
+        return usage_error("--lane", "--check, --set-baseline* and --plot cover every lane");
     for (int k = 0; k < N_SECTIONS; k++)
         n_status += o->sel[k] && (sections[k].filters & F_STATUS);
     if (o->ex.status && !n_status) {
@@ -542,7 +634,29 @@ static int set_baseline(const options *o, const report_ctx *c)
         fprintf(stderr, PROG ": %s\n", err); /* starts with the path */
         return -1;
     }
-    if (o->baseline_last) {
+    /* an open alert: the recent passages may come from a damaged bridge,
+     * and a baseline taken from them would hide the damage */
+    amfi_alert_rec *open = NULL;
+    int n_open = 0;
+    if (amfi_store_open_alerts(s, &open, &n_open, err, sizeof err) != 0)
+        rc = data_error(c, "%s", err);
+    if (rc == 0 && n_open > 0) {
+        char t[32], names[512] = "";
+        size_t at = 0;
+        for (int k = 0; k < n_open && at < sizeof names; k++)
+            at += (size_t)snprintf(names + at, sizeof names - at, "%s%s %s (since %s UTC)",
+                                   k ? ", " : "", amfi_cli_shown(open[k].level),
+                                   amfi_cli_shown(open[k].kind), report_utc(open[k].utime, t));
+        if (o->force)
+            printf("warning: --force: a baseline while %d alert%s open: %s\n", n_open,
+                   n_open > 1 ? "s are" : " is", names);
+        else
+            rc = data_error(c, "%d alert%s open: %s; a baseline now may be taken from damaged "
+                            "data: clear the cause first, or give --force", n_open,
+                            n_open > 1 ? "s are" : " is", names);
+    }
+    free(open);
+    if (rc == 0 && o->baseline_last) {
         g = malloc((size_t)o->baseline_last * sizeof *g);
         if (!g)
             rc = data_error(c, "out of memory");
@@ -557,7 +671,7 @@ static int set_baseline(const options *o, const report_ctx *c)
             report_mean_std(g, (size_t)n, &b.mean_kg, &b.std_kg);
             b.n = n;
         }
-    } else {
+    } else if (rc == 0) {
         b.mean_kg = o->mean_kg;
         b.std_kg = o->std_kg;
         b.n = o->n;
@@ -578,10 +692,12 @@ static int set_baseline(const options *o, const report_ctx *c)
     }
     if (rc == 0) {
         char t[32];
-        printf("baseline set: mean %.0f kg, STD %.0f kg, n %d, manual, from "
-               "%s UTC\n", b.mean_kg, b.std_kg, b.n, report_utc(b.utime_set, t));
-        printf("(amfid reads the newest baseline row when it starts: restart "
-               "it to use this one)\n");
+        char m1[32], m2[32];
+        const char *u = report_mass_unit(c->units);
+        printf("baseline set: mean %s %s, STD %s %s, n %d, manual, from %s UTC\n",
+               report_mass(c->units, b.mean_kg, m1), u, report_mass(c->units, b.std_kg, m2), u,
+               b.n, report_utc(b.utime_set, t));
+        printf("(a running amfid applies the newest baseline row within a few seconds)\n");
     }
     free(g);
     amfi_store_close(s);
@@ -660,9 +776,11 @@ static void print_next(const options *o)
 static void context_for(report_ctx *c, const options *o, int k)
 {
     c->ex = o->ex;
-    if (!(sections[k].filters & F_RANGE)) {
+    if (!(sections[k].filters & F_TIME)) {
         c->ex.from = 0;
         c->ex.to = AMFI_STORE_MAX_UTIME;
+    }
+    if (!(sections[k].filters & F_LANE)) {
         c->ex.lane_given = 0;
         c->ex.lane = 0;
     }
@@ -773,8 +891,9 @@ static int run_section(const options *o, report_ctx *c, int k, int *printed)
 }
 
 /* --plot: site name from the store's meta (site.name), else the config's
- * bridge.name, else the database's file name; thresholds from --config or
- * the indicator defaults. Every section's plots, in their places. */
+ * bridge.name, else the database's file name; thresholds from what amfid
+ * recorded in the store (meta daemon.indicators), else --config, else the
+ * indicator defaults. Every section's plots, in their places. */
 static int plot(const options *o, const amfi_site_config *cfg, const report_ctx *c)
 {
     amfi_store *s = c->s;
@@ -782,11 +901,26 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
     int found = 0;
     amfi_indicator_params ip;
     amfi_indicator_params_default(&ip);
+    const char *ip_from = "built-in defaults";
     if (amfi_store_meta_get(s, "site.name", site, sizeof site, &found, err,
                             sizeof err) != 0)
         return data_error(c, "%s", err);
-    if (cfg) {
+    /* the thresholds: what amfid ran with (meta daemon.indicators), else
+     * --config's, else the defaults */
+    char rec[4097], why[256];
+    int have_rec = 0;
+    if (amfi_store_meta_get(s, "daemon.indicators", rec, sizeof rec, &have_rec, err,
+                            sizeof err) != 0)
+        return data_error(c, "%s", err);
+    if (have_rec) {
+        if (amfi_indicator_params_parse(rec, &ip, why, sizeof why) != 0)
+            return data_error(c, "meta daemon.indicators: %s", why);
+        ip_from = "amfid's, from the store";
+    } else if (cfg) {
         ip = cfg->daemon.indicators;
+        ip_from = "--config";
+    }
+    if (cfg) {
         if (!found) {
             snprintf(site, sizeof site, "%s", cfg->site.name);
             found = 1;
@@ -797,18 +931,20 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
         snprintf(site, sizeof site, "%s", b ? b + 1 : o->db);
     }
     /* every section's plots in their places */
-    enum { MAX_PLOTS = N_SECTIONS * 4 };
+    enum { MAX_PLOTS = N_SECTIONS * MAX_SECTION_PLOTS };
     const plot_def *order[MAX_PLOTS], *made[MAX_PLOTS];
     int n_plots = 0, n_made = 0, rc = 0;
     for (int k = 0; k < N_SECTIONS; k++)
-        for (int j = 0; j < 4 && sections[k].plots[j].place > 0; j++) {
+        for (int j = 0; j < MAX_SECTION_PLOTS && sections[k].plots[j].place > 0; j++) {
             int i = n_plots++;
             for (; i > 0 && order[i - 1]->place > sections[k].plots[j].place; i--)
                 order[i] = order[i - 1];
             order[i] = &sections[k].plots[j];
         }
     report_plot_frame p;
-    rc = report_plot_begin(&p, s, o->plot_dir, site, &ip, err, sizeof err);
+    rc = report_plot_begin(&p, s, o->plot_dir, site, &ip, o->ex.from, o->ex.to, err, sizeof err);
+    p.ip_from = ip_from;
+    p.units = c->units;
     for (int i = 0; rc == 0 && i < n_plots; i++) {
         int drawn = 0;
         rc = order[i]->draw(&p, &drawn, err, sizeof err);
@@ -915,6 +1051,32 @@ static int report_main(options *op)
     c.site = o.site;
     c.format = o.format;
     c.cfg = o.config ? cfg : NULL;
+    /* the classes and limits: what amfid ran with (meta daemon.classes),
+     * else --config's, else the defaults */
+    static amfi_class_params recorded;
+    char rec[4097];
+    int have_rec = 0;
+    c.classes = &cfg->classes;
+    c.classes_from = o.config ? "--config" : "built-in defaults";
+    if (amfi_store_meta_get(c.s, "daemon.classes", rec, sizeof rec, &have_rec, err,
+                            sizeof err) != 0) {
+        data_error(&c, "%s", err);
+        amfi_store_close(c.s);
+        free(cfg);
+        return EXIT_DATA;
+    }
+    if (have_rec) {
+        char why[256];
+        if (amfi_class_params_parse(rec, &recorded, why, sizeof why) != 0) {
+            data_error(&c, "meta daemon.classes: %s", why);
+            amfi_store_close(c.s);
+            free(cfg);
+            return EXIT_DATA;
+        }
+        c.classes = &recorded;
+        c.classes_from = "amfid's, from the store";
+    }
+    c.units = o.units >= 0 ? o.units : cfg->report.units;
     c.out = stdout;
     /* the sections shown by default only when the store has their data */
     for (int k = 0; k < N_SECTIONS; k++) {

@@ -15,9 +15,11 @@
  *   report_passages.c    --passages, --histogram, --overloads; gvw.png,
  *                        gvw_histogram.png, passages_per_hour.png, speed.png
  *   report_speed.c       --speed; speed_correction.png
+ *   report_classes.c     --classes and --class-histogram
  *   report_scale.c       the scale and known-truck lines; scale.png,
  *                        known_truck.png, temperature.png
  *   report_natfreq.c     the natural-frequency lines; natfreq.png
+ *   report_residual.c    the solver's residual line; residual.png
  *   report_pg.c          --pg: the fleet and one site from PostgreSQL
  *   report_cols.c        CSV and JSON of a column list (report_cols.h)
  *   report_plot.c        gnuplot helpers and the plot frame (report_plot.h)
@@ -26,15 +28,17 @@
  * Who calls whom (tests/common/call_graph.sh reads it from the objects
  * with nm, fails on a circle and when this list differs; report_cols.c,
  * report_plot.c, report_util.c and report_pg.c call no report file):
- *   amfi-report.c -> report_indicators.c report_natfreq.c report_passages.c report_pg.c
- *   amfi-report.c -> report_plot.c report_scale.c report_speed.c report_summary.c
+ *   amfi-report.c -> report_classes.c report_indicators.c report_natfreq.c report_passages.c report_pg.c
+ *   amfi-report.c -> report_plot.c report_residual.c report_scale.c report_speed.c report_summary.c
  *   amfi-report.c -> report_util.c
+ *   report_classes.c -> report_cols.c report_util.c
  *   report_indicators.c -> report_cols.c report_plot.c report_util.c
  *   report_natfreq.c -> report_plot.c
  *   report_passages.c -> report_cols.c report_plot.c report_util.c
+ *   report_residual.c -> report_plot.c report_util.c
  *   report_scale.c -> report_plot.c
  *   report_speed.c -> report_cols.c report_plot.c report_util.c
- *   report_summary.c -> report_cols.c report_natfreq.c report_scale.c report_util.c
+ *   report_summary.c -> report_cols.c report_natfreq.c report_residual.c report_scale.c report_util.c
  *
  * Single-threaded, the caller's thread; the store is read through store/.
  */
@@ -76,6 +80,9 @@ typedef struct report_ctx {
     FILE *out;
     json_t *root;                 /* FMT_JSON: the document */
     const amfi_site_config *cfg;  /* --config, or NULL */
+    const amfi_class_params *classes; /* amfid's (meta daemon.classes), else --config's, else the defaults */
+    const char *classes_from;     /* which of the three, for the output */
+    int units;                    /* AMFI_REPORT_UNITS_*: of the tables (not CSV, JSON) */
     char err[512];
 } report_ctx;
 
@@ -101,6 +108,17 @@ const char *report_utc(long long utime, char buf[32]);
 const char *report_duration(double s, char buf[32]);
 /* "-" for NaN, else printf of fmt into buf. */
 const char *report_num(double x, const char *fmt, char buf[32]);
+
+/* The units of the tables and plots (units: AMFI_REPORT_UNITS_*): a mass in
+ * kg ("%.0f") or t ("%.2f"), a speed in m/s ("%.2f") or km/h ("%.1f"); the
+ * value, its unit, and the number as text ("-" for NaN). CSV and JSON stay
+ * in kg and m/s. */
+double report_mass_val(int units, double kg);
+const char *report_mass_unit(int units);
+const char *report_mass(int units, double kg, char buf[32]);
+double report_speed_val(int units, double mps);
+const char *report_speed_unit(int units);
+const char *report_speed(int units, double mps, char buf[32]);
 
 /* ISO 8601 in UTC: "2025-11-22", "2025-11-22T13:05", "2025-11-22 13:05:09",
  * "2025-11-22T13:05:09.25", each with an optional Z or zero offset (+00:00):

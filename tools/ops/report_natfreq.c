@@ -102,12 +102,15 @@ int natfreq_plot(report_plot_frame *p, int *made, char *err, size_t errlen)
     FILE *gp = p->gp;
     amfi_f1_rec *a = NULL;
     size_t n = 0;
-    if (amfi_store_f1_series(s, 0, AMFI_STORE_MAX_UTIME, 0, &a, &n, err, errlen) != 0)
+    if (amfi_store_f1_series(s, p->from, p->to, 0, &a, &n, err, errlen) != 0)
         return -1;
     if (n == 0) {
         free(a);
         return 0;
     }
+    size_t n_comp = 0; /* no legend entry for a series without a point */
+    for (size_t k = 0; k < n; k++)
+        n_comp += isfinite(a[k].f1_comp_hz) != 0;
     FILE *f = report_data_open(dir, "natfreq.dat", err, errlen);
     if (!f) {
         free(a);
@@ -128,11 +131,10 @@ int natfreq_plot(report_plot_frame *p, int *made, char *err, size_t errlen)
             "set title \"Natural frequency f1 from each passage's free vibration: raw and "
             "temperature-compensated\\n%s\"\n"
             "set xlabel 'time (UTC, data time)'\nset ylabel 'f1 (Hz)'\n"
-            "plot d.'natfreq.dat' using 1:2 with points pt 7 ps 0.4 lc rgb '#aaaaaa' title 'raw', \\\n"
-            "     d.'natfreq.dat' using 1:3 with points pt 7 ps 0.4 lc rgb '#1f77b4' title "
-            "'compensated'\n"
+            "plot d.'natfreq.dat' using 1:2 with points pt 7 ps 0.4 lc rgb '#aaaaaa' title 'raw'%s\n"
             "set output\n",
-            sub);
+            sub, n_comp ? ", \\\n     d.'natfreq.dat' using 1:3 with points pt 7 ps 0.4 "
+                          "lc rgb '#1f77b4' title 'compensated'" : "");
     *made = 1;
     return 0;
 }

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amfi_classify.h"
 #include "report_cols.h"
 
 #define MAX_LANES 64 /* distinct lanes a histogram keeps apart */
@@ -90,27 +91,23 @@ static const report_col passage_cols[] = {
 
 typedef struct list_ctx {
     int fmt;
+    int units;
     FILE *f;
     int64_t n;
     int werr; /* 1: the output refused a write */
 } list_ctx;
 
-static void table_line(FILE *f, int64_t id, const amfi_passage_row *r)
+static void table_line(FILE *f, int units, int64_t id, const amfi_passage_row *r)
 {
-    char t[32], loads[12 * 10 + 1] = "";
+    char t[32], loads[12 * 10 + 1] = "", m[32];
     size_t used = 0;
     for (int a = 0; a < r->n_axles && used < sizeof loads; a++) {
-        int w = isnan(r->axle_kg[a])
-                    ? snprintf(loads + used, sizeof loads - used, "%s-", a ? "/" : "")
-                    : snprintf(loads + used, sizeof loads - used, "%s%.0f", a ? "/" : "",
-                               r->axle_kg[a]);
+        int w = snprintf(loads + used, sizeof loads - used, "%s%s", a ? "/" : "",
+                         report_mass(units, r->axle_kg[a], m));
         used += w > 0 ? (size_t)w : 0;
     }
-    char sp[16] = "-", gvw[16] = "-";
-    if (!isnan(r->speed_mps))
-        snprintf(sp, sizeof sp, "%.2f", r->speed_mps);
-    if (!isnan(r->gvw_kg))
-        snprintf(gvw, sizeof gvw, "%.0f", r->gvw_kg);
+    char spb[32], gvwb[32];
+    const char *sp = report_speed(units, r->speed_mps, spb), *gvw = report_mass(units, r->gvw_kg, gvwb);
     fprintf(f, "%-20s  %8lld  %10lld  %4d  %6s  %2d  %8s  %-28s  %-8s  %.200s\n",
             report_iso(r->utime, t), (long long)id, (long long)r->vehicle_id, r->lane, sp,
             r->n_axles, gvw, loads[0] ? loads : "-", r->status, r->reason);
@@ -121,7 +118,7 @@ static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
     list_ctx *c = vctx;
     c->n++;
     if (c->fmt == FMT_TABLE) {
-        table_line(c->f, id, r);
+        table_line(c->f, c->units, id, r);
         return 0;
     }
     pas_row row = {.id = id, .r = r};
@@ -143,11 +140,14 @@ static int list_one(void *vctx, int64_t id, const amfi_passage_row *r)
 
 static int list(report_ctx *c, int fmt)
 {
-    list_ctx l = {fmt, c->out, 0, 0};
+    list_ctx l = {fmt, c->units, c->out, 0, 0};
     FILE *f = c->out;
+    char hg[16], hl[32];
+    snprintf(hg, sizeof hg, "GVW %s", report_mass_unit(c->units));
+    snprintf(hl, sizeof hl, "axle loads %s", report_mass_unit(c->units));
     if (fmt == FMT_TABLE)
         fprintf(f, "== passages\n%-20s  %8s  %10s  %4s  %6s  %2s  %8s  %-28s  %-8s  %s\n",
-                "time (UTC)", "id", "vehicle", "lane", "m/s", "ax", "GVW kg", "axle loads kg",
+                "time (UTC)", "id", "vehicle", "lane", report_speed_unit(c->units), "ax", hg, hl,
                 "status", "reason");
     else if (fmt == FMT_CSV)
         report_cols_csv_header(f, passage_cols, REPORT_NCOLS(passage_cols), NULL, 0);
@@ -288,7 +288,10 @@ int histogram_table(report_ctx *c)
         return -1;
     }
     int64_t lane_total[MAX_LANES] = {0};
-    fprintf(f, "== GVW histogram of ok passages, %.0f kg bins\n%-17s", c->ex.bin_kg, "GVW kg");
+    char bw[32], hg[16], lo[32], hi[32];
+    snprintf(hg, sizeof hg, "GVW %s", report_mass_unit(c->units));
+    fprintf(f, "== GVW histogram of ok passages, %s %s bins\n%-17s",
+            report_mass(c->units, c->ex.bin_kg, bw), report_mass_unit(c->units), hg);
     for (int i = 0; i < h.n_lanes; i++)
         fprintf(f, "  lane %-4d", h.sorted[i]);
     fprintf(f, "  %9s\n", "all");
@@ -297,7 +300,7 @@ int histogram_table(report_ctx *c)
         bin_of(&h, b, &r);
         if (r.all == 0)
             continue;
-        fprintf(f, "%7.0f .. %7.0f", r.lo, r.hi);
+        fprintf(f, "%7s .. %7s", report_mass(c->units, r.lo, lo), report_mass(c->units, r.hi, hi));
         for (int i = 0; i < h.n_lanes; i++) {
             lane_total[i] += r.n[i];
             fprintf(f, "  %9lld", (long long)r.n[i]);
@@ -350,12 +353,21 @@ int histogram_export(report_ctx *c)
 
 /* ---- overloads -------------------------------------------------------------------- */
 
+/* What a passage exceeded: its class's GVW limit, or a group's (a single
+ * axle outside groups is a group of one). */
+typedef struct over_item {
+    int group;             /* 0: the gross weight; 1: an axle group */
+    int first, n_axles;    /* the group's axles, 0-based (group) */
+    const char *kind;      /* "gross", or the group's kind */
+    double load_kg, limit_kg;
+} over_item;
+
 typedef struct over_row {
     int64_t id;
     const amfi_passage_row *r;
-    char t[32], what[16];
-    double gvw_pct, max_axle_kg, axle_pct;
-    int max_axle;
+    char t[32], cls[AMFI_CLASS_NAME_LEN], axles[64];
+    double gvw_limit_kg;
+    const over_item *it; /* the CSV line's item */
 } over_row;
 
 #define O(row) ((const over_row *)(row))
@@ -364,101 +376,257 @@ static void o_utime(const void *w, report_val *v) { v->i = O(w)->r->utime; }
 static void o_id(const void *w, report_val *v) { v->i = O(w)->id; }
 static void o_vehicle(const void *w, report_val *v) { v->i = O(w)->r->vehicle_id; }
 static void o_lane(const void *w, report_val *v) { v->i = O(w)->r->lane; }
+static void o_class(const void *w, report_val *v) { v->s = O(w)->cls; }
 static void o_gvw(const void *w, report_val *v) { v->x = O(w)->r->gvw_kg; }
-static void o_gvw_pct(const void *w, report_val *v) { v->x = O(w)->gvw_pct; }
-static void o_max_axle_kg(const void *w, report_val *v) { v->x = O(w)->max_axle_kg; }
-static void o_max_axle(const void *w, report_val *v) { v->i = O(w)->max_axle; }
-static void o_axle_pct(const void *w, report_val *v) { v->x = O(w)->axle_pct; }
-static void o_what(const void *w, report_val *v) { v->s = O(w)->what; }
+static void o_gvw_limit(const void *w, report_val *v) { v->x = O(w)->gvw_limit_kg; }
+static void o_limit(const void *w, report_val *v) { v->s = O(w)->it->group ? "group" : "gvw"; }
+static void o_axles(const void *w, report_val *v)
+{
+    v->s = O(w)->axles;
+    v->null = !O(w)->it->group;
+}
+static void o_kind(const void *w, report_val *v) { v->s = O(w)->it->kind; }
+static void o_load(const void *w, report_val *v) { v->x = O(w)->it->load_kg; }
+static void o_limit_kg(const void *w, report_val *v) { v->x = O(w)->it->limit_kg; }
+static void o_pct(const void *w, report_val *v)
+{
+    v->x = 100.0 * (O(w)->it->load_kg / O(w)->it->limit_kg - 1);
+}
 #undef O
 
+/* CSV: one line per limit exceeded; JSON: these inside each passage's
+ * "exceeded" array (over_item_cols) after its columns (over_cols). */
 static const report_col over_cols[] = {
     REPORT_COL("time_utc", COL_WORD, "", NULL, COL_BOTH, o_time),
     REPORT_COL("utime", COL_INT, "us", NULL, COL_BOTH, o_utime),
     REPORT_COL("passage_id", COL_INT, "", NULL, COL_BOTH, o_id),
     REPORT_COL("vehicle_id", COL_INT, "", NULL, COL_BOTH, o_vehicle),
     REPORT_COL("lane", COL_INT, "", NULL, COL_BOTH, o_lane),
+    REPORT_COL("class", COL_TEXT, "", NULL, COL_BOTH, o_class),
     REPORT_COL("gvw_kg", COL_NUM, "kg", "%.1f", COL_BOTH, o_gvw),
-    REPORT_COL("gvw_over_pct", COL_NUM, "%", "%.3f", COL_CSV, o_gvw_pct),
-    REPORT_COL("max_axle_kg", COL_NUM, "kg", "%.1f", COL_BOTH, o_max_axle_kg),
-    REPORT_COL("max_axle", COL_INT, "", NULL, COL_BOTH, o_max_axle),
-    REPORT_COL("axle_over_pct", COL_NUM, "%", "%.3f", COL_CSV, o_axle_pct),
-    REPORT_COL("over", COL_WORD, "", NULL, COL_BOTH, o_what),
+    REPORT_COL("gvw_limit_kg", COL_NUM, "kg", "%.1f", COL_BOTH, o_gvw_limit),
+    REPORT_COL("limit", COL_WORD, "", NULL, COL_CSV, o_limit),
+    REPORT_COL("axles", COL_WORD, "", NULL, COL_CSV, o_axles),
+    REPORT_COL("kind", COL_WORD, "", NULL, COL_CSV, o_kind),
+    REPORT_COL("load_kg", COL_NUM, "kg", "%.1f", COL_CSV, o_load),
+    REPORT_COL("limit_kg", COL_NUM, "kg", "%.1f", COL_CSV, o_limit_kg),
+    REPORT_COL("over_pct", COL_NUM, "%", "%.3f", COL_CSV, o_pct),
 };
+static const report_col over_item_cols[] = {
+    REPORT_COL("limit", COL_WORD, "", NULL, COL_JSON, o_limit),
+    REPORT_COL("axles", COL_WORD, "", NULL, COL_JSON, o_axles),
+    REPORT_COL("kind", COL_WORD, "", NULL, COL_JSON, o_kind),
+    REPORT_COL("load_kg", COL_NUM, "kg", "%.1f", COL_JSON, o_load),
+    REPORT_COL("limit_kg", COL_NUM, "kg", "%.1f", COL_JSON, o_limit_kg),
+    REPORT_COL("over_pct", COL_NUM, "%", "%.3f", COL_JSON, o_pct),
+};
+
+#define MAX_OVER_CLASSES 32
+
+/* The counts of one class. */
+typedef struct over_class {
+    char name[AMFI_CLASS_NAME_LEN];
+    int64_t checked, over_gvw, over_group, over_any;
+} over_class;
 
 typedef struct over_ctx {
     const export_opts *o;
+    int units;
+    const amfi_class_params *cp;
     int fmt;
     FILE *f;
     json_t *arr;
-    int64_t checked, over_gvw, over_axle, over_any;
+    int64_t checked, over_gvw, over_group, over_any, unclassified;
+    over_class cls[MAX_OVER_CLASSES + 1]; /* the last: every further class */
+    int n_cls;
 } over_ctx;
+
+static over_class *class_counts(over_ctx *c, const char *name)
+{
+    for (int i = 0; i < c->n_cls; i++)
+        if (strcmp(c->cls[i].name, name) == 0)
+            return &c->cls[i];
+    if (c->n_cls == MAX_OVER_CLASSES + 1)
+        return &c->cls[MAX_OVER_CLASSES];
+    over_class *k = &c->cls[c->n_cls++];
+    snprintf(k->name, sizeof k->name, "%s", c->n_cls == MAX_OVER_CLASSES + 1 ? "other" : name);
+    return k;
+}
+
+/* "2-3": the 1-based axles first .. first + n − 1 */
+static void axle_words(int first, int n, char *buf, size_t len)
+{
+    if (n == 1)
+        snprintf(buf, len, "%d", first + 1);
+    else
+        snprintf(buf, len, "%d-%d", first + 1, first + n);
+}
 
 static int over_one(void *vctx, int64_t id, const amfi_passage_row *r)
 {
     over_ctx *c = vctx;
+    amfi_classification cl;
+    char why[256];
+    over_row w = {.id = id, .r = r};
+    over_item it[AMFI_MAX_AXLES + 1];
+    int n_it = 0;
     c->checked++;
-    over_row w = {.id = id, .r = r, .max_axle_kg = -INFINITY};
-    for (int a = 0; a < r->n_axles; a++)
-        if (r->axle_kg[a] > w.max_axle_kg)
-            w.max_axle_kg = r->axle_kg[a], w.max_axle = a + 1;
-    int og = r->gvw_kg > c->o->gvw_limit_kg, oa = w.max_axle_kg > c->o->axle_limit_kg;
+    /* the class, its groups and their limits (classes: of --config, else
+     * the defaults); the report.limits where no class limit is known */
+    if (amfi_classify(c->cp, r->n_axles, r->spacing_m, r->axle_kg, &cl, why, sizeof why) != 0) {
+        c->unclassified++;
+        memset(&cl, 0, sizeof cl);
+        snprintf(cl.name, sizeof cl.name, "unknown");
+        cl.gvw_limit_kg = NAN;
+        cl.n_groups = r->n_axles;
+        for (int a = 0; a < r->n_axles; a++)
+            cl.group[a] = (amfi_axle_group){.first = a, .n_axles = 1, .load_kg = r->axle_kg[a],
+                                            .kind = AMFI_GROUP_SINGLE, .limit_kg = NAN};
+    }
+    snprintf(w.cls, sizeof w.cls, "%s", cl.name);
+    w.gvw_limit_kg = isfinite(cl.gvw_limit_kg) && cl.gvw_limit_kg > 0 ? cl.gvw_limit_kg
+                                                                      : c->o->gvw_limit_kg;
+    if (r->gvw_kg > w.gvw_limit_kg)
+        it[n_it++] = (over_item){0, 0, 0, "gross", r->gvw_kg, w.gvw_limit_kg};
+    int og = n_it > 0, ogr = 0;
+    for (int g = 0; g < cl.n_groups; g++) {
+        const amfi_axle_group *gr = &cl.group[g];
+        double lim = gr->limit_kg;
+        if (!(isfinite(lim) && lim > 0) && gr->n_axles == 1)
+            lim = c->o->axle_limit_kg; /* a single axle without a class limit */
+        if (isfinite(lim) && lim > 0 && gr->load_kg > lim) {
+            it[n_it++] = (over_item){1, gr->first, gr->n_axles, amfi_group_kind_name(gr->kind),
+                                     gr->load_kg, lim};
+            ogr = 1;
+        }
+    }
+    over_class *k = class_counts(c, cl.name);
+    k->checked++;
+    k->over_gvw += og;
+    k->over_group += ogr;
+    k->over_any += og || ogr;
     c->over_gvw += og;
-    c->over_axle += oa;
-    if (!og && !oa)
+    c->over_group += ogr;
+    if (!og && !ogr)
         return 0;
     c->over_any++;
-    snprintf(w.what, sizeof w.what, "%s%s%s", og ? "gvw" : "", og && oa ? "+" : "",
-             oa ? "axle" : "");
     report_iso(r->utime, w.t);
-    w.gvw_pct = 100.0 * (r->gvw_kg / c->o->gvw_limit_kg - 1);
-    w.axle_pct = 100.0 * (w.max_axle_kg / c->o->axle_limit_kg - 1);
-    if (c->fmt == FMT_TABLE)
-        fprintf(c->f, "%-20s  %8lld  %10lld  %4d  %8.0f  %+6.1f %%  %8.0f (axle %d)  %+6.1f %%  %s\n",
-                w.t, (long long)id, (long long)r->vehicle_id, r->lane, r->gvw_kg, w.gvw_pct,
-                w.max_axle_kg, w.max_axle, w.axle_pct, w.what);
-    else if (c->fmt == FMT_CSV)
-        report_cols_csv_row(c->f, over_cols, REPORT_NCOLS(over_cols), &w);
-    else
-        json_array_append_new(c->arr,
-                              report_cols_json_row(over_cols, REPORT_NCOLS(over_cols), &w, COL_JSON));
+    if (c->fmt == FMT_TABLE) {
+        char m1[32], m2[32];
+        fprintf(c->f, "%-20s  %8lld  %10lld  %4d  %-7.7s  %8s  %8s ", w.t, (long long)id,
+                (long long)r->vehicle_id, r->lane, w.cls, report_mass(c->units, r->gvw_kg, m1),
+                report_mass(c->units, w.gvw_limit_kg, m2));
+        for (int i = 0; i < n_it; i++) {
+            char ax[64];
+            axle_words(it[i].first, it[i].n_axles, ax, sizeof ax);
+            if (it[i].group)
+                fprintf(c->f, "%s axle%s %s %s %s > %s %s (%+.1f %%)", i ? ";" : "",
+                        it[i].n_axles > 1 ? "s" : "", ax, it[i].kind,
+                        report_mass(c->units, it[i].load_kg, m1),
+                        report_mass(c->units, it[i].limit_kg, m2), report_mass_unit(c->units),
+                        100.0 * (it[i].load_kg / it[i].limit_kg - 1));
+            else
+                fprintf(c->f, " GVW %+.1f %%", 100.0 * (it[i].load_kg / it[i].limit_kg - 1));
+        }
+        fputc('\n', c->f);
+    } else if (c->fmt == FMT_CSV) {
+        for (int i = 0; i < n_it; i++) {
+            w.it = &it[i];
+            axle_words(it[i].first, it[i].n_axles, w.axles, sizeof w.axles);
+            report_cols_csv_row(c->f, over_cols, REPORT_NCOLS(over_cols), &w);
+        }
+    } else {
+        json_t *o = report_cols_json_row(over_cols, REPORT_NCOLS(over_cols), &w, COL_JSON);
+        json_t *ex = json_array();
+        for (int i = 0; i < n_it; i++) {
+            w.it = &it[i];
+            axle_words(it[i].first, it[i].n_axles, w.axles, sizeof w.axles);
+            json_array_append_new(ex, report_cols_json_row(over_item_cols,
+                                                           REPORT_NCOLS(over_item_cols), &w,
+                                                           COL_JSON));
+        }
+        json_object_set_new(o, "exceeded", ex);
+        json_array_append_new(c->arr, o);
+    }
     return 0;
+}
+
+static int cmp_class(const void *a, const void *b)
+{
+    return strcmp(((const over_class *)a)->name, ((const over_class *)b)->name);
 }
 
 static int overloads(report_ctx *rc, int fmt)
 {
     const export_opts *o = &rc->ex;
-    over_ctx c = {o, fmt, rc->out, NULL, 0, 0, 0, 0};
+    over_ctx *c = calloc(1, sizeof *c);
+    if (!c)
+        return report_fail(rc, "out of memory");
+    *c = (over_ctx){.o = o, .units = rc->units, .cp = rc->classes, .fmt = fmt, .f = rc->out};
+    char hg[16], hl[16], l1[32], l2[32];
+    snprintf(hg, sizeof hg, "GVW %s", report_mass_unit(rc->units));
+    snprintf(hl, sizeof hl, "limit %s", report_mass_unit(rc->units));
+    const char *scheme = amfi_class_scheme_name(rc->classes->scheme);
     if (fmt == FMT_TABLE)
-        fprintf(c.f, "== overloads (ok passages; limits: GVW %.0f kg, axle %.0f kg)\n"
-                     "%-20s  %8s  %10s  %4s  %8s  %8s  %-19s  %8s  %s\n",
-                o->gvw_limit_kg, o->axle_limit_kg, "time (UTC)", "id", "vehicle", "lane",
-                "GVW kg", "over", "heaviest axle kg", "over", "limit");
+        fprintf(c->f, "== overloads (ok passages; limits by class and axle group, scheme %s, %s; "
+                      "report.limits GVW %s %s, axle %s %s where no class limit applies)\n"
+                      "%-20s  %8s  %10s  %4s  %-7s  %8s  %8s  %s\n",
+                scheme, rc->classes_from ? rc->classes_from : "built-in defaults", report_mass(rc->units, o->gvw_limit_kg, l1), report_mass_unit(rc->units),
+                report_mass(rc->units, o->axle_limit_kg, l2), report_mass_unit(rc->units),
+                "time (UTC)", "id", "vehicle", "lane", "class", hg, hl, "exceeded");
     else if (fmt == FMT_CSV)
-        report_cols_csv_header(c.f, over_cols, REPORT_NCOLS(over_cols), NULL, 0);
+        report_cols_csv_header(c->f, over_cols, REPORT_NCOLS(over_cols), NULL, 0);
     else
-        c.arr = json_array();
-    if (each(rc, "ok", over_one, &c) != 0) {
-        json_decref(c.arr);
+        c->arr = json_array();
+    if (each(rc, "ok", over_one, c) != 0) {
+        json_decref(c->arr);
+        free(c);
         return -1;
     }
-    if (fmt == FMT_TABLE)
-        fprintf(c.f, "checked %lld ok passages: %lld over the GVW limit, %lld with an axle over "
-                     "the axle limit, %lld overloaded in all (%.2f %%)\n",
-                (long long)c.checked, (long long)c.over_gvw, (long long)c.over_axle,
-                (long long)c.over_any,
-                c.checked ? 100.0 * (double)c.over_any / (double)c.checked : 0.0);
-    else if (fmt == FMT_JSON) {
-        json_t *ob = json_object();
+    qsort(c->cls, (size_t)c->n_cls, sizeof *c->cls, cmp_class);
+    if (fmt == FMT_TABLE) {
+        fprintf(c->f, "checked %lld ok passages: %lld over their class's GVW limit, %lld with an "
+                      "axle group over its limit, %lld overloaded in all (%.2f %%)\n",
+                (long long)c->checked, (long long)c->over_gvw, (long long)c->over_group,
+                (long long)c->over_any,
+                c->checked ? 100.0 * (double)c->over_any / (double)c->checked : 0.0);
+        if (c->unclassified)
+            fprintf(c->f, "(%lld passages could not be classified: their limits are "
+                          "report.limits')\n", (long long)c->unclassified);
+        if (c->n_cls > 0)
+            fprintf(c->f, "%-8s  %8s  %8s  %10s  %10s  %7s\n", "class", "checked", "over GVW",
+                    "over group", "overloaded", "%");
+        for (int i = 0; i < c->n_cls; i++)
+            fprintf(c->f, "%-8s  %8lld  %8lld  %10lld  %10lld  %7.2f\n", c->cls[i].name,
+                    (long long)c->cls[i].checked, (long long)c->cls[i].over_gvw,
+                    (long long)c->cls[i].over_group, (long long)c->cls[i].over_any,
+                    100.0 * (double)c->cls[i].over_any / (double)c->cls[i].checked);
+    } else if (fmt == FMT_JSON) {
+        json_t *ob = json_object(), *bc = json_array();
+        json_object_set_new(ob, "scheme", json_string(scheme));
+        json_object_set_new(ob, "limits_from",
+                            json_string(rc->classes_from ? rc->classes_from : "built-in defaults"));
         json_object_set_new(ob, "gvw_limit_kg", json_real(o->gvw_limit_kg));
         json_object_set_new(ob, "axle_limit_kg", json_real(o->axle_limit_kg));
-        json_object_set_new(ob, "checked", json_integer(c.checked));
-        json_object_set_new(ob, "over_gvw", json_integer(c.over_gvw));
-        json_object_set_new(ob, "over_axle", json_integer(c.over_axle));
-        json_object_set_new(ob, "overloaded", json_integer(c.over_any));
-        json_object_set_new(ob, "passages", c.arr);
+        json_object_set_new(ob, "checked", json_integer(c->checked));
+        json_object_set_new(ob, "over_gvw", json_integer(c->over_gvw));
+        json_object_set_new(ob, "over_group", json_integer(c->over_group));
+        json_object_set_new(ob, "overloaded", json_integer(c->over_any));
+        json_object_set_new(ob, "unclassified", json_integer(c->unclassified));
+        for (int i = 0; i < c->n_cls; i++) {
+            json_t *k = json_object();
+            json_object_set_new(k, "class", json_string(c->cls[i].name));
+            json_object_set_new(k, "checked", json_integer(c->cls[i].checked));
+            json_object_set_new(k, "over_gvw", json_integer(c->cls[i].over_gvw));
+            json_object_set_new(k, "over_group", json_integer(c->cls[i].over_group));
+            json_object_set_new(k, "overloaded", json_integer(c->cls[i].over_any));
+            json_array_append_new(bc, k);
+        }
+        json_object_set_new(ob, "by_class", bc);
+        json_object_set_new(ob, "passages", c->arr);
         json_object_set_new(rc->root, "overloads", ob);
     }
+    free(c);
     return 0;
 }
 
@@ -471,18 +639,21 @@ static const char *const status_colour[AMFI_STORE_N_STATUS] = {
     "#1f77b4", "#ff7f0e", "#9467bd", "#d62728", "#8c564b", "#7f7f7f", "#000000"};
 
 /* gvw.png: the GVW per passage over time with the baseline band; writes
- * passages.dat (t gvw_t status speed_kmh) and band.dat. */
+ * passages.dat (t gvw status speed, in p->units) and band.dat. */
 int passages_plot_gvw(report_plot_frame *p, int *made, char *err, size_t errlen)
 {
     FILE *f = report_data_open(p->dir, "passages.dat", err, errlen);
     if (!f)
         return -1;
-    fprintf(f, "# time_s gvw_t status(0 ok,1 gap,2 late,3 overload,4 multiple,5 invalid,6 error) speed_kmh\n");
+    const int u = p->units;
+    const char *mu = report_mass_unit(u), *su = report_speed_unit(u);
+    fprintf(f, "# time_s gvw_%s status(0 ok,1 gap,2 late,3 overload,4 multiple,5 invalid,6 error) speed_%s\n",
+            mu, u == AMFI_REPORT_UNITS_ENGINEERING ? "kmh" : "mps");
     size_t n_gvw = 0;
     for (size_t k = 0; k < p->n_pas; k++) {
         const report_pas *a = &p->pas[k];
-        fprintf(f, "%.3f %.4f %d %.3f\n", a->t, isnan(a->gvw) ? NAN : a->gvw / 1000, a->status,
-                isnan(a->speed) ? NAN : a->speed * 3.6);
+        fprintf(f, "%.3f %.4f %d %.3f\n", a->t, isnan(a->gvw) ? NAN : report_mass_val(u, a->gvw),
+                a->status, isnan(a->speed) ? NAN : report_speed_val(u, a->speed));
         n_gvw += !isnan(a->gvw);
     }
     if (report_data_close(f, p->dir, "passages.dat", err, errlen) != 0)
@@ -494,8 +665,9 @@ int passages_plot_gvw(report_plot_frame *p, int *made, char *err, size_t errlen)
         const amfi_baseline *b = &p->b;
         double tb = fmax(p->t0, (double)b->utime_set / 1e6);
         for (int k = 0; k < 2; k++)
-            fprintf(f, "%.3f %.4f %.4f %.4f\n", k ? p->t1 : tb, (b->mean_kg - 2 * b->std_kg) / 1000,
-                    (b->mean_kg + 2 * b->std_kg) / 1000, b->mean_kg / 1000);
+            fprintf(f, "%.3f %.4f %.4f %.4f\n", k ? p->t1 : tb,
+                    report_mass_val(u, b->mean_kg - 2 * b->std_kg),
+                    report_mass_val(u, b->mean_kg + 2 * b->std_kg), report_mass_val(u, b->mean_kg));
     } else {
         fprintf(f, "%.3f NaN NaN NaN\n", p->t0);
     }
@@ -504,16 +676,19 @@ int passages_plot_gvw(report_plot_frame *p, int *made, char *err, size_t errlen)
     fprintf(p->gp,
         "set output o.'gvw.png'\n"
         "set title \"Inferred gross vehicle weight per passage\\n%s\"\n"
-        "set ylabel 'GVW (t)'\n"
+        "set ylabel 'GVW (%s)'\n"
         "%s"
         "plot d.'band.dat' using 1:2:3 with filledcurves fc rgb '#b0d0b0' fs transparent solid 0.5 title 'baseline mean +/- 2 STD', \\\n"
         "     d.'band.dat' using 1:4 with lines lw 2 lc rgb '#2ca02c' title 'baseline mean', \\\n"
         "     d.'passages.dat' using 1:($3==0?$2:NaN) with points pt 7 ps 0.4 lc rgb '#1f77b4' title 'ok', \\\n"
         "     d.'passages.dat' using 1:($3!=0?$2:NaN) with points pt 2 ps 0.6 lc rgb '#d62728' title 'not ok (solved)'\n"
         "unset label 99\nset autoscale y\n",
-        p->sub,
+        p->sub, mu,
         /* gnuplot refuses a plot without one valid point: a fixed range and a word */
-        n_gvw ? "" : "set yrange [0:60]\nset label 99 'no passage with an inferred GVW in this store' at graph 0.5, graph 0.5 center\n");
+        n_gvw ? "" : u == AMFI_REPORT_UNITS_ENGINEERING
+                         ? "set yrange [0:60]\nset label 99 'no passage with an inferred GVW in this store' at graph 0.5, graph 0.5 center\n"
+                         : "set yrange [0:60000]\nset label 99 'no passage with an inferred GVW in this store' at graph 0.5, graph 0.5 center\n");
+    (void)su;
     *made = 1;
     return 0;
 }
@@ -531,7 +706,7 @@ int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t e
     }
     for (size_t k = 0; k < n; k++)
         if (p->pas[k].status == 0 && !isnan(p->pas[k].gvw))
-            ok[n_ok++] = p->pas[k].gvw / 1000;
+            ok[n_ok++] = report_mass_val(p->units, p->pas[k].gvw);
     int win = p->n_ind > 0 && p->ind[0].row.n > 0 ? p->ind[0].row.n : 500;
     size_t nb_end = 0, nb = 0, nla = n_ok < (size_t)win ? n_ok : (size_t)win;
     if (p->found) {
@@ -553,7 +728,7 @@ int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t e
     }
     if (!(hi > lo)) {
         lo = 0;
-        hi = 60;
+        hi = report_mass_val(p->units, 60000);
     }
     int nbins = 30;
     double w = (hi - lo) / nbins, hb[64], hl[64];
@@ -563,8 +738,9 @@ int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t e
     FILE *f = report_data_open(p->dir, "histogram.dat", err, errlen);
     if (!f)
         return -1;
-    fprintf(f, "# gvw_t_bin_centre baseline_fraction latest_fraction (bin %.3f t; baseline n %zu, latest n %zu)\n",
-            w, nb, nla);
+    const char *mu = report_mass_unit(p->units);
+    fprintf(f, "# gvw_%s_bin_centre baseline_fraction latest_fraction (bin %.3f %s; baseline n %zu, latest n %zu)\n",
+            mu, w, mu, nb, nla);
     for (int k = 0; k < nbins; k++)
         fprintf(f, "%.4f %.5f %.5f\n", lo + (k + 0.5) * w, hb[k], hl[k]);
     if (report_data_close(f, p->dir, "histogram.dat", err, errlen) != 0)
@@ -573,27 +749,22 @@ int passages_plot_histogram(report_plot_frame *p, int *made, char *err, size_t e
         "set output o.'gvw_histogram.png'\n"
         "set xdata\nset format x '%%g'\nset autoscale x\n"
         "set title \"GVW distribution: baseline (%zu ok passages) against the latest window (%zu)\\n%s\"\n"
-        "set xlabel 'GVW (t), bins of %.2f t'\nset ylabel 'fraction of passages'\n"
+        "set xlabel 'GVW (%s), bins of %.*f %s'\nset ylabel 'fraction of passages'\n"
         "set style fill transparent solid 0.45 noborder\nset boxwidth %.4f\n"
         "plot d.'histogram.dat' using 1:2 with boxes lc rgb '#2ca02c' title 'baseline', \\\n"
         "     d.'histogram.dat' using 1:3 with boxes lc rgb '#d62728' title 'latest window'\n",
-        nb, nla, p->sub, w, w);
+        nb, nla, p->sub, mu, p->units == AMFI_REPORT_UNITS_ENGINEERING ? 2 : 0, w, mu, w);
     *made = 1;
     return 0;
 }
 
 /* passages_per_hour.png: passages per hour by status, cumulative columns so
- * the boxes stack; the bucket adapts to the span. Writes hourly.dat. */
+ * the boxes stack. A bucket is one hour (what the axis says), or one day
+ * over more than 400 hours (then its mean per hour). Writes hourly.dat. */
 int passages_plot_per_hour(report_plot_frame *p, int *made, char *err, size_t errlen)
 {
-    static const double buckets[] = {60, 300, 900, 3600, 86400};
     const double t0 = p->t0, t1 = p->t1;
-    double bw = 86400;
-    for (int k = 0; k < 5; k++)
-        if ((t1 - t0) / buckets[k] <= 200) {
-            bw = buckets[k];
-            break;
-        }
+    const double bw = (t1 - t0) / 3600 <= 400 ? 3600 : 86400;
     int nbk = (int)floor((t1 - t0) / bw) + 1;
     if (nbk > 100000)
         nbk = 100000;
@@ -629,11 +800,11 @@ int passages_plot_per_hour(report_plot_frame *p, int *made, char *err, size_t er
     fprintf(p->gp,
         "set output o.'passages_per_hour.png'\n"
         "set xdata time\nset format x \"%%H:%%M\\n%%d %%b\"\nset xrange [%.3f:%.3f]\n"
-        "set title \"Passages per hour by status (buckets of %.0f min)\\n%s\"\n"
+        "set title \"Passages per hour by status (buckets of %s)\\n%s\"\n"
         "set xlabel 'time (UTC, data time)'\nset ylabel 'passages per hour'\n"
         "set style fill solid 0.8 border lc rgb 'black'\nset boxwidth %.0f\nset yrange [0:*]\n"
         "plot ",
-        tb0, tb0 + nbk * bw, bw / 60, p->sub, bw * 0.9);
+        tb0, tb0 + nbk * bw, bw == 3600 ? "1 h" : "1 day, mean per hour", p->sub, bw * 0.9);
     for (int k = AMFI_STORE_N_STATUS - 1; k >= 0; k--)
         fprintf(p->gp, "d.'hourly.dat' using 1:%d with boxes lc rgb '%s' title '%s'%s", k + 2,
                 status_colour[k], amfi_store_status_name(k), k ? ", \\\n     " : "\n");
@@ -647,7 +818,8 @@ static int cmp_d(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* speed.png: the speed distribution in 2 km/h bins; writes speed.dat. */
+/* speed.png: the speed distribution in bins of 2 km/h (engineering) or
+ * 0.5 m/s (si); writes speed.dat. */
 int passages_plot_speed(report_plot_frame *p, int *made, char *err, size_t errlen)
 {
     size_t n_sp = 0;
@@ -658,22 +830,25 @@ int passages_plot_speed(report_plot_frame *p, int *made, char *err, size_t errle
     }
     for (size_t k = 0; k < p->n_pas; k++)
         if (!isnan(p->pas[k].speed))
-            sp[n_sp++] = p->pas[k].speed * 3.6;
+            sp[n_sp++] = report_speed_val(p->units, p->pas[k].speed);
     FILE *f = report_data_open(p->dir, "speed.dat", err, errlen);
     if (!f) {
         free(sp);
         return -1;
     }
-    fprintf(f, "# speed_kmh_bin_centre passages (bin 2 km/h)\n");
+    const int eng = p->units == AMFI_REPORT_UNITS_ENGINEERING;
+    const double bw = eng ? 2.0 : 0.5;
+    const char *su = report_speed_unit(p->units);
+    fprintf(f, "# speed_%s_bin_centre passages (bin %g %s)\n", eng ? "kmh" : "mps", bw, su);
     qsort(sp, n_sp, sizeof *sp, cmp_d);
     for (size_t k = 0; k < n_sp;) {
-        double b0 = floor(sp[k] / 2) * 2;
+        double b0 = floor(sp[k] / bw) * bw;
         size_t c = 0;
-        while (k < n_sp && sp[k] < b0 + 2) {
+        while (k < n_sp && sp[k] < b0 + bw) {
             c++;
             k++;
         }
-        fprintf(f, "%.1f %zu\n", b0 + 1, c);
+        fprintf(f, "%.2f %zu\n", b0 + bw / 2, c);
     }
     if (n_sp == 0)
         fprintf(f, "NaN 0\n");
@@ -684,13 +859,14 @@ int passages_plot_speed(report_plot_frame *p, int *made, char *err, size_t errle
         "set output o.'speed.png'\n"
         "set xdata\nset format x '%%g'\nset autoscale x\nset yrange [0:*]\n"
         "set title \"Speed distribution (%zu passages with a speed)\\n%s\"\n"
-        "set xlabel 'speed (km/h), bins of 2 km/h'\nset ylabel 'passages'\n"
-        "set style fill solid 0.7 border lc rgb 'black'\nset boxwidth 1.8\n"
+        "set xlabel 'speed (%s), bins of %g %s'\nset ylabel 'passages'\n"
+        "set style fill solid 0.7 border lc rgb 'black'\nset boxwidth %g\n"
         "%s"
         "plot d.'speed.dat' using 1:2 with boxes lc rgb '#1f77b4' title 'passages'\n"
         "set output\n",
-        n_sp, p->sub,
-        n_sp ? "" : "set xrange [0:150]\nset yrange [0:1]\nset label 99 'no passage with a speed in this store' at graph 0.5, graph 0.5 center\n");
+        n_sp, p->sub, su, bw, su, 0.9 * bw,
+        n_sp ? "" : eng ? "set xrange [0:150]\nset yrange [0:1]\nset label 99 'no passage with a speed in this store' at graph 0.5, graph 0.5 center\n"
+                        : "set xrange [0:42]\nset yrange [0:1]\nset label 99 'no passage with a speed in this store' at graph 0.5, graph 0.5 center\n");
     *made = 1;
     return 0;
 }

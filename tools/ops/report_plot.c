@@ -211,8 +211,14 @@ void report_hist(const double *v, size_t n, double lo, double w, int nb, double 
     }
 }
 
+int report_plot_in_range(const report_plot_frame *p, int64_t utime)
+{
+    return utime >= p->from && utime <= p->to;
+}
+
 int report_plot_begin(report_plot_frame *p, amfi_store *s, const char *dir, const char *site_raw,
-                      const amfi_indicator_params *ip, char *err, size_t errlen)
+                      const amfi_indicator_params *ip, int64_t from, int64_t to, char *err,
+                      size_t errlen)
 {
     int64_t total_ind = 0, total_al = 0;
     char serr[512], path[4096], t0s[32], t1s[32];
@@ -220,13 +226,15 @@ int report_plot_begin(report_plot_frame *p, amfi_store *s, const char *dir, cons
     p->s = s;
     p->dir = dir;
     p->ip = ip;
+    p->from = from;
+    p->to = to;
     gp_text(site_raw, p->site, sizeof p->site);
     if (gp_dir(dir, p->gdir, sizeof p->gdir, err, errlen) != 0)
         return -1;
     snprintf(path, sizeof path, "%s/data", dir);
     if (mkdir_p(dir) != 0 || mkdir_p(path) != 0)
         return fail(err, errlen, "%s: cannot create: %s", path, strerror(errno));
-    if (amfi_store_each_passage(s, 0, AMFI_STORE_MAX_UTIME, NULL, collect, p, serr,
+    if (amfi_store_each_passage(s, from, to, NULL, collect, p, serr,
                                 sizeof serr) != 0
         || amfi_store_get_baseline(s, &p->b, &p->found, serr, sizeof serr) != 0
         || amfi_store_count(s, AMFI_STORE_INDICATORS, &total_ind, serr, sizeof serr) != 0
@@ -244,6 +252,16 @@ int report_plot_begin(report_plot_frame *p, amfi_store *s, const char *dir, cons
             || amfi_store_recent_alerts(s, (int)total_al, p->al, &p->n_al, serr, sizeof serr) != 0)
             return fail(err, errlen, "%s", p->al ? serr : "out of memory");
     }
+    int k = 0; /* the rows in the range, newest first still */
+    for (int i = 0; i < p->n_ind; i++)
+        if (report_plot_in_range(p, p->ind[i].row.utime))
+            p->ind[k++] = p->ind[i];
+    p->n_ind = k;
+    k = 0;
+    for (int i = 0; i < p->n_al; i++)
+        if (report_plot_in_range(p, p->al[i].utime))
+            p->al[k++] = p->al[i];
+    p->n_al = k;
     size_t n = p->n_pas;
     double t0 = n ? p->pas[0].t : 0, t1 = n ? p->pas[n - 1].t : 1;
     if (p->n_ind > 0) { /* newest first */

@@ -32,6 +32,9 @@ typedef struct report_plot_frame {
     amfi_store *s;
     const char *dir;                 /* --plot DIR */
     const amfi_indicator_params *ip; /* the alert thresholds */
+    const char *ip_from;             /* where they come from, for the titles */
+    int units;                       /* AMFI_REPORT_UNITS_*: of GVW and speed */
+    int64_t from, to;                /* --from .. --to, µs: every plot draws only these */
     FILE *gp;                        /* DIR/data/plots.gp, being written */
     char gdir[8200];                 /* dir in a gnuplot single-quoted string */
     char site[128];                  /* the site, safe in a gnuplot string */
@@ -52,12 +55,16 @@ typedef struct report_plot_frame {
  * with a one-line message in err. */
 typedef int (*report_plot_fn)(report_plot_frame *p, int *made, char *err, size_t errlen);
 
-/* Creates dir and dir/data, reads the shared data, opens the script and
- * writes its preamble (terminal, the d and o variables, the time axis).
- * `site` titles every plot; `ip` gives the alert thresholds. 0, or −1 with
- * the message in err (report_plot_free frees it either way). */
+/* Creates dir and dir/data, reads the shared data of [from, to] (µs; 0 and
+ * AMFI_STORE_MAX_UTIME: all), opens the script and writes its preamble
+ * (terminal, the d and o variables, the time axis). `site` titles every
+ * plot; `ip` gives the alert thresholds. 0, or −1 with the message in err
+ * (report_plot_free frees it either way). */
 int report_plot_begin(report_plot_frame *p, amfi_store *s, const char *dir, const char *site,
-                      const amfi_indicator_params *ip, char *err, size_t errlen);
+                      const amfi_indicator_params *ip, int64_t from, int64_t to, char *err,
+                      size_t errlen);
+/* 1 when utime lies in the plots' range */
+int report_plot_in_range(const report_plot_frame *p, int64_t utime);
 /* Closes the script and runs gnuplot on it. 0, or −1 with err. */
 int report_plot_run(report_plot_frame *p, char *err, size_t errlen);
 /* A PNG gnuplot should have written: "plot  PATH  what" on stdout, or −1

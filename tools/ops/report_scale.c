@@ -105,6 +105,16 @@ static int write_evals(const char *dir, const char *name, const amfi_scale_eval_
     return report_data_close(f, dir, name, err, errlen);
 }
 
+/* Keep the rows of the plots' range, in order. */
+static void keep_range(const report_plot_frame *p, amfi_scale_eval_rec *r, size_t *n)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < *n; i++)
+        if (report_plot_in_range(p, r[i].utime))
+            r[k++] = r[i];
+    *n = k;
+}
+
 /* A time axis in data time, y autoscaled, no leftover label. */
 static void time_axis(FILE *gp)
 {
@@ -119,6 +129,7 @@ int scale_plot_scale(report_plot_frame *p, int *made, char *err, size_t errlen)
     size_t nsc = 0;
     if (amfi_store_scale_evals(p->s, "scale_shift", &sc, &nsc, err, errlen) != 0)
         return -1;
+    keep_range(p, sc, &nsc);
     size_t blocks = 0; /* gnuplot refuses a plot without one valid point */
     for (size_t i = 0; i < nsc; i++)
         blocks += strcmp(sc[i].state, "baseline") != 0;
@@ -155,6 +166,7 @@ int scale_plot_known_truck(report_plot_frame *p, int *made, char *err, size_t er
     size_t nkt = 0;
     if (amfi_store_scale_evals(p->s, "known_truck", &kt, &nkt, err, errlen) != 0)
         return -1;
+    keep_range(p, kt, &nkt);
     int rc = 0;
     if (nkt > 0) {
         rc = write_evals(p->dir, "known_truck.dat", kt, nkt, err, errlen);
@@ -182,6 +194,11 @@ int scale_plot_temperature(report_plot_frame *p, int *made, char *err, size_t er
     size_t nenv = 0;
     if (amfi_store_environment_rows(p->s, &env, &nenv, err, errlen) != 0)
         return -1;
+    size_t kept = 0;
+    for (size_t i = 0; i < nenv; i++)
+        if (report_plot_in_range(p, env[i].utime))
+            env[kept++] = env[i];
+    nenv = kept;
     if (nenv == 0) {
         free(env);
         return 0;

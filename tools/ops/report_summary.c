@@ -11,6 +11,7 @@
 
 #include "report_cols.h"
 #include "report_natfreq.h"
+#include "report_residual.h"
 #include "report_scale.h"
 
 /* amfid's intake counters of its newest run (meta intake.*), if any. */
@@ -63,8 +64,11 @@ static int print_baseline(report_ctx *c)
                         "passages, or --set-baseline*)\n");
         return 0;
     }
-    fprintf(c->out, "baseline     mean %.0f kg, STD %.0f kg, n %d, %s, from %s UTC%s%s%s\n",
-            b.mean_kg, b.std_kg, b.n, b.source, report_utc(b.utime_set, t),
+    char m1[32], m2[32];
+    const char *u = report_mass_unit(c->units);
+    fprintf(c->out, "baseline     mean %s %s, STD %s %s, n %d, %s, from %s UTC%s%s%s\n",
+            report_mass(c->units, b.mean_kg, m1), u, report_mass(c->units, b.std_kg, m2), u, b.n,
+            b.source, report_utc(b.utime_set, t),
             b.note[0] ? " \"" : "", b.note, b.note[0] ? "\"" : "");
     return 0;
 }
@@ -100,10 +104,13 @@ int summary_table(report_ctx *c)
     } else {
         report_mean_std(g, ng, &mean, &std);
         report_sort(g, ng);
-        fprintf(f, "GVW, ok      n %zu, mean %.0f kg, STD %s kg, min %.0f, "
-                   "median %.0f, max %.0f kg\n",
-                ng, mean, report_num(std, "%.0f", a), g[0], report_percentile(g, ng, 50),
-                g[ng - 1]);
+        char m[4][32];
+        const char *u = report_mass_unit(c->units);
+        fprintf(f, "GVW, ok      n %zu, mean %s %s, STD %s %s, min %s, median %s, max %s %s\n",
+                ng, report_mass(c->units, mean, m[0]), u, report_mass(c->units, std, a), u,
+                report_mass(c->units, g[0], m[1]),
+                report_mass(c->units, report_percentile(g, ng, 50), m[2]),
+                report_mass(c->units, g[ng - 1], m[3]), u);
     }
     free(g);
     /* what the STD and mean rules were fed (at the calibration temperature
@@ -116,10 +123,14 @@ int summary_table(report_ctx *c)
         report_mean_std(g, ng, &mean, &std);
     if (ng > 0 && (ng != n_ok || mean != raw_mean || !(std == raw_std || isnan(std)))) {
         report_sort(g, ng);
-        fprintf(f, "GVW, fed     n %zu, mean %.0f kg, STD %s kg, min %.0f, median %.0f, max %.0f kg "
+        char m[4][32];
+        const char *u = report_mass_unit(c->units);
+        fprintf(f, "GVW, fed     n %zu, mean %s %s, STD %s %s, min %s, median %s, max %s %s "
                    "(the STD and mean rules' input: compensated to the calibration temperature)\n",
-                ng, mean, report_num(std, "%.0f", a), g[0], report_percentile(g, ng, 50),
-                g[ng - 1]);
+                ng, report_mass(c->units, mean, m[0]), u, report_mass(c->units, std, a), u,
+                report_mass(c->units, g[0], m[1]),
+                report_mass(c->units, report_percentile(g, ng, 50), m[2]),
+                report_mass(c->units, g[ng - 1], m[3]), u);
     }
     free(g);
     report_intake in;
@@ -143,6 +154,9 @@ int summary_table(report_ctx *c)
     if (natfreq_summary(s, f1line, sizeof f1line, c->err, sizeof c->err) != 0)
         return -1;
     fprintf(f, "%s", f1line);
+    if (residual_summary(s, f1line, sizeof f1line, c->err, sizeof c->err) != 0)
+        return -1;
+    fprintf(f, "%s", f1line);
     return print_baseline(c);
 }
 
@@ -158,6 +172,7 @@ typedef struct sum_row {
     char from[32];
     report_intake in;
     natfreq_stats nf;
+    residual_stats rs;
 } sum_row;
 
 #define S(w) ((const sum_row *)(w))
@@ -191,6 +206,13 @@ static void s_f1_sd(const void *w, report_val *v) { v->x = S(w)->nf.sd_hz; }
 static void s_f1c_n(const void *w, report_val *v) { v->i = (int64_t)S(w)->nf.n_comp; }
 static void s_f1c_mean(const void *w, report_val *v) { v->x = S(w)->nf.comp_mean_hz; }
 static void s_f1c_sd(const void *w, report_val *v) { v->x = S(w)->nf.comp_sd_hz; }
+static void s_res_n(const void *w, report_val *v) { v->i = (int64_t)S(w)->rs.n; }
+static void s_res_median(const void *w, report_val *v) { v->x = S(w)->rs.median; }
+static void s_res_p95(const void *w, report_val *v) { v->x = S(w)->rs.p95; }
+static void s_res_first(const void *w, report_val *v) { v->x = S(w)->rs.first_median; }
+static void s_res_last(const void *w, report_val *v) { v->x = S(w)->rs.last_median; }
+static void s_res_growth(const void *w, report_val *v) { v->x = S(w)->rs.growth; }
+static void s_res_quality(const void *w, report_val *v) { v->x = S(w)->rs.quality_median; }
 #undef S
 
 /* CSV items and JSON members in one list: name (CSV item), type, unit,
@@ -249,6 +271,21 @@ static const report_col summary_items[] = {
                .json = "compensated_mean_hz", .group = "natural_frequency"),
     REPORT_COL("f1_comp_sd_hz", COL_NUM, "Hz", "%.6f", COL_BOTH, s_f1c_sd,
                .json = "compensated_sd_hz", .group = "natural_frequency"),
+    /* the solver's residual of the ok passages (report_residual.h) */
+    REPORT_COL("residual_n", COL_INT, "", NULL, COL_BOTH, s_res_n, .json = "n",
+               .group = "residual"),
+    REPORT_COL("residual_median_mps2", COL_NUM, "m/s2", "%.6g", COL_BOTH, s_res_median,
+               .json = "median_mps2", .group = "residual"),
+    REPORT_COL("residual_p95_mps2", COL_NUM, "m/s2", "%.6g", COL_BOTH, s_res_p95,
+               .json = "p95_mps2", .group = "residual"),
+    REPORT_COL("residual_oldest_median_mps2", COL_NUM, "m/s2", "%.6g", COL_BOTH, s_res_first,
+               .json = "oldest_median_mps2", .group = "residual"),
+    REPORT_COL("residual_newest_median_mps2", COL_NUM, "m/s2", "%.6g", COL_BOTH, s_res_last,
+               .json = "newest_median_mps2", .group = "residual"),
+    REPORT_COL("residual_growth", COL_NUM, "", "%.6g", COL_BOTH, s_res_growth,
+               .json = "newest_over_oldest", .group = "residual"),
+    REPORT_COL("quality_median", COL_NUM, "", "%.6g", COL_BOTH, s_res_quality,
+               .json = "quality_median", .group = "residual"),
 };
 
 int summary_export(report_ctx *c)
@@ -261,7 +298,8 @@ int summary_export(report_ctx *c)
     if (amfi_store_passage_summary(c->s, &r.sum, err, errlen) ||
         amfi_store_all_ok_gvw(c->s, &g, &r.ng, err, errlen) ||
         amfi_store_get_baseline(c->s, &r.b, &r.found, err, errlen) ||
-        read_intake(c->s, &r.in, err, errlen) || natfreq_read_stats(c->s, &r.nf, err, errlen)) {
+        read_intake(c->s, &r.in, err, errlen) || natfreq_read_stats(c->s, &r.nf, err, errlen) ||
+        residual_read_stats(c->s, &r.rs, err, errlen)) {
         free(g);
         return -1;
     }

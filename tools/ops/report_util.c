@@ -200,3 +200,35 @@ double report_percentile(const double *v, size_t n, double p)
     return v[k > 0 ? k - 1 : 0];
 }
 
+
+double report_mass_val(int units, double kg)
+{
+    return units == AMFI_REPORT_UNITS_ENGINEERING ? kg / 1000.0 : kg;
+}
+
+const char *report_mass_unit(int units)
+{
+    return units == AMFI_REPORT_UNITS_ENGINEERING ? "t" : "kg";
+}
+
+const char *report_mass(int units, double kg, char buf[32])
+{
+    return report_num(report_mass_val(units, kg),
+                      units == AMFI_REPORT_UNITS_ENGINEERING ? "%.2f" : "%.0f", buf);
+}
+
+double report_speed_val(int units, double mps)
+{
+    return units == AMFI_REPORT_UNITS_ENGINEERING ? mps * 3.6 : mps;
+}
+
+const char *report_speed_unit(int units)
+{
+    return units == AMFI_REPORT_UNITS_ENGINEERING ? "km/h" : "m/s";
+}
+
+const char *report_speed(int units, double mps, char buf[32])
+{
+    return report_num(report_speed_val(units, mps),
+                      units == AMFI_REPORT_UNITS_ENGINEERING ? "%.1f" : "%.2f", buf);
+}
