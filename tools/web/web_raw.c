@@ -109,8 +109,8 @@ static json_t *raw_json(const amfi_raw_rec *r)
     json_object_set(o, "t_last_axle_s", json_object_get(mine, "t_last_axle_s"));
     json_object_set_new(o, "exit_marked", json_false());
     json_object_set_new(o, "exit_reason",
-                        json_string("the store does not record the span length: the exit "
-                                    "(entry + (span + sum of spacings) / speed) is not marked; "
+                        json_string("the store does not record the span length, which the exit "
+                                    "needs (entry + (span + sum of spacings) / speed); "
                                     "t_last_axle_s is the last axle's entry"));
     const int k = bucket(w->n_samples);
     if (k > 1)
