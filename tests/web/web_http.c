@@ -228,6 +228,10 @@ static void check_raw(void)
                 top = json_number_value(json_array_get(a, k));
     }
     CHECK(top == 5.0, "passage 11: the spike of sensor 7 is %g, not 5", top);
+    /* sample 12345 opens bucket 823: its max (the spike) comes before its min */
+    CHECK(rval(j, "raw.sensors.1.samples.1646") == 5.0 && rval(j, "raw.sensors.1.samples.1647") < 1,
+          "passage 11: bucket 823 is %g, %g", rval(j, "raw.sensors.1.samples.1646"),
+          rval(j, "raw.sensors.1.samples.1647"));
     json_decref(j);
     /* passages 14 and 15: one event window, each its own vehicle */
     json_t *a = get_json("/api/passages/14", 200), *b = get_json("/api/passages/15", 200);
