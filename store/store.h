@@ -19,7 +19,7 @@
  * (the estimated speeds), store_environment.c (the environment readings),
  * store_web.c (amfi-web's reads),
  * store_natfreq.c (the natural frequencies), store_raw.c (the passages' raw
- * samples), store_columns.c (the column
+ * samples; store_web_raw.c the oldest window kept), store_columns.c (the column
  * table, store_columns.h: every stored column once), store_rows.c (the
  * INSERTs, bindings and checks of the tables written from a row struct, from
  * the column table), store_scan.c (rows as column values for amfi-sync,
@@ -772,6 +772,12 @@ typedef struct amfi_raw_rec {
 int amfi_store_raw_get(amfi_store *s, int64_t passage_id, amfi_raw_rec *out, int *found,
                        char *err, size_t errlen);
 void amfi_store_raw_free(amfi_raw_rec *r); /* NULL-safe; zeroes it */
+
+/* The oldest raw window kept (store_web_raw.c): its utime, *found 0 when
+ * there is none (or the store is older than version 11). The retention
+ * deletes oldest first (utime, id): a window of a later utime was not
+ * deleted by it (amfi-web's raw_reason). Any handle. */
+int amfi_store_raw_oldest(amfi_store *s, int64_t *utime, int *found, char *err, size_t errlen);
 
 /* One stored passage by id (amfi-solve --from-store; a page per passage):
  * vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason,

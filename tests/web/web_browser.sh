@@ -7,7 +7,8 @@
 # logs nothing itself) and its drawn DOM is checked: the table rows carry
 # the fixture's passage and alert ids, each chart's canvas was drawn
 # (data-drawn) with the expected number of points (data-points), the
-# hostile reason and alert text appear as text, never as elements. Chromium
+# hostile reason and alert text appear as text, never as elements; the
+# vehicle page draws a passage's raw signal (one chart per sensor). Chromium
 # gets a fresh profile in the test's directory and a timeout; everything on
 # 127.0.0.1. Usage: web_browser.sh AMFI_WEB WEB_FIXTURE AMFI_SYNC.
 # Exit 77 without chromium (the PostgreSQL half is skipped without its
@@ -97,6 +98,29 @@ pages() {
     has "$k-vehicle" 'solver: &lt;img src=x onerror="window.__xss=1"&gt;' 1
     has "$k-vehicle" 'id="raw-reason"' 1
     canvas "$k-vehicle" chart-axles 5
+    # the raw signal: one chart per sensor, every sample or 4000 points
+    # (decimated), the entry marked; none from the central database
+    page "$base/vehicle?id=5" "$k-signal"
+    page "$base/vehicle?id=11" "$k-signal-long"
+    page "$base/vehicle?id=15" "$k-signal-event"
+    page "$base/vehicle?id=17" "$k-signal-damaged"
+    if [ "$k" = store ]; then
+        canvas "$k-signal" chart-signal-0 1500
+        canvas "$k-signal" chart-signal-1 1500
+        has "$k-signal" '<canvas id="chart-signal-' 2
+        has "$k-signal" 'id="raw-info"' 1
+        for c in 0 1 2; do canvas "$k-signal-long" chart-signal-$c 4000; done
+        has "$k-signal-long" 'min and max of every 15 samples' 1
+        canvas "$k-signal-event" chart-signal-0 2000
+        has "$k-signal-event" 'data-entry-s="1.7"' 2
+        has "$k-signal-event" '2 vehicle\(s\) in the window' 1
+        has "$k-signal-damaged" 'id="raw-reason"[^>]*>the raw samples are damaged: passage 17' 1
+    else
+        for v in signal signal-long signal-event signal-damaged; do
+            has "$k-$v" 'id="raw-reason"[^>]*>the central database does not ship raw samples' 1
+            has "$k-$v" 'chart-signal' 0
+        done
+    fi
     page "$base/vehicle?id=41" "$k-vehicle-error"
     has "$k-vehicle-error" 'id="error">Could not load: no passage 41' 1
 

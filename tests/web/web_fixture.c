@@ -11,16 +11,64 @@
  * raised with the hostile message: open; mean_shift raised then cleared),
  * twelve environment readings, site.id SITE (web-test), a hostile
  * site.name and amfid's intake counters.
+ *
+ * Raw samples (amfi_passage_row.raw, store.h): passage 5 a window of two
+ * sensors (ids 3, 7 at 10 and 15.125 m) × 1500 samples at 1000 Hz, float64,
+ * sample 0 at −0.5 s; passage 11 a long one, three sensors × 30000 samples
+ * at 1000 Hz stored as float32, with one spike of 5.0 at sample 12345 of
+ * its second sensor (a browser gets it decimated); passages 14 and 15 one
+ * event window of two vehicles (two sensors × 2000 samples at 500 Hz,
+ * held by 14, linked by 15, the second vehicle entering 1.2 s after the
+ * first); passage 2 a window deleted by the retention (amfi_store_raw_prune)
+ * and passage 17 one whose blob is then damaged by raw SQL
+ * (store_testing.h).
  */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "store.h"
+#include "store_testing.h"
 
 #define HOSTILE "<img src=x onerror=\"window.__xss=1\">'&amp;</td><script>window.__xss=2</script>"
 #define T0 INT64_C(1768006800000000) /* 2026-01-10T01:00:00Z */
 #define HOUR INT64_C(3600000000)
+
+/* The raw window of passage k (2, 5, 11, 14), samples into buf. */
+static double buf[3 * 30000];
+static void make_window(amfi_raw_window *w, int k, int64_t utime, double speed, int n_axles,
+                        const double *spacing)
+{
+    memset(w, 0, sizeof *w);
+    const int long_one = k == 11, event = k == 14;
+    w->utime = utime;
+    w->rate_hz = event ? 500 : 1000;
+    w->t_first_s = -0.5;
+    w->n_samples = long_one ? 30000 : event ? 2000 : k == 2 ? 500 : 1500;
+    w->n_sensors = long_one ? 3 : k == 2 ? 1 : 2;
+    for (int i = 0; i < w->n_sensors; i++) {
+        w->sensor_id[i] = 3 + 4 * i;
+        w->sensor_at_m[i] = 10.0 + 5.125 * i;
+        for (int j = 0; j < w->n_samples; j++)
+            buf[i * w->n_samples + j] = 0.01 * (i + 1) * sin(0.013 * j + i) + 1e-4 * (j % 7);
+    }
+    if (long_one)
+        buf[w->n_samples + 12345] = 5.0;
+    w->n_vehicles = event ? 2 : 1;
+    for (int v = 0; v < w->n_vehicles; v++) {
+        amfi_raw_vehicle *e = &w->vehicle[v];
+        e->vehicle_id = 1000 + k + v;
+        e->utime = utime + v * INT64_C(1200000);
+        e->lane = 1 + (k + v) % 2;
+        e->speed_mps = speed;
+        e->n_axles = n_axles;
+        for (int a = 0; a + 1 < n_axles; a++)
+            e->spacing_m[a] = spacing[a];
+    }
+    amfi_lambda_default(&w->lambda);
+    amfi_speed_prior_default(&w->speed_prior);
+    w->samples = buf;
+}
 
 static int check(int rc, const char *what, const char *err)
 {
@@ -50,8 +98,12 @@ int main(int argc, char **argv)
     if (!rc)
         rc = check(amfi_store_meta_set(s, "intake.passages_lost", "0", err, sizeof err), "intake",
                    err);
+    int64_t event_window = 0;
     for (int k = 1; rc == 0 && k <= 40; k++) {
         amfi_passage_row r;
+        amfi_raw_window w;
+        amfi_raw_put put;
+        memset(&put, 0, sizeof put);
         memset(&r, 0, sizeof r);
         r.vehicle_id = 1000 + k;
         r.utime = T0 + (k - 1) * HOUR;
@@ -97,8 +149,32 @@ int main(int argc, char **argv)
             r.status = k == 7 ? "error" : "ok";
             r.reason = k == 7 ? "solver: " HOSTILE : "";
         }
+        if (k == 2 || k == 5 || k == 11 || k == 14 || k == 17) {
+            make_window(&w, k, r.utime, r.speed_mps, r.n_axles, r.spacing_m);
+            put.window = &w;
+            put.float32 = k == 11;
+            r.raw = &put;
+            r.n_vehicles = k == 14 ? 2 : 1;
+        } else if (k == 15) {
+            put.window_id = event_window;
+            put.vehicle = 1;
+            r.raw = &put;
+            r.n_vehicles = 2;
+        }
         rc = check(amfi_store_add_passage(s, &r, NULL, err, sizeof err), "passage", err);
+        if (rc == 0 && r.raw && put.status != 0)
+            rc = check(put.status, "raw samples", put.err);
+        if (k == 14)
+            event_window = put.stored_window_id;
     }
+    /* the retention deletes passage 2's window (the only one before 01:30Z
+     * of the second hour) */
+    amfi_raw_pruned pr;
+    if (!rc)
+        rc = check(amfi_store_raw_prune(s, T0 + HOUR + HOUR / 2, -1, 10, &pr, err, sizeof err),
+                   "raw retention", err);
+    if (!rc && pr.by_age != 1)
+        rc = check(1, "raw retention", "not one window deleted");
     amfi_baseline b = {.utime_set = T0, .n = 30, .mean_kg = 20000, .std_kg = 4000};
     strcpy(b.source, "auto");
     if (!rc)
@@ -131,5 +207,18 @@ int main(int argc, char **argv)
     if (!rc)
         rc = check(amfi_store_add_environment(s, env, 12, err, sizeof err), "environment", err);
     amfi_store_close(s);
+    /* passage 17's blob damaged in the middle (its length kept) */
+    amfi_store_test_db *db = rc ? NULL : amfi_store_test_open(argv[1], 0, err, sizeof err);
+    if (!rc && !db)
+        rc = check(1, "store_testing", err);
+    if (!rc)
+        rc = check(amfi_store_test_exec(db,
+                                        "UPDATE raw_windows SET samples = CAST(substr(samples, "
+                                        "1, bytes / 2) || x'00ff00ff' || substr(samples, bytes "
+                                        "/ 2 + 5) AS BLOB) WHERE id = (SELECT window_id FROM "
+                                        "passage_raw WHERE passage_id = 17)",
+                                        err, sizeof err),
+                   "damage", err);
+    amfi_store_test_close(db);
     return rc ? 1 : 0;
 }

@@ -12,6 +12,7 @@
  */
 #include <arpa/inet.h>
 #include <jansson.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -166,6 +167,111 @@ static const char *sval(json_t *j, const char *path)
     return s ? s : "(none)";
 }
 
+static double rval(json_t *j, const char *path)
+{
+    json_t *v = at(j, path);
+    return json_is_number(v) ? json_number_value(v) : NAN;
+}
+
+static int has_text(json_t *j, const char *path, const char *want)
+{
+    return strstr(sval(j, path), want) != NULL;
+}
+
+/* The raw samples of the fixture's passages (web_fixture.c). */
+static void check_raw(void)
+{
+    const long long t0 = 1768006800000000LL; /* 2026-01-10T01:00:00Z */
+    /* passage 5: every sample, exactly, with its time base and vehicle */
+    json_t *j = get_json("/api/passages/5", 200);
+    CHECK(json_is_object(at(j, "raw")) && json_is_null(at(j, "raw_reason")),
+          "passage 5: raw %s", sval(j, "raw_reason"));
+    CHECK(rval(j, "raw.rate_hz") == 1000 && ival(j, "raw.n_samples") == 1500
+              && ival(j, "raw.t0_utime") == t0 + 4 * 3600000000LL - 500000
+              && strcmp(sval(j, "raw.precision"), "float64") == 0
+              && at(j, "raw.decimated") == NULL,
+          "passage 5: time base %g %lld %lld %s", rval(j, "raw.rate_hz"),
+          ival(j, "raw.n_samples"), ival(j, "raw.t0_utime"), sval(j, "raw.precision"));
+    CHECK(json_array_size(at(j, "raw.sensors")) == 2
+              && json_array_size(at(j, "raw.sensors.0.samples")) == 1500
+              && json_array_size(at(j, "raw.sensors.1.samples")) == 1500
+              && ival(j, "raw.sensors.1.id") == 7 && rval(j, "raw.sensors.1.at_m") == 15.125,
+          "passage 5: sensors");
+    /* amfi-web writes numbers to 10 significant digits */
+    CHECK(fabs(rval(j, "raw.sensors.1.samples.100") - (0.02 * sin(0.013 * 100 + 1) + 1e-4 * 2))
+              < 1e-11,
+          "passage 5: sample 100 of sensor 7: %.17g", rval(j, "raw.sensors.1.samples.100"));
+    CHECK(fabs(rval(j, "raw.t_entry_s") - 0.5) < 1e-9
+              && fabs(rval(j, "raw.t_last_axle_s") - (0.5 + 1.3 / 20)) < 1e-9
+              && json_array_size(at(j, "raw.vehicles")) == 1 && ival(j, "raw.vehicle") == 0
+              && ival(j, "raw.vehicles.0.vehicle_id") == 1005
+              && json_is_false(at(j, "raw.exit_marked")) && has_text(j, "raw.exit_reason", "span"),
+          "passage 5: entry %g, last axle %g", rval(j, "raw.t_entry_s"),
+          rval(j, "raw.t_last_axle_s"));
+    json_decref(j);
+    /* passage 11: 30000 samples a sensor, sent as the min and max of 2000
+     * buckets of 15: 4000 points, the spike kept */
+    j = get_json("/api/passages/11", 200);
+    CHECK(ival(j, "raw.decimated") == 15 && ival(j, "raw.n_samples") == 30000
+              && strcmp(sval(j, "raw.precision"), "float32") == 0,
+          "passage 11: decimated %lld of %lld, %s", ival(j, "raw.decimated"),
+          ival(j, "raw.n_samples"), sval(j, "raw.precision"));
+    double top = -1;
+    for (int i = 0; i < 3; i++) {
+        char path[64];
+        snprintf(path, sizeof path, "raw.sensors.%d.samples", i);
+        json_t *a = at(j, path);
+        CHECK(json_array_size(a) == 4000, "passage 11: sensor %d: %zu points", i,
+              json_array_size(a));
+        for (size_t k = 0; i == 1 && k < json_array_size(a); k++)
+            if (json_number_value(json_array_get(a, k)) > top)
+                top = json_number_value(json_array_get(a, k));
+    }
+    CHECK(top == 5.0, "passage 11: the spike of sensor 7 is %g, not 5", top);
+    /* sample 12345 opens bucket 823: its max (the spike) comes before its min */
+    CHECK(rval(j, "raw.sensors.1.samples.1646") == 5.0 && rval(j, "raw.sensors.1.samples.1647") < 1,
+          "passage 11: bucket 823 is %g, %g", rval(j, "raw.sensors.1.samples.1646"),
+          rval(j, "raw.sensors.1.samples.1647"));
+    json_decref(j);
+    /* passages 14 and 15: one event window, each its own vehicle */
+    json_t *a = get_json("/api/passages/14", 200), *b = get_json("/api/passages/15", 200);
+    CHECK(ival(a, "raw.window_id") > 0 && ival(a, "raw.window_id") == ival(b, "raw.window_id")
+              && ival(a, "raw.vehicle") == 0 && ival(b, "raw.vehicle") == 1
+              && json_array_size(at(b, "raw.vehicles")) == 2
+              && json_array_size(at(b, "raw.sensors.0.samples")) == 2000
+              && rval(b, "raw.rate_hz") == 500,
+          "passages 14, 15: windows %lld %lld, vehicles %lld %lld", ival(a, "raw.window_id"),
+          ival(b, "raw.window_id"), ival(a, "raw.vehicle"), ival(b, "raw.vehicle"));
+    CHECK(fabs(rval(a, "raw.t_entry_s") - 0.5) < 1e-9 && fabs(rval(b, "raw.t_entry_s") - 1.7) < 1e-9
+              && fabs(rval(b, "raw.vehicles.0.t_entry_s") - 0.5) < 1e-9,
+          "passages 14, 15: entries %g %g", rval(a, "raw.t_entry_s"), rval(b, "raw.t_entry_s"));
+    json_decref(a);
+    json_decref(b);
+    /* the reasons: deleted by the retention, never weighed, not kept, damaged */
+    j = get_json("/api/passages/2", 200);
+    CHECK(json_is_null(at(j, "raw")) && has_text(j, "raw_reason", "or deleted by the retention")
+              && has_text(j, "raw_reason", "not newer than the oldest window kept "
+                                           "(2026-01-10T05:00:00"),
+          "passage 2: %s", sval(j, "raw_reason"));
+    json_decref(j);
+    j = get_json("/api/passages/3", 200);
+    CHECK(json_is_null(at(j, "raw")) && has_text(j, "raw_reason", "never complete"),
+          "passage 3: %s", sval(j, "raw_reason"));
+    json_decref(j);
+    j = get_json("/api/passages/7", 200);
+    CHECK(json_is_null(at(j, "raw")) && has_text(j, "raw_reason", "daemon.store.raw.keep")
+              && has_text(j, "raw_reason", "not the retention")
+              && has_text(j, "raw_reason", "the oldest kept is from 2026-01-10T05:00:00"),
+          "passage 7: %s", sval(j, "raw_reason"));
+    json_decref(j);
+    j = get_json("/api/passages/17", 200);
+    CHECK(json_is_null(at(j, "raw")) && has_text(j, "raw_reason", "damaged")
+              && has_text(j, "raw_reason", "passage 17") && ival(j, "id") == 17
+              && json_array_size(at(j, "axles")) == 2,
+          "passage 17: %s", sval(j, "raw_reason"));
+    json_decref(j);
+}
+
 /* a 400 naming `param` */
 static void bad(const char *target, const char *param)
 {
@@ -289,6 +395,7 @@ int main(int argc, char **argv)
               && json_array_size(at(j, "axles")) == 0 && json_is_null(at(j, "class")),
           "passage 3: invalid, no axles, nulls");
     json_decref(j);
+    check_raw();
     json_decref(get_json("/api/passages/41", 404));
     json_decref(get_json("/api/passages/0", 404));
     json_decref(get_json("/api/passages/abc", 404));

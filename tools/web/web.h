@@ -5,7 +5,7 @@
  * amfi-web.c (options, the HTTP server on libmicrohttpd, routing, headers,
  * the central database's copy), web_api.c (the JSON API: parameters checked
  * and answered from store.h's reads), web_time.c (times in and out),
- * web_raw.c (a passage's raw samples: the hook for the raw store) and
+ * web_raw.c (a passage's raw samples, bounded for a browser) and
  * web_assets.c (generated at build time: the pages, the script and the
  * style sheet, embedded). One thread serves every request, so the store
  * handle is used by one thread at a time (store.h).
@@ -59,9 +59,11 @@ int64_t web_now_us(void);
 
 /* ---- raw samples (web_raw.c) --------------------------------------------- */
 
-/* The raw samples of passage id, or NULL with *why saying why there are
- * none (this store keeps none). */
-json_t *web_raw(amfi_store *s, int64_t id, const char **why);
+/* The raw samples of passage p, at most 4000 points per sensor (min/max per
+ * bucket beyond), or NULL with why (whylen bytes) saying why there are none:
+ * the central database, never weighed, not kept, not kept or deleted by the
+ * retention, damaged (named). */
+json_t *web_raw(const web_source *src, const amfi_web_passage *p, char *why, size_t whylen);
 
 /* ---- embedded files (web_assets.c, generated) ---------------------------- */
 

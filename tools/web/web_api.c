@@ -495,9 +495,9 @@ static web_reply api_passage(const web_source *src, const char *id_text, const w
         return reply(404, web_error(msg, NULL));
     }
     json_t *o = passage_json(wp, 1);
+    char why[600];
+    json_t *raw = web_raw(src, wp, why, sizeof why);
     free(wp);
-    const char *why = NULL;
-    json_t *raw = web_raw(src->store, id, &why);
     json_object_set_new(o, "raw", raw ? raw : json_null());
     json_object_set_new(o, "raw_reason", raw ? json_null() : json_string(why));
     return reply(200, o);

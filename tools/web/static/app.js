@@ -182,21 +182,61 @@ async function pageVehicle() {
   }
   parts.push(el('h2', {}, 'Signal'));
   if (p.raw && p.raw.sensors) {
-    const rate = p.raw.rate_hz;
+    parts.push(el('p', {class: 'muted', id: 'raw-info'}, signalInfo(p.raw)));
     for (const [k, sensor] of p.raw.sensors.entries()) {
-      const step = Math.max(1, Math.ceil(sensor.samples.length / 2000));
-      const xs = [], ys = [];
-      for (let i = 0; i < sensor.samples.length; i += step) {
-        xs.push((i / rate).toFixed(3));
-        ys.push(sensor.samples[i]);
-      }
-      parts.push(chart('chart-signal-' + k, 'line', xs,
-                       [{label: sensor.name, data: ys, pointRadius: 0}], 'm/s²'));
+      parts.push(signalChart('chart-signal-' + k, p.raw, sensor));
     }
   } else {
     parts.push(el('p', {id: 'raw-reason', class: 'muted'}, p.raw_reason || 'no raw samples'));
   }
   main.replaceChildren(...parts);
+}
+
+// ---- the raw signal of a passage (docs/web.md: /api/passages/ID "raw") ----------
+function signalInfo(raw) {
+  const me = raw.vehicles[raw.vehicle];
+  return raw.n_samples + ' samples a sensor at ' + raw.rate_hz + ' Hz (' + raw.precision +
+    '), from ' + when(raw.t0_utc) + '; ' + raw.vehicles.length + ' vehicle(s) in the window' +
+    (raw.decimated ? '; drawn as the min and max of every ' + raw.decimated + ' samples' : '') +
+    '. Marked: this vehicle\'s entry (' + num(raw.t_entry_s, 3) + ' s) and its last axle\'s (' +
+    num(me.t_last_axle_s, 3) + ' s)' + (raw.exit_marked ? '' : '; exit not marked: ' + raw.exit_reason) + '.';
+}
+
+// one chart per sensor: time after sample 0 (s) on a linear axis; a
+// decimated sensor's points 2b, 2b + 1 are bucket b (its min and max)
+function signalChart(id, raw, sensor) {
+  const k = raw.decimated || 1;
+  const pts = sensor.samples.map((y, i) => ({x: (k > 1 ? Math.floor(i / 2) * k + (i % 2) * (k - 1) : i) / raw.rate_hz, y: y}));
+  const canvas = el('canvas', {id: id, 'data-points': String(pts.length),
+                               'data-entry-s': String(raw.t_entry_s)});
+  const box = el('div', {class: 'chart'}, canvas);
+  if (typeof Chart === 'undefined') {
+    box.appendChild(el('p', {class: 'muted'}, 'Charts need Chart.js (libjs-chart.js).'));
+    return box;
+  }
+  let lo = Infinity, hi = -Infinity;
+  for (const y of sensor.samples) { lo = Math.min(lo, y); hi = Math.max(hi, y); }
+  const mark = (label, t, color, dash) => ({label: label, data: [{x: t, y: lo}, {x: t, y: hi}],
+    borderColor: color, borderDash: dash, pointRadius: 0, borderWidth: 1});
+  const sets = [{label: 'sensor ' + sensor.id + ' at ' + num(sensor.at_m, 2) + ' m', data: pts,
+                 borderColor: '#236', pointRadius: 0, borderWidth: 1}];
+  const me = raw.vehicles[raw.vehicle];
+  sets.push(mark('entry', me.t_entry_s, '#c00', []),
+            mark('last axle in', me.t_last_axle_s, '#c60', [4, 3]));
+  raw.vehicles.forEach((v, i) => {
+    if (i !== raw.vehicle) sets.push(mark('vehicle ' + v.vehicle_id + ' entry', v.t_entry_s, '#999', [2, 2]));
+  });
+  setTimeout(() => {
+    new Chart(canvas, {
+      type: 'line', data: {datasets: sets},
+      options: {animation: false, responsive: true, maintainAspectRatio: false, parsing: false,
+                normalized: true, spanGaps: true,
+                scales: {x: {type: 'linear', title: {display: true, text: 's after ' + when(raw.t0_utc)}},
+                         y: {title: {display: true, text: 'm/s²'}}}}
+    });
+    canvas.setAttribute('data-drawn', '1');
+  }, 0);
+  return box;
 }
 
 // ---- trends ----------------------------------------------------------------------
