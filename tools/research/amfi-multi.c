@@ -4,7 +4,8 @@
  *
  *   amfi-multi [--events N] [--seed S] [--noise FRACTION] [--min-headway S]
  *              [--alone] [--loose] [--lambda-factor F] [--quarter]
- *              [--population FILE.csv [--min-gap M]] [--mid-only] [--dump DIR]
+ *              [--population FILE.csv [--min-gap M]] [--mid-only] [--noise-free]
+ *              [--entry-shift S] [--dump DIR]
  *              [--config FILE.yaml]
  *
  * Each event: two half-cars (GVW 10..40 t, front axle share 0.35..0.6,
@@ -51,7 +52,11 @@
  * (default 4: overhangs) behind the leader's last axle; the rows then carry
  * the class, the axle count and every axle (';'-separated lists) in place
  * of the two axle columns. --mid-only solves from the mid-span sensor
- * only (with and without noise; the issue's condition is the first). --dump DIR writes each event's
+ * only (with and without noise; the issue's condition is the first);
+ * --noise-free skips the noisy conditions (their draws too, so the events
+ * differ from a run with them); --entry-shift S gives the solver the
+ * follower's entry S s late (the simulation is unchanged: where it falls on
+ * the calculation grid). --dump DIR writes each event's
  * mid-span record as DIR/eN.csv (t,accel on the event's clock) and one line
  * per event to DIR/events.txt: the event, each vehicle's truth, and the
  * amfi-solve --vehicle arguments that solve the record with the same
@@ -100,6 +105,8 @@ static void usage(FILE *f)
                "  -g, --min-gap M     with --population: least gap from the leader's last axle\n"
                "                      to the follower's first, m, 0 .. 50 (default 4)\n"
                "  -1, --mid-only      only the one-sensor (mid-span) conditions\n"
+               "  -0, --noise-free    no noisy conditions (and no noise draws)\n"
+               "  -e, --entry-shift S the follower's entry S s late in the solve, |S| <= 0.01\n"
                "  -d, --dump DIR      each event's mid-span record and amfi-solve arguments\n"
                "  -c, --config FILE   site configuration (default paper-20m.yaml)\n"
                "  -h, --help          this help\n"
@@ -225,12 +232,15 @@ int main(int argc, char **argv)
                                               {"min-gap", required_argument, NULL, 'g'},
                                               {"mid-only", no_argument, NULL, '1'},
                                               {"dump", required_argument, NULL, 'd'},
+                                              {"noise-free", no_argument, NULL, '0'},
+                                              {"entry-shift", required_argument, NULL, 'e'},
                                               {"config", required_argument, NULL, 'c'},
                                               AMFI_CLI_END};
     int n_events = 100;
     unsigned long seed = 1;
     double noise = 0.02, min_headway = 0.5, lambda_factor = 0.0, min_gap = 4.0;
-    int alone = 0, loose = 0, quarter = 0, mid_only = 0;
+    int alone = 0, loose = 0, quarter = 0, mid_only = 0, noise_free = 0;
+    double entry_shift = 0.0;
     const char *config = NULL, *population = NULL, *dump = NULL;
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -240,6 +250,8 @@ int main(int argc, char **argv)
         case 'l': loose = 1; break;
         case 'q': quarter = 1; break;
         case '1': mid_only = 1; break;
+        case '0': noise_free = 1; break;
+        case 'e': entry_shift = amfi_cli_num(&c, optarg, -0.01, 0.01); break;
         case 'f': lambda_factor = amfi_cli_num(&c, optarg, 1e-4, 1); break;
         case 'n': n_events = (int)amfi_cli_integer(&c, optarg, 10, 100000); break;
         case 's': seed = (unsigned long)amfi_cli_integer(&c, optarg, 0, 4294967295.0); break;
@@ -482,7 +494,7 @@ int main(int argc, char **argv)
                 alone_truth[k][2 * e + i] = t1;
             }
         }
-        for (int z = 0; z < 2; z++) {
+        for (int z = 0; z < 2 - noise_free; z++) {
             double rms[3] = {0, 0, 0};
             for (int i = 0; i < 3; i++) {
                 for (int k = 0; k < n; k++)
@@ -506,7 +518,7 @@ int main(int argc, char **argv)
                     mp.accel[0] = ch[z][1];
                 mp.n_vehicles = 2;
                 for (int i = 0; i < 2; i++) {
-                    mp.vehicle[i].entry_s = entry[i];
+                    mp.vehicle[i].entry_s = entry[i] + (i ? entry_shift : 0.0);
                     mp.vehicle[i].speed_mps = v;
                     mp.vehicle[i].n_axles = nax[i];
                     for (int a = 0; a + 1 < nax[i]; a++)
@@ -560,7 +572,7 @@ int main(int argc, char **argv)
     const char *names[4] = {"1 sensor, no noise", "1 sensor, noise", "3 sensors, no noise",
                             "3 sensors, noise"};
     for (int k = 0; k < 4; k++) {
-        if (mid_only && k >= 2)
+        if ((mid_only && k >= 2) || (noise_free && (k & 1)))
             continue;
         char name[96];
         snprintf(name, sizeof name, "%s", names[k]);
