@@ -4,7 +4,8 @@
 # Two two-axle vehicles at 25 m/s, the second entering 0.5 s after the first
 # (12.5 m behind), are the same axle trajectories as one four-axle vehicle
 # with spacings 5, 7.5, 4: amfi-mkcase writes that case, and the joint solve
-# must give the one-vehicle solve's numbers (every key before the timing: the
+# (an event of two vehicles: weighed at λ/10, AMFI_MULTI_QUALITY_LAMBDA)
+# must give the one-vehicle solve's numbers at λ/10 (every key before the timing: the
 # same text, the same numbers to 1e-9 relative: the printed 10 digits may
 # differ in the last one where the two paths' axle positions differ by
 # round-off; a solve this ill-conditioned amplifies that, LAPACK's
@@ -28,9 +29,12 @@ config="--config $confdir/paper-20m.yaml"
 "$mkcase" $config --out "$tmp/two.csv" --speed 25 --axle-loads-kg 10400,7600,9000,6000 \
     --axle-spacing 5,7.5,4 --pre 0.5 --post 0.5 --scan-rate 1000 > "$tmp/truth" ||
     fail "amfi-mkcase: exit $?"
+lambda=$(sed -n 's/^  lambda: \([0-9.eE+-]*\) .*/\1/p' "$confdir/paper-20m.yaml")
+[ -n "$lambda" ] || fail "no fixed solver.lambda in $confdir/paper-20m.yaml"
 # shellcheck disable=SC2086
 "$solve" $config --accel "$tmp/two.csv" --speed 25 --axle-spacing 5,7.5,4 \
-    --entry-time 0.5 > "$tmp/one.json" || fail "one-vehicle solve: exit $?"
+    --entry-time 0.5 --lambda "$(awk -v l="$lambda" 'BEGIN { printf "%.17g", l / 10 }')" \
+    > "$tmp/one.json" || fail "one-vehicle solve: exit $?"
 # shellcheck disable=SC2086
 "$solve" $config --accel "$tmp/two.csv" --vehicle 0.5:25:5 --vehicle 1.0:25:4 \
     > "$tmp/joint.json" || fail "joint solve: exit $?"

@@ -449,7 +449,9 @@ double amfi_speed_dip_at(const amfi_speed_prior *p, const double *j, int n, int 
  * difference of their forces changes neither the fit nor the smoothing
  * term), and solved apart they leave the sweep singular. */
 #define AMFI_MULTI_COINCIDENT_M 0.01
-/* The factor on λ of amfi_solve_multi's second sweep (quality figure). */
+/* The factor on λ of amfi_solve_multi's second sweep: an event of several
+ * vehicles is weighed at λ times this and its quality figure is the change
+ * from λ (amfi_multi_passage.lambda_factor). */
 #define AMFI_MULTI_QUALITY_LAMBDA 0.1
 
 /* One vehicle of an event: its first axle reaches x = 0 at entry_s, on the
@@ -470,15 +472,19 @@ typedef struct amfi_multi_passage {
     const double *accel[AMFI_MAX_SENSORS];
     int n_vehicles; /* 1 .. AMFI_MAX_VEHICLES */
     amfi_vehicle vehicle[AMFI_MAX_VEHICLES];
-    /* 0 (the default: a zeroed struct) or 1: the event is solved at the λ of
-     * the call; f in [1e-4, 1): an event of two or more vehicles is solved
-     * at λ·f (and its quality sweep at λ·f·AMFI_MULTI_QUALITY_LAMBDA); a
-     * vehicle alone always at λ. Round five (docs/results/multi-vehicle.md):
-     * the joint solve's error lies largely against the direction the
-     * weights move when λ is loosened, and 0.1 lowers the mean error in
-     * every condition measured, but the worst of coincident axles rises and
-     * `quality` then no longer ranks the errors; off by default (amfid does
-     * not set it). */
+    /* 0 (the default: a zeroed struct): an event of two or more vehicles
+     * at a fixed λ is swept at λ and at λ·AMFI_MULTI_QUALITY_LAMBDA and
+     * weighed by the second sweep (round six, docs/results/multi-vehicle.md:
+     * the fixed λ, one vehicle's, over-smooths a joint solve; on simulated
+     * truck pairs, one mid-span sensor, the pair sums erred 1.2-1.5 % mean
+     * abs and up to 6.8 % at λ, 0.55 % and 1.5 % at λ/10, where the same
+     * vehicles solved alone do not move with λ); with the L-curve, at its
+     * λ; an event of one inseparable group (coincident axles, below: side
+     * by side) at λ, as one vehicle. f in [1e-4, 1]: an event of two or more vehicles is weighed at
+     * λ·f and its quality sweep run at λ·f·AMFI_MULTI_QUALITY_LAMBDA (f = 1:
+     * the weights at λ, as before round six). A vehicle alone is always
+     * weighed at λ. The quality figure is the same in the default and at
+     * f = 1 (the change between λ and λ/10). */
     double lambda_factor;
 } amfi_multi_passage;
 
@@ -500,8 +506,9 @@ typedef struct amfi_vehicle_result {
     int n_merged;
     double group_gvw_kg;
     /* How well this vehicle's weight is determined in the event: 1 + the
-     * change of gvw_kg, in % of it, when the event is solved again at λ ×
-     * AMFI_MULTI_QUALITY_LAMBDA. Load that close axles of different vehicles
+     * change of its GVW, in % of the GVW at the tighter λ, between the
+     * event's two sweeps (λ and λ × AMFI_MULTI_QUALITY_LAMBDA by default,
+     * see lambda_factor). Load that close axles of different vehicles
      * trade is decided by the regularisation, so a weight that moves with λ
      * is one the data do not fix (docs/results/multi-vehicle.md: the worst
      * tenth by this figure holds 21-35 of the 60 largest errors of 300
