@@ -51,6 +51,12 @@ near "$st" 1.10 0.03 || fail "stiffness x$st, as built x1.10"
 near "$ms" 1.00 0.03 || fail "mass x$ms, as built x1.00"
 near "$ck" 0.010 0.002 || fail "clock offset $ck s, as built 0.010 s"
 near "$ss" 1.00 1e-9 || fail "speed scale x$ss, held at the design's 1"
+# the search's evaluations (each: every searched run solved at the site's
+# rate): the Jacobian's base point is the point just evaluated, and the
+# search stops when a trial step is within the difference steps of its
+# point; a count, not a time (this set: 10)
+ev=$(num evaluations)
+[ -n "$ev" ] && [ "$ev" -le 22 ] || fail "the search took $ev evaluations (at most 22)"
 # the stages' CPU seconds in the JSON line
 for k in modal_and_design scans search final; do
   grep -q "\"cpu_s\":{.*\"$k\":[0-9]" "$dir/com.json" || fail "com.json: no cpu_s.$k"
