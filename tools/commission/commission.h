@@ -131,6 +131,10 @@ typedef struct cm_options {
                                 (amfi_solve_speed, this SD as the prior) and only the
                                 mean of the detector's error is its speed scale;
                                 0 (default): the detector's speeds, one common scale */
+    int resolved_modes;      /* 1: solve with the modes the calculation step resolves
+                                (AMFI_MODES_RESOLVED) where the site says observable or
+                                all: the scans and the search (set by cm_identify); the
+                                weighings before and after keep the site's modes */
     int verbose;             /* progress on stderr */
 } cm_options;
 

@@ -198,6 +198,9 @@ int cm_evaluate(const amfi_site_config *site, const double *p, const cm_runs *ru
     amfi_solver_params sp = site->solver;
     sp.calc_rate_hz = calc_rate_hz;
     sp.post_roll_s = o->tail_s;
+    if (o->resolved_modes &&
+        (sp.modes == AMFI_MODES_OBSERVABLE || sp.modes == AMFI_MODES_ALL))
+        sp.modes = AMFI_MODES_RESOLVED;
     sp.max_axles = AMFI_MAX_AXLES;
     if (amfi_solver_create(b, &sp, &s, err, errlen) != AMFI_OK) {
         amfi_bridge_destroy(b);
@@ -915,7 +918,15 @@ int cm_identify(const amfi_site_config *design0, cm_runs *runs,
     memset(&q, 0, sizeof q);
     q.design = &design;
     q.runs = runs;
-    q.o = &o;
+    /* The scans and the search solve with the modes the calculation step
+     * resolves (below half its rate): a mode above it is aliased, and the
+     * sweep's cost grows with the modes (libamfi: the same GVW to 0.1 kg
+     * as every observable mode, several times faster; docs/results/
+     * speed-estimation.md). The weighings before and after keep the
+     * site's own modes. */
+    cm_options o_search = o;
+    o_search.resolved_modes = 1;
+    q.o = &o_search;
     q.use = use;
     q.n_use = pick_runs(runs, o.max_search_runs, use);
     q.f1 = res->f1_meas_hz;
