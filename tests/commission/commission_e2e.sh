@@ -68,6 +68,22 @@ l=$(sed -n 's/^  lambda: \([-0-9.e+]*\).*/\1/p' "$dir/site.yaml")
 near "$l" 7.94e-9 1e-12 || fail "site.yaml: lambda $l, not the design's 7.94e-9"
 [ -s "$dir/report/report.md" ] || fail "no report"
 
+# A detector clock measured apart, in the design's detector: section, and
+# held: the runs are weighed with it (before, the runs were weighed with no
+# clock offset and the section only added to the output: the mass took the
+# 10 ms) and the site file keeps it
+{ cat "$dir/design.yaml"; printf 'detector:\n  clock_offset_s: 0.010\n'; } > "$dir/design_clock.yaml"
+"$com" --config "$dir/design_clock.yaml" --runs "$dir/cal/RUNS.csv" --out "$dir/site_clock.yaml" \
+  --hold bearings --hold sensor --hold speed --hold clock > "$dir/com_clock.json" \
+  2> "$dir/commission.log" || fail "amfi-commission (the clock given) exited $?"
+cat "$dir/com_clock.json"
+st=$(sed -n 's/.*"stiffness_scale":\([-0-9.e+]*\).*/\1/p' "$dir/com_clock.json")
+ms=$(sed -n 's/.*"mass_scale":\([-0-9.e+]*\).*/\1/p' "$dir/com_clock.json")
+ck=$(sed -n 's/.*"clock_offset_s":\([-0-9.e+]*\).*/\1/p' "$dir/com_clock.json")
+near "$st" 1.10 0.03 || fail "the clock given: stiffness x$st, as built x1.10"
+near "$ms" 1.00 0.03 || fail "the clock given: mass x$ms, as built x1.00"
+near "$ck" 0.010 1e-9 || fail "the clock given: clock offset $ck s, the design's 0.010 s"
+
 # weigh NAME SITE: amfid on SITE over the bus, the as-built traffic from
 # sim_publisher (the same vehicles each time); the stored gross weights
 # joined with the stored truth into NAME.csv for amfi-accuracy
