@@ -14,7 +14,9 @@
 #
 # usage: commission-trial.sh BIN_DIR DESIGN.yaml CASE.yaml OUT_DIR
 #          [RUNS_PER_TRUCK (10)] [VEHICLES (200)] [POPULATION.csv]
-# environment: COMMISSION_ARGS (extra amfi-commission options),
+# environment: COMMISSION_ARGS (extra amfi-commission options; the paper's
+#                Table 5 detector, SIM_ARGS="--noise 0.03 --speed-error
+#                0,0.03": "--speed-sd 0.03 --hold clock"),
 #              SIM_ARGS (extra sim_publisher options for both simulations),
 #              CAL_ARGS (extra sim_publisher options for the calibration runs
 #                        only, after SIM_ARGS),

@@ -5,7 +5,9 @@
 # exit (1 for the input, 2 for the command line), and writes no site file:
 # missing files, a run whose loads do not match its axles, too few runs,
 # speeds too alike, runs without enough free vibration, a multi-channel run
-# file without one of the site's sensors.
+# file without one of the site's sensors; with each run's speed estimated
+# (--speed-sd): the clock not held, speeds that scatter too much for the
+# runs to fix the detector's scale.
 # Usage: commission_cli.sh SIM_PUBLISHER AMFI_COMMISSION DESIGN.yaml
 set -u
 sim=$1 com=$2 design=$3
@@ -66,6 +68,19 @@ refuse 1 'too alike' --config "$design" --runs "$dir/alike/RUNS.csv" --out "$dir
 # ... unless one of the two is held: then the set goes on (not checked here)
 # runs that keep too little free vibration to identify the bridge
 refuse 1 'free vibration' --config "$design" --runs "$dir/short/RUNS.csv" --out "$dir/site.yaml"
+# each run's speed estimated (--speed-sd): the clock offset cannot be told
+# from the mass then, and must be held
+refuse 2 "speed-sd: '0.5' is not a number in" --config "$design" --runs "$R" \
+  --out "$dir/site.yaml" --speed-sd 0.5
+refuse 1 "cannot tell the detector's clock offset from the mass: hold clock" \
+  --config "$design" --runs "$R" --out "$dir/site.yaml" --speed-sd 0.03
+# speeds that scatter too much for 4 runs to fix the detector's scale (its
+# random error 8 % SD)
+"$sim" --config "$design" --calibration-runs "$dir/noisy" --runs-per-truck 2 \
+  --speed-error 0,0.08 --seed 3 2>/dev/null || fail "sim_publisher (speed error) exited $?"
+refuse 1 "the runs' speeds scatter by .* 4 runs fix its speed scale only to" \
+  --config "$design" --runs "$dir/noisy/RUNS.csv" --out "$dir/site.yaml" --speed-sd 0.1 \
+  --hold clock
 # a multi-channel file that lacks one of the site's sensors
 cat > "$dir/two.yaml" <<EOF
 sensors:

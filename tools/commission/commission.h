@@ -52,10 +52,24 @@ typedef struct cm_run {
     double rate_hz;
     double t0_s;            /* first sample on the file's clock */
     double *accel[AMFI_MAX_SENSORS];  /* n_samples each, owned */
+    /* Each run's own speed (cm_options.speed_sd > 0; 0 and the detector's
+     * speed otherwise): the run's speed at model clock offset c is
+     *   speed_mps · exp(−(speed_eps + (c − cm_runs.clock_ref) · speed_gdev))
+     * before the common speed scale. speed_eps: log(detector / estimated)
+     * less its mean over the runs (the random part of the detector's error;
+     * the mean is the common scale's); speed_gdev: how that moves with the
+     * clock the estimate assumed (an entry time late by δ makes the
+     * estimate match the exit, v·(1 + δ·v/L)), less its mean. */
+    double speed_eps, speed_gdev;
+    double speed_est_mps;   /* the estimate (0: not estimated) */
+    double speed_ref_mps;   /* the speed that places the free-vibration stretch */
 } cm_run;
 
 typedef struct cm_runs {
     int n;
+    int speed_estimated;    /* 1: the runs' speed_eps and speed_gdev apply */
+    double clock_ref;       /* the clock offset the estimates assumed, s */
+    double speed_ymean, speed_gmean; /* means of log(detector/estimate) and the slope */
     cm_run run[CM_MAX_RUNS];
 } cm_runs;
 
@@ -111,6 +125,16 @@ typedef struct cm_options {
     int max_search_runs;     /* runs used while searching (default 8, spread in speed) */
     int fit_lambda;          /* 1: λ from the runs (leave one out); 0 (default): the
                                 design's (the runs' λ weighed traffic 0.3-0.6 % heavy) */
+    double speed_sd;         /* > 0: the detector's speed carries a random error of this
+                                relative SD per run (the paper's Table 5: 0.03): each
+                                run's speed is estimated from its acceleration
+                                (amfi_solve_speed, this SD as the prior) and only the
+                                mean of the detector's error is its speed scale;
+                                0 (default): the detector's speeds, one common scale */
+    int resolved_modes;      /* 1: solve with the modes the calculation step resolves
+                                (AMFI_MODES_RESOLVED) where the site says observable or
+                                all: the scans and the search (set by cm_identify); the
+                                weighings before and after keep the site's modes */
     int verbose;             /* progress on stderr */
 } cm_options;
 
@@ -145,6 +169,17 @@ typedef struct cm_result {
     int iterations, evaluations; /* the search's */
     int scan_evaluations;       /* the scans' (at their coarse rate, on fewer runs) */
     double seconds;
+    /* the runs' own speeds (speed_sd > 0): each run's speed at the
+     * commissioned clock and scale (the true speed as found), the SD of the
+     * detector's random part over the runs, % */
+    int speeds_estimated;
+    double run_speed_mps[CM_MAX_RUNS];
+    double run_speed_sd_pct;
+    /* the detector's speed scale found (log, and its SD): p[CM_P_SPEED], or
+     * with the runs' speeds estimated (p[CM_P_SPEED] then 0: each run is
+     * weighed at its own) the mean of their log(detector / estimate) */
+    double speed_scale_log, speed_scale_sd;
+    double cpu_speed_s;         /* CPU seconds of the runs' speed estimates */
     /* process CPU seconds of the stages: modal identification with the
      * design's weighing, the scans, the search, the final weighing */
     double cpu_modal_s, cpu_scan_s, cpu_search_s, cpu_final_s;
@@ -167,10 +202,11 @@ int cm_evaluate(const amfi_site_config *site, const double *p, const cm_runs *ru
 int cm_site_apply(const amfi_site_config *design, const double *p, amfi_site_config *out,
                   char *err, size_t errlen);
 
-/* All three stages. 0 and *res; −1 with one line in err when the runs
+/* All three stages (and, with o->speed_sd > 0, each run's speed estimated
+ * first: written into the runs' speed fields). 0 and *res; −1 with one line in err when the runs
  * cannot identify the model (too few, speeds too alike, parameters that
  * trade against each other: named) or a solve fails. */
-int cm_identify(const amfi_site_config *design, const cm_runs *runs,
+int cm_identify(const amfi_site_config *design, cm_runs *runs,
                 const double *const *amb, const int *amb_n, const double *amb_rate, int n_amb,
                 const cm_options *o, cm_result *res, char *err, size_t errlen);
 

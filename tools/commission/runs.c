@@ -186,6 +186,7 @@ int cm_runs_read(const char *path, const amfi_site_config *site, cm_runs *out, c
                           amfi_csv_quote(f[1], fl[1], q), MIN_SPEED_MPS, MAX_SPEED_MPS);
             goto fail;
         }
+        run->speed_ref_mps = run->speed_mps;
         int ns = 0;
         if (fl[2] > 0 && !(fl[2] == 1 && f[2][0] == '-')) {
             ns = parse_list(f[2], fl[2], run->spacing_m, AMFI_MAX_AXLES - 1, 0.3, MAX_SPACING_M,

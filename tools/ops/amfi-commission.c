@@ -42,7 +42,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: " PROG " --config DESIGN.yaml --runs RUNS.csv [--ambient FILE.csv ...]\n"
             "                       --out SITE.yaml [--report DIR] [--hold NAME ...] [--fit-lambda]\n"
-            "                       [--verbose]\n"
+            "                       [--speed-sd F] [--verbose]\n"
             "Commission a site's bridge model from calibration trucks of known axle loads and\n"
             "the bridge's free vibration (docs/commissioning.md).\n"
             "  --config FILE     the site file from the drawings (bridge, sensors, solver)\n"
@@ -56,6 +56,10 @@ static void usage(FILE *f)
             "                    bearings, sensor, clock or speed (repeatable)\n"
             "  --fit-lambda      choose lambda from the runs (leaving each out) instead of\n"
             "                    keeping the design's\n"
+            "  --speed-sd F      the detector's speed has a random error of relative SD F per\n"
+            "                    run (e.g. 0.03): each run's speed is estimated from its\n"
+            "                    acceleration, the detector's mean error is its speed scale\n"
+            "                    (default 0: the detector's speeds, one common scale)\n"
             "  --verbose         the search's progress on stderr\n"
             "Exit 0 commissioned, 1 bad input or runs that cannot identify the model, 2 bad\n"
             "command line.\n");
@@ -212,10 +216,16 @@ static void put_header(text *t, const char *design, const char *runs_path, int n
            "ratio %.4f (+- %.4f).\n",
         r->n_modal, r->f1_meas_hz, r->f1_meas_sd_hz, r->zeta_meas, r->zeta_meas_sd);
     put(t, "# Model f1: design %.4f Hz, commissioned %.4f Hz.\n", r->before.f1_hz, r->after.f1_hz);
+    if (r->speeds_estimated)
+        put(t, "# Each run's speed estimated from its acceleration (the detector's random error\n"
+               "# per run: SD %.2f %% over the runs); the speed scale is the mean of its error.\n",
+            r->run_speed_sd_pct);
     put(t, "# Fitted (value +- standard uncertainty; from f1, the runs' known axle loads\n"
            "# and their fit with the free vibration after the last axle):\n");
     for (int k = 0; k < CM_N_PARAMS; k++) {
         double v = r->p[k], sd = r->sd[k];
+        if (k == CM_P_SPEED)
+            v = r->speed_scale_log, sd = r->speed_scale_sd;
         switch (k) {
         case CM_P_EI: { /* reported as the stiffness scale c·r */
             double ls = r->p[CM_P_EI] + r->p[CM_P_MASS];
@@ -352,11 +362,12 @@ static int write_report(const char *dir, const cm_runs *runs, const cm_result *r
     FILE *f = fopen(path, "w");
     if (!f)
         goto io;
-    fprintf(f, "file,speed_mps,gvw_kg,gvw_err_before_pct,gvw_err_after_pct,gvw_err_loo_pct,"
-               "fit_before,fit_after\n");
+    fprintf(f, "file,speed_mps,speed_found_mps,gvw_kg,gvw_err_before_pct,gvw_err_after_pct,"
+               "gvw_err_loo_pct,fit_before,fit_after\n");
     for (int i = 0; i < runs->n; i++)
-        fprintf(f, "%s,%.3f,%.1f,%.3f,%.3f,%.3f,%.5f,%.5f\n", runs->run[i].file,
-                runs->run[i].speed_mps, runs->run[i].gvw_kg, r->before.gvw_err_pct[i],
+        fprintf(f, "%s,%.3f,%.4f,%.1f,%.3f,%.3f,%.3f,%.5f,%.5f\n", runs->run[i].file,
+                runs->run[i].speed_mps, r->run_speed_mps[i], runs->run[i].gvw_kg,
+                r->before.gvw_err_pct[i],
                 r->after.gvw_err_pct[i], r->loo_gvw_err_pct[i], r->before.resid_rel[i],
                 r->after.resid_rel[i]);
     if (fclose(f) != 0)
@@ -384,6 +395,10 @@ static int write_report(const char *dir, const cm_runs *runs, const cm_result *r
     fprintf(f, "Damping ratio measured %.4f ± %.4f.\n\n", r->zeta_meas, r->zeta_meas_sd);
     fprintf(f, "## Runs\n\nGVW errors in %%; fit = residual/signal with the free vibration "
                "after the last axle in the window.\n\n");
+    if (r->speeds_estimated)
+        fprintf(f, "Each run's speed was estimated from its acceleration (runs.csv: "
+                   "speed_found_mps); the detector's random error per run has an SD of "
+                   "%.2f %% over the runs.\n\n", r->run_speed_sd_pct);
     fprintf(f, "| run | speed m/s | GVW kg | design | commissioned | left out | fit design | "
                "fit commissioned |\n|---|---|---|---|---|---|---|---|\n");
     for (int i = 0; i < runs->n; i++)
@@ -426,6 +441,7 @@ int main(int argc, char **argv)
                                          {"hold", required_argument, NULL, 257},
                                          {"verbose", no_argument, NULL, 'v'},
                                          {"fit-lambda", no_argument, NULL, 258},
+                                         {"speed-sd", required_argument, NULL, 259},
                                          AMFI_CLI_END};
     amfi_cli cli;
     amfi_cli_init(&cli, PROG, argc, argv, opts, usage);
@@ -442,6 +458,7 @@ int main(int argc, char **argv)
         case 'v': o.verbose = 1; break;
         case 256: report = optarg; break;
         case 258: o.fit_lambda = 1; break;
+        case 259: o.speed_sd = amfi_cli_num(&cli, optarg, 0, 0.15); break;
         case 'a':
             if (n_amb == MAX_AMBIENT)
                 amfi_cli_fail(&cli, "at most %d records", MAX_AMBIENT);
@@ -501,7 +518,7 @@ int main(int argc, char **argv)
         goto done;
     }
     res.site.detector.clock_offset_s = design.detector.clock_offset_s + res.p[CM_P_CLOCK];
-    res.site.detector.speed_scale = design.detector.speed_scale * exp(res.p[CM_P_SPEED]);
+    res.site.detector.speed_scale = design.detector.speed_scale * exp(res.speed_scale_log);
     if (write_site(out, config, runs_path, n_amb, &runs, &res, &design, err, sizeof err) != 0 ||
         (report && write_report(report, &runs, &res, err, sizeof err) != 0)) {
         fprintf(stderr, PROG ": %s\n", err);
@@ -532,12 +549,16 @@ int main(int argc, char **argv)
     json_object_set_new(j, "fit_design", amfi_json_num(res.before.mean_resid_rel));
     json_object_set_new(j, "fit", amfi_json_num(res.after.mean_resid_rel));
     json_object_set_new(j, "class_runs", have_class ? json_string(cls.class_name) : json_null());
+    json_object_set_new(j, "run_speeds", json_string(res.speeds_estimated ? "estimated" : "detector"));
+    if (res.speeds_estimated)
+        json_object_set_new(j, "run_speed_sd_pct", amfi_json_num(res.run_speed_sd_pct));
     json_object_set_new(j, "iterations", json_integer(res.iterations));
     json_object_set_new(j, "evaluations", json_integer(res.evaluations));
     json_object_set_new(j, "scan_evaluations", json_integer(res.scan_evaluations));
     json_object_set_new(j, "seconds", amfi_json_num(res.seconds));
     json_t *cpu = json_object();
     json_object_set_new(cpu, "modal_and_design", amfi_json_num(res.cpu_modal_s));
+    json_object_set_new(cpu, "run_speeds", amfi_json_num(res.cpu_speed_s));
     json_object_set_new(cpu, "scans", amfi_json_num(res.cpu_scan_s));
     json_object_set_new(cpu, "search", amfi_json_num(res.cpu_search_s));
     json_object_set_new(cpu, "final", amfi_json_num(res.cpu_final_s));
