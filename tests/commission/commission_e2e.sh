@@ -89,7 +89,7 @@ near "$ck" 0.010 1e-9 || fail "the clock given: clock offset $ck s, the design's
 # joined with the stored truth into NAME.csv for amfi-accuracy
 weigh() {
   amfid_start "$amfid" "$2"
-  timeout 120 "$sim" --config "$dir/design.yaml" --as-built "$dir/as-built.yaml" --vehicles $N \
+  timeout 120 "$sim" --allow-production-bus --config "$dir/design.yaml" --as-built "$dir/as-built.yaml" --vehicles $N \
     --population "$pop" --headway 3 --speedup 10 --seed 11 2> "$dir/sim_$1.log" || fail "$1: sim_publisher exited $?"
   sleep 1
   amfid_stop
