@@ -172,6 +172,15 @@ static double deck_at(amfid_ctx *d, int64_t utime)
     return environment_deck_at(d, utime, d->cfg->daemon.scale_max_temp_gap_s);
 }
 
+int freevib_reference(double *f_ref_hz)
+{
+    amfi_natfreq_model m;
+    if (!F.comp || !amfi_natfreq_comp_model(F.comp, &m) || !(m.f_ref_hz > 0))
+        return 0;
+    *f_ref_hz = m.f_ref_hz;
+    return 1;
+}
+
 /* Whether this row (of an event: one vehicle's) carries the f1. */
 static int carries(const job *j)
 {

@@ -300,6 +300,14 @@ static const char schema_v10[] =
     "ALTER TABLE passages ADD COLUMN overload INTEGER\n"
     "  CHECK (overload IN (0, 1));\n";
 
+/* Version 11: the model fit of each passage weighed alone (amfid's
+ * modelfit.c, the model_mismatch alert): the residual of the site's model
+ * over the free vibration after the last axle, relative to the signal
+ * there. NULL in rows written before and where not fitted. */
+static const char schema_v11[] =
+    "ALTER TABLE passages ADD COLUMN fit_ratio REAL\n"
+    "  CHECK (fit_ratio > 0 AND fit_ratio <= 1000);\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
@@ -313,6 +321,7 @@ const st_migration st_migrations[] = {
     {8, "passages: gvw_comp_kg (the weight the STD and mean rules were fed)", schema_v8},
     {9, "refusals: refused bus messages summarised per period, channel and reason", schema_v9},
     {10, "passages: class, axle_groups and overload (classify/)", schema_v10},
+    {11, "passages: fit_ratio (the model's residual over the free vibration)", schema_v11},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]
