@@ -29,7 +29,7 @@
  *   freevib.c -> environment.c log.c pipeline.c timer.c
  *   intake.c -> admit.c bus.c freevib.c log.c modelfit.c pipeline.c pool.c reject.c
  *   metrics.c -> log.c reject.c timer.c
- *   modelfit.c -> log.c metrics.c
+ *   modelfit.c -> freevib.c log.c metrics.c
  *   natalert.c -> freevib.c log.c metrics.c
  *   notify.c -> log.c
  *   pipeline.c -> log.c metrics.c notify.c pool.c reorder.c sink.c
@@ -238,6 +238,10 @@ void freevib_estimate(amfid_ctx *c, job *j, amfi_ring *const *rings);
 /* The baseline's f1 at the calibration temperature: 1 and *f_ref_hz once the
  * compensation is fitted, else 0. */
 int freevib_reference(double *f_ref_hz);
+/* f1(T) / f1(calibration temperature) at the deck temperature of utime by the
+ * compensation's temperature model (its fitted slopes, or alerts.scale's
+ * prior ones halved and turned); 1 without a temperature. */
+double freevib_time_scale(amfid_ctx *c, int64_t utime);
 
 /* ---- the model fit (modelfit.c) ------------------------------------------------ */
 

@@ -87,6 +87,7 @@ void modelfit_take(amfid_ctx *c, job *j, amfi_ring *const *rings)
         }
     j->accel_fit = a;
     j->fit_n = n;
+    j->fit_scale = freevib_time_scale(c, j->w.v.utime);
 }
 
 static int modelfit_start(amfid_ctx *c, char *err, size_t errlen)

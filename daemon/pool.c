@@ -230,12 +230,18 @@ static void fit_job(amfi_solver *s, double span_m, job *j)
 {
     amfi_passage p;
     memset(&p, 0, sizeof p);
+    /* A bridge of stiffness κ·EI under a load moving at v is, on the time
+     * τ = s·t (s = sqrt κ, the ratio of its frequencies), the model under
+     * the load over κ moving at v / s (the damping ratios over s): the data
+     * resampled on τ (rate / s) with the speed v / s are fitted by the model
+     * itself, and the ratio of two accelerations does not see the scale. */
+    const double sc = j->fit_scale > 0.5 && j->fit_scale < 2.0 ? j->fit_scale : 1.0;
     p.n_samples = j->fit_n;
-    p.scan_rate_hz = j->scan_rate_hz;
-    p.t_first_s = j->w.t_first_s;
+    p.scan_rate_hz = j->scan_rate_hz / sc;
+    p.t_first_s = j->w.t_first_s * sc;
     for (int i = 0; i < j->n_sensors; i++)
         p.accel[i] = j->accel_fit + (size_t)i * j->fit_n;
-    p.speed_mps = j->speed_estimated ? j->speed_used_mps : j->w.v.speed_mps;
+    p.speed_mps = (j->speed_estimated ? j->speed_used_mps : j->w.v.speed_mps) / sc;
     p.n_axles = j->w.v.n_axles;
     for (int a = 0; a + 1 < p.n_axles; a++)
         p.axle_spacing_m[a] = j->w.v.spacing_m[a];

@@ -58,6 +58,10 @@ typedef struct job {
      * through free vibration after the last exit, owned (NULL: no fit) */
     double *accel_fit;
     int fit_n;
+    double fit_scale;        /* the bridge's frequencies at the deck temperature over
+                                the model's (freevib_time_scale): the fit runs on
+                                time stretched by it, so that the temperature's
+                                stiffness is not taken for a model that fails */
     int fit_done;            /* result: 1 when fit_ratio holds the figure */
     double fit_ratio;        /* the extended solve's residual over the free vibration
                                 / the signal there (RMS ratio) */
