@@ -214,6 +214,10 @@ static const char fleet_v7[] =
     "ALTER TABLE passages ADD COLUMN class text, ADD COLUMN axle_groups text,\n"
     "  ADD COLUMN overload integer;\n";
 
+/* Version 8 (site store version 11): the passages' model fit, as amfid's
+ * modelfit module stores it. Rows shipped before keep NULL. */
+static const char fleet_v8[] = "ALTER TABLE passages ADD COLUMN fit_ratio double precision;\n";
+
 /* A later version that adds a site table enables row-level security on it
  * with the two policies of version 6 (fleet_site, fleet_reader), grants
  * amfi_site SELECT, INSERT and amfi_reader SELECT on it, and revokes a new
@@ -229,6 +233,7 @@ const struct fleet_migration fleet_migrations[] = {
     {6, "one role per site: fleet_site_roles, row-level security on every site table, "
         "fleet_migrations written by the owner only", fleet_v6},
     {7, "passages: class, axle_groups and overload", fleet_v7},
+    {8, "passages: fit_ratio (the model fit)", fleet_v8},
 };
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);
 

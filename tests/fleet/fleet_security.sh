@@ -178,6 +178,7 @@ DO $$ DECLARE t text; BEGIN
 END $$;
 DROP TABLE fleet_site_roles;
 ALTER TABLE passages DROP COLUMN class, DROP COLUMN axle_groups, DROP COLUMN overload;
+ALTER TABLE passages DROP COLUMN fit_ratio;
 DELETE FROM fleet_migrations WHERE version > 5;
 CREATE ROLE amfi_sync LOGIN;
 GRANT USAGE ON SCHEMA public TO amfi_sync;
@@ -193,7 +194,7 @@ psql -X -q -v ON_ERROR_STOP=1 "$upw" -c "INSERT INTO fleet_migrations VALUES (77
     fail "at version 5, the forged cleared alert did not close site-v's alert"
 pg_q "DELETE FROM alerts WHERE site_id = 'site-v' AND id = 9999; DELETE FROM fleet_migrations WHERE version = 77"
 "$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 5 -> 7"
-[ "$(psql -X -At "$up" -c 'SELECT max(version) FROM fleet_migrations')" = 7 ] || fail "not migrated to 7"
+[ "$(psql -X -At "$up" -c 'SELECT max(version) FROM fleet_migrations')" = 8 ] || fail "not migrated to 8"
 add_rows "$tmp/u.db" 200
 "$sync" --db "$tmp/u.db" --pg "$upw" --once 2> "$tmp/upw.log"
 [ $? = 2 ] || fail "the shared writer after the migration: not refused"
