@@ -12,7 +12,12 @@
 #      ratio below 0.05) and neither alert is raised, although the deck
 #      moves the raw f1 and the weights; after it the natfreq alert is raised
 #      within 20 passages and model_mismatch within 40 (the damage);
-#   2. an as-built bridge whose bearings hold 2 EI/L of rotation (seized:
+#   2. the main job's scenario shortened (scripts/main.sh: no climate, so
+#      nothing compensated: the natfreq alert on the raw f1 against the mean
+#      of the first 30 estimates; vehicles 2 s apart, 20 % stiffness lost
+#      from vehicle 50 of 75): natfreq raised within 15 passages of the
+#      loss, neither alert before it;
+#   3. an as-built bridge whose bearings hold 2 EI/L of rotation (seized:
 #      f1 +30 %, GVW −38 % uncommissioned), 60 vehicles, no climate:
 #      model_mismatch (warning) raised once within them, logged, stored,
 #      published on the alert channel; the restart after finds it open and
@@ -65,7 +70,25 @@ echo "after the loss: natfreq raised at passage ${nf:-none}, model_mismatch at $
 [ "$(q "SELECT level FROM alerts WHERE kind = 'natfreq'")" = warning ] || fail "natfreq not a warning"
 grep -q "ALERT natfreq (warning)" "$dir/amfid.log" || fail "natfreq not in the journal"
 
-# ---- 2. seized bearings, uncommissioned -------------------------------------
+# ---- 2. the main job's scenario, shortened: no deck temperature -------------
+rm -f "$dir"/s.db*
+amfid_start "$amfid" "$dir/amfid.yaml"
+timeout 300 "$sim" --vehicles 75 --headway 2 --speedup 25 --seed 1 \
+  --damage 0.2 --damage-step-at 50 2> "$dir/sim.log" || fail "sim_publisher exited $?"
+sleep 1
+amfid_stop
+step=$(q "SELECT utime FROM passages WHERE vehicle_id = 48")
+[ -n "$step" ] || fail "no passage of vehicle 48"
+early=$(q "SELECT count(*) FROM alerts WHERE raised = 1 AND kind IN ('model_mismatch', 'natfreq') AND utime < $step")
+[ "$early" = 0 ] || fail "main job: raised before the loss: $(q "SELECT kind, message FROM alerts")"
+nf=$(after natfreq)
+echo "main job, shortened: natfreq raised at passage ${nf:-none} after the loss" \
+     "($(q "SELECT count(*) FROM passages WHERE f1_hz IS NOT NULL") of 75 with an f1, none compensated:" \
+     "$(q "SELECT count(*) FROM passages WHERE f1_comp_hz IS NOT NULL"))"
+[ -n "$nf" ] && [ "$nf" -le 15 ] || fail "main job: natfreq not raised within 15 passages of the loss"
+grep -q "uncompensated (no deck temperature)" "$dir/amfid.log" || fail "main job: not the raw mode"
+
+# ---- 3. seized bearings, uncommissioned -------------------------------------
 rm -f "$dir"/s.db*
 amfid_start "$amfid" "$dir/amfid.yaml"
 lcm-logger -c AMFI_ALERT -f "$dir/alerts.log" > "$dir/logger.log" 2>&1 &
