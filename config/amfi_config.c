@@ -161,6 +161,11 @@ void amfi_config_defaults(amfi_site_config *c)
     amfi_natfreq_params_default(&d->natfreq);
     d->natfreq_free_s = 2.0;  /* 11 periods of paper-20m's 5.7 Hz (docs/indicators.md) */
     d->natfreq_baseline_n = 200;
+    /* The model_mismatch and natfreq alerts (docs/indicators.md section 10,
+     * docs/results/model-fit.md and natural-frequency.md for the figures). */
+    d->model_fit_free_s = 0.5;
+    d->model_fit = (amfi_level_params){1, 25, 0.1, 0.05, 10, 25};
+    d->natfreq_alert = (amfi_level_params){1, 15, 0.015, 0.0075, 5, 15};
     /* Bounded intake (docs/daemon.md): generous against real traffic. */
     d->vehicle_ahead_s = 120.0;
     d->min_speed_mps = 2.0;

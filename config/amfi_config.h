@@ -28,6 +28,7 @@
 #include "known_truck.h"
 #include "scale.h"
 #include "natfreq.h"
+#include "level_rule.h"
 #include "speed_drift.h"
 
 #ifdef __cplusplus
@@ -124,6 +125,18 @@ typedef struct amfi_daemon_config {
      * amfi_known_truck_params_default(). */
     int known_truck_enabled;      /* alerts.known_truck.enabled: on (1) | off */
     amfi_known_truck_params known_truck;
+    /* alerts.model_fit.*: the model_mismatch alert (daemon/modelfit.c,
+     * docs/indicators.md section 10): each passage weighed alone is solved
+     * again over a window extended free_s past its last exit, and the
+     * model's residual over that free vibration, relative to the signal,
+     * is watched by a median level rule (level_rule.h). */
+    double model_fit_free_s;      /* alerts.model_fit.free_s: s of free vibration fitted,
+                                     [0.2, 10], at most daemon.natural_frequency.free_s */
+    amfi_level_params model_fit;  /* its rule: window, raise, clear, raise_after, clear_after */
+    /* alerts.natfreq.*: the natfreq alert (daemon/natalert.c): the relative
+     * drop 1 − f1_comp / f1_ref of the temperature-compensated first natural
+     * frequency against its baseline, watched by the same rule. */
+    amfi_level_params natfreq_alert;
     /* daemon.indicators.*: the indicator engine's own parameters
      * (indicators.h, docs/indicators.md), its defaults from
      * amfi_indicator_params_default() and checked, at load, by

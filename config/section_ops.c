@@ -7,7 +7,9 @@
  * collector (metrics.textfile). Both are off by default. Also the
  * speed-drift alert's settings (alerts.speed_drift, speed_drift.h), the scale
  * indicator's (alerts.scale, scale.h) and the known truck's
- * (alerts.known_truck, known_truck.h). Runs on the loader's thread.
+ * (alerts.known_truck, known_truck.h), the model_mismatch alert's
+ * (alerts.model_fit) and the natural frequency's (alerts.natfreq), both
+ * level_rule.h. Runs on the loader's thread.
  */
 #include "sections.h"
 
@@ -75,6 +77,28 @@ static const field known_truck_fields[] = {
     {.key = "clear_after", .kind = &amfi_cfg_k_int, .off = TRUCK(clear_after), .lo = 1, .hi = 1000000},
     {.key = NULL}};
 
+/* alerts.model_fit and alerts.natfreq: a median level rule each
+ * (level_rule.h; amfi_level_params_check in ops_check for clear < raise). */
+#define LEVEL_FIELDS(m, unit_hi)                                                                  \
+    {.key = "enabled", .kind = &amfi_cfg_k_enum, .off = OPS(m.enabled), .aux = amfi_cfg_onoff_names}, \
+    {.key = "window", .kind = &amfi_cfg_k_int, .off = OPS(m.window), .lo = 1, .hi = 10000},      \
+    {.key = "raise", .kind = &amfi_cfg_k_double, .off = OPS(m.raise), .lo = 0, .hi = unit_hi,    \
+     .flags = F_LO_OPEN},                                                                        \
+    {.key = "clear", .kind = &amfi_cfg_k_double, .off = OPS(m.clear), .lo = 0, .hi = unit_hi},   \
+    {.key = "raise_after", .kind = &amfi_cfg_k_int, .off = OPS(m.raise_after), .lo = 1,          \
+     .hi = 100000},                                                                              \
+    {.key = "clear_after", .kind = &amfi_cfg_k_int, .off = OPS(m.clear_after), .lo = 1,          \
+     .hi = 100000}
+
+static const field model_fit_fields[] = {
+    {.key = "free_s", .kind = &amfi_cfg_k_double, .off = OPS(model_fit_free_s), .lo = 0.2, .hi = 10},
+    LEVEL_FIELDS(model_fit, 10),
+    {.key = NULL}};
+
+static const field natfreq_alert_fields[] = {
+    LEVEL_FIELDS(natfreq_alert, 0.5),
+    {.key = NULL}};
+
 const field amfi_cfg_alerts_fields[] = {
     {.key = "command", .kind = &amfi_cfg_k_path, .off = OPS(alert_command), .hi = OPS_CAP(alert_command)},
     {.key = "command_timeout_s", .kind = &amfi_cfg_k_double, .off = OPS(alert_timeout_s), .lo = 0,
@@ -86,6 +110,8 @@ const field amfi_cfg_alerts_fields[] = {
     {.key = "speed_drift", .kind = &amfi_cfg_k_map, .aux = speed_drift_fields},
     {.key = "scale", .kind = &amfi_cfg_k_map, .aux = scale_fields},
     {.key = "known_truck", .kind = &amfi_cfg_k_map, .aux = known_truck_fields},
+    {.key = "model_fit", .kind = &amfi_cfg_k_map, .aux = model_fit_fields},
+    {.key = "natfreq", .kind = &amfi_cfg_k_map, .aux = natfreq_alert_fields},
     {.key = NULL}};
 
 const field amfi_cfg_metrics_fields[] = {
@@ -122,6 +148,20 @@ int amfi_cfg_ops_check(ctx *x, amfi_site_config *c)
         return blame(x, "scale", blamed, why);
     if (amfi_known_truck_params_check(&c->daemon.known_truck, &blamed, why, sizeof why) != 0)
         return blame(x, "known_truck", blamed, why);
+    if (amfi_level_params_check(&c->daemon.model_fit, &blamed, why, sizeof why) != 0)
+        return blame(x, "model_fit", blamed, why);
+    if (amfi_level_params_check(&c->daemon.natfreq_alert, &blamed, why, sizeof why) != 0)
+        return blame(x, "natfreq", blamed, why);
+    /* the extended solve fits free vibration the tracker recorded */
+    if (c->daemon.model_fit.enabled && c->daemon.natfreq_free_s > 0 &&
+        c->daemon.model_fit_free_s > c->daemon.natfreq_free_s) {
+        char w2[192];
+        snprintf(w2, sizeof w2,
+                 "%g s is more free vibration than amfid records "
+                 "(daemon.natural_frequency.free_s %g s)",
+                 c->daemon.model_fit_free_s, c->daemon.natfreq_free_s);
+        return blame(x, "model_fit", "free_s", w2);
+    }
     if (cmd[0]) {
         int line = amfi_cfg_noted(x, "alerts.command");
         if (cmd[0] != '/')

@@ -70,6 +70,8 @@ static const amfid_module *const modules[] = {
     &drift_module,       /* the speed-drift alert */
     &stdmean_module,     /* the STD and mean rules */
     &scaleind_module,    /* the scale indicator and the known-truck runs */
+    &modelfit_module,    /* the model fit: passages.fit_ratio, the model_mismatch alert */
+    &natalert_module,    /* the natfreq alert */
     &reject_module,      /* refused messages: summaries */
     &status_module,      /* the heartbeat */
 };
@@ -277,7 +279,11 @@ static int start_runtime(amfid *h)
         return brc;
     if (bus_subscribe_all(c))
         return 1;
-    if (pool_start(&h->pool, h->bridge, &h->cfg.solver, h->cfg.daemon.workers,
+    if (pool_start(&h->pool, h->bridge, &h->cfg.solver,
+                   h->cfg.daemon.model_fit.enabled && h->cfg.daemon.natfreq_free_s > 0
+                       ? h->cfg.daemon.model_fit_free_s
+                       : 0.0,
+                   h->cfg.daemon.workers,
                    h->cfg.daemon.queue_size, err, sizeof err)) {
         LOG_ERR("%s", err);
         return 1;

@@ -15,23 +15,25 @@
  * (refused messages), intake.c (the bus handlers, the rings, the tracker,
  * windows to jobs), pool.c (solver threads), pipeline.c (reorder.c → sink.c
  * → the fan-out of a stored passage), alert.c (one alert out),
- * environment.c, freevib.c, drift.c, stdmean.c, scaleind.c (the
- * indicators), classes.c (class and axle groups of each passage), raw.c
- * (the passages' raw samples and their retention), notify.c, metrics.c,
- * status.c (heartbeat, intake record).
+ * environment.c, freevib.c, drift.c, stdmean.c, scaleind.c, modelfit.c,
+ * natalert.c (the indicators), classes.c (class and axle groups of each
+ * passage), raw.c (the passages' raw samples and their retention),
+ * notify.c, metrics.c, status.c (heartbeat, intake record).
  *
  * Who calls whom (from the built objects; tests/common/call_graph.sh
  * fails when this list differs from the library, or when it has a circle):
  *   admit.c -> reject.c
  *   alert.c -> log.c metrics.c notify.c
- *   amfid.c -> alert.c bus.c classes.c drift.c environment.c freevib.c intake.c log.c metrics.c notify.c pipeline.c pool.c raw.c reject.c scaleind.c status.c stdmean.c timer.c
+ *   amfid.c -> alert.c bus.c classes.c drift.c environment.c freevib.c intake.c log.c metrics.c modelfit.c natalert.c notify.c pipeline.c pool.c raw.c reject.c scaleind.c status.c stdmean.c timer.c
  *   bus.c -> admit.c log.c reject.c
  *   classes.c -> log.c
  *   drift.c -> log.c metrics.c
  *   environment.c -> admit.c bus.c log.c reject.c
  *   freevib.c -> environment.c log.c pipeline.c timer.c
- *   intake.c -> admit.c bus.c freevib.c log.c pipeline.c pool.c reject.c
+ *   intake.c -> admit.c bus.c freevib.c log.c modelfit.c pipeline.c pool.c reject.c
  *   metrics.c -> log.c reject.c timer.c
+ *   modelfit.c -> freevib.c log.c metrics.c
+ *   natalert.c -> freevib.c log.c metrics.c
  *   notify.c -> log.c
  *   pipeline.c -> log.c metrics.c notify.c pool.c reorder.c sink.c
  *   raw.c -> log.c timer.c
@@ -151,8 +153,8 @@ struct amfid_module {
 /* The modules (amfid.c's table holds them, in order). */
 extern const amfid_module environment_lost_module, intake_module, environment_module,
     record_module, metrics_module, notify_module, freevib_module, classes_module,
-    pipeline_module, drift_module, stdmean_module, scaleind_module, reject_module, status_module,
-    raw_module;
+    pipeline_module, drift_module, stdmean_module, scaleind_module, modelfit_module,
+    natalert_module, reject_module, status_module, raw_module;
 
 /* ---- timers (timer.c) ------------------------------------------------------- */
 
@@ -237,6 +239,20 @@ double environment_deck_at(amfid_ctx *c, int64_t utime, double max_gap_s);
 
 /* At release: the window's free vibration (in rings) into j->f1_* (NaN: none). */
 void freevib_estimate(amfid_ctx *c, job *j, amfi_ring *const *rings);
+/* The baseline's f1 at the calibration temperature: 1 and *f_ref_hz once the
+ * compensation is fitted, else 0. */
+int freevib_reference(double *f_ref_hz);
+/* f1(T) / f1(calibration temperature) at the deck temperature of utime by the
+ * compensation's temperature model (its fitted slopes, or alerts.scale's
+ * prior ones halved and turned); 1 without a temperature. */
+double freevib_time_scale(amfid_ctx *c, int64_t utime);
+
+/* ---- the model fit (modelfit.c) ------------------------------------------------ */
+
+/* At release: an ok window of one vehicle with enough free vibration gets
+ * its samples through alerts.model_fit.free_s past the exit (j->accel_fit)
+ * for its solver thread's second solve. */
+void modelfit_take(amfid_ctx *c, job *j, amfi_ring *const *rings);
 
 /* ---- the pipeline (pipeline.c) ------------------------------------------------- */
 

@@ -172,6 +172,28 @@ static double deck_at(amfid_ctx *d, int64_t utime)
     return environment_deck_at(d, utime, d->cfg->daemon.scale_max_temp_gap_s);
 }
 
+int freevib_reference(double *f_ref_hz)
+{
+    amfi_natfreq_model m;
+    if (!F.comp || !amfi_natfreq_comp_model(F.comp, &m) || !(m.f_ref_hz > 0))
+        return 0;
+    *f_ref_hz = m.f_ref_hz;
+    return 1;
+}
+
+double freevib_time_scale(amfid_ctx *d, int64_t utime)
+{
+    const double t = deck_at(d, utime);
+    if (!isfinite(t))
+        return 1.0;
+    amfi_natfreq_model m;
+    double warm = -0.5 * d->cfg->daemon.scale.warm_slope, frost = -0.5 * d->cfg->daemon.scale.frost_slope;
+    if (F.comp && amfi_natfreq_comp_model(F.comp, &m))
+        warm = m.warm, frost = m.frost;
+    const double k = amfi_scale_temp_factor(&d->cfg->daemon.scale, warm, frost, t);
+    return k > 0.5 && k < 2.0 ? 1.0 / k : 1.0;
+}
+
 /* Whether this row (of an event: one vehicle's) carries the f1. */
 static int carries(const job *j)
 {

@@ -87,6 +87,7 @@ void intake_release(amfid_ctx *d, int flush)
                 missing += m < 0 ? w.n : m;
             }
             freevib_estimate(d, j, I.rings); /* the free vibration's samples are in the rings now */
+            modelfit_take(d, j, I.rings);
             if (!j->accel || missing > 0) {
                 snprintf(j->status, sizeof j->status, "gap");
                 snprintf(j->reason, sizeof j->reason, "%d samples missing in the window",

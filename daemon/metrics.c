@@ -33,7 +33,7 @@
 
 #define SOLVE_BUCKETS 12
 #define SOLVE_RECENT 1024
-#define OPEN_KINDS 8
+#define OPEN_KINDS 16
 static struct metrics_state {
     int64_t by_status[16];        /* stored passages per amfi_store_status_name(k) */
     int64_t solve_le[SOLVE_BUCKETS]; /* solves of at most bucket_s[i] s */

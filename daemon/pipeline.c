@@ -93,6 +93,7 @@ static void publish_passage(amfid_ctx *d, const amfid_passage *p)
     m.reference_gvw_kg = j->w.v.reference_gvw_kg > 0 ? j->w.v.reference_gvw_kg : NAN;
     m.f1_hz = r->f1_hz;
     m.f1_comp_hz = r->f1_comp_hz;
+    m.fit_ratio = r->fit_ratio > 0 ? r->fit_ratio : NAN;
     /* the class and groups as stored (the classes module's row hook): the
      * groups' axles and, solved, their loads from the row's axles */
     int16_t g_axles[AMFI_MAX_AXLES] = {0};

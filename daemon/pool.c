@@ -24,6 +24,7 @@ void job_free(job *j)
 {
     if (j) {
         free(j->accel);
+        free(j->accel_fit);
         free(j);
     }
 }
@@ -218,9 +219,72 @@ static void solve_job(amfi_solver *s, job *j)
     j->residual_rms = r.residual_rms;
 }
 
+/* The model fit (docs/indicators.md section 10): the passage solved again
+ * with the same λ and speed over a window extended fit_free_s past the last
+ * exit; the relative residual of the fitted model over that free vibration
+ * (every sensor, the calculation steps after the exit, the data linearly
+ * interpolated as the solver does). With the model right the free vibration
+ * is the state at exit left to itself, which the fit reproduces; with
+ * another bridge (stiffness, bearings, sensor position) it is not. */
+static void fit_job(amfi_solver *s, double span_m, job *j)
+{
+    amfi_passage p;
+    memset(&p, 0, sizeof p);
+    /* A bridge of stiffness κ·EI under a load moving at v is, on the time
+     * τ = s·t (s = sqrt κ, the ratio of its frequencies), the model under
+     * the load over κ moving at v / s (the damping ratios over s): the data
+     * resampled on τ (rate / s) with the speed v / s are fitted by the model
+     * itself, and the ratio of two accelerations does not see the scale. */
+    const double sc = j->fit_scale > 0.5 && j->fit_scale < 2.0 ? j->fit_scale : 1.0;
+    p.n_samples = j->fit_n;
+    p.scan_rate_hz = j->scan_rate_hz / sc;
+    p.t_first_s = j->w.t_first_s * sc;
+    for (int i = 0; i < j->n_sensors; i++)
+        p.accel[i] = j->accel_fit + (size_t)i * j->fit_n;
+    p.speed_mps = (j->speed_estimated ? j->speed_used_mps : j->w.v.speed_mps) / sc;
+    p.n_axles = j->w.v.n_axles;
+    for (int a = 0; a + 1 < p.n_axles; a++)
+        p.axle_spacing_m[a] = j->w.v.spacing_m[a];
+    amfi_lambda lam = j->lambda;
+    lam.automatic = 0; /* the λ the weighing chose */
+    lam.lambda_ref = j->lambda_used;
+    amfi_result r;
+    char err[256];
+    if (amfi_solve(s, &p, &lam, &r, err, sizeof err) != 0) {
+        snprintf(j->fit_why, sizeof j->fit_why, "%s", "solve refused");
+        return;
+    }
+    const double exit_s = amfi_passage_window(span_m, p.speed_mps, p.n_axles, p.axle_spacing_m,
+                                              0.0, 0.0).on_span_s;
+    const int ns = j->n_sensors;
+    double e2 = 0.0, s2 = 0.0;
+    for (int k = 0; k < r.n_steps; k++) {
+        const double t = r.t0_s + (k + 1) * r.h_s; /* model_accel row k is y_{k+1} */
+        if (t <= exit_s)
+            continue;
+        double u = (t - p.t_first_s) * p.scan_rate_hz;
+        int i = (int)floor(u);
+        if (i < 0 || i > p.n_samples - 2)
+            continue;
+        const double f = u - i;
+        for (int si = 0; si < ns; si++) {
+            const double d = (1 - f) * p.accel[si][i] + f * p.accel[si][i + 1];
+            const double e = r.model_accel[(size_t)k * ns + si] - d;
+            e2 += e * e;
+            s2 += d * d;
+        }
+    }
+    if (!(s2 > 0) || !isfinite(e2)) {
+        snprintf(j->fit_why, sizeof j->fit_why, "%s", "no free vibration");
+        return;
+    }
+    j->fit_ratio = sqrt(e2 / s2);
+    j->fit_done = 1;
+}
+
 typedef struct worker_arg {
     pool *p;
-    amfi_solver *solver;
+    amfi_solver *solver, *fit;
 } worker_arg;
 
 static void *worker_main(void *arg)
@@ -230,6 +294,8 @@ static void *worker_main(void *arg)
     job *j;
     while ((j = queue_pop(&wa.p->jobs, 1)) != NULL) {
         solve_job(wa.solver, j);
+        if (j->accel_fit && wa.fit && j->solved && j->w.n_vehicles == 1)
+            fit_job(wa.fit, wa.p->span_m, j);
         while (queue_push(&wa.p->results, j) != 0) /* never full: sized with jobs */
             usleep(1000);
         uint64_t one = 1;
@@ -240,9 +306,13 @@ static void *worker_main(void *arg)
 }
 
 int pool_start(pool *p, const amfi_bridge *bridge, const amfi_solver_params *sp,
-               int n_threads, int queue_size, char *err, size_t errlen)
+               double fit_free_s, int n_threads, int queue_size, char *err, size_t errlen)
 {
     memset(p, 0, sizeof *p);
+    p->fit_free_s = fit_free_s;
+    p->span_m = amfi_bridge_params_of(bridge)->span_m;
+    amfi_solver_params fsp = *sp;
+    fsp.post_roll_s += fit_free_s;
     p->efd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     p->efd_open = p->efd >= 0;
     if (p->efd < 0 || queue_init(&p->jobs, queue_size)) {
@@ -258,7 +328,8 @@ int pool_start(pool *p, const amfi_bridge *bridge, const amfi_solver_params *sp,
     p->n_threads = n_threads;
     p->threads = calloc((size_t)n_threads, sizeof *p->threads);
     p->solvers = calloc((size_t)n_threads, sizeof *p->solvers);
-    if (!p->threads || !p->solvers) {
+    p->fit_solvers = fit_free_s > 0 ? calloc((size_t)n_threads, sizeof *p->fit_solvers) : NULL;
+    if (!p->threads || !p->solvers || (fit_free_s > 0 && !p->fit_solvers)) {
         snprintf(err, errlen, "out of memory at start-up");
         return -1;
     }
@@ -270,8 +341,15 @@ int pool_start(pool *p, const amfi_bridge *bridge, const amfi_solver_params *sp,
             free(wa);
             return -1;
         }
+        if (p->fit_solvers &&
+            amfi_solver_create(bridge, &fsp, &p->fit_solvers[i], serr, sizeof serr)) {
+            snprintf(err, errlen, "solver thread %d, the model fit's: %s", i, serr);
+            free(wa);
+            return -1;
+        }
         wa->p = p;
         wa->solver = p->solvers[i];
+        wa->fit = p->fit_solvers ? p->fit_solvers[i] : NULL;
         if (pthread_create(&p->threads[i], NULL, worker_main, wa) != 0) {
             snprintf(err, errlen, "solver thread %d: cannot start it", i);
             free(wa);
@@ -293,6 +371,10 @@ void pool_join(pool *p)
     for (int i = 0; p->solvers && i < p->n_threads; i++) {
         amfi_solver_destroy(p->solvers[i]);
         p->solvers[i] = NULL;
+        if (p->fit_solvers) {
+            amfi_solver_destroy(p->fit_solvers[i]);
+            p->fit_solvers[i] = NULL;
+        }
     }
 }
 
@@ -311,8 +393,10 @@ void pool_stop(pool *p)
     }
     free(p->threads);
     free(p->solvers);
+    free(p->fit_solvers);
     p->threads = NULL;
     p->solvers = NULL;
+    p->fit_solvers = NULL;
     if (p->efd_open)
         close(p->efd);
     p->efd_open = 0;

@@ -56,6 +56,19 @@ typedef struct job {
     /* a vehicle's job of an event (pipeline.c): 1 when some vehicle of the
      * event is not stored ok (raw.c keeps the window's samples: failed) */
     int event_not_ok;
+    /* the model fit (modelfit.c): a vehicle weighed alone with free vibration
+     * recorded: fit_n samples per sensor from the window's first (w.k0),
+     * through free vibration after the last exit, owned (NULL: no fit) */
+    double *accel_fit;
+    int fit_n;
+    double fit_scale;        /* the bridge's frequencies at the deck temperature over
+                                the model's (freevib_time_scale): the fit runs on
+                                time stretched by it, so that the temperature's
+                                stiffness is not taken for a model that fails */
+    int fit_done;            /* result: 1 when fit_ratio holds the figure */
+    double fit_ratio;        /* the extended solve's residual over the free vibration
+                                / the signal there (RMS ratio) */
+    char fit_why[64];        /* why not ("" when fit_ratio is set or no fit was asked) */
 } job;
 
 void job_free(job *j);
@@ -84,14 +97,21 @@ typedef struct pool {
     int n_threads, started;
     pthread_t *threads;
     amfi_solver **solvers;   /* one per thread, owned by it while it runs */
+    amfi_solver **fit_solvers; /* the model fit's (post-roll extended by fit_free_s),
+                                  one per thread; NULL: no fit */
+    double fit_free_s;       /* free vibration the fit solve takes past the last exit */
+    double span_m;
     int init;                /* queues initialised */
 } pool;
 
 /* Queues (jobs: queue_size; results: room for every job in flight), the
- * eventfd, one solver per thread and the threads. 0, or −1 with the reason
- * in err (the pool is then half built: pool_stop releases it). */
+ * eventfd, one solver per thread and the threads; fit_free_s > 0: a second
+ * solver per thread whose post-roll is fit_free_s longer, for the model fit
+ * (a job with accel_fit is solved again over its free vibration). 0, or −1
+ * with the reason in err (the pool is then half built: pool_stop releases
+ * it). */
 int pool_start(pool *p, const amfi_bridge *bridge, const amfi_solver_params *sp,
-               int n_threads, int queue_size, char *err, size_t errlen);
+               double fit_free_s, int n_threads, int queue_size, char *err, size_t errlen);
 
 /* Close the job queue, let the threads finish what is queued, join them,
  * free the solvers. The results stay queued for the caller. Idempotent. */

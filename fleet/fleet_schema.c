@@ -281,6 +281,10 @@ static const char fleet_v8[] =
     "  LEFT JOIN fleet_latest_state AS l ON l.site_id = s.site_id\n"
     "  WHERE s.tbl = 'passages';\n";
 
+/* Version 9 (site store version 12): the passages' model fit, as amfid's
+ * modelfit module stores it. Rows shipped before keep NULL. */
+static const char fleet_v9[] = "ALTER TABLE passages ADD COLUMN fit_ratio double precision;\n";
+
 /* roles.sql (the roles and row-level security as they stand now), compiled
  * in by fleet/CMakeLists.txt */
 #include "fleet_roles_sql.h"
@@ -304,6 +308,7 @@ const struct fleet_migration fleet_migrations[] = {
     {7, "passages: class, axle_groups and overload", fleet_v7},
     {8, "fleet_sites: name, position, bridge type and store of each site; fleet_summary; "
         "times in the views as timestamptz", fleet_v8},
+    {9, "passages: fit_ratio (the model fit)", fleet_v9},
 };
 const char *const fleet_roles_sql = fleet_roles_sql_text;
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);

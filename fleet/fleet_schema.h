@@ -55,6 +55,6 @@ int fleet_hash_cols(const char *table);
 
 /* The oldest site store schema (PRAGMA user_version) whose columns
  * fleet_tables names: amfid migrates older stores when it starts. */
-#define FLEET_MIN_STORE_VERSION 10
+#define FLEET_MIN_STORE_VERSION 12
 
 #endif

@@ -74,7 +74,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 11
+#define AMFI_STORE_SCHEMA_VERSION 12
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -192,6 +192,10 @@ typedef struct amfi_passage_row {
     /* Not a column: the passage's raw samples, written in its transaction
      * (raw_windows, passage_raw; amfi_raw_put below), or NULL: none. */
     struct amfi_raw_put *raw;
+    double fit_ratio;    /* the model fit (amfid's modelfit.c): the RMS residual of
+                            the model solved over the free vibration after the last
+                            axle, relative to the signal there, (0, 1000]; NaN
+                            or 0: not fitted (NULL) */
 } amfi_passage_row;
 /* The range of a reference GVW (a calibration truck), kg. */
 #define AMFI_STORE_MIN_REF_KG 1000.0
@@ -817,6 +821,16 @@ int amfi_store_raw_encode(const double *x, int64_t n, int sensors, int level, in
                           unsigned char **out, size_t *outlen, char *err, size_t errlen);
 int amfi_store_raw_decode(const unsigned char *blob, size_t len, int64_t n, int sensors,
                           int float32, double *x, char *err, size_t errlen);
+
+/* ---- the model fit and the natfreq alert (store_modelfit.c) -------------- */
+
+/* The newest max (>= 1) passages' fit_ratio, or f1_comp_hz, that are not
+ * NULL, oldest first: *out malloc'd (free it; NULL when *n is 0). A value
+ * outside the schema's range is AMFI_STORE_ECORRUPT. */
+int amfi_store_recent_fit_ratios(amfi_store *s, int max, double **out, size_t *n, char *err,
+                                 size_t errlen);
+int amfi_store_recent_f1_comp(amfi_store *s, int max, double **out, size_t *n, char *err,
+                              size_t errlen);
 
 /* ---- rows as column values, for other programs (store_scan.c) ----------- */
 /* amfi-sync ships a store's rows, amfi-report --pg and amfi-fleet-bench

@@ -115,6 +115,9 @@ static const amfi_store_coldef passages[] = {
      .null_rule = AMFI_NULL_FLAG, .flag_off = O(has_overload), .null_ok = 1, .ilo = 0, .ihi = 1,
      .unit = "", .since = 10, .shipped = 7,
      .meaning = "1: GVW or a group above its class's legal limit; NULL not solved"},
+    REAL("fit_ratio", fit_ratio, AMFI_NULL_ZERO, 1, 0, 1000, "", 12, 9,
+         "the model's RMS residual over the free vibration after the last axle / the "
+         "signal's there; NULL not fitted"),
 };
 #undef ROW
 

@@ -331,6 +331,13 @@ static const char schema_v11[] =
     "  vehicle    INTEGER NOT NULL CHECK (vehicle BETWEEN 0 AND 63)  -- its place in the window's vehicles\n"
     ") STRICT;\n"
     "CREATE INDEX passage_raw_window ON passage_raw (window_id);\n";
+/* Version 12: the model fit of each passage weighed alone (amfid's
+ * modelfit.c, the model_mismatch alert): the residual of the site's model
+ * over the free vibration after the last axle, relative to the signal
+ * there. NULL in rows written before and where not fitted. */
+static const char schema_v12[] =
+    "ALTER TABLE passages ADD COLUMN fit_ratio REAL\n"
+    "  CHECK (fit_ratio > 0 AND fit_ratio <= 1000);\n";
 
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
@@ -347,6 +354,7 @@ const st_migration st_migrations[] = {
     {10, "passages: class, axle_groups and overload (classify/)", schema_v10},
     {11, "raw_windows, passage_raw: each passage's raw samples (retention by age and size)",
      schema_v11},
+    {12, "passages: fit_ratio (the model's residual over the free vibration)", schema_v12},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

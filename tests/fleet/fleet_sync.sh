@@ -37,10 +37,11 @@ same() {
 
 case=init
 "$sync" --pg "$PG_CONNINFO" --init-schema 2> "$tmp/init.log" || fail "--init-schema: $(cat "$tmp/init.log")"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 8 ] || fail "schema version"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 9 ] || fail "schema version"
 # a central database of version 1 migrates on the next contact (the views of
 # version 8 stay: each version's views are dropped and made again upward)
-v8_down="DROP VIEW fleet_summary; DROP TABLE fleet_sites;"
+v9_down="ALTER TABLE passages DROP COLUMN fit_ratio;"
+v8_down="$v9_down DROP VIEW fleet_summary; DROP TABLE fleet_sites;"
 v7_down="$v8_down ALTER TABLE passages DROP COLUMN class, DROP COLUMN axle_groups, DROP COLUMN overload;"
 v6_down="$v7_down DO \$\$ DECLARE t text; BEGIN
         FOREACH t IN ARRAY ARRAY['passages', 'axles', 'indicators', 'alerts', 'baseline', 'runs',
@@ -57,15 +58,15 @@ v5_down="$v6_down DROP VIEW fleet_latest_scale; DROP TABLE environment, scale_ev
 pg_q "$v5_down DROP VIEW fleet_window_trend; ALTER TABLE passages DROP COLUMN speed_given_mps,
       DROP COLUMN speed_estimated, DROP COLUMN n_vehicles, DROP COLUMN quality;
       DELETE FROM fleet_migrations WHERE version > 1"
-"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 8"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 8 ] || fail "not migrated to 8"
+"$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "migration 1 -> 9"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 9 ] || fail "not migrated to 9"
 pg_q "SELECT count(*) FROM fleet_window_trend" > /dev/null || fail "no fleet_window_trend after migration"
 grep -q password "$tmp/init.log" && fail "log mentions a password"
-# docs/fleet.md's DDL of versions 5 to 8 (version 8's followed by
+# docs/fleet.md's DDL of versions 5 to 9 (version 9's followed by
 # fleet/roles.sql, as amfi-sync runs it) is what amfi-sync applies: a
 # database migrated by it and one taken back to version 4 and given the
 # document's blocks have the same schema (tables, policies, rights)
-for v in 5 6 7 8; do
+for v in 5 6 7 8 9; do
     awk "/^<!-- fleet-v$v:begin -->/ { on = 1; next } /^<!-- fleet-v$v:end -->/ { on = 0 }
          on && !/^\`\`\`/" "$fleetdoc" > "$tmp/v$v.sql"
     [ -s "$tmp/v$v.sql" ] || fail "no version $v block in $fleetdoc"
@@ -75,14 +76,14 @@ for d in docv5a docv5b; do
     "$sync" --pg "host=$PG_DIR dbname=$d user=postgres" --init-schema --quiet || fail "$d: --init-schema"
 done
 psql -X -q -v ON_ERROR_STOP=1 "host=$PG_DIR dbname=docv5b user=postgres" -c "$v5_down" -f "$tmp/v5.sql" \
-    -f "$tmp/v6.sql" -f "$tmp/v7.sql" -f "$tmp/v8.sql" -f "$(dirname "$fleetdoc")/../fleet/roles.sql" \
-    > "$tmp/v5.log" 2>&1 || fail "docs/fleet.md's version 5 to 8 blocks: $(cat "$tmp/v5.log")"
+    -f "$tmp/v6.sql" -f "$tmp/v7.sql" -f "$tmp/v8.sql" -f "$tmp/v9.sql" -f "$(dirname "$fleetdoc")/../fleet/roles.sql" \
+    > "$tmp/v5.log" 2>&1 || fail "docs/fleet.md's version 5 to 9 blocks: $(cat "$tmp/v5.log")"
 for d in docv5a docv5b; do
     pg_dump -s -T fleet_migrations "host=$PG_DIR dbname=$d user=postgres" > "$tmp/$d.dump" || fail "pg_dump $d"
     grep -v "^\\\\\(un\)\?restrict " "$tmp/$d.dump" > "$tmp/$d.sql"  # a random key per dump
 done
 cmp -s "$tmp/docv5a.sql" "$tmp/docv5b.sql" ||
-    fail "docs/fleet.md's versions 5 to 8 differ from amfi-sync's: $(diff "$tmp/docv5a.sql" "$tmp/docv5b.sql" | head -6)"
+    fail "docs/fleet.md's versions 5 to 9 differ from amfi-sync's: $(diff "$tmp/docv5a.sql" "$tmp/docv5b.sql" | head -6)"
 
 case=three-sites
 for s in a b c; do mkstore "$tmp/$s.db" "site-$s" 3000; done
@@ -298,6 +299,12 @@ sqlite3 "$tmp/a.db" "UPDATE passages SET class = 'A23', axle_groups = '1-1-3', o
 "$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync of a class"
 [ "$(pg_q "SELECT class || ' ' || axle_groups || ' ' || overload FROM passages WHERE site_id = 'site-a' ORDER BY id DESC LIMIT 1")" = "A23 1-1-3 1" ] ||
     fail "class/axle_groups/overload not shipped"
+# the model fit (store version 12, central version 9)
+add_rows "$tmp/a.db" 2
+sqlite3 "$tmp/a.db" "UPDATE passages SET fit_ratio = 0.0125 WHERE id = (SELECT max(id) FROM passages)"
+"$sync" --db "$tmp/a.db" --pg "$PG_CONNINFO" --once --quiet || fail "sync of a model fit"
+[ "$(pg_q "SELECT fit_ratio FROM passages WHERE site_id = 'site-a' ORDER BY id DESC LIMIT 1")" = 0.0125 ] ||
+    fail "fit_ratio not shipped"
 same "$tmp/a.db" site-a
 
 case=usage
@@ -388,11 +395,11 @@ upw="host=$PG_DIR dbname=up4 user=amfi_sync"
 "$sync" --db "$tmp/u.db" --pg "$upw" --once 2> "$tmp/up.log"
 rc=$?
 [ $rc = 1 ] || fail "the writer role at version 4: exit $rc, expected 1"
-grep -q "central schema is at version 4, this program needs 8: run 'amfi-sync --init-schema'" "$tmp/up.log" ||
+grep -q "central schema is at version 4, this program needs 9: run 'amfi-sync --init-schema'" "$tmp/up.log" ||
     fail "the writer role at version 4: $(cat "$tmp/up.log")"
 [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-u'")" = 1000 ] || fail "the writer shipped at version 4"
-"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 4 -> 8"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 8 ] || fail "not migrated to 8"
+"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 4 -> 9"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 9 ] || fail "not migrated to 9"
 "$sync" --db "$tmp/u.db" --pg "$upw" --once 2> "$tmp/up.log"
 rc=$?
 [ $rc = 2 ] || fail "the shared writer after the migration: exit $rc, expected 2"

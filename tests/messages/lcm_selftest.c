@@ -178,6 +178,7 @@ static void round_make(struct round *r, int i)
     r->passage.group_axles = r->passage_group_axles;
     r->passage.group_load_kg = r->passage_group_kg;
     r->passage.overload = (int8_t)(i % 2);
+    r->passage.fit_ratio = i % 3 ? 0.0042 : NAN; /* an event's vehicle: not fitted */
 
     r->unsolved = r->passage;
     r->unsolved.passage_id = 100000 + i;
@@ -196,6 +197,7 @@ static void round_make(struct round *r, int i)
     r->unsolved.group_axles = NULL;
     r->unsolved.group_load_kg = NULL;
     r->unsolved.overload = -1;
+    r->unsolved.fit_ratio = NAN;
 
     r->indicator.utime = r->vehicle.utime;
     r->indicator.indicator_id = 700 + i;
@@ -342,7 +344,8 @@ static void print_round(const struct round *r)
     put_i("n_groups", p->n_groups, ";");
     put_i16a("group_axles", p->group_axles, p->n_groups, ";");
     put_da("group_load_kg", p->group_load_kg, p->n_groups, ";");
-    put_i("overload", p->overload, "\n");
+    put_i("overload", p->overload, ";");
+    put_d("fit_ratio", p->fit_ratio, "\n");
 
     const amfi_indicator_t *d = &r->indicator;
     printf("%s\tamfi.indicator_t\t", AMFI_CHANNEL_INDICATOR);
@@ -533,7 +536,8 @@ static int same_passage(const char *c, const amfi_passage_t *a, const amfi_passa
             same_d(c, "reference_gvw_kg", a->reference_gvw_kg, b->reference_gvw_kg) +
             same_s(c, "vehicle_class", a->vehicle_class, b->vehicle_class) +
             same_i(c, "n_groups", a->n_groups, b->n_groups) +
-            same_i(c, "overload", a->overload, b->overload);
+            same_i(c, "overload", a->overload, b->overload) +
+            same_d(c, "fit_ratio", a->fit_ratio, b->fit_ratio);
     for (int k = 0; !e && k < a->n_groups; k++)
         e += same_i(c, "group_axles", a->group_axles[k], b->group_axles[k]);
     if (!e && a->n_groups)

@@ -145,7 +145,7 @@ static enc random_message(amfi_msg_type t, int big)
                             rnd_double(), NULL, NULL, rnd_double(), 0, NULL, rnd_double(),
                             rnd_double(), NULL, rnd_double(), NULL, rnd_double(),
                             (int8_t)rnd(), (int16_t)rnd(), rnd_double(), rnd_double(),
-                            rnd_double(), rnd_double(), NULL, 0, NULL, NULL, 0};
+                            rnd_double(), rnd_double(), NULL, 0, NULL, NULL, 0, rnd_double()};
         m.status = rnd_string(AMFI_MSG_MAX_PASSAGE_STATUS);
         m.site_id = rnd_string(AMFI_MSG_MAX_PASSAGE_SITE_ID);
         m.reason = rnd_string(AMFI_MSG_MAX_PASSAGE_REASON);
@@ -484,7 +484,7 @@ static enc empty_arrays(amfi_msg_type t)
     case AMFI_MSG_PASSAGE_T: {
         amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
                             1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0,
-                            5.73, 5.70, (char *)"A23", 0, NULL, NULL, 0};
+                            5.73, 5.70, (char *)"A23", 0, NULL, NULL, 0, 0.004};
         ENCODE(passage_t, m);
         break;
     }
@@ -566,7 +566,7 @@ static enc passage_with(const char *vclass, int n_groups)
     }
     amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
                         1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0,
-                        5.73, 5.70, (char *)vclass, (int8_t)n_groups, ax, kg, 1};
+                        5.73, 5.70, (char *)vclass, (int8_t)n_groups, ax, kg, 1, 0.004};
     ENCODE(passage_t, m);
     return e;
 }
@@ -586,9 +586,10 @@ static void test_passage_groups(void **state)
         }
         free(e.buf);
     }
-    /* n_groups is the last message's second-to-last byte (then overload) */
+    /* n_groups is the last message's tenth byte from the end (then overload
+     * and fit_ratio) */
     enc e = passage_with("A23", 0);
-    e.buf[e.len - 2] = 0xff; /* -1 */
+    e.buf[e.len - 10] = 0xff; /* -1 */
     assert_int_equal(amfi_msg_check(AMFI_MSG_PASSAGE_T, e.buf, e.len, why, sizeof why),
                      AMFI_MSG_NEGATIVE_COUNT);
     assert_non_null(strstr(why, "passage_t.group_axles"));

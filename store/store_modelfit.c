@@ -1,0 +1,81 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * store_modelfit.c: the figures amfid's model_mismatch and natfreq alerts
+ * watch, read back after a restart to refill their windows: the newest
+ * passages' fit_ratio (schema version 12) and f1_comp_hz (version 7), not
+ * NULL, oldest first. Every value read back is checked as in store_read.c.
+ * The caller's thread; the statement is prepared and finalized per call.
+ */
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "store_internal.h"
+
+
+/* The newest max values of a column (SQL text fixed here: no name reaches
+ * SQL from outside), oldest first. */
+static int recent(amfi_store *s, const char *sql, const char *what, const range *rg, int max,
+                  double **out, size_t *n, char *err, size_t errlen)
+{
+    int rc = st_check_handle(s, 0, err, errlen);
+    if (rc == 0 && (!out || !n))
+        rc = st_fail(err, errlen, AMFI_EINVAL, "%s: output is NULL", what);
+    if (rc == 0 && max < 1)
+        rc = st_fail(err, errlen, AMFI_EINVAL, "%s: max %d must be >= 1", what, max);
+    if (rc != 0)
+        return rc;
+    *out = NULL;
+    *n = 0;
+    double *a = malloc(sizeof *a * (size_t)max);
+    if (!a)
+        return st_fail(err, errlen, AMFI_ENOMEM, "%s: out of memory for %d values", what, max);
+    sqlite3_stmt *st = NULL;
+    size_t k = 0;
+    int src = sqlite3_prepare_v2(s->db, sql, -1, &st, NULL);
+    if (src != SQLITE_OK) {
+        rc = st_db_fail(s, src, what, err, errlen);
+    } else {
+        sqlite3_bind_int64(st, 1, max);
+        while (rc == 0 && (src = sqlite3_step(st)) == SQLITE_ROW) {
+            origin o = {"passages", sqlite3_column_int64(st, 0)};
+            rc = st_read_real(st, 1, rg, &o, &a[k], err, errlen);
+            if (rc == 0)
+                k++;
+        }
+        if (rc == 0 && src != SQLITE_DONE)
+            rc = st_db_fail(s, src, what, err, errlen);
+    }
+    sqlite3_finalize(st);
+    if (rc != 0 || k == 0) {
+        free(a);
+        return rc;
+    }
+    for (size_t i = 0; i < k / 2; i++) { /* newest first → oldest first */
+        double t = a[i];
+        a[i] = a[k - 1 - i];
+        a[k - 1 - i] = t;
+    }
+    *out = a;
+    *n = k;
+    return 0;
+}
+
+int amfi_store_recent_fit_ratios(amfi_store *s, int max, double **out, size_t *n, char *err,
+                                 size_t errlen)
+{
+    return recent(s,
+                  "SELECT id, fit_ratio FROM passages WHERE fit_ratio IS NOT NULL "
+                  "ORDER BY utime DESC, id DESC LIMIT ?1",
+                  "passages: read the newest model fits", &R_RATIO, max, out, n, err, errlen);
+}
+
+int amfi_store_recent_f1_comp(amfi_store *s, int max, double **out, size_t *n, char *err,
+                              size_t errlen)
+{
+    static const range hz = {0.0, 1000.0, 1, "Hz", 0};
+    return recent(s,
+                  "SELECT id, f1_comp_hz FROM passages WHERE f1_comp_hz IS NOT NULL "
+                  "ORDER BY utime DESC, id DESC LIMIT ?1",
+                  "passages: read the newest compensated natural frequencies", &hz, max, out, n,
+                  err, errlen);
+}
