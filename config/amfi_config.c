@@ -87,6 +87,15 @@ void amfi_config_defaults(amfi_site_config *c)
      * forces, from a window starting 0.3 s before the first axle enters. */
     c->solver.free_initial_state = 1;
     c->solver.pre_roll_s = 0.3;
+    /* A site's solver (config/amfid.yaml, the reference of every key):
+     * the modes below calc_rate_hz / 2, the same weights as the observable
+     * ones at a third of the cost (docs/results/speed-estimation.md,
+     * "Modes"), and room for six axles, the EU mix's trucks; a vehicle with
+     * more is stored invalid (docs/results/multi-vehicle.md). The paper's
+     * own choices (observable, 2) stay in paper-20m.yaml. */
+    c->solver.modes = AMFI_MODES_RESOLVED;
+    c->solver.n_modes = 0;
+    c->solver.max_axles = 6;
     amfi_lambda_default(&c->lambda);
     /* Speed estimation stays off by default: it costs ~100 sweeps a passage
      * and lets a 10 % stiffness loss into the speed (docs/results/speed-estimation.md). */

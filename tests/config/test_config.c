@@ -2,7 +2,8 @@
 /*
  * test_config.c: unit tests of the YAML site loader (config/amfi_config.h).
  *
- * The shipped paper-20m.yaml and sim_publisher.yaml must load to exactly
+ * The shipped paper-20m.yaml (but for the paper's solver.modes and
+ * max_axles) and sim_publisher.yaml must load to exactly
  * amfi_config_defaults(), the other shipped files must load; a file changing
  * every key must land every value in its field; and each bad
  * input of the table below must fail with one line naming ":LINE: key.path"
@@ -68,6 +69,9 @@ static void test_defaults(void **state)
     amfi_solver_params_default(&s, 20.0);
     s.free_initial_state = 1; /* the site recommendation over the library's minimum */
     s.pre_roll_s = 0.3;
+    s.modes = AMFI_MODES_RESOLVED; /* a site's solver (config/amfid.yaml) */
+    s.n_modes = 0;
+    s.max_axles = 6;
     amfi_lambda_default(&l);
     assert_string_equal("paper-20m", c.name);
     assert_memory_equal(&b, &c.bridge, sizeof b);
@@ -143,6 +147,14 @@ static void test_shipped_file_is_the_defaults(void **state)
     rc = amfi_config_load(AMFI_CONFIG_DIR "/paper-20m.yaml", &got, err, sizeof err);
     if (rc)
         fail_msg("%s", err);
+    /* the paper's own solver choices, against a site's defaults (resolved
+     * modes, six axles: config/amfid.yaml) */
+    assert_int_equal(AMFI_MODES_OBSERVABLE, got.solver.modes);
+    assert_int_equal(2, got.solver.max_axles);
+    assert_int_equal(AMFI_MODES_RESOLVED, want.solver.modes);
+    assert_int_equal(6, want.solver.max_axles);
+    want.solver.modes = AMFI_MODES_OBSERVABLE;
+    want.solver.max_axles = 2;
     assert_string_equal(want.name, got.name);
     assert_true(got.bridge.span_m == 20.0 && got.bridge.n_elements == 20);
     assert_true(got.bridge.E_pa == 3.5e10 && got.bridge.A_m2 == 2.046);
@@ -484,12 +496,14 @@ static void test_workspace_bounds(void **state)
     char err[ERRLEN];
 
     (void)state;
-    /* 1 300 001 steps × 8 B × (2·1 + 2·2 + 2·(2·20 + 2)) = 0.87 GiB */
-    if (load_text("solver: {calc_rate_hz: 1e6, max_duration_s: 1}\n", &c, err))
+    /* 1 300 001 steps × 8 B × (2·1 + 2·2 + 2·(2·20 + 2)) = 0.87 GiB (two
+     * axles, the observable modes: the paper's choices) */
+    if (load_text("solver: {calc_rate_hz: 1e6, max_duration_s: 1, max_axles: 2,"
+                  " modes: observable}\n", &c, err))
         fail_msg("%s", err);
     assert_true(c.solver.calc_rate_hz == 1e6);
-    assert_int_equal(-1, load_text("solver: {calc_rate_hz: 1e6, max_duration_s: 1.3}\n",
-                                   &c, err));
+    assert_int_equal(-1, load_text("solver: {calc_rate_hz: 1e6, max_duration_s: 1.3,"
+                                   " max_axles: 2, modes: observable}\n", &c, err));
     assert_non_null(strstr(err, ":1: solver.calc_rate_hz: the solver's workspace would be"));
     /* 10 000 000 steps (56 B each with one axle and one mode): at the bound */
     if (load_text("solver: {calc_rate_hz: 1e6, max_duration_s: 9.699999, max_axles: 1,"

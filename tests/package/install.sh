@@ -24,7 +24,8 @@ for f in "$bindir/amfid" "$bindir/amfi-solve" "$bindir/amfi-report" "$bindir/amf
          "$mandir/man5/amfid.yaml.5.gz" "$mandir/man1/amfi-solve.1.gz" "$mandir/man1/amfi-report.1.gz" \
          "$mandir/man1/sim_publisher.1.gz" "$datadir/amfi/population.csv" "$datadir/amfi/amfi-alert-mail" \
          "$docdir/README.md" "$docdir/LICENSE" "$docdir/docs/daemon.md" "$datadir/java/amfi_types.jar" \
-         "$bindir/amfi-web" "$unitdir/amfi-web.service" "$mandir/man1/amfi-web.1.gz" "$docdir/docs/web.md"; do
+         "$bindir/amfi-web" "$unitdir/amfi-web.service" "$mandir/man1/amfi-web.1.gz" "$docdir/docs/web.md" \
+         "$datadir/amfi/site.yaml"; do
   [ -e "$stage$f" ] || fail "not installed: $f"
 done
 echo "installed files: ok"
@@ -32,6 +33,9 @@ echo "installed files: ok"
 # The installed daemon on the installed configuration.
 out=$("$stage$bindir/amfid" --check-config --config "$stage$sysconfdir/amfid/amfid.yaml" 2>&1) ||
   { echo "$out"; fail "installed amfid --check-config on the installed amfid.yaml"; }
+# the short site file beside it checks too (the example's warnings aside)
+out=$("$stage$bindir/amfid" --check-config --config "$stage$datadir/amfi/site.yaml" 2>&1) ||
+  { echo "$out"; fail "installed amfid --check-config on the installed site.yaml"; }
 echo "installed amfid --check-config: ok"
 for p in amfid amfi-solve amfi-report sim_publisher amfi-mkcase amfi-bench amfi-population amfi-fleet-bench amfi-sync amfi-web amfi-top; do
   v=$("$stage$bindir/$p" --version 2>&1) || fail "installed $p --version exited non-zero"
