@@ -112,7 +112,11 @@ typedef struct amfi_classification {
     int separable[AMFI_MAX_AXLES];  /* 0: the axle is inside a group */
     double gvw_kg;                  /* sum of the loads; NaN without loads */
     double gvw_limit_kg;            /* NaN when none */
-    unsigned over;                  /* AMFI_OVER_* */
+    unsigned over;                  /* AMFI_OVER_*; 0 unless loads_ok */
+    int loads_ok;                   /* 1: loads given and judged against the limits;
+                                       0: none given, or refused (loads_why) */
+    char loads_why[96];             /* why the loads were refused: a single axle or a
+                                       group below zero; "" otherwise */
 } amfi_classification;
 
 /* Group n_axles axles (1 .. AMFI_MAX_AXLES) with n_axles − 1 spacings (m,
@@ -125,10 +129,17 @@ int amfi_axle_groups(int n_axles, const double *spacing_m, const double *axle_kg
 
 /* Classify a vehicle: its groups, class, limits and overloads under p.
  * axle_kg may be NULL (no loads: the CAR / R2 split then goes by R2, no
- * overload is decided). 0, or −1 with a message for bad arguments (axle
- * count, a spacing that is not finite and positive, a load that is not
- * finite or negative). An unknown class is not an error: out->known = 0,
- * name "unknown", the groups still filled. */
+ * overload is decided). Loads are judged per group (a single axle is a
+ * group of one): an axle inside a group is not separable, so it may be
+ * negative as long as its group's sum is not (the group's sum is what is
+ * classified and checked against the limits; separable[] flags such axles).
+ * A single axle or a group below zero is a result the solve could not
+ * give: the class and groups are still filled (loads reported as they are)
+ * but the loads are refused: loads_ok 0, loads_why says which axle or group,
+ * the class decided as without loads and no overload. 0, or −1 with a
+ * message for bad arguments (axle count, a spacing that is not finite and
+ * positive, a load that is not finite). An unknown class is not an error:
+ * out->known = 0, name "unknown", the groups still filled. */
 int amfi_classify(const amfi_class_params *p, int n_axles, const double *spacing_m,
                   const double *axle_kg, amfi_classification *out, char *err,
                   size_t errlen);

@@ -152,7 +152,7 @@ static int eu_class(const amfi_class_params *p, const amfi_classification *c,
 {
     switch (pattern(c)) {
     case 11: /* two single axles: a car or van up to light_max_kg */
-        return isfinite(c->gvw_kg) && c->gvw_kg <= p->light_max_kg ? AMFI_EU_CAR : AMFI_EU_R2;
+        return c->loads_ok && c->gvw_kg <= p->light_max_kg ? AMFI_EU_CAR : AMFI_EU_R2;
     case 12:
         return AMFI_EU_R3;
     case 22:
@@ -288,8 +288,8 @@ int amfi_classify(const amfi_class_params *p, int n_axles, const double *spacing
                 spacing_m[a]);
     if (axle_kg)
         for (int a = 0; a < n_axles; a++)
-            if (!(isfinite(axle_kg[a]) && axle_kg[a] >= 0.0))
-                BAD("axle %d: load %g kg, must be finite and >= 0", a + 1, axle_kg[a]);
+            if (!isfinite(axle_kg[a]))
+                BAD("axle %d: load %g kg, must be finite", a + 1, axle_kg[a]);
     memset(out, 0, sizeof *out);
     out->n_axles = n_axles;
     out->n_groups = amfi_axle_groups(n_axles, spacing_m, axle_kg, p->group_spacing_m,
@@ -304,6 +304,24 @@ int amfi_classify(const amfi_class_params *p, int n_axles, const double *spacing
         out->gvw_kg = 0.0;
         for (int a = 0; a < n_axles; a++)
             out->gvw_kg += axle_kg[a];
+        /* An axle inside a group is not separable: only the group's sum is
+         * judged, a negative share of it is how the solve split the group.
+         * A single axle or a group below zero is a load the solve could not
+         * give: the loads are refused (reported as they are, no limits). */
+        out->loads_ok = 1;
+        for (int i = 0; i < out->n_groups && out->loads_ok; i++) {
+            const amfi_axle_group *g = &out->group[i];
+            if (g->load_kg >= 0.0)
+                continue;
+            out->loads_ok = 0;
+            if (g->n_axles == 1)
+                snprintf(out->loads_why, sizeof out->loads_why,
+                         "axle %d: load %.0f kg < 0 (a single axle)", g->first + 1, g->load_kg);
+            else
+                snprintf(out->loads_why, sizeof out->loads_why,
+                         "group %d (axles %d-%d): load %.0f kg < 0", i + 1, g->first + 1,
+                         g->first + g->n_axles, g->load_kg);
+        }
     }
     out->gvw_limit_kg = NAN;
     int cls;
@@ -330,10 +348,9 @@ int amfi_classify(const amfi_class_params *p, int n_axles, const double *spacing
     out->known = cls >= 0;
     if (!out->known)
         snprintf(out->name, sizeof out->name, "unknown");
-    if (isfinite(out->gvw_kg) && isfinite(out->gvw_limit_kg) &&
-        out->gvw_kg > out->gvw_limit_kg)
+    if (out->loads_ok && isfinite(out->gvw_limit_kg) && out->gvw_kg > out->gvw_limit_kg)
         out->over |= AMFI_OVER_GVW;
-    for (int i = 0; i < out->n_groups; i++)
+    for (int i = 0; out->loads_ok && i < out->n_groups; i++)
         if (isfinite(out->group[i].load_kg) && isfinite(out->group[i].limit_kg) &&
             out->group[i].load_kg > out->group[i].limit_kg)
             out->over |= AMFI_OVER_GROUP;

@@ -28,6 +28,18 @@ set(CPACK_DEBIAN_PACKAGE_HOMEPAGE "file:///usr/share/doc/amfi/README.md")
 # The site configuration is a conffile: an upgrade keeps the operator's edits.
 configure_file(${PROJECT_SOURCE_DIR}/packaging/debian/conffiles.in
   ${CMAKE_BINARY_DIR}/packaging/conffiles @ONLY)
+# The maintainer scripts' lists of units (systemd/CMakeLists.txt's
+# AMFI_OPTIONAL_UNITS, installed disabled, and amfid.service):
+# AMFI_DEB_UNITS all of them (unmask, try-restart, mask, purge),
+# AMFI_DEB_OPTIONAL_UNITS those never enabled (update-state only),
+# AMFI_DEB_STOP_UNITS the order prerm stops them in (amfid last: it stores
+# every pending passage on SIGTERM, after the instruments' feed stopped).
+if(NOT AMFI_OPTIONAL_UNITS)
+  message(FATAL_ERROR "AMFI_OPTIONAL_UNITS empty: systemd/ must come before the package")
+endif()
+list(JOIN AMFI_OPTIONAL_UNITS " " AMFI_DEB_OPTIONAL_UNITS)
+set(AMFI_DEB_UNITS "amfid.service ${AMFI_DEB_OPTIONAL_UNITS}")
+set(AMFI_DEB_STOP_UNITS "${AMFI_DEB_OPTIONAL_UNITS} amfid.service")
 configure_file(${PROJECT_SOURCE_DIR}/packaging/debian/postinst.in
   ${CMAKE_BINARY_DIR}/packaging/postinst @ONLY FILE_PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE WORLD_READ WORLD_EXECUTE)
 configure_file(${PROJECT_SOURCE_DIR}/packaging/debian/prerm.in

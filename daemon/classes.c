@@ -7,7 +7,10 @@
  * axles per group front to back, "1-1-3") and, when it was solved, whether
  * its GVW or a group is above the legal limit. Classification needs only
  * the axle count and the detector's spacings, so passages that were not
- * solved get their class and groups too (their overload stays NULL); a
+ * solved get their class and groups too (their overload stays NULL, as it
+ * does when the classifier refuses the loads: a single axle or a whole
+ * group below zero; an axle below zero inside a group is not separable and
+ * its group's sum is judged); a
  * passage without axles or with a spacing the classifier refuses gets none
  * (NULL), which the detector's checks make rare (intake validates the
  * spacings before a vehicle becomes a passage).
@@ -49,9 +52,14 @@ static void classes_row(amfid_ctx *c, const amfid_passage *p, amfi_passage_row *
     r->has_overload = r->overload = 0;
     if (r->n_axles < 1 || r->n_axles > AMFI_MAX_AXLES)
         return;
+    /* finite loads go to the classifier as they are: an axle below zero
+     * inside a group is the solve's split of the group's load (not
+     * separable), the group's sum is judged; a single axle or a group below
+     * zero refuses the loads (k.loads_ok 0), class and groups still stored,
+     * the overload NULL */
     int loads = !isnan(r->gvw_kg);
     for (int a = 0; loads && a < r->n_axles; a++)
-        loads = isfinite(r->axle_kg[a]) && r->axle_kg[a] >= 0;
+        loads = isfinite(r->axle_kg[a]);
     amfi_classification k;
     char err[160];
     if (amfi_classify(&c->cfg->classes, r->n_axles, r->spacing_m, loads ? r->axle_kg : NULL, &k,
@@ -63,7 +71,7 @@ static void classes_row(amfid_ctx *c, const amfid_passage *p, amfi_passage_row *
     r->vclass = C.name;
     if (groups_text(&k, C.groups, sizeof C.groups))
         r->axle_groups = C.groups;
-    if (loads) {
+    if (loads && k.loads_ok) {
         r->has_overload = 1;
         r->overload = k.over != 0;
     }

@@ -263,7 +263,7 @@ static void refusals(void **state)
     p = eu();
     amfi_classification c;
     char err[128];
-    const double sp[2] = {3.0, NAN}, kg[3] = {1000, -5, 1000};
+    const double sp[2] = {3.0, NAN}, kg[3] = {1000, INFINITY, 1000};
     assert_int_equal(amfi_classify(&p, 3, sp, NULL, &c, err, sizeof err), -1);
     assert_non_null(strstr(err, "spacing 2"));
     const double sp2[2] = {3.0, 1.3};
@@ -271,6 +271,61 @@ static void refusals(void **state)
     assert_non_null(strstr(err, "axle 2"));
     assert_int_equal(amfi_classify(&p, 0, sp2, NULL, &c, err, sizeof err), -1);
     assert_int_equal(amfi_classify(&p, AMFI_MAX_AXLES + 1, sp2, NULL, &c, err, sizeof err), -1);
+}
+
+/* Negative loads as a solve gives them: an axle inside a group is not
+ * separable, so a negative one in a tridem whose sum is positive is
+ * accepted (the class, the group's sum against its limit, the axle flagged
+ * not separable and reported as it is); a negative single axle, or a group
+ * below zero, refuses the loads with the axle or group named, the class
+ * and groups still given, no overload decided. */
+static void negative_loads(void **state)
+{
+    (void)state;
+    amfi_class_params p = eu();
+    amfi_classification c;
+    char err[128] = "";
+    const double a23[4] = {3.75, 6.0, 1.31, 1.31};
+    /* A23 with a tridem of 25 t split 14 / −3.4 / 14.4: the tridem's 25 t is
+     * above its 24 t limit, the gross 42 t above 40 t */
+    const double in_group[5] = {7000, 10000, 14000, -3426, 14426};
+    assert_int_equal(amfi_classify(&p, 5, a23, in_group, &c, err, sizeof err), 0);
+    assert_string_equal(c.name, "A23");
+    assert_int_equal(c.loads_ok, 1);
+    assert_string_equal(c.loads_why, "");
+    assert_int_equal(c.n_groups, 3);
+    assert_int_equal(c.group[2].kind, AMFI_GROUP_TRIDEM);
+    assert_float_equal(c.group[2].load_kg, 25000.0, 1e-6);
+    assert_int_equal(c.separable[3], 0);
+    assert_true(c.over & AMFI_OVER_GROUP);
+    assert_true(c.over & AMFI_OVER_GVW);
+    /* within its limits: no overload although one axle is below zero */
+    const double light[5] = {6000, 9000, 9000, -2000, 9000};
+    assert_int_equal(amfi_classify(&p, 5, a23, light, &c, err, sizeof err), 0);
+    assert_int_equal(c.loads_ok, 1);
+    assert_int_equal(c.over, 0);
+    /* a single axle below zero (the driving axle, axle 2): refused, named */
+    const double single[5] = {7000, -1200, 8000, 8000, 8000};
+    assert_int_equal(amfi_classify(&p, 5, a23, single, &c, err, sizeof err), 0);
+    assert_string_equal(c.name, "A23");
+    assert_int_equal(c.n_groups, 3);
+    assert_int_equal(c.loads_ok, 0);
+    assert_non_null(strstr(c.loads_why, "axle 2"));
+    assert_non_null(strstr(c.loads_why, "single axle"));
+    assert_int_equal(c.over, 0);
+    assert_float_equal(c.group[1].load_kg, -1200.0, 1e-9); /* reported as it is */
+    /* a group below zero: refused, named */
+    const double group[5] = {7000, 9000, 3000, -6000, 1000};
+    assert_int_equal(amfi_classify(&p, 5, a23, group, &c, err, sizeof err), 0);
+    assert_int_equal(c.loads_ok, 0);
+    assert_non_null(strstr(c.loads_why, "group 3 (axles 3-5)"));
+    assert_int_equal(c.over, 0);
+    /* two axles, one below zero: not a CAR by its (negative) gross weight */
+    const double sp2[1] = {2.7}, car[2] = {2500, -900};
+    assert_int_equal(amfi_classify(&p, 2, sp2, car, &c, err, sizeof err), 0);
+    assert_string_equal(c.name, "R2");
+    assert_int_equal(c.loads_ok, 0);
+    assert_non_null(strstr(c.loads_why, "axle 2"));
 }
 
 /* The text form amfid records in the store (meta daemon.classes): every
@@ -330,6 +385,7 @@ int main(void)
         cmocka_unit_test(groups_at_threshold),  cmocka_unit_test(every_eu_class_from_vclass),
         cmocka_unit_test(eu_limits),            cmocka_unit_test(fhwa_typical),
         cmocka_unit_test(refusals),             cmocka_unit_test(params_text),
+        cmocka_unit_test(negative_loads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

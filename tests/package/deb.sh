@@ -24,6 +24,8 @@ done
 files=$(dpkg-deb -c "$deb" | awk '{print $6}')
 for f in ./usr/bin/amfid ./usr/bin/amfi-solve ./usr/bin/amfi-report ./usr/bin/amfi-spy ./usr/bin/sim_publisher \
          ./etc/amfid/amfid.yaml ./lib/systemd/system/amfid.service ./usr/lib/sysusers.d/amfid.conf \
+         ./lib/systemd/system/amfi-sync.service ./lib/systemd/system/amfi-ingest.service \
+         ./lib/systemd/system/amfi-web.service \
          ./usr/lib/tmpfiles.d/amfid.conf ./usr/share/man/man8/amfid.8.gz ./usr/share/man/man5/amfid.yaml.5.gz ./usr/share/doc/amfi/LICENSE \
          ./usr/share/java/amfi_types.jar ./usr/share/amfi/roles.sql ./usr/bin/amfi-top \
          ./usr/share/man/man1/amfi-top.1.gz; do
@@ -101,6 +103,17 @@ dpkgr() {
     --force-confold --log=/dev/null "$@" >"$x/dpkg.log" 2>&1 || { cat "$x/dpkg.log"; fail "dpkg $*"; }
 }
 called() { grep -qx "$1" "$x/calls"; }
+# The units besides amfid's, installed disabled and never enabled by the
+# package; every maintainer script names all of them (stopped on remove,
+# restarted on upgrade, masked on remove, forgotten on purge).
+optional="amfi-sync.service amfi-ingest.service amfi-web.service"
+all="amfid.service $optional"
+none_enabled() { # WHEN
+  for u in $optional; do
+    [ -L "$wants/$u" ] && fail "$1 enabled $u"
+  done
+  return 0
+}
 wants=$r/etc/systemd/system/multi-user.target.wants
 mode() { stat -c '%a %U:%G' "$1"; }
 
@@ -118,21 +131,29 @@ key=$(od -An -tx1 "$r/etc/amfid/bus.key" | tr -d ' \n')
 [ -L "$wants/amfid.service" ] && fail "postinst enabled amfid with the example configuration"
 called 'deb-systemd-invoke start amfid.service' && fail "postinst started amfid with the example configuration"
 grep -q 'still the example (site.id local)' "$x/dpkg.log" || fail "postinst does not say why amfid is not started"
+none_enabled postinst
+for u in $optional; do
+  called "deb-systemd-invoke start $u" && fail "postinst started $u"
+done
 echo "postinst, example: users, /etc/amfi-sync 0700, bus key 0600 32 bytes; amfid neither enabled nor started: ok"
 
 # 2. Upgrade (the same package again): the key kept, running services
 # restarted, still not enabled.
 dpkgr -i "$deb"
 [ "$(od -An -tx1 "$r/etc/amfid/bus.key" | tr -d ' \n')" = "$key" ] || fail "an upgrade replaced the bus key"
-called 'deb-systemd-invoke try-restart amfid.service amfi-sync.service' || { cat "$x/calls"; fail "upgrade: no try-restart"; }
+called "deb-systemd-invoke try-restart $all" || { cat "$x/calls"; fail "upgrade: no try-restart of $all"; }
 [ -L "$wants/amfid.service" ] && fail "upgrade enabled amfid with the example configuration"
-echo "postinst, upgrade: key kept, try-restart of both units: ok"
+none_enabled "an upgrade"
+echo "postinst, upgrade: key kept, try-restart of every unit: ok"
 
-# 3. Removal: both stopped, then masked; a configured site reinstalled from
+# 3. Removal: every unit stopped (amfid last), then masked; a configured site reinstalled from
 # nothing (purge, then a configured amfid.yaml kept by --force-confold):
 # enabled and started; an upgrade of it restarted.
 dpkgr -r amfi
-called 'deb-systemd-invoke stop amfi-sync.service amfid.service' || { cat "$x/calls"; fail "prerm remove: no stop of both units"; }
+called "deb-systemd-invoke stop $optional amfid.service" || { cat "$x/calls"; fail "prerm remove: no stop of $optional amfid.service"; }
+for u in $all; do
+  [ "$(readlink "$r/etc/systemd/system/$u")" = /dev/null ] || fail "postrm remove: $u not masked"
+done
 dpkgr --purge amfi
 mkdir -p "$r/etc/amfid"
 sed 's/^  id: local /  id: a7-km42 /' "$x/root/etc/amfid/amfid.yaml" >"$r/etc/amfid/amfid.yaml"
@@ -141,10 +162,10 @@ mkdir -p "$r/etc/amfid" && printf 'host:5432:fleet:amfi_sync:secret\n' >"$r/etc/
 dpkgr -i "$deb"
 [ -L "$wants/amfid.service" ] || fail "postinst did not enable amfid for a configured site"
 called 'deb-systemd-invoke start amfid.service' || { cat "$x/calls"; fail "postinst did not start amfid for a configured site"; }
-[ -L "$wants/amfi-sync.service" ] && fail "postinst enabled amfi-sync"
+none_enabled "postinst for a configured site"
 [ -f "$r/etc/amfi-sync/pgpass" ] && [ ! -e "$r/etc/amfid/pgpass" ] || fail "postinst did not move /etc/amfid/pgpass to /etc/amfi-sync/"
 dpkgr -i "$deb"
-called 'deb-systemd-invoke try-restart amfid.service amfi-sync.service' || { cat "$x/calls"; fail "configured upgrade: no try-restart"; }
+called "deb-systemd-invoke try-restart $all" || { cat "$x/calls"; fail "configured upgrade: no try-restart of $all"; }
 [ -L "$wants/amfid.service" ] || fail "an upgrade disabled amfid"
 echo "configured site: enabled and started at install, restarted at upgrade; amfi-sync's pgpass moved to /etc/amfi-sync: ok"
 
@@ -155,19 +176,21 @@ grep -q 'try-restart\|start' "$x/calls" && { cat "$x/calls"; fail "postinst (re)
 grep -q 'does not check' "$x/dpkg.log" || fail "postinst does not say the configuration is refused"
 echo "refused configuration: not restarted: ok"
 
-# 5. Purge: both units' enablement and state gone (amfi-sync enabled by
-# the operator, as systemctl enable does it), the bus key and the empty
-# directories too; the operator's pgpass stays.
-ln -s /lib/systemd/system/amfi-sync.service "$wants/amfi-sync.service"
+# 5. Purge: every unit's enablement and state gone (amfi-sync, amfi-ingest
+# and amfi-web enabled by the operator, as systemctl enable does it), the
+# bus key and the empty directories too; the operator's pgpass stays.
+for u in $optional; do
+  ln -s "/lib/systemd/system/$u" "$wants/$u"
+done
 dpkgr -r amfi
 dpkgr --purge amfi
-[ -L "$wants/amfid.service" ] && fail "purge left amfid enabled"
-[ -L "$wants/amfi-sync.service" ] && fail "purge left amfi-sync enabled"
+for u in $all; do
+  [ -L "$wants/$u" ] && fail "purge left $u enabled"
+  [ -L "$r/etc/systemd/system/$u" ] && fail "purge left $u masked"
+done
 left=$(ls "$r/var/lib/systemd/deb-systemd-helper-enabled" "$r/var/lib/systemd/deb-systemd-helper-masked" 2>/dev/null | grep 'amfi')
 [ -z "$left" ] || fail "purge left deb-systemd-helper state: $left"
 [ -e "$r/etc/amfid" ] && fail "purge left /etc/amfid: $(ls -A "$r/etc/amfid")"
 [ -f "$r/etc/amfi-sync/pgpass" ] || fail "purge removed the operator's /etc/amfi-sync/pgpass"
-[ -L "$r/etc/systemd/system/amfid.service" ] && fail "purge left amfid masked"
-[ -L "$r/etc/systemd/system/amfi-sync.service" ] && fail "purge left amfi-sync masked"
-echo "purge: both units' enablement, masks and state, the bus key, /etc/amfid: gone: ok"
+echo "purge: every unit's enablement, masks and state, the bus key, /etc/amfid: gone: ok"
 echo "deb: ok"

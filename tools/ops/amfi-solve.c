@@ -536,17 +536,25 @@ static int write_speed_trace(const char *path, const amfi_speed_result *sr,
 /* The vehicle's class and axle groups under the site's classes: section
  * (classify/amfi_classify.h) into o: "class", "groups" (each group's axles,
  * 0-based within the vehicle, its load, kind and legal limit),
- * "gvw_limit_kg" and "overload" (its gross weight or a group above its
- * limit). 0, or −1 (out of memory; a classification error on stderr). */
+ * "axle_separable" (false for an axle inside a group: its load is the
+ * solve's split of the group's, which may be below zero), "gvw_limit_kg",
+ * "overload" (its gross weight or a group above its limit; null when the
+ * loads were refused) and "loads_refused" (null, or why: a single axle or a
+ * group below zero, also said on stderr). 0, or −1 with the message on
+ * stderr. */
 static int class_json(const amfi_class_params *cp, int n_axles, const double *spacing_m,
-                      const double *axle_kg, json_t *o)
+                      const double *axle_kg, json_t *o, int vehicle)
 {
     amfi_classification k;
-    char err[256];
+    char err[256], who[32] = "";
+    if (vehicle >= 0)
+        snprintf(who, sizeof who, "vehicle %d: ", vehicle + 1);
     if (amfi_classify(cp, n_axles, spacing_m, axle_kg, &k, err, sizeof err) != 0) {
-        fprintf(stderr, PROG ": classification: %s\n", err);
+        fprintf(stderr, PROG ": %sclassification: %s\n", who, err);
         return -1;
     }
+    if (!k.loads_ok)
+        fprintf(stderr, PROG ": %sloads refused for the limits: %s\n", who, k.loads_why);
     json_t *gs = json_array();
     for (int i = 0; gs && i < k.n_groups; i++) {
         const amfi_axle_group *g = &k.group[i];
@@ -558,14 +566,27 @@ static int class_json(const amfi_class_params *cp, int n_axles, const double *sp
                                "limit_kg", amfi_json_num(g->limit_kg));
         if (!go || json_array_append_new(gs, go)) {
             json_decref(gs);
+            fprintf(stderr, PROG ": out of memory\n");
             return -1;
         }
     }
     if (!gs || json_object_set_new(o, "class", json_string(k.name)) ||
         json_object_set_new(o, "groups", gs) ||
         json_object_set_new(o, "gvw_limit_kg", amfi_json_num(k.gvw_limit_kg)) ||
-        json_object_set_new(o, "overload", json_boolean(k.over != 0)))
+        json_object_set_new(o, "overload",
+                            k.loads_ok ? json_boolean(k.over != 0) : json_null())) {
+        fprintf(stderr, PROG ": out of memory\n");
         return -1;
+    }
+    json_t *sep = json_array();
+    for (int a = 0; sep && a < n_axles; a++)
+        json_array_append_new(sep, json_boolean(k.separable[a]));
+    if (!sep || json_object_set_new(o, "axle_separable", sep) ||
+        json_object_set_new(o, "loads_refused",
+                            k.loads_ok ? json_null() : json_string(k.loads_why))) {
+        fprintf(stderr, PROG ": out of memory\n");
+        return -1;
+    }
     return 0;
 }
 
@@ -610,7 +631,7 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
         json_decref(o);
         o = NULL;
     }
-    if (o && !m && class_json(&c->classes, r->n_axles, spacing_m, r->axle_kg, o) != 0) {
+    if (o && !m && class_json(&c->classes, r->n_axles, spacing_m, r->axle_kg, o, -1) != 0) {
         json_decref(o);
         return -1;
     }
@@ -635,7 +656,7 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
                 json_object_set_new(vo, "group_gvw_kg", amfi_json_num(vr->group_gvw_kg));
             }
             if (vo && class_json(&c->classes, vr->n_axles, mp->vehicle[v].axle_spacing_m,
-                                 vr->axle_kg, vo) != 0) {
+                                 vr->axle_kg, vo, v) != 0) {
                 json_decref(vo);
                 json_decref(vs);
                 json_decref(o);
@@ -650,7 +671,15 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
         o = NULL;
     }
     json_decref(extra);
-    return amfi_json_print(stdout, o);
+    if (!o) {
+        fprintf(stderr, PROG ": out of memory\n");
+        return -1;
+    }
+    if (amfi_json_print(stdout, o) != 0) {
+        fprintf(stderr, PROG ": stdout: %s\n", ferror(stdout) ? strerror(errno) : "write failed");
+        return -1;
+    }
+    return 0;
 }
 
 /* --from-store: the passage's raw samples and its stored row into *raw and
@@ -1025,8 +1054,9 @@ int main(int argc, char **argv)
     }
     if (print_json(&cfg, &res, &sres, cfg.speed_estimate, o.n_vehicles ? &mres : NULL,
                    o.spacing_m, &mp, csv.rate_hz,
-                   elapsed_ms(&t_a, &t_b), extra) != 0
-        || fflush(stdout) != 0 || ferror(stdout)) {
+                   elapsed_ms(&t_a, &t_b), extra) != 0)
+        goto done; /* print_json said why */
+    if (fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, PROG ": stdout: %s\n", strerror(errno));
         goto done;
     }
