@@ -19,6 +19,22 @@ wait_for() {
     sleep 0.1
   done
 }
+# wait_caught PID SIGNUM [SECONDS]: until PID has a handler for signal
+# SIGNUM (/proc/PID/status SigCgt), so that a signal sent next is caught and
+# not the default action (SIGUSR1's kills a program still starting under
+# ASan); 1 when PID has exited or SECONDS (default 60) have passed.
+wait_caught() {
+  _wc_bit=$(( 1 << ($2 - 1) )); _wc_n=$(( ${3:-60} * 10 )); _wc_i=0
+  while :; do
+    _wc_m=$(sed -n 's/^SigCgt:[[:space:]]*//p' "/proc/$1/status" 2>/dev/null) ||
+      { echo "wait_caught: process $1 is gone" >&2; return 1; }
+    [ -n "$_wc_m" ] || { echo "wait_caught: process $1 is gone" >&2; return 1; }
+    [ $(( 0x$_wc_m & _wc_bit )) -ne 0 ] && return 0
+    _wc_i=$((_wc_i + 1))
+    [ $_wc_i -lt $_wc_n ] || { echo "wait_caught: $1 has no handler for signal $2 after ${3:-60} s" >&2; return 1; }
+    sleep 0.1
+  done
+}
 # stop_pid PID [SECONDS]: SIGTERM, wait until it is gone (default 300 s: a
 # drain under ASan takes minutes) and return its exit status (1 on timeout,
 # after SIGKILL).

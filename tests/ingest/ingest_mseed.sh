@@ -19,6 +19,7 @@ ingest=$1 tool=$2
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 . "$(dirname "$0")/../common/bus_key.sh"
+. "$(dirname "$0")/../common/proc.sh"
 fail() { echo "FAIL: $*"; for f in "$dir"/*.log; do echo "--- $f"; tail -30 "$f"; done; exit 1; }
 T0=1767225600000000
 
@@ -97,6 +98,7 @@ kill -0 $ipid || fail "the service ended before the FIFO had a writer"
 { head -c 700 "$dir/c1.mseed"; sleep 0.3; tail -c +701 "$dir/c1.mseed"; } > "$dir/fifo"
 cat "$dir/c2.mseed" > "$dir/fifo"
 nf=$(( ($(wc -c < "$dir/c1.mseed") + $(wc -c < "$dir/c2.mseed")) / 512 ))
+wait_caught $ipid 10 || fail "FIFO: no SIGUSR1 handler"  # SIGUSR1: 10 on Linux
 i=0; until kill -USR1 $ipid && sleep 0.2 && grep -q "amfi-ingest: $nf records" "$dir/fifo.log"; do
   i=$((i + 1)); [ $i -lt 300 ] || fail "the FIFO was not read to its end"; done
 kill -TERM $ipid; wait $ipid || fail "stream from a FIFO: exit status $?"
@@ -109,6 +111,7 @@ grep -q "^sensor 7 intervals 0-3999$" "$dir/got3.log" || fail "FIFO: sensor 7 in
   --mseed-stream "$dir/grow.mseed" --listen none 2> "$dir/grow.log" &
 ipid=$!
 cat "$dir/c1.mseed" >> "$dir/grow.mseed"; sleep 0.5; cat "$dir/c2.mseed" >> "$dir/grow.mseed"
+wait_caught $ipid 10 || fail "growing file: no SIGUSR1 handler"
 i=0; until kill -USR1 $ipid && sleep 0.2 && grep -q "amfi-ingest: $(( $(wc -c < "$dir/grow.mseed") / 512 )) records" "$dir/grow.log"; do
   i=$((i + 1)); [ $i -lt 300 ] || fail "the growing file was not read to its end"; done
 kill -TERM $ipid; wait $ipid || fail "SIGTERM: exit status $?"
