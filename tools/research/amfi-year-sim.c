@@ -32,6 +32,24 @@
  * uniform stiffness change scales every inferred weight by its inverse
  * (issue 14).
  *
+ * --population FILE (e.g. sim_publisher/data/population-eu.csv): the true
+ * GVW is a record of the file instead, drawn as sim_publisher --environment
+ * site draws it (amfi_mix_classify_by_class: loaded at or above its own
+ * class's median; amfi_mix_pick with the day's loaded share, or the file's
+ * own loaded fraction with drift off), classed by classify/ (scheme eu).
+ * --meas-rel F adds an error part proportional to the true GVW: e ~
+ * normal(0, sqrt(meas_sd² + (F · GVW)²)).
+ *
+ * Class filters (--std-filter, --scale-filter, as amfid's
+ * daemon.indicators.classes and min_gvw_kg): "all", or CLASSES[@MIN_KG]
+ * (comma-separated EU classes or "trucks", every class but CAR): only the
+ * vehicles of those classes whose weight fed (at the calibration
+ * temperature) is at least MIN_KG feed that indicator. A filtered
+ * indicator's baseline takes as many of its vehicles as pooled (its days
+ * grow with 1 / the fraction of the file that passes), and the scale
+ * indicator's vehicles_per_day and class_split_kg are the flow × that
+ * fraction and the median of the records that pass.
+ *
  * Indicators: amfid's engine with amfi_indicator_params_default (the STD
  * rule "std_increase", warning, and the mean rule "mean_shift", info; the
  * automatic baseline is the first baseline_n vehicles after commissioning,
