@@ -20,10 +20,13 @@
 # left out, counted in amfid's log, are those of the store's rows; after a
 # restart the window is refilled with those passages only, and an automatic
 # baseline collected from other passages is not applied.
+# amfi-report --set-baseline-last takes the same passages (the filter amfid
+# recorded in meta).
 # Usage: daemon_classes.sh AMFID SIM_PUBLISHER LCM_PASSAGES LCM_INJECT CONFIG POPULATION_EU
+#     AMFI_REPORT
 set -u
 . "$(dirname "$0")/../common/bus_prologue.sh"
-amfid=$1 sim=$2 listen=$3 inject=$4 config=$5 popeu=$6
+amfid=$1 sim=$2 listen=$3 inject=$4 config=$5 popeu=$6 report=$7
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 q() { sqlite3 "$dir/s.db" "$1"; }
 
@@ -129,6 +132,11 @@ want="STD and mean rules: $fed passages fed of classes A23,A33 from 20000 kg, $o
 grep -qF "$want" "$dir/cls.log" || { grep "STD and mean" "$dir/cls.log"; fail "class filter: expected '$want'"; }
 sqlite3 "$dir/cls.db" "SELECT value FROM meta WHERE key = 'daemon.indicators.classes'" |
   grep -qx 'classes=A23,A33 min_gvw_kg=20000' || fail "meta daemon.indicators.classes"
+# amfi-report's baseline from the newest passages takes the filter's only
+"$report" --db "$dir/cls.db" --set-baseline-last $((fed + 1)) > "$dir/report.txt" 2>&1 &&
+  fail "amfi-report --set-baseline-last $((fed + 1)) found more than the filter's $fed passages"
+grep -q "only $fed ok passages stored" "$dir/report.txt" ||
+  { cat "$dir/report.txt"; fail "amfi-report --set-baseline-last: not the filter's $fed passages"; }
 # a restart (vehicles only: nothing more feeds) with a manual baseline: the
 # window is refilled with the filter's passages only
 qc "INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note)
