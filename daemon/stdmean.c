@@ -55,10 +55,13 @@ static struct {
     long long fed, not_class, below_min;
 } M;
 
-/* The automatic baseline's note: what it was collected from. */
+/* The automatic baseline's note: what it was collected from (cut to the
+ * note's length, the same cut when it is written and when it is compared). */
 static void auto_note(char *buf, size_t len, int n)
 {
-    snprintf(buf, len, "first %d ok passages%s", n, M.filter_text);
+    const int w = snprintf(buf, len, "first %d ok passages", n);
+    if (w > 0 && (size_t)w < len)
+        snprintf(buf + w, len - (size_t)w, "%.*s", (int)(len - (size_t)w - 1), M.filter_text);
 }
 
 /* 1 when the stored passage p passes daemon.indicators.classes and min_gvw_kg
@@ -186,7 +189,13 @@ static int stdmean_restore(amfid_ctx *c)
         return 0;
     char note[sizeof b.note];
     auto_note(note, sizeof note, b.n);
-    if (strcmp(b.source, "auto") == 0 && strcmp(b.note, note) != 0) {
+    /* filtered: the note must name this filter; pooled: any automatic
+     * baseline but one whose note names a filter (notes of older versions
+     * or of other tools are taken as before) */
+    const int other = M.filter_text[0] ? strcmp(b.note, note) != 0
+                                       : strstr(b.note, " ok passages of classes ") != NULL ||
+                                             strstr(b.note, " ok passages from ") != NULL;
+    if (strcmp(b.source, "auto") == 0 && other) {
         /* collected from other passages (another class filter): seen, not
          * applied; the timer leaves it be */
         LOG_WARN("baseline in the store (%s: %s) was not collected from the passages that feed "

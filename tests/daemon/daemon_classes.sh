@@ -153,4 +153,12 @@ qc "INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note)
 grep -qF "(auto: first 100 ok passages) was not collected from the passages that feed the rules now" "$dir/cls3.log" &&
   ! grep -q "window refilled" "$dir/cls3.log" ||
   { grep -i "window\|baseline" "$dir/cls3.log"; fail "class filter: a pooled automatic baseline was applied"; }
+# and pooled again, a baseline collected under a filter is not applied either
+qc "INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note)
+    VALUES (0, 100, 30000, 3000, 'auto', 'first 100 ok passages of classes A23,A33 from 20000 kg')"
+"$amfid" --config "$dir/amfid.yaml" --db "$dir/cls.db" --lcm-url "file://$dir/novdata.log?speed=0" \
+  2> "$dir/cls4.log" || { cat "$dir/cls4.log"; fail "amfid restarted pooled: exit status $?"; }
+grep -qF "(auto: first 100 ok passages of classes A23,A33 from 20000 kg) was not collected" "$dir/cls4.log" &&
+  ! grep -q "window refilled" "$dir/cls4.log" ||
+  { grep -i "window\|baseline" "$dir/cls4.log"; fail "pooled: a filtered automatic baseline was applied"; }
 echo "daemon_classes: the STD and mean rules fed $fed of the $((fed + other + light)) ok passages (classes A23,A33 from 20 t), refilled with them after a restart"
