@@ -810,6 +810,10 @@ static int parse_filter(const char *v, filter *f, char *why, size_t whylen)
             return -1;
         }
     }
+    if (!buf[0] || buf[0] == ',' || buf[strlen(buf) - 1] == ',' || strstr(buf, ",,")) {
+        snprintf(why, whylen, "an empty class name (names separated by single commas)");
+        return -1;
+    }
     char *save = NULL;
     for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         int found = 0;
