@@ -145,6 +145,11 @@ int amfi_classify(const amfi_class_params *p, int n_axles, const double *spacing
                   size_t errlen);
 
 const char *amfi_class_scheme_name(amfi_class_scheme s); /* "eu", "fhwa13" */
+/* The number of classes of scheme s (eu: 8, fhwa13: 13) and a class's
+ * index from its name ("A23": AMFI_EU_A23; "FHWA9": 8), −1 when the name is
+ * not a class of s ("unknown" is none). */
+int amfi_class_count(amfi_class_scheme s);
+int amfi_class_index(amfi_class_scheme s, const char *name);
 const char *amfi_eu_class_name(amfi_eu_class c);          /* "CAR" .. "A33" */
 const char *amfi_group_kind_name(amfi_group_kind k);      /* "single", "tandem", ... */
 

@@ -29,6 +29,30 @@ const char *amfi_class_scheme_name(amfi_class_scheme s)
     return s == AMFI_CLASS_SCHEME_FHWA13 ? "fhwa13" : "eu";
 }
 
+int amfi_class_count(amfi_class_scheme s)
+{
+    return s == AMFI_CLASS_SCHEME_FHWA13 ? 13 : AMFI_EU_N;
+}
+
+int amfi_class_index(amfi_class_scheme s, const char *name)
+{
+    if (!name)
+        return -1;
+    if (s == AMFI_CLASS_SCHEME_FHWA13) {
+        char buf[AMFI_CLASS_NAME_LEN];
+        for (int k = 1; k <= 13; k++) {
+            snprintf(buf, sizeof buf, "FHWA%d", k);
+            if (strcmp(name, buf) == 0)
+                return k - 1;
+        }
+        return -1;
+    }
+    for (int k = 0; k < AMFI_EU_N; k++)
+        if (strcmp(name, eu_names[k]) == 0)
+            return k;
+    return -1;
+}
+
 const char *amfi_group_kind_name(amfi_group_kind k)
 {
     switch (k) {

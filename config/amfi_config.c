@@ -142,6 +142,8 @@ void amfi_config_defaults(amfi_site_config *c)
     d->inseparable_quality_lanes = 3.0;
     d->single_presence_only = 0;
     d->ind_temp_compensated = 1;
+    d->ind_classes[0] = '\0';
+    d->ind_min_gvw_kg = 0.0;
     d->status_period_s = 1.0;
     d->alert_timeout_s = 30.0;
     d->alert_max_running = 4;

@@ -98,6 +98,11 @@ typedef struct amfi_daemon_config {
                                  a vehicle of an event with vehicles of several lanes */
     int single_presence_only; /* daemon.indicators.single_presence_only: the
                                  indicators take only passages weighed alone */
+    char ind_classes[128];    /* daemon.indicators.classes: the classes (of classes.scheme)
+                                 whose passages feed the STD and mean rules,
+                                 comma-separated; "" every passage */
+    double ind_min_gvw_kg;    /* daemon.indicators.min_gvw_kg: and whose weight fed is at
+                                 least this, kg, [0, 100000]; 0 every weight */
     int ind_temp_compensated; /* daemon.indicators.temperature: 1 compensated
                                  (the STD and mean rules get each GVW at the
                                  calibration temperature), 0 raw */

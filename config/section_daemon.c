@@ -91,6 +91,9 @@ static const field indicator_fields[] = {
      .aux = amfi_cfg_onoff_names},
     {.key = "temperature", .kind = &amfi_cfg_k_enum, .off = DC(ind_temp_compensated),
      .aux = temperature_names},
+    STR("classes", ind_classes, 0),
+    {.key = "min_gvw_kg", .kind = &amfi_cfg_k_double, .off = DC(ind_min_gvw_kg), .lo = 0,
+     .hi = 100000},
     {.key = NULL}};
 
 /* Offsets of the estimator's amfi_natfreq_params inside the site config. */
@@ -232,6 +235,40 @@ int amfi_cfg_daemon_check(ctx *x, amfi_site_config *c)
                             "'%c' in '%s': names are A-Z a-z 0-9 _ . - separated by commas", *p,
                             s);
             }
+        }
+    }
+
+    /* the classes that feed the STD and mean rules: names of classes.scheme
+     * separated by single commas, each once */
+    {
+        const char *s = c->daemon.ind_classes;
+        unsigned seen = 0;
+        const int cls_line = amfi_cfg_first_noted(x, "daemon.indicators.classes", "daemon", NULL);
+        for (const char *p = s; *s;) {
+            const char *e = strchr(p, ',');
+            const size_t len = e ? (size_t)(e - p) : strlen(p);
+            char name[32];
+            if (len == 0)
+                return amfi_cfg_fail(x, cls_line, "daemon.indicators.classes",
+                                     "an empty name in '%s' (class names separated by single "
+                                     "commas)", s);
+            snprintf(name, sizeof name, "%.*s", (int)(len < sizeof name ? len : sizeof name - 1),
+                     p);
+            const int k = len < sizeof name ? amfi_class_index(c->classes.scheme, name) : -1;
+            if (k < 0)
+                return amfi_cfg_fail(x, cls_line, "daemon.indicators.classes",
+                                     "'%.*s' is not a class of classes.scheme %s (%s)", (int)len,
+                                     p, amfi_class_scheme_name(c->classes.scheme),
+                                     c->classes.scheme == AMFI_CLASS_SCHEME_FHWA13
+                                         ? "FHWA1 .. FHWA13"
+                                         : "CAR, R2, R3, R4, A22, A23, A32, A33");
+            if (seen & (1u << k))
+                return amfi_cfg_fail(x, cls_line, "daemon.indicators.classes",
+                                     "'%s' twice in '%s'", name, s);
+            seen |= 1u << k;
+            if (!e)
+                break;
+            p = e + 1;
         }
     }
 

@@ -379,6 +379,16 @@ int amfi_store_set_baseline(amfi_store *s, const amfi_baseline *b, char *err,
 int amfi_store_recent_ok_gvw(amfi_store *s, int max, double *gvw, int *n,
                              char *err, size_t errlen);
 
+/* The same restricted as amfid restricts what feeds the rules
+ * (daemon.indicators.classes, min_gvw_kg, single_presence_only): only ok
+ * passages whose class is one of classes[0 .. n_classes − 1] (n_classes 0:
+ * any class, NULL too), whose weight fed (gvw_comp_kg, else gvw_kg) is at
+ * least min_kg and, when single_only, weighed alone (n_vehicles <= 1 or
+ * NULL). A class name is 1 .. 15 bytes; n_classes 0 .. 64. */
+int amfi_store_recent_fed_gvw(amfi_store *s, int max, const char *const *classes,
+                              int n_classes, double min_kg, int single_only, double *gvw,
+                              int *n, char *err, size_t errlen);
+
 /* ---- meta: small key/value table for daemon state ---------------------- */
 
 /* key: 1 .. 63 bytes of [A-Za-z0-9_.-]. *found = 0 and val = "" when the

@@ -222,6 +222,73 @@ int amfi_store_recent_ok_gvw(amfi_store *s, int max, double *gvw, int *n,
     return 0;
 }
 
+int amfi_store_recent_fed_gvw(amfi_store *s, int max, const char *const *classes,
+                              int n_classes, double min_kg, int single_only, double *gvw,
+                              int *n, char *err, size_t errlen)
+{
+    int rc = st_check_handle(s, 0, err, errlen), src = SQLITE_OK, count = 0;
+    if (rc == 0 && (!gvw || !n))
+        rc = st_fail(err, errlen, AMFI_EINVAL, "recent fed GVW: output is NULL");
+    if (rc == 0 && max < 1)
+        rc = st_fail(err, errlen, AMFI_EINVAL, "recent fed GVW: max %d must be >= 1", max);
+    if (rc == 0 && (n_classes < 0 || n_classes > 64 || (n_classes > 0 && !classes)))
+        rc = st_fail(err, errlen, AMFI_EINVAL, "recent fed GVW: %d classes (0 .. 64)",
+                     n_classes);
+    for (int k = 0; rc == 0 && k < n_classes; k++)
+        if (!classes[k] || !classes[k][0] || strlen(classes[k]) > 15)
+            rc = st_fail(err, errlen, AMFI_EINVAL,
+                         "recent fed GVW: class %d is empty or longer than 15 bytes", k);
+    if (rc == 0 && !(min_kg >= 0.0 && min_kg <= AMFI_STORE_MAX_KG))
+        rc = st_fail(err, errlen, AMFI_EINVAL, "recent fed GVW: min_kg %g out of [0, %g]",
+                     min_kg, (double)AMFI_STORE_MAX_KG);
+    if (rc != 0)
+        return rc;
+    *n = 0;
+    /* the same rows, in the same order, as recent_ok_gvw, restricted */
+    char sql[1024];
+    size_t len = (size_t)snprintf(sql, sizeof sql,
+                                  "SELECT id, gvw_kg, gvw_comp_kg FROM passages WHERE status = 'ok'"
+                                  " AND coalesce(gvw_comp_kg, gvw_kg) >= ?2%s",
+                                  single_only ? " AND coalesce(n_vehicles, 1) <= 1" : "");
+    for (int k = 0; k < n_classes; k++)
+        len += (size_t)snprintf(sql + len, sizeof sql - len, "%s?%d", k ? ", " : " AND class IN (",
+                                k + 3);
+    len += (size_t)snprintf(sql + len, sizeof sql - len, "%s ORDER BY utime DESC, id DESC LIMIT ?1",
+                            n_classes ? ")" : "");
+    sqlite3_stmt *st = NULL;
+    src = sqlite3_prepare_v2(s->db, sql, -1, &st, NULL);
+    if (src == SQLITE_OK)
+        src = sqlite3_bind_int(st, 1, max);
+    if (src == SQLITE_OK)
+        src = sqlite3_bind_double(st, 2, min_kg);
+    for (int k = 0; src == SQLITE_OK && k < n_classes; k++)
+        src = sqlite3_bind_text(st, k + 3, classes[k], -1, SQLITE_TRANSIENT);
+    /* newest first into gvw[0 ..], reversed below */
+    while (rc == 0 && src == SQLITE_OK && (src = sqlite3_step(st)) == SQLITE_ROW) {
+        origin o = {"passages", sqlite3_column_int64(st, 0)};
+        if (count >= max)
+            rc = st_fail(err, errlen, AMFI_STORE_EDB, "recent fed GVW: more rows than the LIMIT");
+        else
+            rc = st_read_real(st, sqlite3_column_type(st, 2) == SQLITE_NULL ? 1 : 2, &R_KG_POS,
+                              &o, &gvw[count], err, errlen);
+        if (rc == 0)
+            count++;
+        src = SQLITE_OK;
+    }
+    if (rc == 0 && src != SQLITE_DONE)
+        rc = st_db_fail(s, src, "passages: read recent fed GVW", err, errlen);
+    sqlite3_finalize(st);
+    if (rc != 0)
+        return rc;
+    for (int i = 0, j = count - 1; i < j; i++, j--) {
+        double t = gvw[i];
+        gvw[i] = gvw[j];
+        gvw[j] = t;
+    }
+    *n = count;
+    return 0;
+}
+
 int amfi_store_meta_get(amfi_store *s, const char *key, char *val,
                         size_t vallen, int *found, char *err, size_t errlen)
 {

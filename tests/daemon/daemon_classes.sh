@@ -14,10 +14,19 @@
 # their sensor data (the recorded bus, vehicle_t only, replayed through
 # file://): each is stored as gap, not solved, and still gets its class and
 # groups from the spacings, with overload NULL.
+# Then the class filter of the STD and mean rules (daemon.indicators.classes,
+# min_gvw_kg): the recorded bus replayed through a daemon that feeds the
+# rules only A23 and A33 passages of at least 20 t: the passages fed and
+# left out, counted in amfid's log, are those of the store's rows; after a
+# restart the window is refilled with those passages only, and an automatic
+# baseline collected from other passages is not applied.
+# amfi-report --set-baseline-last takes the same passages (the filter amfid
+# recorded in meta).
 # Usage: daemon_classes.sh AMFID SIM_PUBLISHER LCM_PASSAGES LCM_INJECT CONFIG POPULATION_EU
+#     AMFI_REPORT
 set -u
 . "$(dirname "$0")/../common/bus_prologue.sh"
-amfid=$1 sim=$2 listen=$3 inject=$4 config=$5 popeu=$6
+amfid=$1 sim=$2 listen=$3 inject=$4 config=$5 popeu=$6 report=$7
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 q() { sqlite3 "$dir/s.db" "$1"; }
 
@@ -100,3 +109,56 @@ awk 'NR == FNR { cls[$1] = $2; grp[$1] = $3; next }
        if ($4 != "gap" || $5 != "NULL") { print "vehicle " $1 ": status " $4 ", overload " $5 ", expected gap NULL"; bad++ } }
      END { exit bad > 0 }' "$dir/want.txt" "$dir/gap.txt" || fail "passages not solved: class or groups wrong"
 echo "daemon_classes: the same $N vehicles without sensor data stored as gap with their class and groups"
+
+# The class filter of the STD and mean rules: the recorded bus (every channel)
+# replayed with daemon.indicators.classes A23,A33 and min_gvw_kg 20000.
+sed -e 's/^    classes: "" /    classes: A23,A33 /' -e 's/^    min_gvw_kg: 0 /    min_gvw_kg: 20000 /' \
+  "$dir/amfid.yaml" > "$dir/cls.yaml"
+grep -q '^    classes: A23,A33 ' "$dir/cls.yaml" && grep -q '^    min_gvw_kg: 20000 ' "$dir/cls.yaml" ||
+  fail "the test's daemon.indicators.classes / min_gvw_kg did not apply"
+"$amfid" --config "$dir/cls.yaml" --db "$dir/cls.db" --lcm-url "file://$dir/passages.log?speed=0" \
+  2> "$dir/cls.log" || { cat "$dir/cls.log"; fail "amfid with a class filter: exit status $?"; }
+qc() { sqlite3 "$dir/cls.db" "$1"; }
+fed=$(qc "SELECT count(*) FROM passages WHERE status = 'ok' AND class IN ('A23', 'A33')
+          AND gvw_comp_kg >= 20000")
+other=$(qc "SELECT count(*) FROM passages WHERE status = 'ok' AND ifnull(class, '') NOT IN ('A23', 'A33')")
+light=$(qc "SELECT count(*) FROM passages WHERE status = 'ok' AND class IN ('A23', 'A33')
+            AND gvw_comp_kg < 20000")
+qc "SELECT vehicle_id, class, status, round(gvw_comp_kg) FROM passages ORDER BY vehicle_id" | tr '|' ' '
+# the test population: one A23 of 34 t and one A33 of 16 t, six of other classes
+[ "$fed" -ge 1 ] && [ "$light" -ge 1 ] && [ "$other" -ge 5 ] ||
+  fail "class filter: $fed passages to feed, $light light, $other of other classes (expected >= 1, 1, 5)"
+want="STD and mean rules: $fed passages fed of classes A23,A33 from 20000 kg, $other of other classes or none, $light below 20000 kg left out"
+grep -qF "$want" "$dir/cls.log" || { grep "STD and mean" "$dir/cls.log"; fail "class filter: expected '$want'"; }
+sqlite3 "$dir/cls.db" "SELECT value FROM meta WHERE key = 'daemon.indicators.classes'" |
+  grep -qx 'classes=A23,A33 min_gvw_kg=20000' || fail "meta daemon.indicators.classes"
+# amfi-report's baseline from the newest passages takes the filter's only
+"$report" --db "$dir/cls.db" --set-baseline-last $((fed + 1)) > "$dir/report.txt" 2>&1 &&
+  fail "amfi-report --set-baseline-last $((fed + 1)) found more than the filter's $fed passages"
+grep -q "only $fed ok passages stored" "$dir/report.txt" ||
+  { cat "$dir/report.txt"; fail "amfi-report --set-baseline-last: not the filter's $fed passages"; }
+# a restart (vehicles only: nothing more feeds) with a manual baseline: the
+# window is refilled with the filter's passages only
+qc "INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note)
+    VALUES (0, 100, 30000, 3000, 'manual', 'test')"
+"$amfid" --config "$dir/cls.yaml" --db "$dir/cls.db" --lcm-url "file://$dir/novdata.log?speed=0" \
+  2> "$dir/cls2.log" || { cat "$dir/cls2.log"; fail "amfid restarted with a class filter: exit status $?"; }
+grep -qF "window refilled from the store: $fed ok passages of classes A23,A33 from 20000 kg" "$dir/cls2.log" ||
+  { grep -i "window\|baseline" "$dir/cls2.log"; fail "class filter: the window refill is not $fed passages"; }
+# an automatic baseline collected from every passage is not applied under the filter
+qc "INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note)
+    VALUES (0, 100, 20000, 5000, 'auto', 'first 100 ok passages')"
+"$amfid" --config "$dir/cls.yaml" --db "$dir/cls.db" --lcm-url "file://$dir/novdata.log?speed=0" \
+  2> "$dir/cls3.log" || { cat "$dir/cls3.log"; fail "amfid restarted again: exit status $?"; }
+grep -qF "(auto: first 100 ok passages) was not collected from the passages that feed the rules now" "$dir/cls3.log" &&
+  ! grep -q "window refilled" "$dir/cls3.log" ||
+  { grep -i "window\|baseline" "$dir/cls3.log"; fail "class filter: a pooled automatic baseline was applied"; }
+# and pooled again, a baseline collected under a filter is not applied either
+qc "INSERT INTO baseline (utime_set, n, mean_kg, std_kg, source, note)
+    VALUES (0, 100, 30000, 3000, 'auto', 'first 100 ok passages of classes A23,A33 from 20000 kg')"
+"$amfid" --config "$dir/amfid.yaml" --db "$dir/cls.db" --lcm-url "file://$dir/novdata.log?speed=0" \
+  2> "$dir/cls4.log" || { cat "$dir/cls4.log"; fail "amfid restarted pooled: exit status $?"; }
+grep -qF "(auto: first 100 ok passages of classes A23,A33 from 20000 kg) was not collected" "$dir/cls4.log" &&
+  ! grep -q "window refilled" "$dir/cls4.log" ||
+  { grep -i "window\|baseline" "$dir/cls4.log"; fail "pooled: a filtered automatic baseline was applied"; }
+echo "daemon_classes: the STD and mean rules fed $fed of the $((fed + other + light)) ok passages (classes A23,A33 from 20 t), refilled with them after a restart"

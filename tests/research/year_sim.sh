@@ -6,9 +6,11 @@
 # scale indicator detects within days, the known truck within 3 runs, the
 # same seed gives the same table, and bad options are refused naming the
 # flag.
-#   year_sim.sh AMFI_YEAR_SIM
+# A class filter on the EU population labels the STD and mean rows with it
+# and leaves the others pooled; a bad filter is refused.
+#   year_sim.sh AMFI_YEAR_SIM [POPULATION_EU]
 set -eu
-ys=$1
+ys=$1 popeu=${2:-}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
@@ -36,7 +38,7 @@ done
 # one drift at a time: the rows say which
 for d in temperature mix; do
   "$ys" --years 1 --det-runs 1 --damage 0.1 --seed 3 --drift $d >"$work/$d.md" 2>/dev/null || fail "--drift $d"
-  [ "$(grep -c "^| [a-z_]* | $d | " "$work/$d.md")" -eq 7 ] || fail "--drift $d: $(cat "$work/$d.md")"
+  [ "$(grep -c "^| [a-z_]* | $d | " "$work/$d.md")" -eq 8 ] || fail "--drift $d: $(cat "$work/$d.md")"
 done
 "$ys" --years 1 --det-runs 3 --damage 0.1 --seed 3 >"$work/b.md" 2>/dev/null
 # the same numbers (tests/common/num_cmp.sh: floating point not byte for byte)
@@ -46,4 +48,21 @@ for bad in "--drift sideways" "--damage 0.9" "--years 0" "--scale-fa 0" "--truck
   if "$ys" $bad >/dev/null 2>"$work/bad.err"; then fail "$bad accepted"; fi
   grep -q -- "${bad%% *}" "$work/bad.err" || fail "$bad: message does not name the flag"
 done
+if [ -n "$popeu" ]; then
+  "$ys" --population "$popeu" --std-filter A23@22500 --years 1 --det-runs 1 --damage 0.1 --seed 3 \
+    --drift on >"$work/cls.md" 2>"$work/cls.err" || { cat "$work/cls.err" >&2; fail "--std-filter run"; }
+  cat "$work/cls.md"
+  for k in std_increase mean_shift; do
+    [ "$(grep -c "^| $k \[A23@22500\] | on | " "$work/cls.md")" -eq 2 ] || fail "$k: not labelled with its filter"
+  done
+  for k in scale_shift known_truck; do
+    [ "$(grep -c "^| $k | on | " "$work/cls.md")" -eq 2 ] || fail "$k: not pooled"
+  done
+  for bad in "--std-filter B7" "--std-filter A23@heavy" "--scale-filter A23,"; do
+    if "$ys" --population "$popeu" $bad >/dev/null 2>"$work/bad.err"; then fail "$bad accepted"; fi
+    grep -q -- "${bad%% *}" "$work/bad.err" || fail "$bad: message does not name the flag"
+  done
+  if "$ys" --std-filter A23 >/dev/null 2>"$work/bad.err"; then fail "a filter without --population accepted"; fi
+  grep -q -- "--population" "$work/bad.err" || fail "a filter without --population: $(cat "$work/bad.err")"
+fi
 echo "year_sim: ok"

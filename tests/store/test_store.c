@@ -656,6 +656,62 @@ static void test_recent_ok_gvw(void **state)
     assert_int_equal(AMFI_EINVAL, amfi_store_recent_ok_gvw(f->s, 4, NULL, &n, err, sizeof err));
 }
 
+/* The window refill under a class filter: class, weight fed (gvw_comp_kg,
+ * else gvw_kg) and single presence select the rows; the order and LIMIT are
+ * recent_ok_gvw's. */
+static void test_recent_fed_gvw(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN];
+    double g[16];
+    int n = -1;
+    amfi_passage_row r;
+    static const char *const cls[8] = {"A23", "R2", "A23", "A33", "A23", NULL, "A23", "A23"};
+    for (int k = 0; k < 8; k++) {
+        ok_row(&r, k, DAY_US + 10 * (k + 1), 20000.0 + 1000.0 * k);
+        r.vclass = cls[k];
+        if (k == 2)
+            r.gvw_comp_kg = 15000.0; /* light at the calibration temperature */
+        if (k == 6)
+            r.n_vehicles = 2;        /* weighed with another vehicle */
+        if (k == 7) {
+            r.status = "late";
+            r.reason = "arrived after the window closed";
+        }
+        assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    }
+    const char *a23[] = {"A23"}, *two[] = {"A23", "A33"};
+    /* A23 ok: k = 0 2 4 6; from 18 t: 0 4 6; alone: 0 4 */
+    assert_int_equal(0, amfi_store_recent_fed_gvw(f->s, 16, a23, 1, 18000.0, 0, g, &n, err,
+                                                  sizeof err));
+    assert_int_equal(3, n);
+    assert_true(g[0] == 20000.0 && g[1] == 24000.0 && g[2] == 26000.0);
+    assert_int_equal(0, amfi_store_recent_fed_gvw(f->s, 16, a23, 1, 18000.0, 1, g, &n, err,
+                                                  sizeof err));
+    assert_int_equal(2, n);
+    assert_true(g[0] == 20000.0 && g[1] == 24000.0);
+    /* the LIMIT keeps the newest */
+    assert_int_equal(0, amfi_store_recent_fed_gvw(f->s, 1, two, 2, 0.0, 0, g, &n, err,
+                                                  sizeof err));
+    assert_int_equal(1, n);
+    assert_true(g[0] == 26000.0);
+    assert_int_equal(0, amfi_store_recent_fed_gvw(f->s, 16, two, 2, 0.0, 0, g, &n, err,
+                                                  sizeof err));
+    assert_int_equal(5, n);
+    assert_true(g[1] == 15000.0 && g[2] == 23000.0);
+    /* no class: every ok passage, as recent_ok_gvw */
+    assert_int_equal(0, amfi_store_recent_fed_gvw(f->s, 16, NULL, 0, 0.0, 0, g, &n, err,
+                                                  sizeof err));
+    assert_int_equal(7, n);
+    assert_int_equal(AMFI_EINVAL, amfi_store_recent_fed_gvw(f->s, 16, NULL, 1, 0.0, 0, g, &n,
+                                                            err, sizeof err));
+    const char *bad[] = {""};
+    assert_int_equal(AMFI_EINVAL, amfi_store_recent_fed_gvw(f->s, 16, bad, 1, 0.0, 0, g, &n,
+                                                            err, sizeof err));
+    assert_int_equal(AMFI_EINVAL, amfi_store_recent_fed_gvw(f->s, 16, a23, 1, -1.0, 0, g, &n,
+                                                            err, sizeof err));
+}
+
 static void test_meta(void **state)
 {
     fixture *f = *state;
@@ -1839,6 +1895,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_indicators_alerts, setup, teardown),
         cmocka_unit_test_setup_teardown(test_baseline, setup, teardown),
         cmocka_unit_test_setup_teardown(test_recent_ok_gvw, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_recent_fed_gvw, setup, teardown),
         cmocka_unit_test_setup_teardown(test_meta, setup, teardown),
         cmocka_unit_test_setup_teardown(test_integrity_check, setup, teardown),
         cmocka_unit_test_setup_teardown(test_corrupt_rows_reported, setup, teardown),

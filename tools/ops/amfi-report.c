@@ -660,9 +660,36 @@ static int set_baseline(const options *o, const report_ctx *c)
         g = malloc((size_t)o->baseline_last * sizeof *g);
         if (!g)
             rc = data_error(c, "out of memory");
+        /* the passages amfid feeds the rules: its class filter as it
+         * recorded it (meta daemon.indicators.classes), else every one */
+        char rec[512], names_buf[128] = "";
+        const char *names[32];
+        int found = 0, n_names = 0;
+        double min_kg = 0.0;
+        if (rc == 0 && amfi_store_meta_get(s, "daemon.indicators.classes", rec, sizeof rec,
+                                           &found, err, sizeof err) != 0)
+            rc = data_error(c, "%s", err);
+        if (rc == 0 && found) {
+            char *end = NULL;
+            const char *m = strstr(rec, " min_gvw_kg=");
+            if (strncmp(rec, "classes=", 8) != 0 || !m || (size_t)(m - rec - 8) >= sizeof names_buf)
+                rc = data_error(c, "meta daemon.indicators.classes: '%s' is not "
+                                "'classes=LIST min_gvw_kg=KG'", amfi_cli_shown(rec));
+            if (rc == 0) {
+                memcpy(names_buf, rec + 8, (size_t)(m - rec - 8));
+                names_buf[m - rec - 8] = '\0';
+                min_kg = strtod(m + 12, &end);
+                if (end == m + 12 || *end || !(min_kg >= 0.0 && min_kg <= 1e5))
+                    rc = data_error(c, "meta daemon.indicators.classes: min_gvw_kg in '%s'",
+                                    amfi_cli_shown(rec));
+            }
+            for (char *save = NULL, *t = rc == 0 ? strtok_r(names_buf, ",", &save) : NULL;
+                 t && n_names < 32; t = strtok_r(NULL, ",", &save))
+                names[n_names++] = t;
+        }
         if (rc == 0
-            && amfi_store_recent_ok_gvw(s, o->baseline_last, g, &n, err,
-                                        sizeof err) != 0)
+            && amfi_store_recent_fed_gvw(s, o->baseline_last, names, n_names, min_kg, 0, g, &n,
+                                         err, sizeof err) != 0)
             rc = data_error(c, "%s", err);
         if (rc == 0 && n < o->baseline_last)
             rc = data_error(c, "only %d ok passages stored, --set-baseline-last "

@@ -10,6 +10,7 @@
  * the environment on and off (issue 14, docs/results/year-evaluation.md).
  *
  *   amfi-year-sim [--seed S] [--years N] [--det-runs N] [--flow VEH_PER_DAY]
+ *                 [--population FILE] [--meas-rel F] [--std-filter F] [--scale-filter F]
  *                 [--damage P1,P2,...] [--meas-sd T]
  *                 [--drift on|off|both|temperature|mix]
  *                 [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]
@@ -30,6 +31,24 @@
  * solver assumes the configured modulus, the bridge has E·f·(1 − d), and a
  * uniform stiffness change scales every inferred weight by its inverse
  * (issue 14).
+ *
+ * --population FILE (e.g. sim_publisher/data/population-eu.csv): the true
+ * GVW is a record of the file instead, drawn as sim_publisher --environment
+ * site draws it (amfi_mix_classify_by_class: loaded at or above its own
+ * class's median; amfi_mix_pick with the day's loaded share, or the file's
+ * own loaded fraction with drift off), classed by classify/ (scheme eu).
+ * --meas-rel F adds an error part proportional to the true GVW: e ~
+ * normal(0, sqrt(meas_sd² + (F · GVW)²)).
+ *
+ * Class filters (--std-filter, --scale-filter, as amfid's
+ * daemon.indicators.classes and min_gvw_kg): "all", or CLASSES[@MIN_KG]
+ * (comma-separated EU classes or "trucks", every class but CAR): only the
+ * vehicles of those classes whose weight fed (at the calibration
+ * temperature) is at least MIN_KG feed that indicator. A filtered
+ * indicator's baseline takes as many of its vehicles as pooled (its days
+ * grow with 1 / the fraction of the file that passes), and the scale
+ * indicator's vehicles_per_day and class_split_kg are the flow × that
+ * fraction and the median of the records that pass.
  *
  * Indicators: amfid's engine with amfi_indicator_params_default (the STD
  * rule "std_increase", warning, and the mean rule "mean_shift", info; the
@@ -74,12 +93,14 @@
 #include <string.h>
 #include <time.h>
 
+#include "amfi_classify.h"
 #include "amfi_cli.h"
 #include "environment.h"
 #include "indicators.h"
 #include "mix.h"
 #include "known_truck.h"
 #include "scale.h"
+#include "traffic.h"
 
 #define PROG "amfi-year-sim"
 #define GVW_MU 8765.0
@@ -94,6 +115,28 @@
  * modulus), the traffic mix (the loaded share and the weekday flow). */
 #define DRIFT_TEMP 1
 #define DRIFT_MIX 2
+
+/* Which vehicles feed an indicator (--std-filter, --scale-filter): every one,
+ * or those of the classes in `mask` (bit: amfi_eu_class) whose weight fed
+ * (at the calibration temperature where the rules get it so) is at least
+ * min_kg. */
+typedef struct {
+    int all;
+    unsigned mask;
+    double min_kg;
+    char text[64];
+} filter;
+
+/* --population: the records, their EU class (classify/, −1: none), the mix's
+ * per-class empty/loaded split (sim_publisher/mix.c) and the population's own
+ * loaded fraction (the share with drift off). */
+static struct {
+    amfi_vehicle_rec *recs;
+    int n;
+    int *cls;
+    amfi_mix_classes mc;
+    double own_share;
+} POP;
 
 typedef struct {
     unsigned long seed;
@@ -112,6 +155,9 @@ typedef struct {
     int scale_block, scale_blocks; /* --scale-block, --scale-baseline-blocks (0: default) */
     double scale_design;           /* --scale-design (0: default) */
     int baseline_n;                /* --baseline-n: the STD rule's baseline (0: default) */
+    const char *population;        /* --population: a vehicle file (NULL: the normal law) */
+    double meas_rel;               /* --meas-rel: the error's part proportional to GVW */
+    filter std_f, scale_f;         /* --std-filter, --scale-filter */
 } opts;
 
 /* One run's world: the climate, the calendar, the damage. */
@@ -124,6 +170,7 @@ typedef struct {
     double damage;     /* from damage_t_s on */
     double damage_t_s; /* run time of the damage, s; INFINITY: none */
     double deck_c;     /* deck temperature at the last vehicle (drift off: DECK_OFF_C) */
+    int cls;           /* EU class of the last vehicle (−1: none; the normal law: −1) */
 } world;
 
 /* A true GVW, loaded with probability `share`. */
@@ -139,12 +186,22 @@ static double draw_gvw(gsl_rng *rng, double share)
 
 static double true_gvw(world *w, double t_s)
 {
+    if (POP.recs) { /* the vehicle file: a record of the day's share, sim_publisher's draw */
+        const double share = (w->drift & DRIFT_MIX)
+                                 ? amfi_mix_loaded_share(&w->mix, w->day0 + t_s / DAY_S)
+                                 : POP.own_share;
+        const double u1 = gsl_rng_uniform(w->rng), u2 = gsl_rng_uniform(w->rng);
+        const int k = amfi_mix_pick(&POP.mc, share, u1, u2);
+        w->cls = POP.cls[k];
+        return POP.recs[k].gvw_kg;
+    }
+    w->cls = -1;
     return draw_gvw(w->rng,
                     (w->drift & DRIFT_MIX) ? amfi_mix_loaded_share(&w->mix, w->day0 + t_s / DAY_S)
                                            : 0.5);
 }
 
-static double inferred(world *w, double t_s, double meas_sd)
+static double inferred(world *w, double t_s, double meas_sd, double meas_rel)
 {
     double f = 1.0;
     w->deck_c = DECK_OFF_C;
@@ -154,7 +211,9 @@ static double inferred(world *w, double t_s, double meas_sd)
         w->deck_c = w->env.deck_c;
     }
     const double d = t_s >= w->damage_t_s ? w->damage : 0.0;
-    double x = true_gvw(w, t_s) + gsl_ran_gaussian_ziggurat(w->rng, meas_sd);
+    const double g = true_gvw(w, t_s);
+    double x = g + gsl_ran_gaussian_ziggurat(w->rng, meas_rel > 0 ? hypot(meas_sd, meas_rel * g)
+                                                                   : meas_sd);
     if (x < 1.0)
         x = 1.0;
     return x / ((1.0 - d) * f);
@@ -170,7 +229,7 @@ static void world_start(world *w, gsl_rng *rng, int drift)
     amfi_env_params_site(&ep);
     amfi_env_init(&w->env, &ep, w->day0, gsl_rng_get(rng));
     amfi_mix_params_site(&w->mix);
-    w->mix.split_kg = GVW_MU;
+    w->mix.split_kg = GVW_MU; /* the normal law's; a vehicle file splits per class */
     w->damage_t_s = INFINITY;
 }
 
@@ -185,7 +244,49 @@ typedef struct {
     amfi_known_truck *truck;
     amfi_scale_params sp; /* the scale indicator's parameters (its temperature model) */
     int std_comp;         /* feed the STD/mean engine compensated weights */
+    const filter *std_f, *scale_f;
 } engines;
+
+/* 1 when a vehicle of class cls (−1: none) whose weight fed is g_kg passes f. */
+static int passes(const filter *f, int cls, double g_kg)
+{
+    if (f->all)
+        return 1;
+    return cls >= 0 && (f->mask & (1u << cls)) && g_kg >= f->min_kg;
+}
+
+static int cmp_double(const void *a, const void *b);
+
+/* The median true GVW of the vehicle file's records that pass f. */
+static double filter_median(const filter *f)
+{
+    double *g = malloc(sizeof(double) * (size_t)POP.n);
+    int m = 0;
+    if (!g) {
+        fprintf(stderr, "%s: out of memory\n", PROG);
+        exit(1);
+    }
+    for (int i = 0; i < POP.n; i++)
+        if (passes(f, POP.cls[i], POP.recs[i].gvw_kg))
+            g[m++] = POP.recs[i].gvw_kg;
+    qsort(g, (size_t)m, sizeof *g, cmp_double);
+    const double med = m % 2 ? g[m / 2] : 0.5 * (g[m / 2 - 1] + g[m / 2]);
+    free(g);
+    return med;
+}
+
+/* The fraction of the vehicle file (true GVW, the population's own mix) that
+ * passes f: the flow an indicator so filtered is fed, for its baseline's days
+ * and the scale indicator's vehicles a day. */
+static double filter_fraction(const filter *f)
+{
+    if (f->all || !POP.recs)
+        return 1.0;
+    long k = 0;
+    for (int i = 0; i < POP.n; i++)
+        k += passes(f, POP.cls[i], POP.recs[i].gvw_kg);
+    return (double)k / POP.n;
+}
 
 /* The STD engine's and the scale indicator's parameters: the defaults with
  * the options applied. */
@@ -195,7 +296,9 @@ static void engine_params(const opts *o, amfi_indicator_params *pp, amfi_scale_p
     amfi_scale_params sp;
     amfi_indicator_params_default(&p);
     amfi_scale_params_default(&sp);
-    sp.vehicles_per_day = o->flow;
+    sp.vehicles_per_day = o->flow * filter_fraction(&o->scale_f);
+    if (POP.recs) /* as a site sets alerts.scale.class_split_kg: the median of what it is fed */
+        sp.class_split_kg = filter_median(&o->scale_f);
     if (o->baseline_n > 0)
         p.baseline_n = o->baseline_n;
     if (o->scale_block > 0)
@@ -231,6 +334,8 @@ static engines make(const opts *o)
     }
     e.sp = sp;
     e.std_comp = o->std_comp;
+    e.std_f = &o->std_f;
+    e.scale_f = &o->scale_f;
     return e;
 }
 
@@ -260,7 +365,7 @@ static int truck_run(engines *e, world *w, double t_s, double meas_sd)
 }
 
 /* Raises in this push: bit 1 << K_*. */
-static int push(engines *e, double gvw, double deck_c)
+static int push(engines *e, double gvw, double deck_c, int cls)
 {
     amfi_alert_event ev[2], sev;
     int n = 0, r = 0;
@@ -272,14 +377,15 @@ static int push(engines *e, double gvw, double deck_c)
             warm = m.warm_slope, frost = m.frost_slope;
         g_std = gvw * amfi_scale_temp_factor(&e->sp, warm, frost, deck_c);
     }
-    if (amfi_indicators_push(e->ind, g_std, NULL, ev, &n) < 0) {
+    if (passes(e->std_f, cls, g_std) && amfi_indicators_push(e->ind, g_std, NULL, ev, &n) < 0) {
         fprintf(stderr, "%s: push rejected %g kg\n", PROG, gvw);
         exit(1);
     }
     for (int i = 0; i < n; i++)
         if (ev[i].raised)
             r |= strcmp(ev[i].kind, "std_increase") == 0 ? 1 << K_STD : 1 << K_MEAN;
-    const int sr = amfi_scale_push(e->scale, gvw, deck_c, NULL, &sev);
+    const int sr = passes(e->scale_f, cls, g_std) ? amfi_scale_push(e->scale, gvw, deck_c, NULL, &sev)
+                                                   : 0;
     if (sr < 0) {
         fprintf(stderr, "%s: scale push rejected %g kg at %g °C\n", PROG, gvw, deck_c);
         exit(1);
@@ -323,8 +429,8 @@ static long run(world *w, const opts *o, double days, outcome *out)
         const long n = (long)floor(flow + gsl_rng_uniform(w->rng));
         for (long i = 0; i < n; i++) {
             const double t = (day + (i + gsl_rng_uniform(w->rng)) / (double)n) * DAY_S;
-            const double g = inferred(w, t, o->meas_sd);
-            int r = push(&e, g, w->deck_c);
+            const double g = inferred(w, t, o->meas_sd, o->meas_rel);
+            int r = push(&e, g, w->deck_c, w->cls);
             const int damaged = t >= w->damage_t_s;
             pushed++;
             if (damaged)
@@ -348,8 +454,8 @@ static long run(world *w, const opts *o, double days, outcome *out)
                     out->det_days[k] = (t - w->damage_t_s) / DAY_S;
                 }
             }
-            if (damaged && out->det_veh[K_STD] >= 0 && out->det_veh[K_SCALE] >= 0 &&
-                out->det_veh[K_TRUCK] >= 0) {
+            if (damaged && out->det_veh[K_STD] >= 0 && out->det_veh[K_MEAN] >= 0 &&
+                out->det_veh[K_SCALE] >= 0 && out->det_veh[K_TRUCK] >= 0) {
                 unmake(&e);
                 return pushed;
             }
@@ -381,9 +487,21 @@ static double baseline_days(const opts *o)
     amfi_indicator_params p;
     amfi_scale_params sp;
     engine_params(o, &p, &sp);
-    const double nb = p.baseline_n, ns = (double)sp.block * sp.baseline_blocks;
+    const double nb = p.baseline_n / filter_fraction(&o->std_f),
+                 ns = (double)sp.block * sp.baseline_blocks / filter_fraction(&o->scale_f);
     const double d = 1.2 * (nb > ns ? nb : ns) / o->flow;
     return d > 30.0 ? ceil(d) : 30.0;
+}
+
+/* A kind's name in the table, with its filter when it has one. */
+static const char *kind_label(const opts *o, int k)
+{
+    static char buf[N_KIND][96];
+    const filter *f = k == K_STD || k == K_MEAN ? &o->std_f : k == K_SCALE ? &o->scale_f : NULL;
+    if (!f || f->all)
+        return kind_name[k];
+    snprintf(buf[k], sizeof buf[k], "%s [%s]", kind_name[k], f->text);
+    return buf[k];
 }
 
 static void evaluate(const opts *o, gsl_rng *rng, int drift)
@@ -409,11 +527,11 @@ static void evaluate(const opts *o, gsl_rng *rng, int drift)
     for (int k = 0; k < N_KIND; k++)
         printf("| %s | %s | healthy | %ld years, %.0f vehicles/run | %.2f/year (%ld runs with "
                "any, at most %ld in one) | | | | |\n",
-               kind_name[k], dn, o->years, (double)vehicles / (double)o->years,
+               kind_label(o, k), dn, o->years, (double)vehicles / (double)o->years,
                (double)fa[k] / (double)o->years, fa_runs[k], fa_max[k]);
     fflush(stdout);
-    enum { NK = 3 };
-    const int kinds[NK] = {K_STD, K_SCALE, K_TRUCK};
+    enum { NK = 4 };
+    const int kinds[NK] = {K_STD, K_MEAN, K_SCALE, K_TRUCK};
     for (int d = 0; d < o->n_damage; d++) {
         double *dv[NK], *dd[NK];
         long found[NK] = {0}, early[NK] = {0};
@@ -446,11 +564,11 @@ static void evaluate(const opts *o, gsl_rng *rng, int drift)
             if (found[j])
                 printf("| %s | %s | %.1f %% | %ld/%ld detected (%ld runs with a false alert "
                        "before) | | %.0f | %.0f | %.2f | %.2f |\n",
-                       kind_name[kinds[j]], dn, 100.0 * o->damage[d], found[j], o->det_runs,
+                       kind_label(o, kinds[j]), dn, 100.0 * o->damage[d], found[j], o->det_runs,
                        early[j], quantile(dv[j], found[j], 0.5), quantile(dv[j], found[j], 0.95),
                        quantile(dd[j], found[j], 0.5), quantile(dd[j], found[j], 0.95));
             else
-                printf("| %s | %s | %.1f %% | 0/%ld detected | | | | | |\n", kind_name[kinds[j]],
+                printf("| %s | %s | %.1f %% | 0/%ld detected | | | | | |\n", kind_label(o, kinds[j]),
                        dn, 100.0 * o->damage[d], o->det_runs);
             free(dv[j]);
             free(dd[j]);
@@ -664,6 +782,91 @@ static void mix_probe(const opts *o, gsl_rng *rng)
     printf("\nln s of a 2.5 %% stiffness loss: %+.4f\n", log(1.0 / 0.975));
 }
 
+/* --std-filter / --scale-filter: "all", or CLASSES[@MIN_KG] with CLASSES
+ * comma-separated EU class names (classify/: CAR, R2 .. A33) or "trucks"
+ * (every class but CAR). 0, or −1 with why. */
+static int parse_filter(const char *v, filter *f, char *why, size_t whylen)
+{
+    filter t = {0};
+    snprintf(t.text, sizeof t.text, "%s", v);
+    if (!strcmp(v, "all")) {
+        t.all = 1;
+        *f = t;
+        return 0;
+    }
+    char buf[64];
+    if (strlen(v) >= sizeof buf) {
+        snprintf(why, whylen, "longer than %zu characters", sizeof buf - 1);
+        return -1;
+    }
+    snprintf(buf, sizeof buf, "%s", v);
+    char *at = strchr(buf, '@');
+    if (at) {
+        char *end;
+        *at++ = '\0';
+        t.min_kg = strtod(at, &end);
+        if (end == at || *end || !(t.min_kg >= 0 && t.min_kg <= 1e5)) {
+            snprintf(why, whylen, "the weight after @ is not a number of kg in [0, 100000]");
+            return -1;
+        }
+    }
+    if (!buf[0] || buf[0] == ',' || buf[strlen(buf) - 1] == ',' || strstr(buf, ",,")) {
+        snprintf(why, whylen, "an empty class name (names separated by single commas)");
+        return -1;
+    }
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        int found = 0;
+        for (int k = 0; k < AMFI_EU_N; k++)
+            if (!strcmp(tok, amfi_eu_class_name((amfi_eu_class)k)) ||
+                (!strcmp(tok, "trucks") && k != AMFI_EU_CAR)) {
+                t.mask |= 1u << k;
+                found = 1;
+            }
+        if (!found) {
+            snprintf(why, whylen, "'%s' is not an EU class (CAR, R2 .. A33) or trucks", tok);
+            return -1;
+        }
+    }
+    if (!t.mask) {
+        snprintf(why, whylen, "no class");
+        return -1;
+    }
+    *f = t;
+    return 0;
+}
+
+/* --population: the vehicle file, each record's EU class, the per-class split. */
+static void load_population(const char *path)
+{
+    char err[512];
+    amfi_class_params cp;
+    amfi_class_params_default(&cp);
+    if (amfi_traffic_read(path, &POP.recs, &POP.n, err, sizeof err) != 0 ||
+        amfi_mix_classify_by_class(POP.recs, POP.n, &POP.mc, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", PROG, err);
+        exit(2);
+    }
+    POP.cls = malloc(sizeof(int) * (size_t)POP.n);
+    if (!POP.cls) {
+        fprintf(stderr, "%s: out of memory\n", PROG);
+        exit(1);
+    }
+    for (int i = 0; i < POP.n; i++) {
+        amfi_classification k;
+        const amfi_vehicle_rec *r = &POP.recs[i];
+        POP.cls[i] = -1;
+        if (amfi_classify(&cp, r->n_axles, r->spacing_m, r->axle_kg, &k, err, sizeof err) != 0) {
+            fprintf(stderr, "%s: %s line %ld: %s\n", PROG, path, r->line, err);
+            exit(2);
+        }
+        for (int c = 0; k.known && c < AMFI_EU_N; c++)
+            if (!strcmp(k.name, amfi_eu_class_name((amfi_eu_class)c)))
+                POP.cls[i] = c;
+    }
+    POP.own_share = (double)POP.mc.n_loaded / POP.n;
+}
+
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -671,7 +874,8 @@ static void usage(FILE *f)
             "       [--damage P1,P2,...] [--meas-sd T] [--drift on|off|both|temperature|mix]\n"
             "       [--scale-fa F] [--mix-probe] [--prior-scale F] [--truck-runs N]\n"
             "       [--std-raw] [--scale-block B] [--scale-baseline-blocks N]\n"
-            "       [--scale-design D] [--baseline-n N]\n"
+            "       [--scale-design D] [--baseline-n N] [--population FILE]\n"
+            "       [--meas-rel F] [--std-filter F] [--scale-filter F]\n"
             "A year of traffic with the site climate and the drifting mix, watched by\n"
             "amfid's indicator engine: false alarms per healthy year, detection delays.\n"
             "  --seed S          generator seed (default 1)\n"
@@ -693,6 +897,13 @@ static void usage(FILE *f)
             "  --scale-baseline-blocks N  its baseline blocks (default 40)\n"
             "  --scale-design D  the stiffness loss its CUSUM is tuned for (default 0.025)\n"
             "  --baseline-n N    the STD rule's baseline, vehicles (default 10000)\n"
+            "  --population FILE draw the vehicles from this file (sim_publisher's format,\n"
+            "                    e.g. sim_publisher/data/population-eu.csv), loaded at\n"
+            "                    each class's median (default: the normal law)\n"
+            "  --meas-rel F      per-vehicle error's part proportional to GVW (default 0)\n"
+            "  --std-filter F    vehicles fed to the STD and mean rules: all (default) or\n"
+            "                    CLASSES[@MIN_KG], e.g. A23@25000 or trucks\n"
+            "  --scale-filter F  the same for the scale indicator\n"
             "  -h, --help        this help\n"
             "  -V, --version     print the version\n",
             PROG);
@@ -702,11 +913,12 @@ int main(int argc, char **argv)
 {
     opts o = {.seed = 1, .years = 20, .det_runs = 20, .flow = 2000, .meas_sd = 300.0,
               .n_damage = 3, .damage = {0.025, 0.05, 0.10}, .n_modes = 2, .modes = {0, DRIFT_TEMP | DRIFT_MIX},
-              .prior_scale = 1.0, .truck_runs = 1, .std_comp = 1};
+              .prior_scale = 1.0, .truck_runs = 1, .std_comp = 1,
+              .std_f = {.all = 1, .text = "all"}, .scale_f = {.all = 1, .text = "all"}};
     enum {
         O_SEED = 256, O_YEARS, O_DET_RUNS, O_FLOW, O_DAMAGE, O_MEAS_SD, O_DRIFT, O_SCALE_FA,
         O_MIX_PROBE, O_PRIOR_SCALE, O_TRUCK_RUNS, O_STD_RAW, O_SCALE_BLOCK, O_SCALE_BLOCKS,
-        O_SCALE_DESIGN, O_BASELINE_N
+        O_SCALE_DESIGN, O_BASELINE_N, O_POPULATION, O_MEAS_REL, O_STD_FILTER, O_SCALE_FILTER
     };
     static const struct option longopts[] = {
         {"seed", required_argument, NULL, O_SEED},
@@ -725,6 +937,10 @@ int main(int argc, char **argv)
         {"scale-baseline-blocks", required_argument, NULL, O_SCALE_BLOCKS},
         {"scale-design", required_argument, NULL, O_SCALE_DESIGN},
         {"baseline-n", required_argument, NULL, O_BASELINE_N},
+        {"population", required_argument, NULL, O_POPULATION},
+        {"meas-rel", required_argument, NULL, O_MEAS_REL},
+        {"std-filter", required_argument, NULL, O_STD_FILTER},
+        {"scale-filter", required_argument, NULL, O_SCALE_FILTER},
         AMFI_CLI_END};
     amfi_cli c;
     amfi_cli_init(&c, PROG, argc, argv, longopts, usage);
@@ -746,6 +962,17 @@ int main(int argc, char **argv)
         case O_SCALE_BLOCKS: o.scale_blocks = (int)amfi_cli_integer(&c, v, 4, 1e5); break;
         case O_SCALE_DESIGN: o.scale_design = amfi_cli_num(&c, v, 1e-3, 0.49); break;
         case O_BASELINE_N: o.baseline_n = (int)amfi_cli_integer(&c, v, 10, 1e6); break;
+        case O_POPULATION: o.population = v; break;
+        case O_MEAS_REL: o.meas_rel = amfi_cli_num(&c, v, 0, 0.5); break;
+        case O_STD_FILTER:
+        case O_SCALE_FILTER: {
+            char why[128];
+            if (parse_filter(v, k == O_STD_FILTER ? &o.std_f : &o.scale_f, why, sizeof why))
+                amfi_cli_fail(&c, "%s '%s': %s",
+                              k == O_STD_FILTER ? "--std-filter" : "--scale-filter",
+                              amfi_cli_shown(v), why);
+            break;
+        }
         case O_PRIOR_SCALE: o.prior_scale = amfi_cli_num(&c, v, 0, 5); break;
         case O_TRUCK_RUNS: o.truck_runs = (int)amfi_cli_integer(&c, v, 1, 7); break;
         case O_DRIFT:
@@ -770,6 +997,12 @@ int main(int argc, char **argv)
             break;
         }
     }
+    if (o.population)
+        load_population(o.population);
+    if ((!o.std_f.all || !o.scale_f.all) && !o.population)
+        amfi_cli_fail(&c, "a class filter needs --population (the normal law has no classes)");
+    if (filter_fraction(&o.std_f) <= 0.0 || filter_fraction(&o.scale_f) <= 0.0)
+        amfi_cli_fail(&c, "no vehicle of %s passes the filter", o.population);
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     if (!rng)
         return 1;
@@ -787,5 +1020,8 @@ int main(int argc, char **argv)
         evaluate(&o, rng, o.modes[m]);
     fprintf(stderr, "%s: %.1f s CPU\n", PROG, (double)(clock() - c0) / CLOCKS_PER_SEC);
     gsl_rng_free(rng);
+    free(POP.cls);
+    amfi_mix_classes_free(&POP.mc);
+    amfi_traffic_free(POP.recs);
     return 0;
 }
