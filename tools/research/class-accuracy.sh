@@ -12,7 +12,8 @@
 #      and every axle spacing (SOLVE_ARGS, e.g. --estimate-speed): its axle
 #      loads, class and axle groups;
 #   4. per class (the population's) and for all vehicles, amfi-accuracy
-#      (CONDITION, ENVIRONMENT) on the criteria against the static loads:
+#      (CONDITION, ENVIRONMENT) on the criteria against the static loads
+#      (REFERENCE):
 #        gross       the gross weight;
 #        group       a group of two or more axles (amfi-solve's groups), its
 #                    load against the sum of its axles' static loads;
@@ -32,7 +33,11 @@
 #                "--noise 0.03 --speed-error 0,0.03"),
 #              SOLVE_ARGS (extra amfi-solve options, e.g. --estimate-speed),
 #              SEED (sim_publisher's seed, 1),
-#              CONDITION (RR2), ENVIRONMENT (I): amfi-accuracy's
+#              CONDITION (RR2), ENVIRONMENT (I): amfi-accuracy's,
+#              REFERENCE: static (the static loads, the default) or span (each
+#                axle's mean contact force while on the span, AMFI_GRAVITY
+#                9.81: what the bridge felt; static minus span is the
+#                vehicle's dynamics, span minus measured the inverse problem's)
 set -u
 [ $# -ge 2 ] || { echo "usage: class-accuracy.sh BIN_DIR OUT_DIR [PER_CLASS] [POPULATION.csv]" >&2; exit 2; }
 bin=$1 out=$2 per=${3:-30}
@@ -43,6 +48,8 @@ sim=$bin/sim_publisher/sim_publisher
 solve=$bin/tools/ops/amfi-solve
 acc=$bin/tools/ops/amfi-accuracy
 die() { echo "class-accuracy: $*" >&2; exit 1; }
+ref=${REFERENCE:-static}
+case $ref in static|span) ;; *) die "REFERENCE: '$ref' is not static or span";; esac
 case $per in ''|*[!0-9]*) die "PER_CLASS: '$per' is not a whole number";; esac
 [ "$per" -ge 1 ] || die "PER_CLASS: must be at least 1"
 [ -r "$pop" ] || die "$pop: cannot read the population"
@@ -82,14 +89,19 @@ while read -r name speed entry sp; do
 done < "$out/passages.txt" >> "$out/solve.txt"
 
 # 4. criteria per class: vehicles.csv and weights-CLASS.csv
-awk -v out="$out" '
+awk -v out="$out" -v ref="$ref" '
   FNR == 1 { f++ }
   # the sample: class of record k (vehicle v0000k)
   f == 1 { if (FNR == 1) { split($0, h, ","); for (i in h) hc[h[i]] = i; next }
            split($0, a, ","); cls[sprintf("v%05d", FNR - 1)] = a[hc["class"]]; next }
   # meta.csv: the true static loads
   f == 2 { if (FNR == 1) { n = split($0, h, ","); for (i = 1; i <= n; i++) mc[h[i]] = i; next }
-           split($0, a, ","); tk[a[mc["name"]]] = a[mc["axle_kgs"]]; tg[a[mc["name"]]] = a[mc["gvw_kg"]]; next }
+           split($0, a, ","); nm = a[mc["name"]]
+           if (ref == "span") {  # the mean contact force on the span, in kg
+             k = split(a[mc["mean_forces_N"]], fz, ";"); tk[nm] = ""; tg[nm] = 0
+             for (i = 1; i <= k; i++) { tk[nm] = tk[nm] (i > 1 ? ";" : "") sprintf("%.6f", fz[i] / 9.81); tg[nm] += fz[i] / 9.81 }
+           } else { tk[nm] = a[mc["axle_kgs"]]; tg[nm] = a[mc["gvw_kg"]] }
+           next }
   # solve.txt
   { split($0, a, "\t"); name = a[1]; j = a[2]; c = cls[name]
     if (j == "refused") { refused = refused " " name "(" c ")"; nref++; next }
