@@ -5,7 +5,9 @@
 # (header, a gross row for every class and for all, criteria and classes of
 # COST 323's names), the numbers and classes read back from amfi-accuracy's
 # JSON lines for every row, the vehicles' classes as amfi-solve decided them,
-# and refusals of a bad sample size and of a population without classes.
+# its vehicles.csv and pairs.txt, the same table again from the run's files
+# (SOLVED), and refusals of a bad sample size and of a population without
+# classes.
 # Not the accuracy targets (docs/results/class-accuracy.md).
 # Usage: class_accuracy.sh TOOL BIN_DIR POPULATION_EU
 set -u
@@ -25,8 +27,13 @@ head -1 "$dir/table.txt" | awk '{ exit !($1 == "class" && $2 == "n" && $3 == "cr
 # the sample: three of each of the seven classes
 [ "$(tail -n +2 "$t/sample.csv" | wc -l)" -eq 21 ] || fail "the sample has not 21 vehicles"
 [ "$(tail -n +2 "$t/vehicles.csv" | wc -l)" -eq 21 ] || fail "vehicles.csv has not 21 vehicles"
-awk -F, 'NR > 1 && $2 != $3 { print "vehicle " $1 ": class " $2 ", amfi-solve " $3; bad++ } END { exit bad > 0 }' \
-  "$t/vehicles.csv" || fail "amfi-solve classed a vehicle otherwise"
+awk -F, 'NF != 8 { print "line " NR ": " NF " fields"; bad++ }
+  NR > 1 && $2 != $3 { print "vehicle " $1 ": class " $2 ", amfi-solve " $3; bad++ }
+  NR > 1 { n = split($4, g, "-"); a = 0; for (i = 1; i <= n; i++) a += g[i]
+           if (split($7, x, ";") != a || split($8, y, ";") != a) { print "vehicle " $1 ": axles"; bad++ } }
+  END { exit bad > 0 }' "$t/vehicles.csv" || fail "vehicles.csv"
+# pairs.txt: a header and a row per class
+[ "$(wc -l < "$t/pairs.txt")" -eq 8 ] || fail "pairs.txt: $(cat "$t/pairs.txt")"
 grep -qx "classed otherwise by amfi-solve: 0 *" "$dir/table.txt" || fail "the classed-otherwise line"
 grep -qx "refused by amfi-solve: 0 *" "$dir/table.txt" || fail "the refused line"
 # every row: a known class and criterion, n a whole number; with a COST 323
@@ -67,6 +74,11 @@ done || exit 1
 # the inputs amfi-accuracy read: a header and one row per weighed value
 head -1 "$t/weights-all.csv" | grep -qx "criterion,measured_kg,reference_kg" || fail "weights-all.csv header"
 [ "$(grep -c '^gross,' "$t/weights-all.csv")" -eq 21 ] || fail "weights-all.csv: not 21 gross rows"
+
+# the same run judged again from its files: the same table
+SOLVED=$t sh "$tool" "$bin" "$dir/again" 3 "$pop" > "$dir/again.txt" 2> "$dir/err" ||
+  { cat "$dir/err"; fail "SOLVED: exit $?"; }
+cmp -s "$dir/table.txt" "$dir/again.txt" || fail "SOLVED: another table: $(diff "$dir/table.txt" "$dir/again.txt")"
 
 # refusals: a bad sample size, a population without a class column
 sh "$tool" "$bin" "$dir/bad" x "$pop" > /dev/null 2> "$dir/err" && fail "PER_CLASS x accepted"

@@ -24,8 +24,12 @@
 #   class n criterion mean_pct std_pct pi_pct pi0_pct cost323_class
 # with the whole sample as class "all"; then a line of the vehicles whose
 # class amfi-solve decided otherwise, and of those amfi-solve refused.
-# OUT keeps vehicles.csv (one row per vehicle), weights-CLASS.csv (the
-# amfi-accuracy inputs) and accuracy-CLASS.json (its output).
+# OUT keeps vehicles.csv (one row per vehicle: the groups as axles per
+# group, 1-1-3; the true and weighed axle loads as lists separated by ';'),
+# weights-CLASS.csv (the amfi-accuracy inputs), accuracy-CLASS.json (its
+# output) and pairs.txt: per class, the neighbouring groups of a vehicle (a
+# single axle a group of one), the correlation of their errors (kg) and the
+# RMS relative error of the front one, the back one and their sum.
 #
 # usage: class-accuracy.sh BIN_DIR OUT_DIR [PER_CLASS (30)] [POPULATION.csv]
 # environment: CONFIG (site file, config/paper-20m.yaml),
@@ -37,7 +41,10 @@
 #              REFERENCE: static (the static loads, the default) or span (each
 #                axle's mean contact force while on the span, AMFI_GRAVITY
 #                9.81: what the bridge felt; static minus span is the
-#                vehicle's dynamics, span minus measured the inverse problem's)
+#                vehicle's dynamics, span minus measured the inverse problem's),
+#              SOLVED (an earlier OUT_DIR: its sample, passages and amfi-solve
+#                results judged again, e.g. with another REFERENCE; steps
+#                1-3 skipped, PER_CLASS and POPULATION unused)
 set -u
 [ $# -ge 2 ] || { echo "usage: class-accuracy.sh BIN_DIR OUT_DIR [PER_CLASS] [POPULATION.csv]" >&2; exit 2; }
 bin=$1 out=$2 per=${3:-30}
@@ -56,37 +63,46 @@ case $per in ''|*[!0-9]*) die "PER_CLASS: '$per' is not a whole number";; esac
 [ -r "$cfg" ] || die "$cfg: cannot read the site file"
 
 rm -rf "$out" && mkdir -p "$out" || die "cannot create $out"
-# 1. the sample: the header, then the first PER_CLASS records of each class
-awk -F, -v per="$per" -v p="$pop" '
-  NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i
-            if (!("class" in c)) { print p ": no class column (a class-format population is needed)" > "/dev/stderr"; exit 1 }
-            print; next }
-  ++k[$c["class"]] <= per { print }' "$pop" > "$out/sample.csv" || die "the sample"
-nveh=$(($(wc -l < "$out/sample.csv") - 1))
-[ "$nveh" -ge 1 ] || die "$pop: no vehicles"
+if [ -n "${SOLVED:-}" ]; then
+  # an earlier run's sample, passages and weights, judged again (REFERENCE)
+  for f in sample.csv sim/meta.csv solve.txt; do
+    [ -r "$SOLVED/$f" ] || die "SOLVED: $SOLVED/$f: cannot read"
+  done
+  mkdir -p "$out/sim" && cp "$SOLVED/sample.csv" "$SOLVED/solve.txt" "$out/" &&
+    cp "$SOLVED/sim/meta.csv" "$out/sim/" || die "cannot copy $SOLVED"
+else
+  # 1. the sample: the header, then the first PER_CLASS records of each class
+  awk -F, -v per="$per" -v p="$pop" '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i
+              if (!("class" in c)) { print p ": no class column (a class-format population is needed)" > "/dev/stderr"; exit 1 }
+              print; next }
+    ++k[$c["class"]] <= per { print }' "$pop" > "$out/sample.csv" || die "the sample"
+  nveh=$(($(wc -l < "$out/sample.csv") - 1))
+  [ "$nveh" -ge 1 ] || die "$pop: no vehicles"
 
-# 2. the passages
-# shellcheck disable=SC2086
-"$sim" --config "$cfg" --population "$out/sample.csv" --out "$out/sim" --vehicles "$nveh" \
-  --seed "${SEED:-1}" ${SIM_ARGS:-} 2>"$out/sim.err" || die "sim_publisher --out: $(cat "$out/sim.err")"
-
-# 3. every vehicle weighed: NAME<TAB>amfi-solve's JSON line (or "refused")
-awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
-  { s = $c["axle_spacings_m"]; gsub(";", ",", s)
-    print $c["name"], $c["speed_mps"], $c["entry_time_s"], s }' "$out/sim/meta.csv" > "$out/passages.txt" ||
-  die "meta.csv"
-: > "$out/solve.txt"
-while read -r name speed entry sp; do
+  # 2. the passages
   # shellcheck disable=SC2086
-  if r=$("$solve" --config "$cfg" --accel "$out/sim/$name.csv" --speed "$speed" \
-           --axle-spacing "$sp" --entry-time "$entry" ${SOLVE_ARGS:-} 2>>"$out/solve.err"); then
-    printf '%s\t%s\n' "$name" "$r"
-  else
-    rc=$?
-    [ $rc -eq 1 ] || die "amfi-solve $name exited $rc: $(tail -1 "$out/solve.err")"
-    printf '%s\trefused\n' "$name"
-  fi
-done < "$out/passages.txt" >> "$out/solve.txt"
+  "$sim" --config "$cfg" --population "$out/sample.csv" --out "$out/sim" --vehicles "$nveh" \
+    --seed "${SEED:-1}" ${SIM_ARGS:-} 2>"$out/sim.err" || die "sim_publisher --out: $(cat "$out/sim.err")"
+
+  # 3. every vehicle weighed: NAME<TAB>amfi-solve's JSON line (or "refused")
+  awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    { s = $c["axle_spacings_m"]; gsub(";", ",", s)
+      print $c["name"], $c["speed_mps"], $c["entry_time_s"], s }' "$out/sim/meta.csv" > "$out/passages.txt" ||
+    die "meta.csv"
+  : > "$out/solve.txt"
+  while read -r name speed entry sp; do
+    # shellcheck disable=SC2086
+    if r=$("$solve" --config "$cfg" --accel "$out/sim/$name.csv" --speed "$speed" \
+             --axle-spacing "$sp" --entry-time "$entry" ${SOLVE_ARGS:-} 2>>"$out/solve.err"); then
+      printf '%s\t%s\n' "$name" "$r"
+    else
+      rc=$?
+      [ $rc -eq 1 ] || die "amfi-solve $name exited $rc: $(tail -1 "$out/solve.err")"
+      printf '%s\trefused\n' "$name"
+    fi
+  done < "$out/passages.txt" >> "$out/solve.txt"
+fi
 
 # 4. criteria per class: vehicles.csv and weights-CLASS.csv
 awk -v out="$out" -v ref="$ref" '
@@ -126,7 +142,8 @@ awk -v out="$out" -v ref="$ref" '
     }
     if (ng == 0) { print "class-accuracy: " name ": no groups in amfi-solve'"'"'s line" > "/dev/stderr"; exit 1 }
     row(c, "gross", gvw, tg[name])
-    printf "%s,%s,%s,%s,%.6f,%.3f,%s,%s\n", name, c, sc, gs, tg[name], gvw, tk[name], s >> (out "/vehicles.csv")
+    ls = s; gsub(",", ";", ls)
+    printf "%s,%s,%s,%s,%.6f,%.3f,%s,%s\n", name, c, sc, gs, tg[name], gvw, tk[name], ls >> (out "/vehicles.csv")
     seen[c] = 1 }
   function row(c, k, mm, rr) {
     line = sprintf("%s,%.6f,%.6f", k, mm, rr)
@@ -166,3 +183,21 @@ classes=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "class") k = i;
   awk -F'|' '{ split($1, o, " "); printf "classed otherwise by amfi-solve: %d%s\n", o[1], substr($1, length(o[1]) + 1)
                split($3, r, " "); printf "refused by amfi-solve: %d %s\n", r[1], $2 }' "$out/summary.txt"
 } | tee "$out/table.txt"
+
+# 6. why a group or a single axle is harder than the gross weight: the errors
+# (kg) of neighbouring groups of a vehicle (a single axle a group of one),
+# their correlation and the RMS relative errors of each and of their sum
+awk -F, 'NR > 1 { c = $2; ng = split($4, g, "-"); split($7, t, ";"); split($8, m, ";"); a = 1
+    for (i = 1; i <= ng; i++) { T[i] = M[i] = 0
+      for (k = 0; k < g[i]; k++) { T[i] += t[a]; M[i] += m[a]; a++ } }
+    for (i = 1; i < ng; i++) {
+      e1 = M[i] - T[i]; e2 = M[i + 1] - T[i + 1]; n[c]++
+      s1[c] += e1; s2[c] += e2; q1[c] += e1 * e1; q2[c] += e2 * e2; x[c] += e1 * e2
+      P1[c] += (100 * e1 / T[i]) ^ 2; P2[c] += (100 * e2 / T[i + 1]) ^ 2
+      PS[c] += (100 * (e1 + e2) / (T[i] + T[i + 1])) ^ 2 } }
+  END { printf "%-6s %5s %7s %9s %9s %9s\n", "class", "pairs", "corr", "rms_1_pct", "rms_2_pct", "rms_sum_pct"
+    for (c in n) { N = n[c]; v1 = q1[c] / N - (s1[c] / N) ^ 2; v2 = q2[c] / N - (s2[c] / N) ^ 2
+      cv = x[c] / N - s1[c] / N * s2[c] / N
+      printf "%-6s %5d %7.2f %9.2f %9.2f %9.2f\n", c, N, (v1 > 0 && v2 > 0 ? cv / sqrt(v1 * v2) : 0),
+             sqrt(P1[c] / N), sqrt(P2[c] / N), sqrt(PS[c] / N) } }' "$out/vehicles.csv" > "$out/pairs.txt" ||
+  die "pairs.txt"
