@@ -25,7 +25,7 @@ export AMFI_DATA_DIR="$top/config:$top/sim_publisher/data"
 # the heavy traffic by class (docs/simulator.md, "Vehicle classes")
 population="$top/sim_publisher/data/population-eu.csv"
 echo "== amfid and sim_publisher on a private bus: 500 trucks of the EU mix, 20 % damage from vehicle 251 (half way)"
-echo "   (about a minute; logs in $out)"
+echo "   (a minute or more: about 55 s of CPU; logs in $out)"
 OPENBLAS_NUM_THREADS=1 unshare --net bash -c '
   set -eu
   ip link set lo up
