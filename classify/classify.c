@@ -202,7 +202,7 @@ static double largest_legal_kg(const amfi_class_params *p, int n)
                          group_limit(p, AMFI_GROUP_MOTOR_TANDEM, 1.8)),
                     group_limit(p, AMFI_GROUP_STEER_PAIR, 0.0));
     if (n == 3)
-        return fmax(group_limit(p, AMFI_GROUP_TRIDEM, 1.4), 3.0 * p->single_axle_kg);
+        return group_limit(p, AMFI_GROUP_TRIDEM, 1.4);
     return n * single;
 }
 

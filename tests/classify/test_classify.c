@@ -358,6 +358,16 @@ static void implausible_loads(void **state)
     assert_int_equal(amfi_classify(&p, 4, a22, heavy, &c, err, sizeof err), 0);
     assert_int_equal(c.loads_ok, 1);
     assert_true(c.over & AMFI_OVER_GROUP);
+    /* a tridem: over 10 x 24 t refused, just under it an overload */
+    const double a23[4] = {3.75, 6.0, 1.31, 1.31};
+    const double tridem[5] = {7000, 11000, 81000, 81000, 81000};
+    assert_int_equal(amfi_classify(&p, 5, a23, tridem, &c, err, sizeof err), 0);
+    assert_int_equal(c.loads_ok, 0);
+    assert_non_null(strstr(c.loads_why, "group 3: load 243000 kg, over 10 x any legal load of 3 axles (24000 kg)"));
+    const double tridem_less[5] = {7000, 11000, 79000, 79000, 79000};
+    assert_int_equal(amfi_classify(&p, 5, a23, tridem_less, &c, err, sizeof err), 0);
+    assert_int_equal(c.loads_ok, 1);
+    assert_true(c.over & AMFI_OVER_GROUP);
     /* an unknown class (a road train of seven single axles) is judged too */
     const double sp7[6] = {3.0, 4.0, 4.0, 4.0, 4.0, 4.0};
     const double train[7] = {7000, 9000, 9000, 9000, 9000, 200000, 9000};
