@@ -337,7 +337,8 @@ int amfi_classify(const amfi_class_params *p, int n_axles, const double *spacing
                 out->loads_ok = 0;
                 snprintf(out->loads_why, sizeof out->loads_why,
                          "%s %d: load %.0f kg, over %g x any legal load of %d axle%s (%.0f kg)",
-                         g->n_axles == 1 ? "single axle" : "group", g->n_axles == 1 ? g->first + 1 : i + 1,
+                         g->n_axles == 1 ? "single axle" : "group",
+                         g->n_axles == 1 ? g->first + 1 : i + 1,
                          g->load_kg, AMFI_CLASS_IMPLAUSIBLE_FACTOR, g->n_axles,
                          g->n_axles == 1 ? "" : "s", most / AMFI_CLASS_IMPLAUSIBLE_FACTOR);
                 break;

@@ -363,7 +363,8 @@ static void implausible_loads(void **state)
     const double tridem[5] = {7000, 11000, 81000, 81000, 81000};
     assert_int_equal(amfi_classify(&p, 5, a23, tridem, &c, err, sizeof err), 0);
     assert_int_equal(c.loads_ok, 0);
-    assert_non_null(strstr(c.loads_why, "group 3: load 243000 kg, over 10 x any legal load of 3 axles (24000 kg)"));
+    assert_non_null(strstr(c.loads_why, "group 3: load 243000 kg, over 10 x any legal load "
+                                        "of 3 axles (24000 kg)"));
     const double tridem_less[5] = {7000, 11000, 79000, 79000, 79000};
     assert_int_equal(amfi_classify(&p, 5, a23, tridem_less, &c, err, sizeof err), 0);
     assert_int_equal(c.loads_ok, 1);
