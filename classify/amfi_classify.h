@@ -100,6 +100,12 @@ typedef struct amfi_axle_group {
     double limit_kg;         /* its legal limit; NaN when none is known */
 } amfi_axle_group;
 
+/* A group (or single axle) whose load is more than this many times the
+ * largest legal load of any group of its axle count (under the limits of
+ * amfi_class_params, whatever the class) is not an overload but a load no
+ * vehicle carries: the loads are refused (loads_why). */
+#define AMFI_CLASS_IMPLAUSIBLE_FACTOR 10.0
+
 #define AMFI_OVER_GVW 1u   /* gross weight above its class's limit */
 #define AMFI_OVER_GROUP 2u /* a group (or single axle outside groups) above its limit */
 
@@ -115,8 +121,10 @@ typedef struct amfi_classification {
     unsigned over;                  /* AMFI_OVER_*; 0 unless loads_ok */
     int loads_ok;                   /* 1: loads given and judged against the limits;
                                        0: none given, or refused (loads_why) */
-    char loads_why[96];             /* why the loads were refused: a single axle or a
-                                       group below zero; "" otherwise */
+    char loads_why[112];            /* why the loads were refused: a single axle or a
+                                       group below zero, or above
+                                       AMFI_CLASS_IMPLAUSIBLE_FACTOR x any legal load
+                                       of its axle count; "" otherwise */
 } amfi_classification;
 
 /* Group n_axles axles (1 .. AMFI_MAX_AXLES) with n_axles − 1 spacings (m,
@@ -133,7 +141,9 @@ int amfi_axle_groups(int n_axles, const double *spacing_m, const double *axle_kg
  * group of one): an axle inside a group is not separable, so it may be
  * negative as long as its group's sum is not (the group's sum is what is
  * classified and checked against the limits; separable[] flags such axles).
- * A single axle or a group below zero is a result the solve could not
+ * A single axle or a group below zero, or a group above
+ * AMFI_CLASS_IMPLAUSIBLE_FACTOR x the largest legal load of any group of
+ * its axle count, is a result the solve could not
  * give: the class and groups are still filled (loads reported as they are)
  * but the loads are refused: loads_ok 0, loads_why says which axle or group,
  * the class decided as without loads and no overload. 0, or −1 with a

@@ -211,6 +211,25 @@ static double group_limit(const amfi_class_params *p, amfi_group_kind k, double 
     }
 }
 
+/* The largest legal load of any group of n axles under p's limits (Council
+ * Directive 96/53/EC, Annex I, 3: a single driving axle, the widest trailer
+ * tandem or twin steer, the widest tridem; a longer group as that many
+ * driving axles), whatever the class and scheme: the scale against which a
+ * load is implausible (AMFI_CLASS_IMPLAUSIBLE_FACTOR). */
+static double largest_legal_kg(const amfi_class_params *p, int n)
+{
+    const double single = fmax(p->single_axle_kg, p->driving_axle_kg);
+    if (n <= 1)
+        return single;
+    if (n == 2)
+        return fmax(fmax(group_limit(p, AMFI_GROUP_TANDEM, 1.8),
+                         group_limit(p, AMFI_GROUP_MOTOR_TANDEM, 1.8)),
+                    group_limit(p, AMFI_GROUP_STEER_PAIR, 0.0));
+    if (n == 3)
+        return group_limit(p, AMFI_GROUP_TRIDEM, 1.4);
+    return n * single;
+}
+
 /* The kinds of the groups of a European class. */
 static void eu_kinds(int cls, amfi_classification *c)
 {
@@ -335,6 +354,19 @@ int amfi_classify(const amfi_class_params *p, int n_axles, const double *spacing
         out->loads_ok = 1;
         for (int i = 0; i < out->n_groups && out->loads_ok; i++) {
             const amfi_axle_group *g = &out->group[i];
+            const double most = AMFI_CLASS_IMPLAUSIBLE_FACTOR * largest_legal_kg(p, g->n_axles);
+            if (g->load_kg > most) {
+                /* no vehicle carries that: a broken solve or a wrong
+                 * detector record, not an overload */
+                out->loads_ok = 0;
+                snprintf(out->loads_why, sizeof out->loads_why,
+                         "%s %d: load %.0f kg, over %g x any legal load of %d axle%s (%.0f kg)",
+                         g->n_axles == 1 ? "single axle" : "group",
+                         g->n_axles == 1 ? g->first + 1 : i + 1,
+                         g->load_kg, AMFI_CLASS_IMPLAUSIBLE_FACTOR, g->n_axles,
+                         g->n_axles == 1 ? "" : "s", most / AMFI_CLASS_IMPLAUSIBLE_FACTOR);
+                break;
+            }
             if (g->load_kg >= 0.0)
                 continue;
             out->loads_ok = 0;

@@ -2,8 +2,10 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # The main job: install what is missing, build, then on a private bus (a
 # network namespace of its own: nothing leaves this machine) amfid listens
-# while sim_publisher streams 500 vehicles, one every 2 s of data at 25 times
-# real time, the bridge losing 20 % of its stiffness from vehicle 251 on (half way).
+# while sim_publisher streams 500 vehicles of the European heavy traffic by
+# class (sim_publisher/data/population-eu.csv: two-axle rigid trucks to
+# six-axle articulated ones), one every 2 s of data at 25 times real time,
+# the bridge losing 20 % of its stiffness from vehicle 251 on (half way).
 # Ends with what amfid stored: passages, indicator trend, alerts, and the
 # plots of them (PNG files next to the database, named at the end).
 set -euo pipefail
@@ -20,8 +22,10 @@ config="$top/config/demo.yaml"
 "$bin/daemon/amfid" --make-bus-key "$out/bus.key" >/dev/null
 # the shipped population (and configurations) for a build that is not installed
 export AMFI_DATA_DIR="$top/config:$top/sim_publisher/data"
-echo "== amfid and sim_publisher on a private bus: 500 vehicles, 20 % damage from vehicle 251 (half way)"
-echo "   (about a minute; logs in $out)"
+# the heavy traffic by class (docs/simulator.md, "Vehicle classes")
+population="$top/sim_publisher/data/population-eu.csv"
+echo "== amfid and sim_publisher on a private bus: 500 trucks of the EU mix, 20 % damage from vehicle 251 (half way)"
+echo "   (a minute or more: about 55 s of CPU; logs in $out)"
 OPENBLAS_NUM_THREADS=1 unshare --net bash -c '
   set -eu
   ip link set lo up
@@ -29,12 +33,13 @@ OPENBLAS_NUM_THREADS=1 unshare --net bash -c '
   "$1/daemon/amfid" --config "$2" --db "$3/demo.db" --bus-key "$3/bus.key" 2> "$3/amfid.log" &
   pid=$!
   for i in $(seq 100); do grep -q running "$3/amfid.log" && break; sleep 0.1; done
-  "$1/sim_publisher/sim_publisher" --allow-production-bus --config "$2" --bus-key "$3/bus.key" --vehicles 500 --headway 2 --speedup 25 \
+  "$1/sim_publisher/sim_publisher" --allow-production-bus --config "$2" --bus-key "$3/bus.key" \
+    --population "$4" --vehicles 500 --headway 2 --speedup 25 \
     --damage 0.2 --damage-step-at 250 --seed 1 2> "$3/sim_publisher.log"
   sleep 1
   kill -TERM "$pid"
   wait "$pid"
-' demo "$bin" "$config" "$out"
+' demo "$bin" "$config" "$out" "$population"
 grep -E "ALERT|alert cleared|baseline" "$out/amfid.log" | sed 's/^<[0-9]>//' || true
 echo
 "$bin/tools/ops/amfi-report" --db "$out/demo.db" --summary --trend --alerts --errors

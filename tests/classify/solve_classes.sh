@@ -6,8 +6,9 @@
 # given every spacing): class A23, groups [0], [1], [2,3,4] with the
 # tridem's load within 7 % of its static truth (COST 323 B+(7), a group of
 # axles; measured +3.3 %), the limits of 96/53/EC (40 t, 24 t tridem), the
-# same through --vehicle; the FHWA scheme from the site file (FHWA9); a
-# bad classes: section refused with FILE:LINE.
+# same through --vehicle; the passage 25 times as strong refused for the
+# limits (a 150 t steer axle is no overload); the FHWA scheme from the site file
+# (FHWA9); a bad classes: section refused with FILE:LINE.
 #   solve_classes.sh SIM_PUBLISHER AMFI_SOLVE CONFIG_DIR
 set -u
 sim=${1:?usage: solve_classes.sh SIM_PUBLISHER AMFI_SOLVE CONFIG_DIR}
@@ -56,6 +57,21 @@ printf '%s' "$outv" | grep -q '"vehicles":\[{.*"class":"A23","groups":\[{"axles"
 outf=$("$solve" --config "$work/fhwa.yaml" --accel "$work/out/v00001.csv" --speed 25 \
        --axle-spacing 3.75,5.67,1.31,1.31 --entry-time "$entry") || fail "fhwa13: exit $?"
 printf '%s' "$outf" | grep -q '"class":"FHWA9"' || fail "fhwa13: not FHWA9"
+
+# the same passage 25 times as strong: a 150 t steer axle (and a 540 t
+# tridem) is no overload but a load no vehicle carries (over 10 x the
+# largest legal single axle, 11.5 t): the loads refused with the first such
+# axle or group named, the class and groups still given, exit 0 and one
+# line on stderr
+awk -F, 'NR == 1 { print; next } { printf "%s,%.9g\n", $1, 25 * $2 }' "$work/out/v00001.csv" \
+  >"$work/strong.csv" || fail "strong.csv"
+# shellcheck disable=SC2086
+outs=$("$solve" $cfg --accel "$work/strong.csv" --speed 25 --axle-spacing 3.75,5.67,1.31,1.31 \
+       --entry-time "$entry" 2>"$work/strong.err") || fail "implausible loads: exit $?"
+printf '%s' "$outs" | grep -q '"class":"A23".*"overload":null,.*"loads_refused":"single axle 1: load [0-9]* kg, over 10 x any legal load of 1 axle (11500 kg)"' ||
+  { echo "$outs"; fail "implausible loads: not refused"; }
+[ "$(wc -l <"$work/strong.err")" -eq 1 ] && grep -q "loads refused for the limits: single axle 1: " "$work/strong.err" ||
+  { cat "$work/strong.err"; fail "implausible loads: stderr"; }
 
 # a bad classes: section: refused at its line
 { cat "$confdir/paper-20m.yaml"; printf 'classes:\n  group_spacing_m: 4\n'; } >"$work/bad.yaml"

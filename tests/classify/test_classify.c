@@ -328,6 +328,56 @@ static void negative_loads(void **state)
     assert_non_null(strstr(c.loads_why, "axle 2"));
 }
 
+/* A load an order of magnitude above any legal configuration (a broken
+ * solve, a wrong detector record) is refused, not an overload: the trailer
+ * tandem of an A22 at 250 t (the largest legal tandem 20 t), a single axle
+ * at 130 t (11.5 t); the class and groups still given, no overload. A heavy
+ * but possible overload (a 40 t tandem) is still an overload. */
+static void implausible_loads(void **state)
+{
+    (void)state;
+    amfi_class_params p = eu();
+    amfi_classification c;
+    char err[128] = "";
+    const double a22[3] = {3.7, 6.6, 1.31};
+    const double tandem[4] = {7000, 11000, 125000, 125000};
+    assert_int_equal(amfi_classify(&p, 4, a22, tandem, &c, err, sizeof err), 0);
+    assert_string_equal(c.name, "A22");
+    assert_int_equal(c.n_groups, 3);
+    assert_int_equal(c.loads_ok, 0);
+    assert_int_equal(c.over, 0);
+    assert_non_null(strstr(c.loads_why, "group 3: load 250000 kg"));
+    assert_non_null(strstr(c.loads_why, "(20000 kg)"));
+    assert_float_equal(c.group[2].load_kg, 250000.0, 1e-6); /* reported as it is */
+    const double single[4] = {130000, 11000, 9000, 9000};
+    assert_int_equal(amfi_classify(&p, 4, a22, single, &c, err, sizeof err), 0);
+    assert_int_equal(c.loads_ok, 0);
+    assert_non_null(strstr(c.loads_why, "single axle 1: load 130000 kg"));
+    assert_int_equal(c.over, 0);
+    const double heavy[4] = {7000, 11000, 20000, 20000};
+    assert_int_equal(amfi_classify(&p, 4, a22, heavy, &c, err, sizeof err), 0);
+    assert_int_equal(c.loads_ok, 1);
+    assert_true(c.over & AMFI_OVER_GROUP);
+    /* a tridem: over 10 x 24 t refused, just under it an overload */
+    const double a23[4] = {3.75, 6.0, 1.31, 1.31};
+    const double tridem[5] = {7000, 11000, 81000, 81000, 81000};
+    assert_int_equal(amfi_classify(&p, 5, a23, tridem, &c, err, sizeof err), 0);
+    assert_int_equal(c.loads_ok, 0);
+    assert_non_null(strstr(c.loads_why, "group 3: load 243000 kg, over 10 x any legal load "
+                                        "of 3 axles (24000 kg)"));
+    const double tridem_less[5] = {7000, 11000, 79000, 79000, 79000};
+    assert_int_equal(amfi_classify(&p, 5, a23, tridem_less, &c, err, sizeof err), 0);
+    assert_int_equal(c.loads_ok, 1);
+    assert_true(c.over & AMFI_OVER_GROUP);
+    /* an unknown class (a road train of seven single axles) is judged too */
+    const double sp7[6] = {3.0, 4.0, 4.0, 4.0, 4.0, 4.0};
+    const double train[7] = {7000, 9000, 9000, 9000, 9000, 200000, 9000};
+    assert_int_equal(amfi_classify(&p, 7, sp7, train, &c, err, sizeof err), 0);
+    assert_string_equal(c.name, "unknown");
+    assert_int_equal(c.loads_ok, 0);
+    assert_non_null(strstr(c.loads_why, "single axle 6"));
+}
+
 /* The text form amfid records in the store (meta daemon.classes): every
  * field round-trips exactly; a damaged text is refused naming the field,
  * *p untouched. */
@@ -385,7 +435,7 @@ int main(void)
         cmocka_unit_test(groups_at_threshold),  cmocka_unit_test(every_eu_class_from_vclass),
         cmocka_unit_test(eu_limits),            cmocka_unit_test(fhwa_typical),
         cmocka_unit_test(refusals),             cmocka_unit_test(params_text),
-        cmocka_unit_test(negative_loads),
+        cmocka_unit_test(negative_loads),       cmocka_unit_test(implausible_loads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

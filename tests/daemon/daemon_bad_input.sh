@@ -23,15 +23,25 @@ fail() { echo "FAIL: $*"; tail -30 "$dir/amfid.log"; exit 1; }
   2> "$dir/amfid.log"; rc=$?
 [ $rc -eq 0 ] || fail "amfid exit status $rc"
 for what in "malformed accel_block_t" "malformed vehicle_t" "malformed truth_t" \
-            "vehicle_t 424242 rejected: speed_mps" "sensor 99 .* rejected: sensor_id not in the configuration"; do
+            "vehicle_t 424242 rejected: speed_mps" "sensor 99 .* rejected: sensor_id not in the configuration" \
+            "vehicle_t 424243 rejected: n_spacings must be n_axles - 1" \
+            "vehicle_t 424244 rejected: n_axles out of range for the solver"; do
   grep -q "$what" "$dir/amfid.log" || fail "no log line for: $what"
 done
-grep -q "stopped: 4 passages stored (3 ok)" "$dir/amfid.log" || fail "counts: $(grep stopped "$dir/amfid.log")"
+grep -q "stopped: 6 passages stored (3 ok)" "$dir/amfid.log" || fail "counts: $(grep stopped "$dir/amfid.log")"
 sqlite3 "$dir/a.db" "SELECT status FROM passages WHERE vehicle_id = 424242" | grep -qx invalid ||
   fail "the invalid vehicle was not stored as invalid"
+# spacings that do not match the axle count, more axles than the solver takes
+# (solver.max_axles 6):
+# stored invalid with the reason, no class
+for v in "424243|n_spacings must be n_axles - 1" "424244|n_axles out of range for the solver"; do
+  sqlite3 "$dir/a.db" "SELECT count(*) FROM passages WHERE vehicle_id = ${v%%|*} AND status = 'invalid'
+                       AND instr(reason, '${v#*|}') > 0 AND class IS NULL" | grep -qx 1 ||
+    fail "vehicle ${v%%|*}: $(sqlite3 "$dir/a.db" "SELECT * FROM passages WHERE vehicle_id = ${v%%|*}")"
+done
 [ "$(sqlite3 "$dir/a.db" "SELECT count(*) FROM passages WHERE status = 'ok'")" -eq 3 ] ||
   fail "the three real vehicles are not all ok"
-echo "bad input: $(grep -c 'rejected' "$dir/amfid.log") rejections logged, 3 vehicles ok, 1 invalid stored"
+echo "bad input: $(grep -c 'rejected' "$dir/amfid.log") rejections logged, 3 vehicles ok, 3 invalid stored"
 
 # Vehicles and no sensor data at all (the DAQ is down): each vehicle is
 # stored as gap with its reason, and amfid stops cleanly (it used to crash

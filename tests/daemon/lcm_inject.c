@@ -4,7 +4,8 @@
  * carry, for amfid's bad-input test (tests/daemon/daemon_bad_input.sh):
  *   after the 50th AMFI_ACCEL event: the same event again (duplicate), its
  *   first half (truncated), 40 random bytes on AMFI_ACCEL, AMFI_VEHICLE and
- *   AMFI_TRUTH, a well-formed vehicle_t with speed −3 m/s, an accel block
+ *   AMFI_TRUTH, a well-formed vehicle_t with speed −3 m/s, one with five
+ *   axles and two spacings, one with 7 axles, an accel block
  *   from sensor 99; the 60th and 61st accel events swapped (out of order).
  *
  *   lcm_inject IN.log OUT.log
@@ -321,6 +322,15 @@ int main(int argc, char **argv)
             amfi_vehicle_t v = {e->timestamp + 500000, 424242, 1, -3.0, 2, 1, &spacing, "inject", 0.0};
             unsigned char buf[256];
             int n = amfi_vehicle_t_encode(buf, 0, sizeof buf, &v);
+            rc |= n < 0 || put(out, &num, e->timestamp, AMFI_CHANNEL_VEHICLE, buf, n);
+            /* well formed, but its spacings do not match its axle count (an
+             * A23's five axles with two spacings), and one with 13 axles */
+            double sp[12] = {3.7, 6.0, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3};
+            amfi_vehicle_t few = {e->timestamp + 600000, 424243, 1, 25.0, 5, 2, sp, "inject", 0.0};
+            n = amfi_vehicle_t_encode(buf, 0, sizeof buf, &few);
+            rc |= n < 0 || put(out, &num, e->timestamp, AMFI_CHANNEL_VEHICLE, buf, n);
+            amfi_vehicle_t many = {e->timestamp + 700000, 424244, 1, 25.0, 7, 6, sp, "inject", 0.0};
+            n = amfi_vehicle_t_encode(buf, 0, sizeof buf, &many);
             rc |= n < 0 || put(out, &num, e->timestamp, AMFI_CHANNEL_VEHICLE, buf, n);
             amfi_accel_block_t m;
             memset(&m, 0, sizeof m);

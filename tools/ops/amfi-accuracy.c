@@ -130,7 +130,10 @@ static int read_input(const char *path, series err[AMFI_COST323_N_CRITERIA], cha
                 amfi_csv_close(r, 0);
                 return -1;
             }
-            double lo = k == 0 ? 0.0 : MIN_REFERENCE_KG;
+            /* a measured value may be below zero: a solver reports the axles
+             * of a group it cannot separate as it split them (docs/classes.md),
+             * and that error counts like any other */
+            double lo = k == 0 ? -MAX_WEIGHT_KG : MIN_REFERENCE_KG;
             if (!(w[k] >= lo && w[k] <= MAX_WEIGHT_KG)) {
                 amfi_csv_fail(r, ln, col, "%g kg is outside [%g, %g]", w[k], lo, MAX_WEIGHT_KG);
                 amfi_csv_close(r, 0);
