@@ -16,7 +16,6 @@
  * keeps a hash of the last shipped row: a store restored from an older backup
  * (ids going backwards, or a different row at a shipped id) is refused. */
 #define _POSIX_C_SOURCE 200809L
-#include <errno.h>
 #include <inttypes.h>
 #include <libpq-fe.h>
 #include <signal.h>
