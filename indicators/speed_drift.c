@@ -8,6 +8,7 @@
  */
 #include "speed_drift.h"
 
+#include "ind_internal.h"
 #include "level_rule.h"
 
 #include <math.h>
@@ -27,29 +28,20 @@ void amfi_speed_drift_params_default(amfi_speed_drift_params *p)
     p->threshold = 0.02;
 }
 
-#define BLAME(name, ...)                                                                      \
-    do {                                                                                      \
-        if (field)                                                                            \
-            *field = name;                                                                    \
-        if (err && errlen)                                                                    \
-            snprintf(err, errlen, __VA_ARGS__);                                               \
-        return AMFI_IND_EINVAL;                                                               \
-    } while (0)
-
 int amfi_speed_drift_params_check(const amfi_speed_drift_params *p, const char **field,
                                   char *err, size_t errlen)
 {
     if (field)
         *field = NULL;
     if (!p)
-        BLAME(NULL, "speed drift: no parameters");
+        IND_BLAME(NULL, "speed drift: no parameters");
     if (p->enabled != 0 && p->enabled != 1)
-        BLAME("enabled", "enabled must be on or off (1 or 0), got %d", p->enabled);
+        IND_BLAME("enabled", "enabled must be on or off (1 or 0), got %d", p->enabled);
     if (p->window < 2 || p->window > AMFI_SPEED_DRIFT_MAX_WINDOW)
-        BLAME("window", "window must be 2 .. %d estimated passages, got %d",
+        IND_BLAME("window", "window must be 2 .. %d estimated passages, got %d",
               AMFI_SPEED_DRIFT_MAX_WINDOW, p->window);
     if (!(p->threshold > 0 && p->threshold <= AMFI_SPEED_DRIFT_MAX_THRESHOLD))
-        BLAME("threshold", "threshold must be in (0, %g], got %g", AMFI_SPEED_DRIFT_MAX_THRESHOLD,
+        IND_BLAME("threshold", "threshold must be in (0, %g], got %g", AMFI_SPEED_DRIFT_MAX_THRESHOLD,
               p->threshold);
     return AMFI_IND_OK;
 }
