@@ -16,7 +16,6 @@
  * keeps a hash of the last shipped row: a store restored from an older backup
  * (ids going backwards, or a different row at a shipped id) is refused. */
 #define _POSIX_C_SOURCE 200809L
-#include <errno.h>
 #include <inttypes.h>
 #include <libpq-fe.h>
 #include <signal.h>
@@ -493,32 +492,12 @@ static int store_site_id(amfi_store *db, char out[SITE_ID_MAX + 1])
 /* What the store says of its site (the meta amfid writes from site.* of
  * amfid.yaml) and of itself (the started_at of its first run, written once
  * at its first start: the store's identity), each value checked as the
- * configuration loader checks it; "" where the store has none. */
+ * configuration loader checks it (fleet_site_text_ok, fleet_site_coord_ok);
+ * "" where the store has none. */
 struct site_facts {
     char name[128], lat[32], lon[32], bridge_type[64];
     char started[64]; /* runs id 1: started_at */
 };
-static int text_ok(const char *s)
-{
-    /* UTF-8, no control characters (amfid.yaml(5): site.name, site.bridge_type) */
-    const unsigned char *p = (const unsigned char *)s;
-    while (*p) {
-        int n = *p < 0x80 ? 1 : (*p & 0xe0) == 0xc0 && *p >= 0xc2 ? 2 : (*p & 0xf0) == 0xe0 ? 3
-              : (*p & 0xf8) == 0xf0 && *p <= 0xf4 ? 4 : 0;
-        if (!n || (n == 1 && (*p < 0x20 || *p == 0x7f))) return 0;
-        for (int k = 1; k < n; k++)
-            if ((p[k] & 0xc0) != 0x80) return 0;
-        p += n;
-    }
-    return 1;
-}
-static int coord_ok(const char *s, double lim)
-{
-    char *end;
-    errno = 0;
-    double x = strtod(s, &end);
-    return *s && !*end && errno == 0 && x >= -lim && x <= lim;
-}
 static int first_run(void *ctx, const amfi_store_value *v, int n)
 {
     char tmp[40];
@@ -551,7 +530,7 @@ static int site_facts_read(amfi_store *db, const char *site, const char *store, 
         }
         if (!found) continue;
         int ok = strlen(val) > 0 && strlen(val) < keys[i].cap
-                 && (keys[i].lim > 0 ? coord_ok(val, keys[i].lim) : text_ok(val));
+                 && (keys[i].lim > 0 ? fleet_site_coord_ok(val, keys[i].lim) : fleet_site_text_ok(val));
         if (!ok) {
             fprintf(stderr, "amfi-sync: refused: site '%s' store %s: meta '%s': %s (amfid.yaml(5)). "
                             "Nothing shipped (see docs/fleet.md, 'Bad values')\n",

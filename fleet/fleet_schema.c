@@ -5,7 +5,9 @@
  * per-table high-water mark and the hash of the last shipped row. */
 #include "fleet_schema.h"
 
+#include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "store.h"
@@ -357,4 +359,26 @@ int fleet_hash_cols(const char *table)
         if (!first || defs[j]->shipped < first) first = defs[j]->shipped;
     for (int j = 0; j < n && defs[j]->shipped == first; j++) h++;
     return h;
+}
+
+int fleet_site_text_ok(const char *s)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    while (*p) {
+        int n = *p < 0x80 ? 1 : (*p & 0xe0) == 0xc0 && *p >= 0xc2 ? 2 : (*p & 0xf0) == 0xe0 ? 3
+              : (*p & 0xf8) == 0xf0 && *p <= 0xf4 ? 4 : 0;
+        if (!n || (n == 1 && (*p < 0x20 || *p == 0x7f))) return 0;
+        for (int k = 1; k < n; k++)
+            if ((p[k] & 0xc0) != 0x80) return 0;
+        p += n;
+    }
+    return 1;
+}
+
+int fleet_site_coord_ok(const char *s, double lim)
+{
+    char *end;
+    errno = 0;
+    double x = strtod(s, &end);
+    return end != s && !*end && errno == 0 && x >= -lim && x <= lim;
 }

@@ -57,4 +57,13 @@ int fleet_hash_cols(const char *table);
  * fleet_tables names: amfid migrates older stores when it starts. */
 #define FLEET_MIN_STORE_VERSION 12
 
+/* A site's facts (fleet_sites; the site store's meta site.*) as
+ * amfid.yaml(5) allows them, checked by amfi-sync before it ships them and
+ * by amfi-report --pg when it reads them back: site.name and
+ * site.bridge_type valid UTF-8 without control characters (their lengths
+ * are the caller's to check); site.latitude / longitude a number of degrees
+ * in [-lim, lim] (nothing after it, not out of a double's range). 1 or 0. */
+int fleet_site_text_ok(const char *s);
+int fleet_site_coord_ok(const char *s, double lim);
+
 #endif

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * ind_internal.h: helpers shared by the parameter checks of the scale and
- * known-truck indicators (scale.c, known_truck.c); not installed, not part
- * of the API. Pure functions.
+ * ind_internal.h: helpers shared by the parameter checks of the
+ * indicators (scale.c, known_truck.c, level_rule.c, speed_drift.c); not
+ * installed, not part of the API. Pure functions.
  */
 #ifndef AMFI_INDICATORS_INTERNAL_H
 #define AMFI_INDICATORS_INTERNAL_H
@@ -30,5 +30,17 @@ static inline int ind_bad(const char *who, const char *name, const char **field,
         snprintf(err, errlen, "%s: %s %s", who, name, why);
     return AMFI_IND_EINVAL;
 }
+
+/* In a parameter check with `field` and `err`, `errlen` in scope: *field
+ * (may be NULL) = name, err (may be NULL) = the printf message; returns
+ * AMFI_IND_EINVAL from the function. */
+#define IND_BLAME(name, ...)                                                                  \
+    do {                                                                                      \
+        if (field)                                                                            \
+            *field = name;                                                                    \
+        if (err && errlen)                                                                    \
+            snprintf(err, errlen, __VA_ARGS__);                                               \
+        return AMFI_IND_EINVAL;                                                               \
+    } while (0)
 
 #endif

@@ -5,6 +5,8 @@
  */
 #include "level_rule.h"
 
+#include "ind_internal.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,37 +20,34 @@ struct amfi_level_rule {
     int alerted, streak;
 };
 
-#define BLAME(name, ...)                                                                      \
-    do {                                                                                      \
-        if (field)                                                                            \
-            *field = name;                                                                    \
-        if (err && errlen)                                                                    \
-            snprintf(err, errlen, __VA_ARGS__);                                               \
-        return AMFI_IND_EINVAL;                                                               \
-    } while (0)
-
 int amfi_level_params_check(const amfi_level_params *p, const char **field, char *err,
                             size_t errlen)
 {
     if (field)
         *field = NULL;
     if (!p)
-        BLAME(NULL, "no parameters");
+        IND_BLAME(NULL, "no parameters");
     if (p->enabled != 0 && p->enabled != 1)
-        BLAME("enabled", "enabled must be on or off (1 or 0), got %d", p->enabled);
+        IND_BLAME("enabled", "enabled must be on or off (1 or 0), got %d", p->enabled);
     if (p->window < 1 || p->window > AMFI_LEVEL_MAX_WINDOW)
-        BLAME("window", "window must be 1 .. %d passages, got %d", AMFI_LEVEL_MAX_WINDOW,
+        IND_BLAME("window", "window must be 1 .. %d passages, got %d", AMFI_LEVEL_MAX_WINDOW,
               p->window);
     if (!isfinite(p->raise))
-        BLAME("raise", "the raise level must be finite");
+        IND_BLAME("raise", "the raise level must be finite");
     if (!isfinite(p->clear) || !(p->clear < p->raise))
-        BLAME("clear", "the clear level (%g) must be below the raise level (%g)", p->clear,
+        IND_BLAME("clear", "the clear level (%g) must be below the raise level (%g)", p->clear,
               p->raise);
+    if (p->absolute != 0 && p->absolute != 1)
+        IND_BLAME("absolute", "absolute must be 1 or 0, got %d", p->absolute);
+    if (p->absolute && !(p->clear > 0))
+        IND_BLAME("clear", "the clear level (%g) of a rule on |median| must be above 0", p->clear);
+    if (p->strict_raise != 0 && p->strict_raise != 1)
+        IND_BLAME("strict_raise", "strict_raise must be 1 or 0, got %d", p->strict_raise);
     if (p->raise_after < 1 || p->raise_after > AMFI_LEVEL_MAX_DEBOUNCE)
-        BLAME("raise_after", "raise_after must be 1 .. %d, got %d", AMFI_LEVEL_MAX_DEBOUNCE,
+        IND_BLAME("raise_after", "raise_after must be 1 .. %d, got %d", AMFI_LEVEL_MAX_DEBOUNCE,
               p->raise_after);
     if (p->clear_after < 1 || p->clear_after > AMFI_LEVEL_MAX_DEBOUNCE)
-        BLAME("clear_after", "clear_after must be 1 .. %d, got %d", AMFI_LEVEL_MAX_DEBOUNCE,
+        IND_BLAME("clear_after", "clear_after must be 1 .. %d, got %d", AMFI_LEVEL_MAX_DEBOUNCE,
               p->clear_after);
     return AMFI_IND_OK;
 }
@@ -152,8 +151,10 @@ int amfi_level_rule_push(amfi_level_rule *l, double x, amfi_level_eval *eval,
     enter(l, x);
     if (l->n < l->p.window)
         return 0;
-    const double m = median(l);
-    const int meets = l->alerted ? m < l->p.clear : m >= l->p.raise;
+    const double m = median(l), v = l->p.absolute ? fabs(m) : m;
+    const int meets = l->alerted          ? v < l->p.clear
+                      : l->p.strict_raise ? v > l->p.raise
+                                          : v >= l->p.raise;
     l->streak = meets ? l->streak + 1 : 0;
     const int change = l->streak >= (l->alerted ? l->p.clear_after : l->p.raise_after);
     if (eval) {
@@ -170,16 +171,21 @@ int amfi_level_rule_push(amfi_level_rule *l, double x, amfi_level_eval *eval,
         alert->level = l->level;
         alert->kind = l->kind;
         alert->raised = l->alerted;
+        const char *pm = l->p.absolute ? "+/-" : "";
         if (l->alerted)
             snprintf(alert->message, sizeof alert->message,
-                     "median %s %.4g over the last %d passages, at or above %.4g for %d "
+                     "median %s %.4g over the last %d passages, %s %s%.4g for %d "
                      "evaluations in a row",
-                     l->what, m, l->n, l->p.raise, l->p.raise_after);
+                     l->what, m, l->n,
+                     l->p.absolute ? (l->p.strict_raise ? "beyond" : "at or beyond")
+                                   : (l->p.strict_raise ? "above" : "at or above"),
+                     pm, l->p.raise, l->p.raise_after);
         else
             snprintf(alert->message, sizeof alert->message,
-                     "median %s %.4g over the last %d passages, below %.4g for %d evaluations "
+                     "median %s %.4g over the last %d passages, %s %s%.4g for %d evaluations "
                      "in a row",
-                     l->what, m, l->n, l->p.clear, l->p.clear_after);
+                     l->what, m, l->n, l->p.absolute ? "within" : "below", pm, l->p.clear,
+                     l->p.clear_after);
     }
     return AMFI_IND_EVAL | AMFI_IND_ALERT;
 }

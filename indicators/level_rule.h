@@ -1,16 +1,19 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * level_rule.h: a debounced level alert on the median of a rolling window,
- * the rule behind amfid's model_mismatch and natfreq alerts: each passage
+ * the rule behind amfid's model_mismatch, natfreq and speed_drift alerts: each passage
  * gives one figure x (the model's relative residual over the free
  * vibration; the compensated natural frequency's relative drop), the median
  * of the last W figures is compared with two levels.
  *
  *   window    a ring of the last W figures; an evaluation needs it full.
  *   cadence   every push with a full window evaluates (O(W log W)).
- *   raise     after raise_after consecutive evaluations with median >= raise.
+ *   raise     after raise_after consecutive evaluations with median >= raise
+ *             (median > raise with strict_raise).
  *   clear     after clear_after consecutive evaluations with median < clear
  *             (clear < raise: hysteresis).
+ *   absolute  the rule looks at |median| instead: a drift either way (the
+ *             speed-drift alert, speed_drift.c: |median c| > T, < T / 2).
  *   alerts    are state changes: one event when raised, one when cleared;
  *             the kind and level are the caller's (create).
  *
@@ -37,6 +40,8 @@ typedef struct amfi_level_params {
     double clear;    /* clear when the median < clear, finite */
     int raise_after; /* consecutive evaluations meeting the raise rule, 1 .. 100000 */
     int clear_after; /* consecutive evaluations meeting the clear rule, 1 .. 100000 */
+    int absolute;     /* 1: compare |median| with the levels (then clear > 0); 0: the median */
+    int strict_raise; /* 1: raise when above raise (>); 0: at or above (>=) */
 } amfi_level_params;
 
 /* 0 when *p is valid, else AMFI_IND_EINVAL with *field (may be NULL) the

@@ -20,7 +20,8 @@
  *   alerts    are state changes: one event when raised, one when cleared.
  *
  * Pure computation: no I/O, no logging; the only allocation is in
- * amfi_speed_drift_create. One handle is used by one thread at a time
+ * amfi_speed_drift_create. Built on the median level rule (level_rule.h:
+ * absolute, strict_raise). One handle is used by one thread at a time
  * (amfid: the main thread, the pipeline). Parameters and defaults:
  * docs/indicators.md, amfid.yaml(5) alerts.speed_drift.
  */

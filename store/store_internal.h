@@ -180,6 +180,29 @@ int st_read_int(sqlite3_stmt *st, int col, int64_t lo, int64_t hi,
 int st_read_text(sqlite3_stmt *st, int col, size_t max, const origin *o,
                  char *buf, size_t buflen, char *err, size_t errlen);
 
+/* One row of st into *rec, a record of the caller's type (ctx: the
+ * caller's, passed through). */
+typedef int (*st_row_fn)(sqlite3_stmt *st, const void *ctx, void *rec, char *err,
+                         size_t errlen);
+/* Step st (prepared and bound) to its end, each row read by `row` into a
+ * growing array of `size`-byte records (the first allocation holds cap0);
+ * then finalize st. rc 0 with rows: *arr (malloc'd, the caller's) and *n;
+ * no row or a failure: *arr NULL, *n 0. A database failure names `what`
+ * ("passages: read residuals"), running out of memory "out of memory for
+ * N <noun>". */
+int st_collect(amfi_store *s, sqlite3_stmt *st, st_row_fn row, const void *ctx, size_t size,
+               size_t cap0,
+               const char *what, const char *noun, void **arr, size_t *n, char *err,
+               size_t errlen);
+/* *yes 1 when the store has table `name` (a store older than the table's
+ * schema version has none); failures name "raw samples: schema". */
+int st_has_table(amfi_store *s, const char *name, int *yes, char *err, size_t errlen);
+/* Step st (columns idx, spacing_m, load_kg of passage `id`'s axles, bound)
+ * into r->spacing_m and r->axle_kg (idx 1 .. r->n_axles); *seen (may be
+ * NULL) the rows read; a database failure names `what`. Does not finalize. */
+int st_read_axles(amfi_store *s, sqlite3_stmt *st, int64_t id, amfi_passage_row *r, int *seen,
+                  const char *what, char *err, size_t errlen);
+
 /* ---- rows from the column table (store_rows.c) --------------------------- */
 
 /* amfi_store_add_alert's arguments as a row (the alerts column table). */

@@ -11,9 +11,16 @@
 
 #include "store_internal.h"
 
+/* One value (id, the value) in range rg. */
+static int read_value(sqlite3_stmt *st, const void *rg, void *rec, char *err, size_t errlen)
+{
+    origin o = {"passages", sqlite3_column_int64(st, 0)};
+    return st_read_real(st, 1, rg, &o, rec, err, errlen);
+}
 
 /* The newest max values of a column (SQL text fixed here: no name reaches
- * SQL from outside), oldest first. */
+ * SQL from outside: id, the value, not NULL, newest first, LIMIT ?1),
+ * oldest first. */
 static int recent(amfi_store *s, const char *sql, const char *what, const range *rg, int max,
                   double **out, size_t *n, char *err, size_t errlen)
 {
@@ -26,38 +33,22 @@ static int recent(amfi_store *s, const char *sql, const char *what, const range 
         return rc;
     *out = NULL;
     *n = 0;
-    double *a = malloc(sizeof *a * (size_t)max);
-    if (!a)
-        return st_fail(err, errlen, AMFI_ENOMEM, "%s: out of memory for %d values", what, max);
     sqlite3_stmt *st = NULL;
-    size_t k = 0;
-    int src = sqlite3_prepare_v2(s->db, sql, -1, &st, NULL);
-    if (src != SQLITE_OK) {
-        rc = st_db_fail(s, src, what, err, errlen);
-    } else {
-        sqlite3_bind_int64(st, 1, max);
-        while (rc == 0 && (src = sqlite3_step(st)) == SQLITE_ROW) {
-            origin o = {"passages", sqlite3_column_int64(st, 0)};
-            rc = st_read_real(st, 1, rg, &o, &a[k], err, errlen);
-            if (rc == 0)
-                k++;
-        }
-        if (rc == 0 && src != SQLITE_DONE)
-            rc = st_db_fail(s, src, what, err, errlen);
-    }
-    sqlite3_finalize(st);
-    if (rc != 0 || k == 0) {
-        free(a);
+    rc = st_prepare(s, sql, &st, what, err, errlen);
+    if (rc != 0)
         return rc;
-    }
-    for (size_t i = 0; i < k / 2; i++) { /* newest first → oldest first */
+    sqlite3_bind_int64(st, 1, max);
+    void *v = NULL;
+    rc = st_collect(s, st, read_value, rg, sizeof **out, (size_t)max, what, "values", &v, n, err,
+                    errlen);
+    double *a = v;
+    for (size_t i = 0, k = *n; i < k / 2; i++) { /* newest first → oldest first */
         double t = a[i];
         a[i] = a[k - 1 - i];
         a[k - 1 - i] = t;
     }
     *out = a;
-    *n = k;
-    return 0;
+    return rc;
 }
 
 int amfi_store_recent_fit_ratios(amfi_store *s, int max, double **out, size_t *n, char *err,

@@ -663,25 +663,6 @@ int st_raw_write(amfi_store *s, int64_t pid, amfi_raw_put *put)
 
 /* ---- reads ------------------------------------------------------------------- */
 
-/* 1 when the store has table `name`. */
-static int has_table(amfi_store *s, const char *name, int *yes, char *err, size_t errlen)
-{
-    sqlite3_stmt *st = NULL;
-    int rc = st_prepare(s, "SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name = ?1",
-                        &st, "raw samples: schema", err, errlen);
-    if (rc != 0)
-        return rc;
-    int src = sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
-    if (src == SQLITE_OK)
-        src = sqlite3_step(st);
-    if (src == SQLITE_ROW)
-        *yes = sqlite3_column_int(st, 0) > 0;
-    else
-        rc = st_db_fail(s, src, "raw samples: schema", err, errlen);
-    sqlite3_finalize(st);
-    return rc;
-}
-
 void amfi_store_raw_free(amfi_raw_rec *r)
 {
     if (!r)
@@ -700,7 +681,7 @@ int amfi_store_raw_get(amfi_store *s, int64_t passage_id, amfi_raw_rec *out, int
         return rc;
     memset(out, 0, sizeof *out);
     *found = 0;
-    rc = has_table(s, "passage_raw", &yes, err, errlen);
+    rc = st_has_table(s, "passage_raw", &yes, err, errlen);
     if (rc != 0 || !yes)
         return rc;
     sqlite3_stmt *st = NULL;
@@ -819,7 +800,7 @@ int amfi_store_raw_usage(amfi_store *s, int64_t *windows, int64_t *bytes, char *
     if (rc == 0)
         *windows = *bytes = 0;
     if (rc == 0)
-        rc = has_table(s, "raw_windows", &yes, err, errlen);
+        rc = st_has_table(s, "raw_windows", &yes, err, errlen);
     if (rc != 0 || !yes)
         return rc;
     sqlite3_stmt *st = NULL;
@@ -878,7 +859,7 @@ int amfi_store_raw_prune(amfi_store *s, int64_t before_utime, int64_t max_bytes,
     if (rc != 0)
         return rc;
     memset(out, 0, sizeof *out);
-    rc = has_table(s, "raw_windows", &yes, err, errlen);
+    rc = st_has_table(s, "raw_windows", &yes, err, errlen);
     if (rc != 0 || !yes)
         return rc;
     int64_t *ids = malloc((size_t)max_windows * sizeof *ids);
@@ -998,21 +979,7 @@ int amfi_store_passage_get(amfi_store *s, int64_t id, amfi_stored_passage *out, 
                     &st, "axles: read", err, errlen);
     if (rc != 0)
         return rc;
-    src = sqlite3_bind_int64(st, 1, id);
-    origin oa = {"axles", id};
-    while (rc == 0 && src == SQLITE_OK) {
-        src = sqlite3_step(st);
-        if (src != SQLITE_ROW)
-            break;
-        rc = st_read_int(st, 0, 1, r->n_axles, &oa, &v, err, errlen);
-        if (rc == 0 && v > 1)
-            rc = st_read_real_or_null(st, 1, &R_SPACING, &oa, &r->spacing_m[v - 2], err, errlen);
-        if (rc == 0)
-            rc = st_read_real_or_null(st, 2, &R_KG, &oa, &r->axle_kg[v - 1], err, errlen);
-        src = SQLITE_OK;
-    }
-    if (rc == 0 && src != SQLITE_DONE)
-        rc = st_db_fail(s, src, "axles: read", err, errlen);
+    rc = st_read_axles(s, st, id, r, NULL, "axles: read", err, errlen);
     sqlite3_finalize(st);
     if (rc != 0)
         *found = 0;

@@ -3,10 +3,12 @@
  * store_read.c: what amfid reads back at start-up (the baseline, the newest
  * ok GVWs, meta keys, whether an alert is open), the typed column readers
  * every read uses (type and range checked: a damaged row is
- * AMFI_STORE_ECORRUPT naming its table, rowid and column), and the
- * integrity check. The caller's thread; no state beyond the handle.
+ * AMFI_STORE_ECORRUPT naming its table, rowid and column), the read shapes
+ * the other readers share (rows into a growing array, whether a table
+ * exists, a passage's axles), and the integrity check. The caller's thread; no state beyond the handle.
  */
 #include <limits.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -413,4 +415,82 @@ int amfi_store_integrity_check(amfi_store *s, char *result, size_t len,
     if (clean)
         snprintf(result, len, "ok");
     return 0;
+}
+
+/* ---- shared read shapes ---------------------------------------------------- */
+
+int st_collect(amfi_store *s, sqlite3_stmt *st, st_row_fn row, const void *ctx, size_t size,
+               size_t cap0,
+               const char *what, const char *noun, void **arr, size_t *n, char *err,
+               size_t errlen)
+{
+    unsigned char *a = NULL;
+    size_t k = 0, cap = 0;
+    int rc = 0, src = SQLITE_DONE;
+    while (rc == 0 && (src = sqlite3_step(st)) == SQLITE_ROW) {
+        if (k == cap) {
+            size_t nc = cap ? 2 * cap : cap0;
+            unsigned char *na = realloc(a, nc * size);
+            if (!na) {
+                rc = st_fail(err, errlen, AMFI_ENOMEM, "out of memory for %zu %s", nc, noun);
+                break;
+            }
+            a = na;
+            cap = nc;
+        }
+        rc = row(st, ctx, a + k * size, err, errlen);
+        if (rc == 0)
+            k++;
+    }
+    if (rc == 0 && src != SQLITE_DONE)
+        rc = st_db_fail(s, src, what, err, errlen);
+    sqlite3_finalize(st);
+    if (rc != 0 || k == 0) {
+        free(a);
+        a = NULL;
+        k = 0;
+    }
+    *arr = a;
+    *n = k;
+    return rc;
+}
+
+int st_has_table(amfi_store *s, const char *name, int *yes, char *err, size_t errlen)
+{
+    sqlite3_stmt *st = NULL;
+    int rc = st_prepare(s, "SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name = ?1",
+                        &st, "raw samples: schema", err, errlen);
+    if (rc != 0)
+        return rc;
+    int src = sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
+    if (src == SQLITE_OK)
+        src = sqlite3_step(st);
+    if (src == SQLITE_ROW)
+        *yes = sqlite3_column_int(st, 0) > 0;
+    else
+        rc = st_db_fail(s, src, "raw samples: schema", err, errlen);
+    sqlite3_finalize(st);
+    return rc;
+}
+
+int st_read_axles(amfi_store *s, sqlite3_stmt *st, int64_t id, amfi_passage_row *r, int *seen,
+                  const char *what, char *err, size_t errlen)
+{
+    origin o = {"axles", id};
+    int rc = 0, k = 0, src = sqlite3_bind_int64(st, 1, id);
+    while (rc == 0 && src == SQLITE_OK && (src = sqlite3_step(st)) == SQLITE_ROW) {
+        int64_t idx = 0;
+        rc = st_read_int(st, 0, 1, r->n_axles, &o, &idx, err, errlen);
+        if (rc == 0 && idx > 1) /* axle 1 has no spacing (NULL, a CHECK of the schema) */
+            rc = st_read_real_or_null(st, 1, &R_SPACING, &o, &r->spacing_m[idx - 2], err, errlen);
+        if (rc == 0)
+            rc = st_read_real_or_null(st, 2, &R_KG, &o, &r->axle_kg[idx - 1], err, errlen);
+        k++;
+        src = SQLITE_OK;
+    }
+    if (rc == 0 && src != SQLITE_DONE)
+        rc = st_db_fail(s, src, what, err, errlen);
+    if (seen)
+        *seen = k;
+    return rc;
 }

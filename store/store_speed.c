@@ -29,47 +29,17 @@ int amfi_store_has_estimated(amfi_store *s, int *yes, char *err, size_t errlen)
     return rc;
 }
 
-/* Step st (columns id, utime, speed_mps, speed_given_mps), appending to *a. */
-static int read_pairs(amfi_store *s, sqlite3_stmt *st, amfi_speed_pair **a, size_t *n,
-                      char *err, size_t errlen)
+/* One row (id, utime, speed_mps, speed_given_mps). */
+static int read_pair(sqlite3_stmt *st, const void *ctx, void *rec, char *err, size_t errlen)
 {
-    size_t cap = 0;
-    int rc = 0, src;
-    while ((src = sqlite3_step(st)) == SQLITE_ROW) {
-        origin o = {"passages", sqlite3_column_int64(st, 0)};
-        amfi_speed_pair p;
-        rc = st_read_int(st, 1, 0, AMFI_STORE_MAX_UTIME, &o, &p.utime, err, errlen);
-        if (rc == 0)
-            rc = st_read_real(st, 2, &R_SPEED_POS, &o, &p.speed_mps, err, errlen);
-        if (rc == 0)
-            rc = st_read_real(st, 3, &R_SPEED_POS, &o, &p.speed_given_mps, err, errlen);
-        if (rc != 0)
-            return rc;
-        if (*n == cap) {
-            size_t nc = cap ? 2 * cap : 256;
-            amfi_speed_pair *na = realloc(*a, nc * sizeof *na);
-            if (!na)
-                return st_fail(err, errlen, AMFI_ENOMEM, "out of memory for %zu speeds", nc);
-            *a = na;
-            cap = nc;
-        }
-        (*a)[(*n)++] = p;
-    }
-    if (src != SQLITE_DONE)
-        rc = st_db_fail(s, src, "passages: read estimated speeds", err, errlen);
-    return rc;
-}
-
-/* Hand the array over (rc 0) or free it. */
-static int hand_over(int rc, amfi_speed_pair *a, size_t n, amfi_speed_pair **out, size_t *nout)
-{
-    if (rc != 0 || n == 0) {
-        free(a);
-        a = NULL;
-        n = 0;
-    }
-    *out = a;
-    *nout = n;
+    (void)ctx;
+    amfi_speed_pair *p = rec;
+    origin o = {"passages", sqlite3_column_int64(st, 0)};
+    int rc = st_read_int(st, 1, 0, AMFI_STORE_MAX_UTIME, &o, &p->utime, err, errlen);
+    if (rc == 0)
+        rc = st_read_real(st, 2, &R_SPEED_POS, &o, &p->speed_mps, err, errlen);
+    if (rc == 0)
+        rc = st_read_real(st, 3, &R_SPEED_POS, &o, &p->speed_given_mps, err, errlen);
     return rc;
 }
 
@@ -79,12 +49,12 @@ static int query_pairs(amfi_store *s, const char *sql, const amfi_passage_filter
                        amfi_speed_pair **out, size_t *n, char *err, size_t errlen)
 {
     sqlite3_stmt *st = NULL;
-    amfi_speed_pair *a = NULL;
-    size_t k = 0;
-    int rc = 0, src = sqlite3_prepare_v2(s->db, sql, -1, &st, NULL);
-    if (src != SQLITE_OK) {
-        rc = st_db_fail(s, src, "speeds: prepare", err, errlen);
-    } else if (f) {
+    *out = NULL;
+    *n = 0;
+    int rc = st_prepare(s, sql, &st, "speeds: prepare", err, errlen);
+    if (rc != 0)
+        return rc;
+    if (f) {
         sqlite3_bind_int64(st, 1, f->from);
         sqlite3_bind_int64(st, 2, f->to);
         if (f->status)
@@ -94,10 +64,11 @@ static int query_pairs(amfi_store *s, const char *sql, const amfi_passage_filter
     } else {
         sqlite3_bind_int(st, 1, max);
     }
-    if (rc == 0)
-        rc = read_pairs(s, st, &a, &k, err, errlen);
-    sqlite3_finalize(st);
-    return hand_over(rc, a, k, out, n);
+    void *a = NULL;
+    rc = st_collect(s, st, read_pair, NULL, sizeof **out, 256, "passages: read estimated speeds",
+                    "speeds", &a, n, err, errlen);
+    *out = a;
+    return rc;
 }
 
 int amfi_store_speed_pairs(amfi_store *s, const amfi_passage_filter *f, amfi_speed_pair **out,

@@ -245,22 +245,8 @@ int amfi_store_web_passage(amfi_store *s, int64_t id, amfi_web_passage *out, int
     }
     if (rc == 0 && *found) {
         amfi_passage_row *r = &out->row;
-        origin oa = {"axles", id};
-        int seen = 0, asrc = SQLITE_DONE;
-        sqlite3_bind_int64(a, 1, id);
-        while (rc == 0 && (asrc = sqlite3_step(a)) == SQLITE_ROW) {
-            int64_t idx = 0;
-            double sp = NAN;
-            rc = st_read_int(a, 0, 1, r->n_axles, &oa, &idx, err, errlen);
-            if (rc == 0) rc = st_read_real_or_null(a, 1, &R_SPACING, &oa, &sp, err, errlen);
-            if (rc == 0 && idx > 1)
-                r->spacing_m[idx - 2] = sp;
-            if (rc == 0)
-                rc = st_read_real_or_null(a, 2, &R_KG, &oa, &r->axle_kg[idx - 1], err, errlen);
-            seen++;
-        }
-        if (rc == 0 && asrc != SQLITE_DONE)
-            rc = st_db_fail(s, asrc, "passage: axles", err, errlen);
+        int seen = 0;
+        rc = st_read_axles(s, a, id, r, &seen, "passage: axles", err, errlen);
         if (rc == 0 && seen != r->n_axles)
             rc = st_fail(err, errlen, AMFI_STORE_ECORRUPT,
                          "%s: passages row %lld: n_axles %d but %d axle rows", s->path,

@@ -20,24 +20,15 @@ int amfi_store_raw_oldest(amfi_store *s, int64_t *utime, int *found, char *err, 
     *found = 0;
     sqlite3_stmt *st = NULL;
     /* a store before raw samples has no raw_windows: no window, no error */
-    rc = st_prepare(s,
-                    "SELECT (SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND "
-                    "name = 'raw_windows')",
-                    &st, "raw samples: schema", err, errlen);
-    if (rc != 0)
-        return rc;
-    int src = sqlite3_step(st);
-    const int has = src == SQLITE_ROW && sqlite3_column_int(st, 0) > 0;
-    if (src != SQLITE_ROW)
-        rc = st_db_fail(s, src, "raw samples: schema", err, errlen);
-    sqlite3_finalize(st);
+    int has = 0;
+    rc = st_has_table(s, "raw_windows", &has, err, errlen);
     if (rc != 0 || !has)
         return rc;
     rc = st_prepare(s, "SELECT utime, id FROM raw_windows ORDER BY utime, id LIMIT 1", &st,
                     "raw_windows: oldest", err, errlen);
     if (rc != 0)
         return rc;
-    src = sqlite3_step(st);
+    int src = sqlite3_step(st);
     if (src == SQLITE_ROW) {
         origin o = {"raw_windows", sqlite3_column_int64(st, 1)};
         rc = st_read_int(st, 0, 0, AMFI_STORE_MAX_UTIME, &o, utime, err, errlen);

@@ -6,7 +6,9 @@
  * ignoring a minority of outliers, the raise debounce (raise_after
  * evaluations in a row, a broken streak starting again), one event per
  * state change, the hysteresis band where nothing happens, the clear
- * debounce, the refill and alert state after a restart, refused figures.
+ * debounce, the refill and alert state after a restart, refused figures;
+ * the two-sided strict mode behind the speed-drift alert (|median| > raise
+ * raises, |median| < clear clears).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -21,7 +23,7 @@
 
 static amfi_level_params params(int w, double raise, double clear, int ra, int ca)
 {
-    amfi_level_params p = {1, w, raise, clear, ra, ca};
+    amfi_level_params p = {1, w, raise, clear, ra, ca, 0, 0};
     return p;
 }
 
@@ -157,6 +159,50 @@ static void test_restore_and_refusals(void **state)
     amfi_level_rule_destroy(l);
 }
 
+/* absolute, strict_raise: a drift either way; a median exactly at the
+ * raise level does not raise, one beyond it does, on either side. */
+static void test_absolute_strict(void **state)
+{
+    (void)state;
+    amfi_level_params p = params(1, 0.02, 0.01, 1, 1);
+    const char *field = NULL;
+    char err[160];
+    p.absolute = 1;
+    p.strict_raise = 1;
+    amfi_level_rule *l = NULL;
+    assert_int_equal(0, amfi_level_rule_create(&p, "speed_drift", "info", "c", &l, err,
+                                               sizeof err));
+    amfi_level_eval ev;
+    amfi_alert_event a;
+    assert_int_equal(AMFI_IND_EVAL, amfi_level_rule_push(l, -0.02, &ev, &a));
+    assert_int_equal(AMFI_IND_EVAL | AMFI_IND_ALERT, amfi_level_rule_push(l, -0.03, &ev, &a));
+    assert_int_equal(1, a.raised);
+    assert_non_null(strstr(a.message, "beyond +/-0.02"));
+    assert_int_equal(AMFI_IND_EVAL, amfi_level_rule_push(l, 0.015, &ev, &a));
+    assert_int_equal(AMFI_IND_EVAL | AMFI_IND_ALERT, amfi_level_rule_push(l, -0.005, &ev, &a));
+    assert_int_equal(0, a.raised);
+    assert_non_null(strstr(a.message, "within +/-0.01"));
+    assert_int_equal(AMFI_IND_EVAL | AMFI_IND_ALERT, amfi_level_rule_push(l, 0.025, &ev, &a));
+    amfi_level_rule_destroy(l);
+    /* not strict: at the level raises */
+    p.strict_raise = 0;
+    assert_int_equal(0, amfi_level_rule_create(&p, "k", "info", "c", &l, err, sizeof err));
+    assert_int_equal(AMFI_IND_EVAL | AMFI_IND_ALERT, amfi_level_rule_push(l, -0.02, &ev, &a));
+    amfi_level_rule_destroy(l);
+    /* |median| is never below a clear level of 0; modes are 0 or 1 */
+    p.clear = 0;
+    assert_int_equal(AMFI_IND_EINVAL, amfi_level_params_check(&p, &field, err, sizeof err));
+    assert_string_equal("clear", field);
+    p.clear = 0.01;
+    p.absolute = 2;
+    assert_int_equal(AMFI_IND_EINVAL, amfi_level_params_check(&p, &field, err, sizeof err));
+    assert_string_equal("absolute", field);
+    p.absolute = 0;
+    p.strict_raise = -1;
+    assert_int_equal(AMFI_IND_EINVAL, amfi_level_params_check(&p, &field, err, sizeof err));
+    assert_string_equal("strict_raise", field);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -164,6 +210,7 @@ int main(void)
         cmocka_unit_test(test_raise_clear),
         cmocka_unit_test(test_broken_streak),
         cmocka_unit_test(test_restore_and_refusals),
+        cmocka_unit_test(test_absolute_strict),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -84,21 +84,6 @@ static int count_ok(const char *v)
     return errno == 0 && end != v && !*end && x >= 0;
 }
 
-/* text without control characters, valid UTF-8 (site.name, site.bridge_type) */
-static int text_ok(const char *s)
-{
-    const unsigned char *p = (const unsigned char *)s;
-    while (*p) {
-        int n = *p < 0x80 ? 1 : (*p & 0xe0) == 0xc0 && *p >= 0xc2 ? 2 : (*p & 0xf0) == 0xe0 ? 3
-              : (*p & 0xf8) == 0xf0 && *p <= 0xf4 ? 4 : 0;
-        if (!n || (n == 1 && (*p < 0x20 || *p == 0x7f))) return 0;
-        for (int k = 1; k < n; k++)
-            if ((p[k] & 0xc0) != 0x80) return 0;
-        p += n;
-    }
-    return 1;
-}
-
 /* The fleet summary's columns (the view fleet_summary, central version 8):
  * 0-6 as the table prints them, then the site's facts and the full times. */
 enum { FS_SITE, FS_PASSAGES, FS_LAST, FS_STATE, FS_RATIO, FS_OPEN, FS_SHIPPED, FS_NAME, FS_LAT,
@@ -112,13 +97,6 @@ static const char fleet_summary_sql[] =
     "  to_char(last_passage AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.US\"Z\"'),"
     "  to_char(last_shipped AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.US\"Z\"')"
     " FROM fleet_summary ORDER BY site_id";
-
-static int coord_ok(const char *v, double lim)
-{
-    char *end;
-    double x = strtod(v, &end);
-    return end != v && !*end && x >= -lim && x <= lim;
-}
 
 /* What is wrong with row i of the fleet summary query, NULL if nothing:
  * site id as amfid's config allows it, counts, a known state, a ratio, the
@@ -146,13 +124,13 @@ static const char *fleet_row_problem(PGresult *r, int i)
             return "fleet_latest_state.std_ratio is not a ratio in [0, 999.999]";
     }
     if (!PQgetisnull(r, i, FS_NAME)
-        && (!text_ok(PQgetvalue(r, i, FS_NAME)) || strlen(PQgetvalue(r, i, FS_NAME)) > 127))
+        && (!fleet_site_text_ok(PQgetvalue(r, i, FS_NAME)) || strlen(PQgetvalue(r, i, FS_NAME)) > 127))
         return "fleet_sites.name is not 1 .. 127 bytes of UTF-8 text without control characters";
     if (!PQgetisnull(r, i, FS_TYPE)
-        && (!text_ok(PQgetvalue(r, i, FS_TYPE)) || strlen(PQgetvalue(r, i, FS_TYPE)) > 63))
+        && (!fleet_site_text_ok(PQgetvalue(r, i, FS_TYPE)) || strlen(PQgetvalue(r, i, FS_TYPE)) > 63))
         return "fleet_sites.bridge_type is not 1 .. 63 bytes of UTF-8 text without control characters";
-    if ((!PQgetisnull(r, i, FS_LAT) && !coord_ok(PQgetvalue(r, i, FS_LAT), 90))
-        || (!PQgetisnull(r, i, FS_LON) && !coord_ok(PQgetvalue(r, i, FS_LON), 180)))
+    if ((!PQgetisnull(r, i, FS_LAT) && !fleet_site_coord_ok(PQgetvalue(r, i, FS_LAT), 90))
+        || (!PQgetisnull(r, i, FS_LON) && !fleet_site_coord_ok(PQgetvalue(r, i, FS_LON), 180)))
         return "fleet_sites.latitude or longitude is not a number of degrees in range";
     return NULL;
 }
@@ -433,8 +411,8 @@ static int site_meta(PGconn *pg, amfi_store *s, const char *site, char *err, siz
     for (int k = 0; rc == 0 && PQntuples(r) == 1 && k < 4; k++) {
         const char *v = PQgetvalue(r, 0, k);
         if (PQgetisnull(r, 0, k)) continue;
-        int ok = k == 1 ? coord_ok(v, 90) : k == 2 ? coord_ok(v, 180)
-                        : text_ok(v) && strlen(v) <= (k == 0 ? 127u : 63u);
+        int ok = k == 1 ? fleet_site_coord_ok(v, 90) : k == 2 ? fleet_site_coord_ok(v, 180)
+                        : fleet_site_text_ok(v) && strlen(v) <= (k == 0 ? 127u : 63u);
         if (!ok)
             rc = fail(err, errlen, 1, "central fleet_sites (site %s): %s is not what amfid.yaml(5) "
                       "allows for %s", site, keys[k] + 5, keys[k]);
