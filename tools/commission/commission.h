@@ -210,6 +210,10 @@ typedef struct cm_result {
     double seg_scale[AMFI_MAX_SEGMENTS], seg_sd_rel[AMFI_MAX_SEGMENTS];
     double seg_corr_max;
     char seg_corr_what[160];
+    /* the most negative correlation between two segments (they trade: one
+     * stiffer, the other softer, fit alike) */
+    double seg_trade_corr;
+    char seg_trade_what[160];
 } cm_result;
 
 /* Stage 1 on every run's tail and the ambient records (n_amb, each amb[i]

@@ -936,11 +936,20 @@ static int segment_results(const amfi_site_config *design, const nls *q, const d
     }
     res->seg_corr_max = 0;
     res->seg_corr_what[0] = 0;
+    res->seg_trade_corr = 0;
+    res->seg_trade_what[0] = 0;
     for (int i = 0; i < n; i++) {
         res->seg_scale[i] = exp(p[CM_P_EI] + p[CM_P_MASS] + p[CM_P_SEG + i]);
         res->seg_sd_rel[i] = sqrt(cs[i][i]);
         for (int j = 0; j < i; j++) {
             const double c = cs[i][j] / sqrt(cs[i][i] * cs[j][j]);
+            if (c < res->seg_trade_corr) {
+                res->seg_trade_corr = c;
+                snprintf(res->seg_trade_what, sizeof res->seg_trade_what,
+                         "segment %d's stiffness (%g .. %g m) from segment %d's (%g .. %g m)",
+                         i + 1, res->seg_x0_m[i], res->seg_x1_m[i], j + 1, res->seg_x0_m[j],
+                         res->seg_x1_m[j]);
+            }
             if (fabs(c) > res->seg_corr_max) {
                 res->seg_corr_max = fabs(c);
                 snprintf(res->seg_corr_what, sizeof res->seg_corr_what,
@@ -1312,11 +1321,14 @@ int cm_identify(const amfi_site_config *design0, cm_runs *runs,
         if (res->n_segments > 0) {
             if (segment_results(&design, &q, p, res, err, errlen) != 0)
                 return -1;
-            if (res->seg_corr_max > 0.98) {
+            /* two segments that move opposite ways trade; a correlation near
+             * +1 is their common level (the mass scale's, f1's), which their
+             * uncertainty below judges */
+            if (res->seg_trade_corr < -0.98) {
                 snprintf(err, errlen,
                          "the runs cannot tell %s (correlation %.3f): they trade against each "
                          "other; fewer segments, or sensors nearer the segments",
-                         res->seg_corr_what, res->seg_corr_max);
+                         res->seg_trade_what, res->seg_trade_corr);
                 return -1;
             }
             for (int i = 0; i < res->n_segments; i++)
