@@ -1321,16 +1321,16 @@ int cm_identify(const amfi_site_config *design0, cm_runs *runs,
         if (res->n_segments > 0) {
             if (segment_results(&design, &q, p, res, err, errlen) != 0)
                 return -1;
-            /* two segments that move opposite ways trade; a correlation near
-             * +1 is their common level (the mass scale's, f1's), which their
-             * uncertainty below judges */
-            if (res->seg_trade_corr < -0.98) {
-                snprintf(err, errlen,
-                         "the runs cannot tell %s (correlation %.3f): they trade against each "
-                         "other; fewer segments, or sensors nearer the segments",
-                         res->seg_trade_what, res->seg_trade_corr);
-                return -1;
-            }
+            /* No refusal on the correlation between two segments' values:
+             * with f1 fixed they are anti-correlated by construction (one
+             * stiffer, the other softer, f1 the same) and with the mass's
+             * uncertainty positively (the common level). Whether the runs
+             * tell the segments apart is the fitted parameters' correlation
+             * (each segment relative to the reference, above) and each
+             * segment's uncertainty (below). Measured: 20 noise-free runs,
+             * the left half 10 % soft, --segments 2 with the detector and
+             * sensor held: the halves' correlation -0.989 while each was
+             * found within 1.2 %. */
             for (int i = 0; i < res->n_segments; i++)
                 if (!(res->seg_sd_rel[i] <= CM_SEG_MAX_SD)) {
                     snprintf(err, errlen,
