@@ -48,7 +48,7 @@ refuse() {
 }
 
 # shellcheck disable=SC2086
-refuse 2 "segments" --config "$design" --runs "$dir/c4/RUNS.csv" --out "$dir/site.yaml" \
+refuse 2 "segments: '9' is not a number in \[2, 8\]" --config "$design" --runs "$dir/c4/RUNS.csv" --out "$dir/site.yaml" \
   --segments 9
 # shellcheck disable=SC2086
 refuse 1 "4 runs for 4 fitted parameters .*at least 8 runs" --config "$design" \
