@@ -90,14 +90,21 @@ cls=$(sed -n 's/.*"criterion":"gross".*"class":"\([^"]*\)".*/\1/p' "$out/accurac
 # site files through amfi-commission's JSON; the truth from the case file
 # is the caller's to compare)
 j=$(cat "$out/commission.json")
-num() { printf '%s' "$j" | sed -n "s/.*\"$1\":\([-0-9.e+]*\).*/\1/p"; }
+# the first occurrence of a key (the top level's: --segments adds each
+# segment's stiffness_scale after it)
+num() { printf '%s' "$j" | grep -o "\"$1\":[-0-9.e+]*" | head -n 1 | cut -d: -f2; }
+# --segments (COMMISSION_ARGS): each segment's E·I scale and its relative
+# uncertainty, front to back ("stiffness" is then the reference segment's)
+segs=$(printf '%s' "$j" | grep -o '"to_m":[-0-9.e+]*,"stiffness_scale":[-0-9.e+]*,"sd_rel":[-0-9.e+]*' |
+  awk -F'[:,]' '{ printf "%s%.4f+-%.2f%%", (NR > 1 ? "/" : ""), $4, 100 * $6 }')
 awk -F, -v f1="$(num f1_commissioned_hz)" -v fm="$(num f1_measured_hz)" \
     -v st="$(num stiffness_scale)" -v ms="$(num mass_scale)" -v ka="$(num bearing_kL_EI)" \
     -v so="$(num sensor_offset_m)" -v ck="$(num clock_offset_s)" -v ss="$(num speed_scale)" \
-    -v cls="$cls" -v secs="$(echo "$t1 - $t0" | bc)" '
+    -v cls="$cls" -v secs="$(echo "$t1 - $t0" | bc)" -v segs="$segs" '
   NR > 1 { e = 100 * ($2 - $3) / $3; n++; s += e; a += (e < 0 ? -e : e)
            if (n == 1 || (e < 0 ? -e : e) > (w < 0 ? -w : w)) w = e }
   END { printf "f1_meas=%.4f f1_model=%.4f stiffness=%.4f mass=%.4f kappa=%.3f sensor=%+.3f " \
                "clock=%+.5f speed=%.4f vehicles=%d gvw_mean=%+.2f gvw_mean_abs=%.2f " \
-               "gvw_worst=%+.2f class=%s commission_s=%.0f\n",
-               fm, f1, st, ms, ka, so, ck, ss, n, s / n, a / n, w, cls, secs }' "$out/gross.csv"
+               "gvw_worst=%+.2f class=%s commission_s=%.0f%s\n",
+               fm, f1, st, ms, ka, so, ck, ss, n, s / n, a / n, w, cls, secs,
+               (segs == "" ? "" : " segments=" segs) }' "$out/gross.csv"

@@ -113,8 +113,21 @@ enum {
     CM_P_SENSOR, /* sensor offset, m (every sensor moved alike) */
     CM_P_CLOCK,  /* detector clock offset, s: detector time − true time */
     CM_P_SPEED,  /* log of the detector's speed scale: reported / true */
-    CM_N_PARAMS
+    /* Per-segment stiffness (cm_options.n_segments > 0): CM_P_SEG + i is
+     * the log of segment i's E·I relative to the common stiffness scale
+     * (site segment i's E·I = c·r·e^{p}·its design E·I). One segment, the
+     * one holding the first sensor, is the reference (held at 0: f1 and the
+     * ratio r fix the common level); the others are fitted. 0 and unused
+     * otherwise (a design's own segments then scale with the common scale). */
+    CM_P_SEG,
+    CM_N_PARAMS = CM_P_SEG + AMFI_MAX_SEGMENTS
 };
+
+/* Per-segment fits: at most this many equal segments, at least 2 runs per
+ * fitted parameter, and each segment's stiffness known to within
+ * CM_SEG_MAX_SD (relative standard uncertainty) or the fit is refused. */
+#define CM_MAX_FIT_SEGMENTS 8
+#define CM_SEG_MAX_SD 0.02
 
 typedef struct cm_options {
     int fit[CM_N_PARAMS];    /* 1: fitted, 0: held at the design's */
@@ -135,6 +148,10 @@ typedef struct cm_options {
                                 (AMFI_MODES_RESOLVED) where the site says observable or
                                 all: the scans and the search (set by cm_identify); the
                                 weighings before and after keep the site's modes */
+    int n_segments;          /* > 0: the span cut into this many equal segments, each
+                                with its own E·I scale (2 .. CM_MAX_FIT_SEGMENTS; the
+                                design's own segments must end on their boundaries);
+                                0 (default): one stiffness scale for the whole beam */
     int verbose;             /* progress on stderr */
 } cm_options;
 
@@ -183,6 +200,20 @@ typedef struct cm_result {
     /* process CPU seconds of the stages: modal identification with the
      * design's weighing, the scans, the search, the final weighing */
     double cpu_modal_s, cpu_scan_s, cpu_search_s, cpu_final_s;
+    /* per-segment stiffness (n_segments > 0): each segment's E·I over the
+     * design's (c·r·e^{p[CM_P_SEG + i]}) and its relative standard
+     * uncertainty (f1's, the common scale's and the fitted parameters'
+     * through the f1 constraint); the largest |correlation| between two
+     * segments' stiffness or a segment's and another fitted parameter */
+    int n_segments, seg_ref;
+    double seg_x0_m[AMFI_MAX_SEGMENTS], seg_x1_m[AMFI_MAX_SEGMENTS];
+    double seg_scale[AMFI_MAX_SEGMENTS], seg_sd_rel[AMFI_MAX_SEGMENTS];
+    double seg_corr_max;
+    char seg_corr_what[160];
+    /* the most negative correlation between two segments (they trade: one
+     * stiffer, the other softer, fit alike) */
+    double seg_trade_corr;
+    char seg_trade_what[160];
 } cm_result;
 
 /* Stage 1 on every run's tail and the ambient records (n_amb, each amb[i]

@@ -5,7 +5,8 @@
  * docs/commissioning.md).
  *
  *   amfi-commission --config DESIGN.yaml --runs RUNS.csv [--ambient FILE.csv ...]
- *                   --out SITE.yaml [--report DIR] [--hold NAME ...] [--verbose]
+ *                   --out SITE.yaml [--report DIR] [--hold NAME ...] [--segments N]
+ *                   [--verbose]
  *
  * Writes SITE.yaml: DESIGN.yaml with the fitted bridge, sensors, λ and
  * detector sections and a comment block giving each value, its uncertainty,
@@ -34,7 +35,7 @@
 #define PROG "amfi-commission"
 #define MAX_AMBIENT 32
 
-static const char *const hold_names[CM_N_PARAMS] = {"stiffness", "mass",  "bearings",
+static const char *const hold_names[CM_P_SEG] = {"stiffness", "mass",  "bearings",
                                                     "sensor",    "clock", "speed"};
 
 static void usage(FILE *f)
@@ -42,7 +43,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: " PROG " --config DESIGN.yaml --runs RUNS.csv [--ambient FILE.csv ...]\n"
             "                       --out SITE.yaml [--report DIR] [--hold NAME ...] [--fit-lambda]\n"
-            "                       [--speed-sd F] [--verbose]\n"
+            "                       [--speed-sd F] [--segments N] [--verbose]\n"
             "Commission a site's bridge model from calibration trucks of known axle loads and\n"
             "the bridge's free vibration (docs/commissioning.md).\n"
             "  --config FILE     the site file from the drawings (bridge, sensors, solver)\n"
@@ -60,9 +61,12 @@ static void usage(FILE *f)
             "                    run (e.g. 0.03): each run's speed is estimated from its\n"
             "                    acceleration, the detector's mean error is its speed scale\n"
             "                    (default 0: the detector's speeds, one common scale)\n"
+            "  --segments N      fit each of N equal segments' stiffness (E.I) instead of one\n"
+            "                    scale for the beam, 2 .. %d; refused when the runs cannot\n"
+            "                    tell them apart\n"
             "  --verbose         the search's progress on stderr\n"
             "Exit 0 commissioned, 1 bad input or runs that cannot identify the model, 2 bad\n"
-            "command line.\n");
+            "command line.\n", CM_MAX_FIT_SEGMENTS);
 }
 
 /* ---- SITE.yaml ---------------------------------------------------------- */
@@ -222,8 +226,16 @@ static void put_header(text *t, const char *design, const char *runs_path, int n
             r->run_speed_sd_pct);
     put(t, "# Fitted (value +- standard uncertainty; from f1, the runs' known axle loads\n"
            "# and their fit with the free vibration after the last axle):\n");
-    for (int k = 0; k < CM_N_PARAMS; k++) {
+    for (int k = 0; k < CM_P_SEG; k++) {
         double v = r->p[k], sd = r->sd[k];
+        if (k == CM_P_EI && r->n_segments > 0) {
+            put(t, "#   flexural stiffness per segment (E.I over the design's):\n");
+            for (int i = 0; i < r->n_segments; i++)
+                put(t, "#     %5.2f .. %5.2f m  x%.5f +- %.5f%s\n", r->seg_x0_m[i],
+                    r->seg_x1_m[i], r->seg_scale[i], r->seg_scale[i] * r->seg_sd_rel[i],
+                    i == r->seg_ref ? " (the reference: the first sensor's segment)" : "");
+            continue;
+        }
         if (k == CM_P_SPEED)
             v = r->speed_scale_log, sd = r->speed_scale_sd;
         switch (k) {
@@ -276,7 +288,11 @@ static void put_header(text *t, const char *design, const char *runs_path, int n
            "(design: %+.2f, %.2f, %+.2f %%).\n",
         r->after.mean_gvw_pct, r->after.mean_abs_gvw_pct, r->after.worst_gvw_pct,
         r->before.mean_gvw_pct, r->before.mean_abs_gvw_pct, r->before.worst_gvw_pct);
-    put(t, "# Largest correlation between fitted parameters %.3f.\n\n", r->corr_max);
+    put(t, "# Largest correlation between fitted parameters %.3f", r->corr_max);
+    if (r->n_segments > 0)
+        put(t, "; between a segment's stiffness and\n# another's or another parameter %.3f (%s)",
+            r->seg_corr_max, r->seg_corr_what[0] ? r->seg_corr_what : "none");
+    put(t, ".\n\n");
 }
 
 static int write_site(const char *out, const char *design_path, const char *runs_path,
@@ -323,6 +339,12 @@ static int write_site(const char *out, const char *design_path, const char *runs
                fabs(a->density_kgm3 / b->density_kgm3 - 1) < 1e-8 &&
                fabs(back.solver.sensor_x_m[0] - r->site.solver.sensor_x_m[0]) < 1e-8 &&
                fabs(back.lambda.lambda_ref / r->lambda_ref - 1) < 1e-5 && !back.lambda.automatic;
+    same = same && a->n_segments == b->n_segments;
+    for (int i = 0; same && i < a->n_segments; i++)
+        same = fabs(a->segments[i].EI_nm2 - b->segments[i].EI_nm2) <=
+                   1e-8 * (1 + b->segments[i].EI_nm2) &&
+               fabs(a->segments[i].mass_kgpm - b->segments[i].mass_kgpm) <=
+                   1e-8 * (1 + b->segments[i].mass_kgpm);
     for (int i = 0; same && i < a->n_supports; i++)
         same = fabs(a->supports[i].k_theta_nmprad - b->supports[i].k_theta_nmprad) <=
                1e-8 * (1 + b->supports[i].k_theta_nmprad);
@@ -393,6 +415,19 @@ static int write_report(const char *dir, const cm_runs *runs, const cm_result *r
     fprintf(f, "| commissioned model | %.4f (%+.2f %%) |\n\n", r->after.f1_hz,
             100 * (r->after.f1_hz / r->f1_meas_hz - 1));
     fprintf(f, "Damping ratio measured %.4f ± %.4f.\n\n", r->zeta_meas, r->zeta_meas_sd);
+    if (r->n_segments > 0) {
+        fprintf(f, "## Stiffness per segment\n\nE·I over the design's, with its standard "
+                   "uncertainty; the reference segment (the first sensor's) carries the "
+                   "common level that f1 fixes.\n\n| segment | from m | to m | E·I scale | "
+                   "± | ± %% |\n|---|---|---|---|---|---|\n");
+        for (int i = 0; i < r->n_segments; i++)
+            fprintf(f, "| %d%s | %.2f | %.2f | %.5f | %.5f | %.2f |\n", i + 1,
+                    i == r->seg_ref ? " (reference)" : "", r->seg_x0_m[i], r->seg_x1_m[i],
+                    r->seg_scale[i], r->seg_scale[i] * r->seg_sd_rel[i],
+                    100 * r->seg_sd_rel[i]);
+        fprintf(f, "\nLargest correlation: %s, %.3f.\n\n",
+                r->seg_corr_what[0] ? r->seg_corr_what : "none", r->seg_corr_max);
+    }
     fprintf(f, "## Runs\n\nGVW errors in %%; fit = residual/signal with the free vibration "
                "after the last axle in the window.\n\n");
     if (r->speeds_estimated)
@@ -442,6 +477,7 @@ int main(int argc, char **argv)
                                          {"verbose", no_argument, NULL, 'v'},
                                          {"fit-lambda", no_argument, NULL, 258},
                                          {"speed-sd", required_argument, NULL, 259},
+                                         {"segments", required_argument, NULL, 260},
                                          AMFI_CLI_END};
     amfi_cli cli;
     amfi_cli_init(&cli, PROG, argc, argv, opts, usage);
@@ -459,6 +495,7 @@ int main(int argc, char **argv)
         case 256: report = optarg; break;
         case 258: o.fit_lambda = 1; break;
         case 259: o.speed_sd = amfi_cli_num(&cli, optarg, 0, 0.15); break;
+        case 260: o.n_segments = (int)amfi_cli_integer(&cli, optarg, 2, CM_MAX_FIT_SEGMENTS); break;
         case 'a':
             if (n_amb == MAX_AMBIENT)
                 amfi_cli_fail(&cli, "at most %d records", MAX_AMBIENT);
@@ -466,7 +503,7 @@ int main(int argc, char **argv)
             break;
         case 257: {
             int found = 0;
-            for (int p = 0; p < CM_N_PARAMS; p++)
+            for (int p = 0; p < CM_P_SEG; p++)
                 if (!strcmp(optarg, hold_names[p]))
                     o.fit[p] = 0, found = 1;
             if (!found)
@@ -537,6 +574,19 @@ int main(int argc, char **argv)
     json_object_set_new(j, "stiffness_scale",
                         amfi_json_num(exp(res.p[CM_P_EI] + res.p[CM_P_MASS])));
     json_object_set_new(j, "mass_scale", amfi_json_num(exp(res.p[CM_P_MASS])));
+    if (res.n_segments > 0) {
+        json_t *sg = json_array();
+        for (int i = 0; i < res.n_segments; i++) {
+            json_t *e = json_object();
+            json_object_set_new(e, "from_m", amfi_json_num(res.seg_x0_m[i]));
+            json_object_set_new(e, "to_m", amfi_json_num(res.seg_x1_m[i]));
+            json_object_set_new(e, "stiffness_scale", amfi_json_num(res.seg_scale[i]));
+            json_object_set_new(e, "sd_rel", amfi_json_num(res.seg_sd_rel[i]));
+            json_array_append_new(sg, e);
+        }
+        json_object_set_new(j, "segments", sg);
+        json_object_set_new(j, "segments_corr_max", amfi_json_num(res.seg_corr_max));
+    }
     json_object_set_new(j, "bearing_kL_EI",
                         amfi_json_num(exp(res.p[CM_P_KAPPA]) > 1e-3 ? exp(res.p[CM_P_KAPPA]) : 0));
     json_object_set_new(j, "sensor_offset_m", amfi_json_num(res.p[CM_P_SENSOR]));
