@@ -832,6 +832,19 @@ int amfi_store_recent_fit_ratios(amfi_store *s, int max, double **out, size_t *n
 int amfi_store_recent_f1_comp(amfi_store *s, int max, double **out, size_t *n, char *err,
                               size_t errlen);
 
+/* One passage's model fit (passages.fit_ratio not NULL). */
+typedef struct amfi_fit_rec {
+    int64_t passage_id;
+    int64_t utime;    /* data time, µs */
+    double fit_ratio; /* RMS of (model − data) over the free vibration / RMS of the data */
+} amfi_fit_rec;
+
+/* The passages with a fit_ratio and from <= utime <= to, oldest first
+ * (utime, id): *out is malloc'd (free it; NULL when *n is 0). A value
+ * outside the schema's range is AMFI_STORE_ECORRUPT. */
+int amfi_store_fit_ratio_series(amfi_store *s, int64_t from, int64_t to, amfi_fit_rec **out,
+                                size_t *n, char *err, size_t errlen);
+
 /* ---- rows as column values, for other programs (store_scan.c) ----------- */
 /* amfi-sync ships a store's rows, amfi-report --pg and amfi-fleet-bench
  * write rows they did not compute: they see rows as the values of the
