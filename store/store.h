@@ -579,11 +579,13 @@ int amfi_store_web_passage(amfi_store *s, int64_t id, amfi_web_passage *out, int
 
 /* The trend series: ok GVW (passages.gvw_kg), the STD indicator's ratio
    (indicators.std_ratio), the natural frequency (passages.f1_hz), the fit
-   residual (passages.residual_rms), the deck temperature (environment.deck_c). */
+   residual (passages.residual_rms), the deck temperature (environment.deck_c),
+   the model fit over the free vibration (passages.fit_ratio). */
 enum { AMFI_WEB_GVW, AMFI_WEB_INDICATOR, AMFI_WEB_NATFREQ, AMFI_WEB_RESIDUAL,
-       AMFI_WEB_TEMPERATURE, AMFI_WEB_N_SERIES };
+       AMFI_WEB_TEMPERATURE, AMFI_WEB_FIT_RATIO, AMFI_WEB_N_SERIES };
 #define AMFI_WEB_MAX_BUCKETS 2000
-/* "gvw", "indicator", "natfreq", "residual", "temperature"; NULL outside. */
+/* "gvw", "indicator", "natfreq", "residual", "temperature", "fit_ratio";
+   NULL outside. */
 const char *amfi_store_web_series_name(int k);
 
 typedef struct amfi_web_bucket {

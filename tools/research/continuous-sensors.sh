@@ -14,6 +14,11 @@
 #             vehicles of sim_publisher/data/population-eu.csv
 #   BRIDGE    single (20 m, the reference), two (20 + 20 m), three
 #             (15 + 20 + 15 m); default: single two
+# Environment: JOBS (default 1) layouts simulated and weighed at once;
+# LAYOUTS (default all) only the layouts named (e.g. "mid1 per-span");
+# SUMMARY_ONLY=1 only reads the runs already in OUT back, over their first
+# VEHICLES vehicles (the same seed gives the same vehicles whatever the
+# count, so a longer run read over fewer vehicles is the shorter run).
 #
 # Prints one line per layout (key=value): bridge, layout, sensors (m),
 # weighed (ok passages) of passages, GVW error inferred / true − 1 in %:
@@ -87,8 +92,8 @@ site() {
   } > "$d/site.yaml"
 }
 
-# run BRIDGE LAYOUT "POS ...": simulate, weigh, print the line
-run() {
+# weigh BRIDGE LAYOUT "POS ...": simulate and weigh into OUT/BRIDGE-LAYOUT
+weigh() {
   site "$1" "$2" "$3"
   d="$out/$1-$2"
   "$bin/daemon/amfid" --make-bus-key "$d/bus.key" > /dev/null 2>&1 || die "amfid --make-bus-key"
@@ -101,15 +106,22 @@ run() {
     --lcm-url "file://$d/s.lcmlog?speed=0" > "$d/amfid.log" 2>&1 \
     || die "$1-$2: amfid: $(tail -2 "$d/amfid.log")"
   rm -f "$d/s.lcmlog"
+}
+
+# summary BRIDGE LAYOUT "POS ...": the line of OUT/BRIDGE-LAYOUT over its
+# first VEHICLES vehicles
+summary() {
+  d="$out/$1-$2"
+  [ -f "$d/a.db" ] || { echo "bridge=$1 layout=$2 not weighed"; return; }
   q() { sqlite3 -separator , "$d/a.db" "$1"; }
-  n=$(q "SELECT count(*) FROM passages")
-  ok=$(q "SELECT count(*) FROM passages WHERE status = 'ok'")
+  n=$(q "SELECT count(*) FROM passages WHERE vehicle_id <= $nveh")
+  ok=$(q "SELECT count(*) FROM passages WHERE status = 'ok' AND vehicle_id <= $nveh")
   {
     echo "vehicle_id,n_axles,speed_mps,true_kg,inferred_kg,err_pct"
     q "SELECT p.vehicle_id, p.n_axles, printf('%.2f', p.speed_mps), printf('%.0f', t.gvw_kg),
               printf('%.0f', p.gvw_kg), printf('%.3f', 100 * (p.gvw_kg / t.gvw_kg - 1))
        FROM passages p JOIN truth t USING (vehicle_id) WHERE p.status = 'ok'
-       ORDER BY p.vehicle_id"
+       AND p.vehicle_id <= $nveh ORDER BY p.vehicle_id"
   } > "$d/errors.csv"
   {
     echo "criterion,measured_kg,reference_kg"
@@ -135,6 +147,22 @@ run() {
        "cost323=${cls:--} delta=${dl:--}"
 }
 
+# run BRIDGE LAYOUT "POS ...": queue it (LAYOUTS), weigh it (JOBS at once)
+queued=""
+running=0
+run() {
+  case " ${LAYOUTS:-$2} " in *" $2 "*) ;; *) return ;; esac
+  queued="$queued$1 $2 $3
+"
+  [ "${SUMMARY_ONLY:-0}" = 1 ] && return
+  weigh "$1" "$2" "$3" &
+  running=$((running + 1))
+  if [ "$running" -ge "${JOBS:-1}" ]; then
+    wait
+    running=0
+  fi
+}
+
 for b in "$@"; do
   case $b in
     single)
@@ -154,4 +182,8 @@ for b in "$@"; do
       run three end-and-middle "6 25" ;;
     *) die "unknown bridge $b (single, two, three)" ;;
   esac
+done
+wait
+printf '%s' "$queued" | while read -r b l p; do
+  summary "$b" "$l" "$p"
 done
