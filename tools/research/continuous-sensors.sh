@@ -185,5 +185,5 @@ for b in "$@"; do
 done
 wait
 printf '%s' "$queued" | while read -r b l p; do
-  summary "$b" "$l" "$p"
+  summary "$b" "$l" "$p" < /dev/null
 done
