@@ -17,8 +17,9 @@
  * raised (warning, model_mismatch) at or above raise for raise_after
  * passages in a row, cleared below clear for clear_after.
  *
- * A module (ctx.h): start builds the rule; restore refills it from the
- * store's newest fit_ratio values and the open alert; row fills
+ * A module (ctx.h): start builds the rule; restore records its parameters
+ * in the store (meta alerts.model_fit, for amfi-report and amfi-web) and
+ * refills it from the store's newest fit_ratio values and the open alert; row fills
  * passages.fit_ratio; on_passage feeds the rule; final logs the counts.
  * modelfit_take (intake.c, at release) copies the window and its free
  * vibration for the solver thread.
@@ -105,6 +106,16 @@ static int modelfit_restore(amfid_ctx *c)
 {
     char err[256];
     int open = 0;
+    /* what this run's rule uses, for the reports (meta alerts.model_fit,
+     * enabled=0 when the fit is off; a reload does not change it: it
+     * applies at the next start) */
+    amfi_level_params rec = c->cfg->daemon.model_fit;
+    char params[256];
+    rec.enabled = on(c);
+    snprintf(err, sizeof err, "the text is longer than %zu bytes", sizeof params);
+    if (amfi_level_params_format(&rec, params, sizeof params) != 0
+        || amfi_store_meta_set(c->store, "alerts.model_fit", params, err, sizeof err) != 0)
+        LOG_WARN("store: the model fit's parameters not recorded: %s", err);
     if (!M.rule)
         return 0;
     double *x = NULL;

@@ -49,6 +49,18 @@ typedef struct amfi_level_params {
 int amfi_level_params_check(const amfi_level_params *p, const char **field, char *err,
                             size_t errlen);
 
+/* The parameters as one line of text, "enabled=1 window=25 raise=0.1
+ * clear=0.05 raise_after=10 clear_after=25" (doubles with %.17g: read back
+ * exactly), into buf: amfid records what its rules ran with in the store
+ * (meta alerts.model_fit), the reports draw those thresholds. 0, or
+ * AMFI_IND_EINVAL when buf is too small (then "" in it) or an argument NULL. */
+int amfi_level_params_format(const amfi_level_params *p, char *buf, size_t len);
+/* The line back: every field there once, as written by
+ * amfi_level_params_format, and the whole passing amfi_level_params_check.
+ * 0 (and *p), or AMFI_IND_EINVAL with err naming the field or the text at
+ * fault (*p unchanged). */
+int amfi_level_params_parse(const char *s, amfi_level_params *p, char *err, size_t errlen);
+
 typedef struct amfi_level_rule amfi_level_rule;
 
 /* kind and level: static strings put into the events ("model_mismatch",

@@ -589,11 +589,13 @@ int amfi_store_web_passage(amfi_store *s, int64_t id, amfi_web_passage *out, int
 
 /* The trend series: ok GVW (passages.gvw_kg), the STD indicator's ratio
    (indicators.std_ratio), the natural frequency (passages.f1_hz), the fit
-   residual (passages.residual_rms), the deck temperature (environment.deck_c). */
+   residual (passages.residual_rms), the deck temperature (environment.deck_c),
+   the model fit over the free vibration (passages.fit_ratio). */
 enum { AMFI_WEB_GVW, AMFI_WEB_INDICATOR, AMFI_WEB_NATFREQ, AMFI_WEB_RESIDUAL,
-       AMFI_WEB_TEMPERATURE, AMFI_WEB_N_SERIES };
+       AMFI_WEB_TEMPERATURE, AMFI_WEB_FIT_RATIO, AMFI_WEB_N_SERIES };
 #define AMFI_WEB_MAX_BUCKETS 2000
-/* "gvw", "indicator", "natfreq", "residual", "temperature"; NULL outside. */
+/* "gvw", "indicator", "natfreq", "residual", "temperature", "fit_ratio";
+   NULL outside. */
 const char *amfi_store_web_series_name(int k);
 
 typedef struct amfi_web_bucket {
@@ -841,6 +843,19 @@ int amfi_store_recent_fit_ratios(amfi_store *s, int max, double **out, size_t *n
                                  size_t errlen);
 int amfi_store_recent_f1_comp(amfi_store *s, int max, double **out, size_t *n, char *err,
                               size_t errlen);
+
+/* One passage's model fit (passages.fit_ratio not NULL). */
+typedef struct amfi_fit_rec {
+    int64_t passage_id;
+    int64_t utime;    /* data time, µs */
+    double fit_ratio; /* RMS of (model − data) over the free vibration / RMS of the data */
+} amfi_fit_rec;
+
+/* The passages with a fit_ratio and from <= utime <= to, oldest first
+ * (utime, id): *out is malloc'd (free it; NULL when *n is 0). A value
+ * outside the schema's range is AMFI_STORE_ECORRUPT. */
+int amfi_store_fit_ratio_series(amfi_store *s, int64_t from, int64_t to, amfi_fit_rec **out,
+                                size_t *n, char *err, size_t errlen);
 
 /* ---- rows as column values, for other programs (store_scan.c) ----------- */
 /* amfi-sync ships a store's rows, amfi-report --pg and amfi-fleet-bench

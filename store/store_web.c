@@ -272,6 +272,7 @@ static const struct {
     [AMFI_WEB_NATFREQ] = {"natfreq", "passages", "f1_hz", "", &R_HZ},
     [AMFI_WEB_RESIDUAL] = {"residual", "passages", "residual_rms", "", &R_NONNEG},
     [AMFI_WEB_TEMPERATURE] = {"temperature", "environment", "deck_c", "", &R_TEMP_C},
+    [AMFI_WEB_FIT_RATIO] = {"fit_ratio", "passages", "fit_ratio", "", &R_RATIO},
 };
 
 const char *amfi_store_web_series_name(int k)

@@ -73,6 +73,51 @@ static void test_params(void **state)
     assert_null(l);
 }
 
+/* The text form amfid records in the store (meta alerts.model_fit) and
+ * the reports read back: exact round trip, every refusal named. */
+static void test_params_text(void **state)
+{
+    (void)state;
+    char buf[256], err[256];
+    amfi_level_params p = params(25, 0.1, 0.05, 10, 25), q;
+    assert_int_equal(0, amfi_level_params_format(&p, buf, sizeof buf));
+    assert_string_equal(buf, "enabled=1 window=25 raise=0.10000000000000001 "
+                             "clear=0.050000000000000003 raise_after=10 clear_after=25");
+    memset(&q, 0, sizeof q);
+    assert_int_equal(0, amfi_level_params_parse(buf, &q, err, sizeof err));
+    assert_int_equal(q.enabled, 1);
+    assert_int_equal(q.window, 25);
+    assert_true(q.raise == 0.1 && q.clear == 0.05);
+    assert_int_equal(q.raise_after, 10);
+    assert_int_equal(q.clear_after, 25);
+    assert_int_equal(AMFI_IND_EINVAL, amfi_level_params_format(&p, buf, 20));
+    assert_string_equal(buf, "");
+    static const struct {
+        const char *text, *says;
+    } bad[] = {
+        {"enabled=1 window=25 raise=0.1 clear=0.05 raise_after=10", "clear_after missing"},
+        {"enabled=1 window=25 raise=x clear=0.05 raise_after=10 clear_after=25",
+         "raise: not a number"},
+        {"enabled=1 window=2.5 raise=0.1 clear=0.05 raise_after=10 clear_after=25",
+         "window: trailing text"},
+        {"enabled=1 window=25 window=25 raise=0.1 clear=0.05 raise_after=10 clear_after=25",
+         "window given twice"},
+        {"enabled=1 size=25 raise=0.1 clear=0.05 raise_after=10 clear_after=25",
+         "unknown field at 'size=25"},
+        {"enabled=1 window=25 raise=0.05 clear=0.1 raise_after=10 clear_after=25",
+         "below the raise level"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        q = p;
+        q.window = 7;
+        err[0] = '\0';
+        assert_int_equal(AMFI_IND_EINVAL, amfi_level_params_parse(bad[i].text, &q, err, sizeof err));
+        if (!strstr(err, bad[i].says))
+            fail_msg("'%s': '%s', want '%s'", bad[i].text, err, bad[i].says);
+        assert_int_equal(q.window, 7); /* unchanged */
+    }
+}
+
 static void test_raise_clear(void **state)
 {
     (void)state;
@@ -207,6 +252,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_params),
+        cmocka_unit_test(test_params_text),
         cmocka_unit_test(test_raise_clear),
         cmocka_unit_test(test_broken_streak),
         cmocka_unit_test(test_restore_and_refusals),

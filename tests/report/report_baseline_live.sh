@@ -51,6 +51,10 @@ case "$rec" in
 "window=50 every=10 baseline_n=100 std_alert_ratio="*) ;;
 *) fail "amfid did not record its indicator parameters in meta daemon.indicators: '$rec'" ;;
 esac
+# the model_mismatch rule (fit_ratio.png and amfi-web draw its levels)
+mf=$(q "SELECT value FROM meta WHERE key = 'alerts.model_fit'")
+[ "$mf" = "enabled=1 window=25 raise=0.10000000000000001 clear=0.050000000000000003 raise_after=10 clear_after=25" ] ||
+  fail "amfid did not record its model fit rule in meta alerts.model_fit: '$mf'"
 case "$(q "SELECT value FROM meta WHERE key = 'daemon.classes'")" in
 "scheme=eu group_spacing_m="*) ;;
 *) fail "amfid did not record its classes in meta daemon.classes" ;;

@@ -209,6 +209,53 @@ tail -1 "$tmp/p6/data/residual.dat" | awk '{ exit !($4 == 0.01) }' || fail "resi
 run --db "$tmp/res.db" --plot "$tmp/p7" --from 2025-11-23T00:01
 [ "$(grep -vc '^#' "$tmp/p7/data/residual.dat")" = 100 ] || fail "residual.dat with --from: not the range's 100 passages"
 
+# ---- the model fit: fit_ratio.png with the thresholds amfid ran with -------------
+# the 41 fixture passages fit (0.003), the 100 after them do not (0.3); amfid
+# recorded a rule of its own (meta alerts.model_fit)
+sqlite3 "$tmp/res.db" "UPDATE passages SET fit_ratio = CASE WHEN id > 1000 THEN 0.3 ELSE 0.003 END
+  WHERE status = 'ok';
+INSERT INTO meta (key, value) VALUES ('alerts.model_fit',
+  'enabled=1 window=5 raise=0.2 clear=0.1 raise_after=3 clear_after=4')" || exit 1
+printf 'alerts:\n  model_fit:\n    raise: 0.4\n    clear: 0.25\n' > "$tmp/mf.yaml"
+run --db "$tmp/res.db" --plot "$tmp/p8" --config "$tmp/mf.yaml"
+[ "$rc" = 0 ] || fail "--plot (fit ratio): status $rc: $(cat "$tmp/err")"
+grep -q 'fit_ratio.png  model fit ratio per passage' "$tmp/out" || fail "--plot: fit_ratio.png not listed: $(cat "$tmp/out")"
+[ -s "$tmp/p8/fit_ratio.png" ] || fail "fit_ratio.png not drawn"
+[ "$(grep -vc '^#' "$tmp/p8/data/fit_ratio.dat")" = 141 ] || fail "fit_ratio.dat: not one row per fitted passage"
+awk '!/^#/ { n++; if (n == 4 && $3 != "nan") bad = 1; if (n == 5 && $3 != 0.003) bad = 1 }
+     END { if ($3 != 0.3) bad = 1; exit bad }' "$tmp/p8/data/fit_ratio.dat" ||
+    fail "fit_ratio.dat: not the median of the last 5 once 5 are there: $(sed -n '2,7p;$p' "$tmp/p8/data/fit_ratio.dat")"
+gp8=$tmp/p8/data/plots.gp
+awk '/fit_ratio.png/ { on = 1 } on && /^plot/ { p = 1 } p && /^set output/ { exit } p' "$gp8" > "$tmp/fit.gp"
+grep -q "title 'median of the last 5'" "$tmp/fit.gp" || fail "fit_ratio.png: not the recorded window: $(cat "$tmp/fit.gp")"
+grep -q "^     0.2 with lines .* title 'raise at >= 0.2 (3 in a row)'" "$tmp/fit.gp" ||
+    fail "fit_ratio.png: not the recorded raise level 0.2: $(cat "$tmp/fit.gp")"
+grep -q "^     0.1 with lines .* title 'clear below 0.1 (4 in a row)'" "$tmp/fit.gp" ||
+    fail "fit_ratio.png: not the recorded clear level 0.1"
+grep -q "model_mismatch; thresholds: amfid's, from the store" "$gp8" || fail "fit_ratio.png: the title does not say where the thresholds come from"
+# the y range (log) holds every value and both levels inside the frame
+read -r lo hi <<EOT
+$(awk '/fit_ratio.png/ { on = 1 } on && /^set yrange/ { gsub(/\[|\]|:/, " "); print $3, $4; exit }' "$gp8")
+EOT
+awk -v lo="${lo:-0}" -v hi="${hi:-0}" 'BEGIN { exit !(lo > 0 && lo < 0.003 && hi > 0.3) }' ||
+    fail "fit_ratio.png: y range [$lo:$hi] does not hold 0.003 .. 0.3"
+grep -A6 "fit_ratio.png" "$gp8" | grep -q "set logscale y" || fail "fit_ratio.png: not on a log axis"
+# without amfid's record: --config's levels; without either: the defaults
+sqlite3 "$tmp/res.db" "DELETE FROM meta WHERE key = 'alerts.model_fit'" || exit 1
+run --db "$tmp/res.db" --plot "$tmp/p9" --config "$tmp/mf.yaml"
+grep -q "title 'raise at >= 0.4 (10 in a row)'" "$tmp/p9/data/plots.gp" &&
+  grep -q "thresholds: --config" "$tmp/p9/data/plots.gp" || fail "fit_ratio.png: not --config's levels"
+run --db "$tmp/res.db" --plot "$tmp/p9" --from 2025-11-23T00:01
+grep -q "title 'raise at >= 0.1 (10 in a row)', .*" "$tmp/p9/data/plots.gp" &&
+  grep -q "title 'clear below 0.05 (25 in a row)'" "$tmp/p9/data/plots.gp" ||
+  fail "fit_ratio.png: not the default levels"
+[ "$(grep -vc '^#' "$tmp/p9/data/fit_ratio.dat")" = 100 ] || fail "fit_ratio.dat with --from: not the range's 100 passages"
+# a damaged record is an error naming it
+sqlite3 "$tmp/res.db" "INSERT INTO meta (key, value) VALUES ('alerts.model_fit', 'enabled=1 window=5 raise=0.1 clear=0.2 raise_after=3 clear_after=4')" || exit 1
+run --db "$tmp/res.db" --plot "$tmp/p9"
+[ "$rc" = 1 ] && grep -q "res.db: meta alerts.model_fit: the clear level (0.2) must be below the raise level (0.1)" "$tmp/err" ||
+    fail "a damaged alerts.model_fit: status $rc: $(cat "$tmp/err")"
+
 # ---- one unit system per output: --units and report.units ---------------------
 # si (the default): tables and plots in kg and m/s
 run --db "$db" --summary --passages --plot "$tmp/u1"

@@ -130,6 +130,17 @@ pages() {
     canvas "$k-trends" chart-natfreq 20
     canvas "$k-trends" chart-residual 36
     canvas "$k-trends" chart-temperature 12
+    # the model fit with the model_mismatch levels as two flat lines: amfid's
+    # (meta alerts.model_fit) from the store, the defaults from the central
+    # database (which does not ship meta)
+    canvas "$k-trends" chart-fit_ratio 15
+    if [ "$k" = store ]; then
+        lv="raise at (&gt;|>)= 0.2 \(median of 5, 3 in a row; amfid's\)\|clear below 0.1 \(4 in a row\)"
+    else
+        lv="raise at (&gt;|>)= 0.1 \(median of 25, 10 in a row; defaults\)\|clear below 0.05 \(25 in a row\)"
+    fi
+    has "$k-trends" "<canvas id=\"chart-fit_ratio\"[^>]*data-series=\"mean\|min\|max\|$lv\"" 1
+    has "$k-trends" 'data-series="mean\|min\|max"' 5
 
     page "$base/alerts" "$k-alerts"
     [ "$(ids "$k-alerts" open-alerts)" = "1" ] || fail "$k-alerts: open '$(ids "$k-alerts" open-alerts)'"

@@ -6,8 +6,9 @@
  * 1 A23 (1-1-3), 2 unknown (1-1); k % 10 == 3 invalid (no axles, reason
  * "detector: axle count 0"); k == 7 status error with a hostile reason
  * (HOSTILE below); k == 9 overloaded; axle j (1-based) of passage k weighs
- * 1000 k + 100 j kg; residual 0.001 k; f1 5.7 − 0.001 k Hz on even k; deck
- * 10 °C. Eight indicator rows, a baseline, three alerts (std_increase
+ * 1000 k + 100 j kg; residual 0.001 k; f1 5.7 − 0.001 k Hz on even k;
+ * model fit ratio 0.01 k on odd k (15 ok passages); deck 10 °C; amfid's
+ * model_mismatch rule recorded (meta alerts.model_fit: MODEL_FIT). Eight indicator rows, a baseline, three alerts (std_increase
  * raised with the hostile message: open; mean_shift raised then cleared),
  * twelve environment readings, site.id SITE (web-test), a hostile
  * site.name and amfid's intake counters.
@@ -31,6 +32,7 @@
 #include "store_testing.h"
 
 #define HOSTILE "<img src=x onerror=\"window.__xss=1\">'&amp;</td><script>window.__xss=2</script>"
+#define MODEL_FIT "enabled=1 window=5 raise=0.2 clear=0.1 raise_after=3 clear_after=4"
 #define T0 INT64_C(1768006800000000) /* 2026-01-10T01:00:00Z */
 #define HOUR INT64_C(3600000000)
 
@@ -136,6 +138,7 @@ int main(int argc, char **argv)
             r.speed_mps = 20.0;
             r.speed_given_mps = 20.5;
             r.residual_rms = 0.001 * k;
+            r.fit_ratio = k % 2 && k != 7 ? 0.01 * k : NAN; /* amfid fits ok passages */
             r.formulation = "displacement";
             r.lambda = 1e-3;
             r.solve_ms = 2.5;
@@ -175,6 +178,9 @@ int main(int argc, char **argv)
                    "raw retention", err);
     if (!rc && pr.by_age != 1)
         rc = check(1, "raw retention", "not one window deleted");
+    if (!rc)
+        rc = check(amfi_store_meta_set(s, "alerts.model_fit", MODEL_FIT, err, sizeof err),
+                   "meta", err);
     amfi_baseline b = {.utime_set = T0, .n = 30, .mean_kg = 20000, .std_kg = 4000};
     strcpy(b.source, "auto");
     if (!rc)

@@ -415,8 +415,9 @@ int main(int argc, char **argv)
     struct {
         const char *series;
         long long n;
-    } tr[] = {{"gvw", 35}, {"indicator", 8}, {"natfreq", 20}, {"residual", 36}, {"temperature", 12}};
-    for (int k = 0; k < 5; k++) {
+    } tr[] = {{"gvw", 35},      {"indicator", 8},    {"natfreq", 20},
+              {"residual", 36}, {"temperature", 12}, {"fit_ratio", 15}};
+    for (int k = 0; k < 6; k++) {
         char t[96];
         snprintf(t, sizeof t, "/api/trends?series=%s&points=7", tr[k].series);
         j = get_json(t, 200);
@@ -426,6 +427,24 @@ int main(int argc, char **argv)
               json_array_size(at(j, "points")), sum_n(at(j, "points")), tr[k].n);
         json_decref(j);
     }
+    /* the model fit with the levels amfid ran with (meta alerts.model_fit) */
+    j = get_json("/api/trends?series=fit_ratio&points=40", 200);
+    CHECK(json_array_size(at(j, "points")) == 15 && sum_n(at(j, "points")) == 15
+              && fabs(rval(j, "points.0.mean") - 0.01) < 1e-12
+              && fabs(rval(j, "points.14.mean") - 0.39) < 1e-12,
+          "fit_ratio: %zu points, first %g, last %g", json_array_size(at(j, "points")),
+          rval(j, "points.0.mean"), rval(j, "points.14.mean"));
+    CHECK(at(j, "thresholds.source") && strcmp(sval(j, "thresholds.source"), "amfid") == 0
+              && fabs(rval(j, "thresholds.raise") - 0.2) < 1e-12
+              && fabs(rval(j, "thresholds.clear") - 0.1) < 1e-12
+              && ival(j, "thresholds.window") == 5 && ival(j, "thresholds.raise_after") == 3
+              && ival(j, "thresholds.clear_after") == 4
+              && at(j, "thresholds.enabled") == json_true(),
+          "fit_ratio: not amfid's recorded thresholds");
+    json_decref(j);
+    j = get_json("/api/trends?series=residual", 200);
+    CHECK(at(j, "thresholds") == NULL, "residual: thresholds it has none of");
+    json_decref(j);
     j = get_json("/api/trends?series=gvw&points=1", 200);
     CHECK(json_array_size(at(j, "points")) == 1 && json_real_value(at(j, "points.0.max")) == 201500,
           "gvw in one point: max");

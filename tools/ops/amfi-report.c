@@ -96,7 +96,7 @@ typedef struct plot_def {
 #define F_LANE 4u   /* --lane */
 #define F_RANGE (F_TIME | F_LANE)
 
-#define MAX_SECTION_PLOTS 5
+#define MAX_SECTION_PLOTS 6
 
 typedef struct section {
     const char *name;                /* --name */
@@ -134,7 +134,9 @@ static const section sections[N_SECTIONS] = {
                   {10, "natfreq.png", "natural frequency per passage, raw and "
                    "temperature-compensated", natfreq_plot},
                   {11, "residual.png", "solver residual per ok passage and its running median",
-                   residual_plot}},
+                   residual_plot},
+                  {12, "fit_ratio.png", "model fit ratio per passage, its running median, the "
+                   "model_mismatch thresholds", fit_ratio_plot}},
         .by_default = 1},
     [SEC_TREND] = {
         .name = "trend", .key = 't', .help = "the last " STR(REPORT_TREND_ROWS) " indicators",
@@ -919,8 +921,8 @@ static int run_section(const options *o, report_ctx *c, int k, int *printed)
 
 /* --plot: site name from the store's meta (site.name), else the config's
  * bridge.name, else the database's file name; thresholds from what amfid
- * recorded in the store (meta daemon.indicators), else --config, else the
- * indicator defaults. Every section's plots, in their places. */
+ * recorded in the store (meta daemon.indicators, alerts.model_fit), else
+ * --config, else the defaults. Every section's plots, in their places. */
 static int plot(const options *o, const amfi_site_config *cfg, const report_ctx *c)
 {
     amfi_store *s = c->s;
@@ -947,6 +949,28 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
         ip = cfg->daemon.indicators;
         ip_from = "--config";
     }
+    /* the model fit's rule likewise (meta alerts.model_fit), else
+     * --config's, else the loader's defaults */
+    amfi_level_params mf;
+    const char *mf_from = "built-in defaults";
+    if (amfi_store_meta_get(s, "alerts.model_fit", rec, sizeof rec, &have_rec, err,
+                            sizeof err) != 0)
+        return data_error(c, "%s", err);
+    if (have_rec) {
+        if (amfi_level_params_parse(rec, &mf, why, sizeof why) != 0)
+            return data_error(c, "meta alerts.model_fit: %s", why);
+        mf_from = "amfid's, from the store";
+    } else if (cfg) {
+        mf = cfg->daemon.model_fit;
+        mf_from = "--config";
+    } else {
+        amfi_site_config *d = malloc(sizeof *d);
+        if (!d)
+            return data_error(c, "out of memory");
+        amfi_config_defaults(d);
+        mf = d->daemon.model_fit;
+        free(d);
+    }
     if (cfg) {
         if (!found) {
             snprintf(site, sizeof site, "%s", cfg->site.name);
@@ -971,6 +995,8 @@ static int plot(const options *o, const amfi_site_config *cfg, const report_ctx 
     report_plot_frame p;
     rc = report_plot_begin(&p, s, o->plot_dir, site, &ip, o->ex.from, o->ex.to, err, sizeof err);
     p.ip_from = ip_from;
+    p.mf = &mf;
+    p.mf_from = mf_from;
     p.units = c->units;
     for (int i = 0; rc == 0 && i < n_plots; i++) {
         int drawn = 0;

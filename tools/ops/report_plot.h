@@ -18,6 +18,7 @@
 #include <stdio.h>
 
 #include "indicators.h"
+#include "level_rule.h"
 #include "store.h"
 
 /* One passage as the plots see it. */
@@ -33,6 +34,8 @@ typedef struct report_plot_frame {
     const char *dir;                 /* --plot DIR */
     const amfi_indicator_params *ip; /* the alert thresholds */
     const char *ip_from;             /* where they come from, for the titles */
+    const amfi_level_params *mf;     /* the model_mismatch rule (alerts.model_fit) */
+    const char *mf_from;             /* where it comes from, for the title */
     int units;                       /* AMFI_REPORT_UNITS_*: of GVW and speed */
     int64_t from, to;                /* --from .. --to, µs: every plot draws only these */
     FILE *gp;                        /* DIR/data/plots.gp, being written */

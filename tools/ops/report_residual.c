@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * report_residual.c: the solver's residual per ok passage in the summary
- * and residual.png (report_residual.h). Single-threaded, the caller's
+ * and residual.png, and the model fit's fit_ratio.png (report_residual.h). Single-threaded, the caller's
  * thread.
  */
 #include "report_residual.h"
@@ -152,6 +152,76 @@ int residual_plot(report_plot_frame *p, int *made, char *err, size_t errlen)
             "unset logscale y\nset format y '%%g'\nset autoscale y\nset output\n",
             yr, p->sub,
             REPORT_RESIDUAL_WINDOW);
+    *made = 1;
+    return 0;
+}
+
+int fit_ratio_plot(report_plot_frame *p, int *made, char *err, size_t errlen)
+{
+    amfi_fit_rec *a = NULL;
+    size_t n = 0;
+    if (amfi_store_fit_ratio_series(p->s, p->from, p->to, &a, &n, err, errlen) != 0)
+        return -1;
+    if (n == 0) {
+        free(a);
+        return 0;
+    }
+    const amfi_level_params *mf = p->mf;
+    const size_t W = (size_t)mf->window;
+    double *win = malloc(W * sizeof *win);
+    FILE *f = win ? report_data_open(p->dir, "fit_ratio.dat", err, errlen) : NULL;
+    if (!f) {
+        if (!win)
+            snprintf(err, errlen, "out of memory for a window of %zu", W);
+        free(win);
+        free(a);
+        return -1;
+    }
+    size_t positive = 0;
+    double lo = HUGE_VAL, hi = 0;
+    fprintf(f, "# time_s fit_ratio median_of_last_%zu (nan: fewer passages)\n", W);
+    for (size_t i = 0; i < n; i++) {
+        double med = NAN;
+        if (i + 1 >= W) {
+            for (size_t j = 0; j < W; j++)
+                win[j] = a[i + 1 - W + j].fit_ratio;
+            report_sort(win, W);
+            med = report_percentile(win, W, 50);
+        }
+        fprintf(f, "%.3f %.6g %.6g\n", (double)a[i].utime / 1e6, a[i].fit_ratio, med);
+        positive += a[i].fit_ratio > 0;
+        lo = fmin(lo, a[i].fit_ratio);
+        hi = fmax(hi, a[i].fit_ratio);
+    }
+    free(win);
+    free(a);
+    if (report_data_close(f, p->dir, "fit_ratio.dat", err, errlen) != 0)
+        return -1;
+    /* the y range holds the values and both levels: on a log axis a factor
+     * 2 around them, else from 0 (a ratio of 0 has no place on a log axis) */
+    const double top = fmax(hi, mf->raise), bottom = fmin(lo, mf->clear);
+    char yr[160];
+    if (positive == n && bottom > 0)
+        snprintf(yr, sizeof yr, "set logscale y\nset format y '%%g'\nset yrange [%.6g:%.6g]\n",
+                 bottom / 2, top * 2);
+    else
+        snprintf(yr, sizeof yr, "set yrange [0:%.6g]\n", top > 0 ? top * 1.1 : 1.0);
+    fprintf(p->gp,
+            "unset label 99\nset output o.'fit_ratio.png'\n"
+            "set xdata time\nset timefmt '%%s'\nset format x \"%%H:%%M\\n%%d %%b\"\n"
+            "set autoscale x\n%s"
+            "set title \"Model fit over the free vibration after each passage (model_mismatch; "
+            "thresholds: %s%s)\\n%s\"\n"
+            "set xlabel 'time (UTC, data time)'\n"
+            "set ylabel 'fit ratio (RMS of model - data / RMS of data)'\n"
+            "plot d.'fit_ratio.dat' using 1:2 with points pt 7 ps 0.4 lc rgb '#aaaaaa' title 'per passage', \\\n"
+            "     d.'fit_ratio.dat' using 1:3 with lines lw 2 lc rgb '#1f77b4' title 'median of the last %d', \\\n"
+            "     %.6g with lines dt 1 lc rgb '#d62728' title 'raise at >= %.4g (%d in a row)', \\\n"
+            "     %.6g with lines dt 2 lc rgb '#2ca02c' title 'clear below %.4g (%d in a row)'\n"
+            "unset logscale y\nset format y '%%g'\nset autoscale y\nset output\n",
+            yr, p->mf_from ? p->mf_from : "built-in defaults",
+            mf->enabled ? "" : ", the alert off", p->sub, mf->window, mf->raise, mf->raise,
+            mf->raise_after, mf->clear, mf->clear, mf->clear_after);
     *made = 1;
     return 0;
 }

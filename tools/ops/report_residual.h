@@ -8,7 +8,11 @@
  * (report_residual.c). A residual that grows while the traffic does not
  * change says the bridge no longer behaves as its model: the oldest and
  * the newest REPORT_RESIDUAL_WINDOW passages are set side by side.
- * Single-threaded; the store is read through amfi_store_residual_series.
+ * And amfid's model fit (passages.fit_ratio, docs/indicators.md section
+ * 10): with --plot, fit_ratio.png, each passage's fit ratio, the running
+ * median the model_mismatch rule watches and its raise and clear levels.
+ * Single-threaded; the store is read through amfi_store_residual_series
+ * and amfi_store_fit_ratio_series.
  */
 #ifndef REPORT_RESIDUAL_H
 #define REPORT_RESIDUAL_H
@@ -40,5 +44,12 @@ int residual_summary(amfi_store *s, char *line, size_t len, char *err, size_t er
  * residual, quality, running median) and appends the plot's commands, when
  * an ok passage of the plots' range has a residual. */
 int residual_plot(report_plot_frame *p, int *made, char *err, size_t errlen);
+
+/* fit_ratio.png (report_plot_fn): writes dir/data/fit_ratio.dat (time,
+ * fit ratio, the median of the last p->mf->window ratios once that many
+ * are there: what amfid's rule compares) and appends the plot's commands
+ * with p->mf's raise and clear levels, when a passage of the plots' range
+ * has a fit ratio. */
+int fit_ratio_plot(report_plot_frame *p, int *made, char *err, size_t errlen);
 
 #endif /* REPORT_RESIDUAL_H */

@@ -13,7 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amfi_config.h"
 #include "amfi_json.h"
+#include "level_rule.h"
 #include "web.h"
 
 #define DEFAULT_LIMIT 50
@@ -536,7 +538,47 @@ static web_reply api_alerts(const web_source *src, const web_param *p, int np)
 
 /* ---- /api/trends ----------------------------------------------------------- */
 
-static const char *const series_units[AMFI_WEB_N_SERIES] = {"kg", "", "Hz", "m/s²", "°C"};
+static const char *const series_units[AMFI_WEB_N_SERIES] = {"kg", "", "Hz", "m/s²", "°C", ""};
+#define SERIES_NAMES "gvw, indicator, natfreq, residual, temperature, fit_ratio"
+
+/* The model_mismatch rule's levels for the fit_ratio series: what amfid
+   ran with (meta alerts.model_fit, written at its start), else the
+   loader's defaults (a store of an older amfid, the central database).
+   NULL with err when the record is damaged or no memory. */
+static json_t *model_fit_levels(amfi_store *s, char *err, size_t errlen)
+{
+    char rec[4097], why[256];
+    int found = 0;
+    amfi_level_params mf;
+    const char *source = "amfid";
+    if (amfi_store_meta_get(s, "alerts.model_fit", rec, sizeof rec, &found, err, errlen) != 0)
+        return NULL;
+    if (found) {
+        if (amfi_level_params_parse(rec, &mf, why, sizeof why) != 0) {
+            snprintf(err, errlen, "meta alerts.model_fit: %s", why);
+            return NULL;
+        }
+    } else {
+        amfi_site_config *d = malloc(sizeof *d);
+        if (!d) {
+            snprintf(err, errlen, "out of memory");
+            return NULL;
+        }
+        amfi_config_defaults(d);
+        mf = d->daemon.model_fit;
+        free(d);
+        source = "defaults";
+    }
+    json_t *o = json_object();
+    json_object_set_new(o, "source", json_string(source));
+    json_object_set_new(o, "enabled", json_boolean(mf.enabled));
+    json_object_set_new(o, "window", json_integer(mf.window));
+    json_object_set_new(o, "raise", amfi_json_num(mf.raise));
+    json_object_set_new(o, "clear", amfi_json_num(mf.clear));
+    json_object_set_new(o, "raise_after", json_integer(mf.raise_after));
+    json_object_set_new(o, "clear_after", json_integer(mf.clear_after));
+    return o;
+}
 
 static web_reply api_trends(const web_source *src, const web_param *p, int np)
 {
@@ -549,14 +591,12 @@ static web_reply api_trends(const web_source *src, const web_param *p, int np)
         return r;
     const char *name = get(p, np, "series");
     if (!name)
-        return reply(400, web_error("series is required (gvw, indicator, natfreq, residual, "
-                                    "temperature)", "series"));
+        return reply(400, web_error("series is required (" SERIES_NAMES ")", "series"));
     int which = 0;
     while (amfi_store_web_series_name(which) && strcmp(amfi_store_web_series_name(which), name))
         which++;
     if (!amfi_store_web_series_name(which))
-        return bad("series",
-                   "'%s' is not a series (gvw, indicator, natfreq, residual, temperature)", name);
+        return bad("series", "'%s' is not a series (" SERIES_NAMES ")", name);
     amfi_web_bucket *b = malloc((size_t)points * sizeof *b);
     if (!b)
         return store_failed("out of memory");
@@ -568,8 +608,15 @@ static web_reply api_trends(const web_source *src, const web_param *p, int np)
         free(b);
         return store_failed(err);
     }
+    json_t *levels = NULL;
+    if (which == AMFI_WEB_FIT_RATIO && !(levels = model_fit_levels(src->store, err, sizeof err))) {
+        free(b);
+        return store_failed(err);
+    }
     json_t *o = json_object(), *arr = json_array();
     json_object_set_new(o, "series", json_string(name));
+    if (levels)
+        json_object_set_new(o, "thresholds", levels);
     set_time(o, "from", from);
     set_time(o, "to", to);
     json_object_set_new(o, "unit", json_string(series_units[which]));

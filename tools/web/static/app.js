@@ -48,7 +48,8 @@ function table(id, head, rows) {
 function cell(v, cls) { return el('td', cls ? {class: cls} : {}, v); }
 
 function chart(id, type, labels, datasets, yTitle) {
-  const canvas = el('canvas', {id: id, 'data-points': String(labels.length)});
+  const canvas = el('canvas', {id: id, 'data-points': String(labels.length),
+                               'data-series': datasets.map(d => d.label).join('|')});
   const box = el('div', {class: 'chart'}, canvas);
   if (typeof Chart === 'undefined') {
     box.appendChild(el('p', {class: 'muted'}, 'Charts need Chart.js (libjs-chart.js).'));
@@ -242,7 +243,22 @@ function signalChart(id, raw, sensor) {
 // ---- trends ----------------------------------------------------------------------
 const seriesList = [['gvw', 'GVW of ok passages', 'kg'], ['indicator', 'STD indicator ratio', ''],
   ['natfreq', 'first natural frequency', 'Hz'], ['residual', 'fit residual RMS', 'm/s²'],
-  ['temperature', 'deck temperature', '°C']];
+  ['temperature', 'deck temperature', '°C'],
+  ['fit_ratio', 'model fit ratio over the free vibration (model_mismatch)', '']];
+
+// the model_mismatch rule's raise and clear levels as flat lines (fit_ratio)
+function levelLines(t) {
+  const th = t.thresholds;
+  if (!th) return [];
+  const flat = v => t.points.map(() => v);
+  const whose = th.source === 'amfid' ? "amfid's" : 'defaults';
+  return [
+    {label: 'raise at >= ' + th.raise + ' (median of ' + th.window + ', ' + th.raise_after +
+            ' in a row; ' + whose + ')', data: flat(th.raise), borderColor: '#c33',
+     pointRadius: 0, borderWidth: 1},
+    {label: 'clear below ' + th.clear + ' (' + th.clear_after + ' in a row)', data: flat(th.clear),
+     borderColor: '#393', borderDash: [6, 4], pointRadius: 0, borderWidth: 1}];
+}
 
 // a from/to form for the pages whose API defaults to the last 30 days
 function rangeForm(action, q, shown) {
@@ -273,7 +289,8 @@ async function pageTrends() {
     parts.push(chart('chart-' + name, 'line', labels, [
       {label: 'mean', data: t.points.map(p => p.mean), borderColor: '#236', pointRadius: 0},
       {label: 'min', data: t.points.map(p => p.min), borderColor: '#9ab', pointRadius: 0},
-      {label: 'max', data: t.points.map(p => p.max), borderColor: '#c96', pointRadius: 0}], unit));
+      {label: 'max', data: t.points.map(p => p.max), borderColor: '#c96', pointRadius: 0},
+      ...levelLines(t)], unit));
   }
   main.replaceChildren(rangeForm('/trends', q, shown), ...parts);
 }
