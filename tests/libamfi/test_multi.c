@@ -585,13 +585,24 @@ static void rejects_bad_events(void **state)
     p = ev.p;
     p.vehicle[1].entry_s = NAN;
     assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
-    /* more axles in all than AMFI_MAX_AXLES */
+    /* more axles in all than AMFI_MAX_EVENT_AXLES (five of ten), and a
+     * vehicle of more than AMFI_MAX_AXLES */
     p = ev.p;
-    p.vehicle[1].n_axles = AMFI_MAX_AXLES - 1;
-    for (int a = 0; a < AMFI_MAX_AXLES - 2; a++)
-        p.vehicle[1].axle_spacing_m[a] = 1.2;
+    p.n_vehicles = 5;
+    for (int v = 0; v < 5; v++) {
+        p.vehicle[v] = ev.p.vehicle[0];
+        p.vehicle[v].entry_s = 0.1 * v;
+        p.vehicle[v].n_axles = 10;
+        for (int a = 0; a < 9; a++)
+            p.vehicle[v].axle_spacing_m[a] = 1.2;
+    }
+    assert_true(5 * 10 > AMFI_MAX_EVENT_AXLES);
     assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
     assert_non_null(strstr(err, "axles in all"));
+    p = ev.p;
+    p.vehicle[1].n_axles = AMFI_MAX_AXLES + 1;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
+    assert_non_null(strstr(err, "vehicle 2"));
     /* the second vehicle leaving after the data ends */
     p = ev.p;
     p.vehicle[1].entry_s = 0.9;
