@@ -479,6 +479,13 @@ static int solve_joint(struct amfi_solver *s, const amfi_multi_passage *p, doubl
     return AMFI_OK;
 }
 
+/* The gain array of a sweep of N steps and na axles kept whole. */
+static size_t full_gain_doubles(const struct amfi_solver *s, int N, int na)
+{
+    const size_t state = (size_t)(s->p.coords == AMFI_COORDS_MODAL ? 2 * s->m : 4 * s->n) + na;
+    return (size_t)N * na * state;
+}
+
 /* Axle k of vehicle ve (offset o_k behind its first) is on the span over
  * [entry + o_k/v, entry + (o_k + L)/v]. */
 static double axle_in(const amfi_vehicle *ve, double o)
@@ -586,9 +593,10 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
         "the data spans [%.6g, %.6g] s but the event needs [%.6g, %.6g] s", p->t_first_s,
         t_last, win.start_s, win.end_s);
     const size_t budget = p->max_segment_bytes ? p->max_segment_bytes : AMFI_MULTI_SEGMENT_BYTES;
+    s->sweep_budget = budget / sizeof(double);
 #define SWEEP_BYTES(t0, t1, n)                                                               \
     (sizeof(double) *                                                                         \
-     amfi_gain_doubles(s, (int)ceil(((t1) - (t0)) * s->p.calc_rate_hz - 1e-6), (n)))
+     full_gain_doubles(s, (int)ceil(((t1) - (t0)) * s->p.calc_rate_hz - 1e-6), (n)))
     const size_t whole = SWEEP_BYTES(win.start_s, win.end_s, na);
     /* a segment starts with the bridge vibrating under its neighbours: it
      * needs the free initial state (else the whole event in one sweep) */

@@ -122,6 +122,10 @@ static int reserve(struct amfi_solver *s, int cap)
 
 size_t amfi_gain_doubles(const struct amfi_solver *s, int N, int na)
 {
+    if (s->p.coords == AMFI_COORDS_MODAL) {
+        int seg;
+        return amfi_sweep_modal_gain_doubles(s->m, na, N, s->sweep_budget, &seg);
+    }
     const size_t state = (size_t)(s->p.coords == AMFI_COORDS_MODAL ? 2 * s->m : 4 * s->n) + na;
     return (size_t)N * na * state;
 }
@@ -238,6 +242,7 @@ int amfi_solver_create(const amfi_bridge *b, const amfi_solver_params *p, amfi_s
     s->n = b->n;
     s->ns = p->n_sensors;
     s->na_max = p->max_axles;
+    s->sweep_budget = AMFI_MULTI_SEGMENT_BYTES / sizeof(double);
     for (int i = 0; i < s->ns; i++)
         s->w[i] = p->sensor_weight[i];
     s->S = malloc(sizeof(double) * s->ns * s->n);
@@ -445,6 +450,7 @@ int amfi_solve_begin(struct amfi_solver *s, const amfi_passage *ps, const amfi_l
         "the data spans [%.6g, %.6g] s but the window needs [%.6g, %.6g] s", ps->t_first_s,
         t_last, t_start, t_end);
 #undef REQ
+    s->sweep_budget = AMFI_MULTI_SEGMENT_BYTES / sizeof(double);
     s->speed = ps->speed_mps;
     s->off[0] = 0.0;
     for (int a = 1; a < ps->n_axles; a++)

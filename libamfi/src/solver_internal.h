@@ -48,6 +48,10 @@ struct amfi_solver {
     double *y;      /* cap × ns: fitted outputs y_1..y_N */
     double *gain;   /* N × na × (state of na) of the sweep: r_j = −(gain_j z_j + gofs_j) */
     size_t gain_len; /* doubles held: the largest amfi_gain_doubles so far */
+    size_t sweep_budget; /* doubles: a modal sweep whose gains would exceed this
+                            keeps checkpoints and one block's gains instead
+                            (sweep_modal.c); AMFI_MULTI_SEGMENT_BYTES, or
+                            amfi_solve_multi's max_segment_bytes */
     double *gofs;   /* cap × na_max */
     int gstride;    /* state size of the widest path */
     double *scratch; /* sweep scratch, sized at create */
@@ -97,6 +101,10 @@ double amfi_axle_mean_force(const struct amfi_solver *s, int a);
 int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
 int amfi_sweep_nodal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
 size_t amfi_sweep_modal_scratch(int m, int na, int ns);
+/* Doubles of a modal sweep's gain array (N steps, na axles, m modes) under
+ * a budget of doubles: all N steps' gains when they fit, else checkpoints
+ * and one block of *seg steps' gains (*seg = N when they fit). */
+size_t amfi_sweep_modal_gain_doubles(int m, int na, int N, size_t budget, int *seg);
 size_t amfi_sweep_nodal_scratch(int n, int na, int ns);
 
 /* Run the sweep of the solver's coordinates (sweep.c). */
