@@ -138,7 +138,7 @@ void amfi_config_defaults(amfi_site_config *c)
     d->max_event_axles = AMFI_MAX_EVENT_AXLES;
     d->inseparable_gap_m = 1.0;
     d->inseparable_share = 0.3;
-    d->inseparable_quality = 5.0;
+    d->inseparable_quality = 8.0;
     d->inseparable_quality_lanes = 3.0;
     d->single_presence_only = 0;
     d->ind_temp_compensated = 1;
