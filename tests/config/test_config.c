@@ -717,7 +717,7 @@ static const bad_case bad_cases[] = {
      "daemon.channels.accel", "characters long"},
     /* issue 13: events of vehicles weighed together */
     {"daemon_event_axles_one", "daemon:\n  max_event_axles: 1\n", 2, "daemon.max_event_axles",
-     "2 .. 12"},
+     "2 .. 48"},
     {"daemon_event_negative", "daemon:\n  max_event_s: -1\n", 2, "daemon.max_event_s",
      "[0, 600]"},
     {"daemon_event_beyond_ring", "daemon:\n  ring_s: 20\n  max_event_s: 30\n", 3,
