@@ -135,10 +135,10 @@ void amfi_config_defaults(amfi_site_config *c)
     d->margin_s = 0.05;
     d->max_wait_s = 10.0;
     d->max_event_s = 10.0;
-    d->max_event_axles = AMFI_MAX_AXLES;
+    d->max_event_axles = AMFI_MAX_EVENT_AXLES;
     d->inseparable_gap_m = 1.0;
     d->inseparable_share = 0.3;
-    d->inseparable_quality = 5.0;
+    d->inseparable_quality = 8.0;
     d->inseparable_quality_lanes = 3.0;
     d->single_presence_only = 0;
     d->ind_temp_compensated = 1;

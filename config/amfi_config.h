@@ -86,7 +86,7 @@ typedef struct amfi_daemon_config {
                                  weighed together while first entry to last exit
                                  is at most this, s, [0, 600]; 0 = never (multiple) */
     int max_event_axles;      /* daemon.max_event_axles: axles of such an event,
-                                 2 .. AMFI_MAX_AXLES */
+                                 2 .. AMFI_MAX_EVENT_AXLES */
     double inseparable_gap_m; /* daemon.inseparable_gap_m: axles of two vehicles
                                  closer than this load the beam at one point, m */
     double inseparable_share; /* daemon.inseparable_share: a vehicle with an axle that

@@ -162,7 +162,7 @@ const field amfi_cfg_daemon_fields[] = {
      .flags = F_LO_OPEN | F_LIVE},
     {.key = "max_event_s", .kind = &amfi_cfg_k_double, .off = DC(max_event_s), .lo = 0, .hi = 600},
     {.key = "max_event_axles", .kind = &amfi_cfg_k_int, .off = DC(max_event_axles), .lo = 2,
-     .hi = AMFI_MAX_AXLES},
+     .hi = AMFI_MAX_EVENT_AXLES},
     {.key = "inseparable_gap_m", .kind = &amfi_cfg_k_double, .off = DC(inseparable_gap_m), .lo = 0,
      .hi = 10},
     {.key = "inseparable_share", .kind = &amfi_cfg_k_double, .off = DC(inseparable_share), .lo = 0,

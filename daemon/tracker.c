@@ -35,14 +35,14 @@ amfi_tracker *amfi_tracker_create(const amfi_tracker_params *p)
     if (!(p->span_m > 0) || !(p->pre_s >= 0) || !(p->post_s >= 0) || !(p->max_wait_s > 0) ||
         p->n_sensors < 1 || p->n_sensors > AMFI_MAX_SENSORS || !(p->max_event_s >= 0) ||
         p->max_event_axles < 0 || p->max_event_axles == 1 ||
-        p->max_event_axles > AMFI_MAX_AXLES || !(p->slow_frac >= 0) || !(p->slow_frac <= 0.5) ||
+        p->max_event_axles > AMFI_MAX_EVENT_AXLES || !(p->slow_frac >= 0) || !(p->slow_frac <= 0.5) ||
         !(p->free_s >= 0) || !(p->free_s <= 3600))
         return NULL;
     amfi_tracker *t = calloc(1, sizeof *t);
     if (t) {
         t->p = *p;
         if (t->p.max_event_axles == 0)
-            t->p.max_event_axles = AMFI_MAX_AXLES;
+            t->p.max_event_axles = AMFI_MAX_EVENT_AXLES;
     }
     return t;
 }

@@ -61,7 +61,7 @@ typedef struct amfi_tracker_params {
     double max_wait_s;   /* data time past a window's end before it is given up */
     int n_sensors;
     double max_event_s;  /* first entry to last exit of an event, s; 0: no events */
-    int max_event_axles; /* axles of an event, 2 .. AMFI_MAX_AXLES (0: AMFI_MAX_AXLES) */
+    int max_event_axles; /* axles of an event, 2 .. AMFI_MAX_EVENT_AXLES (0: that) */
     double slow_frac;    /* the window ends where it would for speed·(1 − slow_frac):
                             room for the speed search's slowest trial (0 .. 0.5) */
     double free_s;       /* free vibration wanted after the event's last exit (at the

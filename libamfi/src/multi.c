@@ -177,7 +177,7 @@ static int coincident_axles(double L, double h, int na, const double *vf, const 
                             const int *veh, int nv, int *unk, int *cnt, double *vf_u,
                             double *off_u, int *vgroup)
 {
-    int parent[AMFI_MAX_AXLES];
+    int parent[AMFI_MAX_EVENT_AXLES];
     for (int a = 0; a < na; a++)
         parent[a] = a;
     for (int a = 0; a < na; a++)
@@ -186,7 +186,7 @@ static int coincident_axles(double L, double h, int na, const double *vf, const 
             if (axle_gap_max(L, vf[a], off[a], vf[b], off[b]) <= tol)
                 uf_join(parent, a, b);
         }
-    int nu = 0, first[AMFI_MAX_AXLES];
+    int nu = 0, first[AMFI_MAX_EVENT_AXLES];
     for (int a = 0; a < na; a++) {
         const int r = uf_root(parent, a);
         if (r == a) { /* the first axle of its set */
@@ -257,7 +257,7 @@ static int quad_inverse(const double *A, int na, const int *idx, int k, double *
  * columns), an unknown's force shared evenly among its axles. */
 static void spread_forces(struct amfi_solver *s, int nu, int na, const int *unk, const int *cnt)
 {
-    double row[AMFI_MAX_AXLES];
+    double row[AMFI_MAX_EVENT_AXLES];
     for (int j = s->N; j >= 0; j--) { /* row j moves right: later rows first */
         memcpy(row, s->force + (size_t)j * nu, sizeof(double) * nu);
         for (int a = 0; a < na; a++)
@@ -265,57 +265,35 @@ static void spread_forces(struct amfi_solver *s, int nu, int na, const int *unk,
     }
 }
 
-int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lambda *lam,
-                     amfi_multi_result *res, char *err, size_t errlen)
+/* The joint solve of the vehicles of p (validated by amfi_solve_multi,
+ * at most AMFI_MAX_EVENT_AXLES axles) over the window [t_start, t_end] on
+ * the samples' clock, inside the samples. Every axle must be on the span
+ * at some step of the window (the segments drop those that are not). */
+static int solve_joint(struct amfi_solver *s, const amfi_multi_passage *p, double t_start,
+                       double t_end, const amfi_lambda *lam, amfi_multi_result *res, char *err,
+                       size_t errlen)
 {
-    if (!s || !p || !lam || !res)
-        return amfi_fail(err, errlen, AMFI_EINVAL, "solve_multi: NULL argument");
 #define REQ(cond, st, ...)                                                \
     do {                                                                  \
         if (!(cond))                                                      \
             return amfi_fail(err, errlen, st, __VA_ARGS__);               \
     } while (0)
-    REQ(p->n_vehicles >= 1 && p->n_vehicles <= AMFI_MAX_VEHICLES, AMFI_EINVAL,
-        "%d vehicles: 1..%d", p->n_vehicles, AMFI_MAX_VEHICLES);
-    int na = 0;
-    for (int v = 0; v < p->n_vehicles; v++) {
-        const amfi_vehicle *ve = &p->vehicle[v];
-        REQ(isfinite(ve->entry_s), AMFI_EINVAL, "vehicle %d: entry time is not finite", v + 1);
-        REQ(isfinite(ve->speed_mps) && ve->speed_mps > 0, AMFI_EINVAL,
-            "vehicle %d: speed must be > 0", v + 1);
-        REQ(ve->n_axles >= 1 && ve->n_axles <= AMFI_MAX_AXLES, AMFI_EINVAL,
-            "vehicle %d: %d axles, 1..%d", v + 1, ve->n_axles, AMFI_MAX_AXLES);
-        for (int a = 0; a + 1 < ve->n_axles; a++)
-            REQ(isfinite(ve->axle_spacing_m[a]) && ve->axle_spacing_m[a] > 0, AMFI_EINVAL,
-                "vehicle %d: axle spacing %d must be > 0", v + 1, a + 1);
-        na += ve->n_axles;
-    }
-    REQ(p->lambda_factor == 0.0 || (p->lambda_factor >= 1e-4 && p->lambda_factor <= 1.0),
-        AMFI_EINVAL, "lambda_factor %g: 0 (off) or 1e-4 .. 1", p->lambda_factor);
-    REQ(na <= AMFI_MAX_AXLES, AMFI_EINVAL, "%d axles in all: at most %d in one event", na,
-        AMFI_MAX_AXLES);
+    int na = 0, rc;
+    for (int v = 0; v < p->n_vehicles; v++)
+        na += p->vehicle[v].n_axles;
     amfi_passage samples;
     memset(&samples, 0, sizeof samples);
     samples.n_samples = p->n_samples;
     samples.scan_rate_hz = p->scan_rate_hz;
     samples.t_first_s = p->t_first_s;
     memcpy(samples.accel, p->accel, sizeof samples.accel);
-    int rc = amfi_check_samples_lambda(s, &samples, lam, err, errlen);
-    if (rc)
-        return rc;
     const double L = s->b->p.span_m;
-    const amfi_passage_times win = amfi_multi_window(L, p, s->p.pre_roll_s, s->p.post_roll_s);
-    const double t_last = p->t_first_s + (p->n_samples - 1) / p->scan_rate_hz;
-    const double tol = 1e-9 + 1e-6 / p->scan_rate_hz;
-    REQ(p->t_first_s <= win.start_s + tol && t_last >= win.end_s - tol, AMFI_ERANGE,
-        "the data spans [%.6g, %.6g] s but the event needs [%.6g, %.6g] s", p->t_first_s,
-        t_last, win.start_s, win.end_s);
     if (amfi_solver_grow_axles(s, na) != 0 || mq_reserve(s, na) != 0)
         return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory for %d axles", na);
     /* axle i of vehicle v at x = v·(t − entry) − offset_i = v·t − (v·entry + offset_i):
      * speed 1, the vehicle's speed as the axle's factor (solver_internal.h) */
-    double vf[AMFI_MAX_AXLES], off[AMFI_MAX_AXLES];
-    int veh[AMFI_MAX_AXLES];
+    double vf[AMFI_MAX_EVENT_AXLES], off[AMFI_MAX_EVENT_AXLES];
+    int veh[AMFI_MAX_EVENT_AXLES];
     int i = 0;
     for (int v = 0; v < p->n_vehicles; v++) {
         const amfi_vehicle *ve = &p->vehicle[v];
@@ -333,8 +311,8 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
      * their forces changes neither the fit nor the smoothing term), so
      * kept apart they leave the sweep's start singular, and whether its
      * factorisation noticed depended on the BLAS's summation order. */
-    int unk[AMFI_MAX_AXLES], cnt[AMFI_MAX_AXLES], vgroup[AMFI_MAX_VEHICLES];
-    double vf_u[AMFI_MAX_AXLES], off_u[AMFI_MAX_AXLES];
+    int unk[AMFI_MAX_EVENT_AXLES], cnt[AMFI_MAX_EVENT_AXLES], vgroup[AMFI_MAX_VEHICLES];
+    double vf_u[AMFI_MAX_EVENT_AXLES], off_u[AMFI_MAX_EVENT_AXLES];
     const int nu = coincident_axles(L, s->h, na, vf, off, veh, p->n_vehicles, unk, cnt, vf_u,
                                     off_u, vgroup);
     s->speed = 1.0;
@@ -345,7 +323,7 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
     memset(res, 0, sizeof *res);
     double lam_h;
     int n_solves = 0;
-    if ((rc = amfi_solve_window(s, &samples, nu, win.start_s, win.end_s, err, errlen)) != 0 ||
+    if ((rc = amfi_solve_window(s, &samples, nu, t_start, t_end, err, errlen)) != 0 ||
         (rc = amfi_solve_lambda(s, lam, &lam_h, &n_solves, err, errlen)) != 0)
         return rc;
     /* An event of several vehicles at a fixed λ, lambda_factor 0 (the
@@ -404,7 +382,7 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
 
     /* the joint result on the axles: an unknown's force and mean shared
      * evenly among its axles (their sum is what the data fix) */
-    double mf[AMFI_MAX_AXLES];
+    double mf[AMFI_MAX_EVENT_AXLES];
     memcpy(mf, res->all.mean_force_N, sizeof(double) * nu);
     spread_forces(s, nu, na, unk, cnt);
     s->na = na;
@@ -423,12 +401,14 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
     }
     res->n_unknowns = nu;
     res->n_vehicles = p->n_vehicles;
+    res->n_segments = 1;
     res->total_gvw_kg = 0.0;
     i = 0;
     for (int v = 0; v < p->n_vehicles; v++) {
         amfi_vehicle_result *vr = &res->vehicle[v];
         vr->first_axle = i;
         vr->n_axles = p->vehicle[v].n_axles;
+        vr->segment = 0;
         vr->group = vgroup[v];
         vr->n_merged = 0;
         vr->gvw_kg = 0.0;
@@ -455,7 +435,7 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
             }
         /* joint: uᵀA⁻¹u with u the indicator of the unknowns of its group's
          * axles (the vehicle's own when it has no group) */
-        int idx[AMFI_MAX_AXLES], k = 0;
+        int idx[AMFI_MAX_EVENT_AXLES], k = 0;
         memcpy(U, A, sizeof(double) * nu * nu);
         double *u = U + nu * nu;
         for (int q = 0; q < nu; q++) {
@@ -495,6 +475,226 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
             }
         }
     }
+#undef REQ
+    return AMFI_OK;
+}
+
+/* The gain array of a sweep of N steps and na axles kept whole. */
+static size_t full_gain_doubles(const struct amfi_solver *s, int N, int na)
+{
+    const size_t state = (size_t)(s->p.coords == AMFI_COORDS_MODAL ? 2 * s->m : 4 * s->n) + na;
+    return (size_t)N * na * state;
+}
+
+/* Axle k of vehicle ve (offset o_k behind its first) is on the span over
+ * [entry + o_k/v, entry + (o_k + L)/v]. */
+static double axle_in(const amfi_vehicle *ve, double o)
+{
+    return ve->entry_s + o / ve->speed_mps;
+}
+
+/* The axles of vehicle ve on the span for more than two calculation steps
+ * inside [t0, t1]: a contiguous run a0 .. a0 + *n − 1 (0 when none);
+ * their offsets o[] (o[0] = 0). */
+static int axles_inside(const amfi_vehicle *ve, double L, double h, double t0, double t1,
+                        int *n)
+{
+    double o = 0.0;
+    int a0 = -1;
+    *n = 0;
+    for (int a = 0; a < ve->n_axles; a++) {
+        if (a > 0)
+            o += ve->axle_spacing_m[a - 1];
+        const double in = axle_in(ve, o), out = axle_in(ve, o + L);
+        if (fmin(out, t1) - fmax(in, t0) > 2.0 * h) {
+            if (a0 < 0)
+                a0 = a;
+            ++*n;
+        }
+    }
+    return a0 < 0 ? 0 : a0;
+}
+
+/* The sub-event of the segment [t0, t1]: every vehicle's axles on the span
+ * inside it (a vehicle cut at the window's edge as one whose first axle is
+ * the first inside, entering then). map[q]: the event's vehicle of q's
+ * vehicle q. Returns the axles. */
+static int segment_event(const amfi_multi_passage *p, double L, double h, double t0, double t1,
+                         amfi_multi_passage *q, int *map)
+{
+    *q = *p;
+    q->n_vehicles = 0;
+    int na = 0;
+    for (int v = 0; v < p->n_vehicles; v++) {
+        const amfi_vehicle *ve = &p->vehicle[v];
+        int n;
+        const int a0 = axles_inside(ve, L, h, t0, t1, &n);
+        if (n == 0)
+            continue;
+        amfi_vehicle *w = &q->vehicle[q->n_vehicles];
+        double o = 0.0;
+        for (int a = 0; a < a0; a++)
+            o += ve->axle_spacing_m[a];
+        w->entry_s = axle_in(ve, o);
+        w->speed_mps = ve->speed_mps;
+        w->n_axles = n;
+        for (int a = 0; a + 1 < n; a++)
+            w->axle_spacing_m[a] = ve->axle_spacing_m[a0 + a];
+        map[q->n_vehicles++] = v;
+        na += n;
+    }
+    return na;
+}
+
+int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lambda *lam,
+                     amfi_multi_result *res, char *err, size_t errlen)
+{
+    if (!s || !p || !lam || !res)
+        return amfi_fail(err, errlen, AMFI_EINVAL, "solve_multi: NULL argument");
+#define REQ(cond, st, ...)                                                \
+    do {                                                                  \
+        if (!(cond))                                                      \
+            return amfi_fail(err, errlen, st, __VA_ARGS__);               \
+    } while (0)
+    REQ(p->n_vehicles >= 1 && p->n_vehicles <= AMFI_MAX_VEHICLES, AMFI_EINVAL,
+        "%d vehicles: 1..%d", p->n_vehicles, AMFI_MAX_VEHICLES);
+    int na = 0;
+    for (int v = 0; v < p->n_vehicles; v++) {
+        const amfi_vehicle *ve = &p->vehicle[v];
+        REQ(isfinite(ve->entry_s), AMFI_EINVAL, "vehicle %d: entry time is not finite", v + 1);
+        REQ(isfinite(ve->speed_mps) && ve->speed_mps > 0, AMFI_EINVAL,
+            "vehicle %d: speed must be > 0", v + 1);
+        REQ(ve->n_axles >= 1 && ve->n_axles <= AMFI_MAX_AXLES, AMFI_EINVAL,
+            "vehicle %d: %d axles, 1..%d", v + 1, ve->n_axles, AMFI_MAX_AXLES);
+        for (int a = 0; a + 1 < ve->n_axles; a++)
+            REQ(isfinite(ve->axle_spacing_m[a]) && ve->axle_spacing_m[a] > 0, AMFI_EINVAL,
+                "vehicle %d: axle spacing %d must be > 0", v + 1, a + 1);
+        na += ve->n_axles;
+    }
+    REQ(p->lambda_factor == 0.0 || (p->lambda_factor >= 1e-4 && p->lambda_factor <= 1.0),
+        AMFI_EINVAL, "lambda_factor %g: 0 (off) or 1e-4 .. 1", p->lambda_factor);
+    REQ(na <= AMFI_MAX_EVENT_AXLES, AMFI_EINVAL, "%d axles in all: at most %d in one event", na,
+        AMFI_MAX_EVENT_AXLES);
+    amfi_passage samples;
+    memset(&samples, 0, sizeof samples);
+    samples.n_samples = p->n_samples;
+    samples.scan_rate_hz = p->scan_rate_hz;
+    samples.t_first_s = p->t_first_s;
+    memcpy(samples.accel, p->accel, sizeof samples.accel);
+    int rc = amfi_check_samples_lambda(s, &samples, lam, err, errlen);
+    if (rc)
+        return rc;
+    const double L = s->b->p.span_m, h = s->h;
+    const double pre = s->p.pre_roll_s, post = s->p.post_roll_s;
+    const amfi_passage_times win = amfi_multi_window(L, p, pre, post);
+    const double t_last = p->t_first_s + (p->n_samples - 1) / p->scan_rate_hz;
+    const double tol = 1e-9 + 1e-6 / p->scan_rate_hz;
+    REQ(p->t_first_s <= win.start_s + tol && t_last >= win.end_s - tol, AMFI_ERANGE,
+        "the data spans [%.6g, %.6g] s but the event needs [%.6g, %.6g] s", p->t_first_s,
+        t_last, win.start_s, win.end_s);
+    const size_t budget = p->max_segment_bytes ? p->max_segment_bytes : AMFI_MULTI_SEGMENT_BYTES;
+    s->sweep_budget = budget / sizeof(double);
+#define SWEEP_BYTES(t0, t1, n)                                                               \
+    (sizeof(double) *                                                                         \
+     full_gain_doubles(s, (int)ceil(((t1) - (t0)) * s->p.calc_rate_hz - 1e-6), (n)))
+    const size_t whole = SWEEP_BYTES(win.start_s, win.end_s, na);
+    /* a segment starts with the bridge vibrating under its neighbours: it
+     * needs the free initial state (else the whole event in one sweep) */
+    if (p->n_vehicles == 1 || whole <= budget || !s->p.free_initial_state) {
+        rc = solve_joint(s, p, win.start_s, win.end_s, lam, res, err, errlen);
+        res->max_segment_bytes = whole;
+        return rc;
+    }
+    /* Segments: the vehicles by entry in clusters (a cluster ends where
+     * the span is empty: every vehicle before has left it before the next
+     * enters); each segment owns the next clusters while its window with
+     * the axles on the span inside it stays within the budget (at least
+     * one cluster: one whose vehicles follow each other on the span
+     * without a break is never cut) and weighs them with those axles as
+     * unknowns: a neighbour of another segment is then on the span inside
+     * a pre- or post-roll only, its axles there unknowns with a free force
+     * at the window's start. Cutting where a vehicle is on the span lost
+     * the earlier data's hold on its force: a pair of trucks following
+     * each other closely, cut at the follower's window, weighed the
+     * follower 10 % light. */
+    if (!s->seg) {
+        s->seg = malloc(sizeof *s->seg);
+        if (!s->seg)
+            return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory for the segments");
+        s->bytes += sizeof *s->seg;
+    }
+    amfi_multi_result *sr = s->seg;
+    int order[AMFI_MAX_VEHICLES], first_axle[AMFI_MAX_VEHICLES];
+    double t_in[AMFI_MAX_VEHICLES], t_out[AMFI_MAX_VEHICLES];
+    for (int v = 0, i = 0; v < p->n_vehicles; v++) {
+        const amfi_vehicle *ve = &p->vehicle[v];
+        const amfi_passage_times one =
+            amfi_passage_window(L, ve->speed_mps, ve->n_axles, ve->axle_spacing_m, 0.0, 0.0);
+        t_in[v] = ve->entry_s - pre;
+        t_out[v] = ve->entry_s + one.on_span_s + post;
+        first_axle[v] = i;
+        i += ve->n_axles;
+        int k = v; /* insertion by entry, stable */
+        while (k > 0 && p->vehicle[order[k - 1]].entry_s > ve->entry_s) {
+            order[k] = order[k - 1];
+            k--;
+        }
+        order[k] = v;
+    }
+    memset(res, 0, sizeof *res);
+    res->n_vehicles = p->n_vehicles;
+    amfi_multi_passage q;
+    int map[AMFI_MAX_VEHICLES], nseg = 0;
+    for (int k = 0; k < p->n_vehicles; nseg++) {
+        /* owners order[k .. e): whole clusters */
+        double t0 = t_in[order[k]], t1 = -INFINITY;
+        int e = k;
+        size_t bytes = 0;
+        while (e < p->n_vehicles) {
+            int c = e; /* the cluster order[e .. c) and its windows' end */
+            double exit_max = -INFINITY, t1e = t1;
+            do {
+                exit_max = fmax(exit_max, t_out[order[c]] - post);
+                t1e = fmax(t1e, t_out[order[c]]);
+                c++;
+            } while (c < p->n_vehicles && p->vehicle[order[c]].entry_s < exit_max);
+            const size_t b = SWEEP_BYTES(t0, t1e, segment_event(p, L, h, t0, t1e, &q, map));
+            if (e > k && b > budget)
+                break;
+            t1 = t1e;
+            bytes = b;
+            e = c;
+        }
+        segment_event(p, L, h, t0, t1, &q, map);
+        if (bytes > res->max_segment_bytes)
+            res->max_segment_bytes = bytes;
+        if ((rc = solve_joint(s, &q, t0, t1, lam, sr, err, errlen)) != 0)
+            return rc;
+        for (int qi = 0; qi < q.n_vehicles; qi++) {
+            const int v = map[qi];
+            int owned = 0;
+            for (int o = k; o < e; o++)
+                owned |= order[o] == v;
+            if (!owned)
+                continue;
+            amfi_vehicle_result *vr = &res->vehicle[v];
+            *vr = sr->vehicle[qi];
+            vr->group = map[sr->vehicle[qi].group];
+            vr->segment = nseg;
+            vr->first_axle = first_axle[v];
+            for (int a = 0; a < vr->n_axles; a++)
+                res->axle_unknown[first_axle[v] + a] =
+                    sr->axle_unknown[sr->vehicle[qi].first_axle + a];
+        }
+        k = e;
+    }
+    res->all = sr->all;
+    res->n_unknowns = sr->n_unknowns;
+    res->n_segments = nseg;
+    res->total_gvw_kg = 0.0;
+    for (int v = 0; v < p->n_vehicles; v++)
+        res->total_gvw_kg += res->vehicle[v].gvw_kg;
+#undef SWEEP_BYTES
 #undef REQ
     return AMFI_OK;
 }

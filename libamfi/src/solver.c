@@ -39,6 +39,7 @@ void amfi_solver_destroy(amfi_solver *s)
     free(s->scratch);
     free(s->lc_lam); /* one block with lc_res, lc_smo, lc_kap */
     free(s->mq);
+    free(s->seg);
     if (s->brent)
         gsl_min_fminimizer_free(s->brent);
     amfi_solver_destroy(s->coarse);
@@ -94,6 +95,9 @@ static int check_params(const amfi_bridge *b, const amfi_solver_params *p, char 
 }
 
 /* Size the per-passage buffers for cap steps. */
+/* The per-step buffers for cap steps and na_max axles; the gain array
+ * apart (gain_reserve: it scales with steps × axles × state, the product a
+ * sweep needs, not the largest steps times the largest axles seen). */
 static int reserve(struct amfi_solver *s, int cap)
 {
     const int na = s->na_max, ns = s->ns;
@@ -106,17 +110,40 @@ static int reserve(struct amfi_solver *s, int cap)
     double *y = realloc(s->y, sizeof(double) * (size_t)cap * ns);
     if (y)
         s->y = y;
-    double *g = realloc(s->gain, sizeof(double) * (size_t)cap * na * s->gstride);
-    if (g)
-        s->gain = g;
     double *go = realloc(s->gofs, sizeof(double) * (size_t)cap * na);
     if (go)
         s->gofs = go;
-    if (!d || !f || !y || !g || !go)
+    if (!d || !f || !y || !go)
         return AMFI_ENOMEM;
-    s->bytes += sizeof(double) * (size_t)(cap - s->cap) *
-                (2 * ns + na + (size_t)na * s->gstride + na);
+    s->bytes += sizeof(double) * (size_t)(cap - s->cap) * (2 * ns + na + (size_t)na);
     s->cap = cap;
+    return AMFI_OK;
+}
+
+size_t amfi_gain_doubles(const struct amfi_solver *s, int N, int na)
+{
+    if (s->p.coords == AMFI_COORDS_MODAL) {
+        int seg;
+        return amfi_sweep_modal_gain_doubles(s->m, na, N, s->sweep_budget, &seg);
+    }
+    const size_t state = (size_t)(s->p.coords == AMFI_COORDS_MODAL ? 2 * s->m : 4 * s->n) + na;
+    return (size_t)N * na * state;
+}
+
+/* The gain array for a sweep of N steps and na axles (packed by the
+ * sweep's own na and state size): grown only when larger than every one
+ * before. */
+static int gain_reserve(struct amfi_solver *s, int N, int na)
+{
+    const size_t len = amfi_gain_doubles(s, N, na);
+    if (len <= s->gain_len)
+        return AMFI_OK;
+    double *g = realloc(s->gain, sizeof(double) * len);
+    if (!g)
+        return AMFI_ENOMEM;
+    s->gain = g;
+    s->bytes += sizeof(double) * (len - s->gain_len);
+    s->gain_len = len;
     return AMFI_OK;
 }
 
@@ -215,6 +242,7 @@ int amfi_solver_create(const amfi_bridge *b, const amfi_solver_params *p, amfi_s
     s->n = b->n;
     s->ns = p->n_sensors;
     s->na_max = p->max_axles;
+    s->sweep_budget = AMFI_MULTI_SEGMENT_BYTES / sizeof(double);
     for (int i = 0; i < s->ns; i++)
         s->w[i] = p->sensor_weight[i];
     s->S = malloc(sizeof(double) * s->ns * s->n);
@@ -256,7 +284,7 @@ int amfi_solver_create(const amfi_bridge *b, const amfi_solver_params *p, amfi_s
     }
     s->bytes += sizeof(double) * s->scratch_len + sizeof *s;
     int cap = (int)ceil((p->max_duration_s + p->pre_roll_s + p->post_roll_s) * p->calc_rate_hz) + 1;
-    if ((rc = reserve(s, cap)) != 0) {
+    if ((rc = reserve(s, cap)) != 0 || (rc = gain_reserve(s, cap, s->na_max)) != 0) {
         rc = amfi_fail(err, errlen, rc, "out of memory for %d steps", cap);
         goto fail;
     }
@@ -346,7 +374,7 @@ int amfi_solver_grow_axles(struct amfi_solver *s, int na)
 {
     if (na <= s->na_max)
         return AMFI_OK;
-    if (na > AMFI_MAX_AXLES)
+    if (na > AMFI_MAX_EVENT_AXLES)
         return AMFI_EINVAL;
     const int old_stride = s->gstride, old_na = s->na_max;
     const size_t old_len = s->scratch_len;
@@ -368,8 +396,7 @@ int amfi_solver_grow_axles(struct amfi_solver *s, int na)
     s->bytes += sizeof(double) * (s->scratch_len - old_len);
     /* the per-step buffers at the same step capacity, for na axles */
     const int cap = s->cap;
-    s->bytes -= sizeof(double) * (size_t)cap *
-                (2 * (size_t)s->ns + old_na + (size_t)old_na * old_stride + old_na);
+    s->bytes -= sizeof(double) * (size_t)cap * (2 * (size_t)s->ns + 2 * (size_t)old_na);
     s->cap = 0;
     s->na_max = na;
     return reserve(s, cap);
@@ -381,7 +408,7 @@ int amfi_solve_window(struct amfi_solver *s, const amfi_passage *ps, int na, dou
     int N = (int)ceil((t_end - t_start) * s->p.calc_rate_hz - 1e-6);
     if (N < 2)
         N = 2;
-    if (N > s->cap && reserve(s, N) != 0)
+    if ((N > s->cap && reserve(s, N) != 0) || gain_reserve(s, N, na) != 0)
         return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory for %d steps", N);
     s->N = N;
     s->na = na;
@@ -423,6 +450,7 @@ int amfi_solve_begin(struct amfi_solver *s, const amfi_passage *ps, const amfi_l
         "the data spans [%.6g, %.6g] s but the window needs [%.6g, %.6g] s", ps->t_first_s,
         t_last, t_start, t_end);
 #undef REQ
+    s->sweep_budget = AMFI_MULTI_SEGMENT_BYTES / sizeof(double);
     s->speed = ps->speed_mps;
     s->off[0] = 0.0;
     for (int a = 1; a < ps->n_axles; a++)

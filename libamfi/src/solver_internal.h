@@ -39,14 +39,19 @@ struct amfi_solver {
     int N;          /* steps of the current passage */
     double t0;      /* time of step 0 relative to entry, s */
     double speed;   /* m/s */
-    double off[AMFI_MAX_AXLES]; /* axle a at x = speed·vf[a]·t − off[a] */
-    double vf[AMFI_MAX_AXLES];  /* per-axle speed factor: 1 for one vehicle; for
+    double off[AMFI_MAX_EVENT_AXLES]; /* axle a at x = speed·vf[a]·t − off[a] */
+    double vf[AMFI_MAX_EVENT_AXLES];  /* per-axle speed factor: 1 for one vehicle; for
                                    several (multi.c) speed = 1 and vf[a] = the
                                    vehicle's speed, off[a] = speed·entry + offset */
     double *d;      /* (cap + 1) × ns: data at the steps */
     double *force;  /* (cap + 1) × na_max */
     double *y;      /* cap × ns: fitted outputs y_1..y_N */
-    double *gain;   /* cap × na_max × gstride: r_j = −(gain_j z_j + gofs_j) */
+    double *gain;   /* N × na × (state of na) of the sweep: r_j = −(gain_j z_j + gofs_j) */
+    size_t gain_len; /* doubles held: the largest amfi_gain_doubles so far */
+    size_t sweep_budget; /* doubles: a modal sweep whose gains would exceed this
+                            keeps checkpoints and one block's gains instead
+                            (sweep_modal.c); AMFI_MULTI_SEGMENT_BYTES, or
+                            amfi_solve_multi's max_segment_bytes */
     double *gofs;   /* cap × na_max */
     int gstride;    /* state size of the widest path */
     double *scratch; /* sweep scratch, sized at create */
@@ -64,6 +69,9 @@ struct amfi_solver {
     int mq_na;
     double *mq;
     size_t mq_len;
+    /* amfi_solve_multi's segments' result (multi.c), allocated at the first
+     * segmented event */
+    struct amfi_multi_result *seg;
 
     /* speed search (speed.c): Brent's minimiser (gsl_min_fminimizer),
      * allocated at the first search, owned and freed with this solver */
@@ -93,6 +101,10 @@ double amfi_axle_mean_force(const struct amfi_solver *s, int a);
 int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
 int amfi_sweep_nodal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm);
 size_t amfi_sweep_modal_scratch(int m, int na, int ns);
+/* Doubles of a modal sweep's gain array (N steps, na axles, m modes) under
+ * a budget of doubles: all N steps' gains when they fit, else checkpoints
+ * and one block of *seg steps' gains (*seg = N when they fit). */
+size_t amfi_sweep_modal_gain_doubles(int m, int na, int N, size_t budget, int *seg);
 size_t amfi_sweep_nodal_scratch(int n, int na, int ns);
 
 /* Run the sweep of the solver's coordinates (sweep.c). */
@@ -130,12 +142,14 @@ int amfi_solve_lambda(struct amfi_solver *s, const amfi_lambda *lam, double *lam
  *   check_samples_lambda: the samples (count, rate, t_first, a pointer per
  *     sensor) and λ, as amfi_solve_begin checks them;
  *   grow_axles: the workspace for na axles (outside any time loop);
- *     AMFI_EINVAL above AMFI_MAX_AXLES, AMFI_ENOMEM;
+ *     AMFI_EINVAL above AMFI_MAX_EVENT_AXLES, AMFI_ENOMEM;
  *   window: na axles over [t_start, t_end] (off[], vf[], speed set by the
  *     caller): size N, resample the data. */
 int amfi_check_samples_lambda(const struct amfi_solver *s, const amfi_passage *ps,
                               const amfi_lambda *lam, char *err, size_t errlen);
 int amfi_solver_grow_axles(struct amfi_solver *s, int na);
+/* Doubles of the gain array of a sweep of N steps and na axles (solver.c). */
+size_t amfi_gain_doubles(const struct amfi_solver *s, int N, int na);
 int amfi_solve_window(struct amfi_solver *s, const amfi_passage *ps, int na, double t_start,
                       double t_end, char *err, size_t errlen);
 int amfi_solve_end(struct amfi_solver *s, const amfi_lambda *lam, double lam_h, int n_solves,

@@ -17,7 +17,9 @@
  *     r_j = −K_j(Tᵀ R A_j z_j + ½ Tᵀ s)      (R, s of step j + 1).
  * Φ is block diagonal (one 2 × 2 block per mode), so A_jᵀ Z A_j costs
  * O((2m)²·na) per step instead of O((2m + na)³). Only the upper block
- * triangle of R_xx is kept. Memory: gains, O(N·na·(2m + na)).
+ * triangle of R_xx is kept. Memory: gains, O(N·na·(2m + na)); beyond the
+ * solver's budget (sweep_budget) O(sqrt N): checkpoints of the backward
+ * state and one block's gains, recomputed in the forward pass.
  */
 #include <math.h>
 #include <string.h>
@@ -72,40 +74,24 @@ static void step_rows(const struct amfi_solver *s, int j, double *phi, double *P
         }
 }
 
-int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm)
+/* The backward sweep's work space (amfi_sweep_modal_scratch). */
+typedef struct bwork {
+    double *Rxx, *Rxg, *Ux, *Vx, *Y, *P, *Rgg, *Ugg, *K, *Vg, *Zgg, *sx, *zsx, *x, *sg, *zsg,
+        *g, *r, *phi, *Cg;
+} bwork;
+
+/* One backward step j: R, s of step j + 1 to those of step j; the gains of
+ * step j into gj (na × (2m + na); NULL: not kept) and s->gofs. */
+static int back_step(struct amfi_solver *s, const bwork *wk, int j, double lam, double *gj)
 {
-    const int m = s->m, m2 = 2 * m, na = s->na, ns = s->ns, N = s->N;
-    const int nst = m2 + na; /* state size, gain row stride */
-    double *w = s->scratch;
-    double *Rxx = w;  w += (size_t)m2 * m2;
-    double *Rxg = w;  w += (size_t)m2 * na;
-    double *Ux = w;   w += (size_t)m2 * na;
-    double *Vx = w;   w += (size_t)m2 * na;
-    double *Y = w;    w += (size_t)m2 * na;
-    double *P = w;    w += (size_t)m2 * na;
-    double *Rgg = w;  w += (size_t)na * na;
-    double *Ugg = w;  w += (size_t)na * na;
-    double *K = w;    w += (size_t)na * na;
-    double *Vg = w;   w += (size_t)na * na;
-    double *Zgg = w;  w += (size_t)na * na;
-    double *sx = w;   w += m2;
-    double *zsx = w;  w += m2;
-    double *x = w;    w += m2;
-    double *sg = w;   w += na;
-    double *zsg = w;  w += na;
-    double *g = w;    w += na;
-    double *r = w;    w += na;
-    double *phi = w;  w += (size_t)na * m;
-    double *Cg = w;   w += (size_t)ns * na;
+    const int m = s->m, m2 = 2 * m, na = s->na, ns = s->ns;
+    const int nst = m2 + na;
+    double *Rxx = wk->Rxx, *Rxg = wk->Rxg, *Ux = wk->Ux, *Vx = wk->Vx, *Y = wk->Y, *P = wk->P;
+    double *Rgg = wk->Rgg, *Ugg = wk->Ugg, *K = wk->K, *Vg = wk->Vg, *Zgg = wk->Zgg;
+    double *sx = wk->sx, *zsx = wk->zsx, *sg = wk->sg, *zsg = wk->zsg, *phi = wk->phi,
+           *Cg = wk->Cg;
     const double *Phi = s->Phi, *Cx = s->Cx, *Hxx = s->Hxx;
-
-    memset(Rxx, 0, sizeof(double) * m2 * m2);
-    memset(Rxg, 0, sizeof(double) * m2 * na);
-    memset(Rgg, 0, sizeof(double) * na * na);
-    memset(sx, 0, sizeof(double) * m2);
-    memset(sg, 0, sizeof(double) * na);
-
-    for (int j = N - 1; j >= 0; j--) {
+    {
         const double *dj = s->d + (size_t)(j + 1) * ns;
         step_rows(s, j, phi, P, Cg);
         memcpy(Ux, Rxg, sizeof(double) * m2 * na);
@@ -133,8 +119,7 @@ int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double
             }
         /* Gains of step j: r_j = −(gain_j z_j + gofs_j),
          * gain = K TᵀRA = [Vxᵀ Φ, Vxᵀ P + Vgᵀ], gofs = ½ K s_g. */
-        double *gj = s->gain + (size_t)j * na * nst;
-        for (int a = 0; a < na; a++) {
+        for (int a = 0; a < na && gj; a++) {
             double *row = gj + (size_t)a * nst;
             for (int k = 0; k < m; k++) {
                 const double *F = Phi + 4 * k;
@@ -266,7 +251,102 @@ int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double
             sg[a] = v;
         }
     }
+    return AMFI_OK;
+}
 
+/* The backward state of a step (what back_step carries): Rxx, Rxg, Rgg,
+ * sx, sg, in doubles. */
+static size_t state_doubles(int m, int na)
+{
+    const size_t m2 = 2 * (size_t)m;
+    return m2 * m2 + m2 * na + (size_t)na * na + m2 + na;
+}
+
+static void state_copy(const bwork *wk, int m, int na, double *dst, int save)
+{
+    const size_t m2 = 2 * (size_t)m;
+    double *part[5] = {wk->Rxx, wk->Rxg, wk->Rgg, wk->sx, wk->sg};
+    const size_t len[5] = {m2 * m2, m2 * na, (size_t)na * na, m2, (size_t)na};
+    for (int i = 0; i < 5; i++) {
+        if (save)
+            memcpy(dst, part[i], sizeof(double) * len[i]);
+        else
+            memcpy(part[i], dst, sizeof(double) * len[i]);
+        dst += len[i];
+    }
+}
+
+size_t amfi_sweep_modal_gain_doubles(int m, int na, int N, size_t budget, int *seg)
+{
+    const size_t row = (size_t)na * (2 * (size_t)m + na);
+    if ((size_t)N * row <= budget || N < 4) {
+        *seg = N;
+        return (size_t)N * row;
+    }
+    /* checkpoints every C steps and one segment's gains: N/C·state + C·row
+     * is least at C = sqrt(N·state/row) */
+    const size_t st = state_doubles(m, na);
+    int C = (int)ceil(sqrt((double)N * (double)st / (double)row));
+    if (C < 1)
+        C = 1;
+    if (C > N)
+        C = N;
+    *seg = C;
+    return (size_t)C * row + (size_t)((N + C - 1) / C) * st;
+}
+
+int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double *smo_norm)
+{
+    const int m = s->m, m2 = 2 * m, na = s->na, ns = s->ns, N = s->N;
+    const int nst = m2 + na; /* state size, gain row stride */
+    double *w = s->scratch;
+    double *Rxx = w;  w += (size_t)m2 * m2;
+    double *Rxg = w;  w += (size_t)m2 * na;
+    double *Ux = w;   w += (size_t)m2 * na;
+    double *Vx = w;   w += (size_t)m2 * na;
+    double *Y = w;    w += (size_t)m2 * na;
+    double *P = w;    w += (size_t)m2 * na;
+    double *Rgg = w;  w += (size_t)na * na;
+    double *Ugg = w;  w += (size_t)na * na;
+    double *K = w;    w += (size_t)na * na;
+    double *Vg = w;   w += (size_t)na * na;
+    double *Zgg = w;  w += (size_t)na * na;
+    double *sx = w;   w += m2;
+    double *zsx = w;  w += m2;
+    double *x = w;    w += m2;
+    double *sg = w;   w += na;
+    double *zsg = w;  w += na;
+    double *g = w;    w += na;
+    double *r = w;    w += na;
+    double *phi = w;  w += (size_t)na * m;
+    double *Cg = w;   w += (size_t)ns * na;
+    const double *Phi = s->Phi, *Cx = s->Cx;
+
+    memset(Rxx, 0, sizeof(double) * m2 * m2);
+    memset(Rxg, 0, sizeof(double) * m2 * na);
+    memset(Rgg, 0, sizeof(double) * na * na);
+    memset(sx, 0, sizeof(double) * m2);
+    memset(sg, 0, sizeof(double) * na);
+
+    const bwork wk = {Rxx, Rxg, Ux, Vx, Y, P, Rgg, Ugg, K, Vg, Zgg, sx, zsx, x, sg, zsg, g, r, phi, Cg};
+    /* Gains of C steps at a time (C = N: all, when they fit the budget):
+     * the backward pass saves its state every C steps; the forward pass
+     * then recomputes each later block's gains from its checkpoint (the
+     * same steps from the same state: the same numbers), so the memory is
+     * O(sqrt N) for twice the backward work. */
+    int C;
+    const size_t grow = (size_t)na * nst; /* gains of one step */
+    amfi_sweep_modal_gain_doubles(m, na, N, s->sweep_budget, &C);
+    const int nblk = (N + C - 1) / C;
+    const size_t st = state_doubles(m, na);
+    double *ckpt = s->gain + (size_t)C * grow; /* checkpoint k: state before block k's steps */
+    for (int j = N - 1; j >= 0; j--) {
+        if (C < N && (j + 1) % C == 0 && j + 1 < N) /* R, s before block (j+1)/C's steps */
+            state_copy(&wk, m, na, ckpt + (size_t)((j + 1) / C) * st, 1);
+        double *gj = j < C ? s->gain + (size_t)j * grow : NULL;
+        if (back_step(s, &wk, j, lam, gj) != 0)
+            return AMFI_ENUM;
+    }
     /* Start: at rest with g_0 free (argmin over g of gᵀR_gg g + s_gᵀg), or
      * with the whole z_0 free (argmin of z_0ᵀR_0 z_0 + s_0ᵀz_0). */
     memset(x, 0, sizeof(double) * m2);
@@ -309,10 +389,27 @@ int amfi_sweep_modal(struct amfi_solver *s, double lam, double *res_norm, double
     }
 
     double res2 = 0.0, smo2 = 0.0;
+    /* a block's recomputation uses the backward work space only (not x,
+     * g, r; phi, P, Cg are set again by step_rows below) */
     for (int j = 0; j < N; j++) {
+        if (j > 0 && j % C == 0) { /* block j/C: its gains from its checkpoint */
+            const int hi = j / C + 1 < nblk ? j + C : N;
+            if (hi < N)
+                state_copy(&wk, m, na, ckpt + (size_t)(hi / C) * st, 0);
+            else {
+                memset(Rxx, 0, sizeof(double) * m2 * m2);
+                memset(Rxg, 0, sizeof(double) * m2 * na);
+                memset(Rgg, 0, sizeof(double) * na * na);
+                memset(sx, 0, sizeof(double) * m2);
+                memset(sg, 0, sizeof(double) * na);
+            }
+            for (int jj = hi - 1; jj >= j; jj--)
+                if (back_step(s, &wk, jj, lam, s->gain + (size_t)(jj - j) * grow) != 0)
+                    return AMFI_ENUM;
+        }
         const double *dj = s->d + (size_t)(j + 1) * ns;
         step_rows(s, j, phi, P, Cg);
-        const double *gj = s->gain + (size_t)j * na * nst;
+        const double *gj = s->gain + (size_t)(j % C) * grow;
         for (int a = 0; a < na; a++) {
             const double *row = gj + (size_t)a * nst;
             double v = s->gofs[(size_t)j * na + a];

@@ -479,7 +479,7 @@ static void test_indicator_defaults_are_the_engines(void **state)
     assert_int_equal(0, c.daemon.single_presence_only);
     assert_int_equal(1, c.daemon.ind_temp_compensated); /* issue 14: compensated */
     assert_true(c.daemon.max_event_s == 10.0);
-    assert_int_equal(AMFI_MAX_AXLES, c.daemon.max_event_axles);
+    assert_int_equal(AMFI_MAX_EVENT_AXLES, c.daemon.max_event_axles);
     if (load_text("daemon:\n  max_event_s: 0\n  max_event_axles: 6\n"
                   "  indicators: {single_presence_only: on, temperature: raw}\n", &c, err))
         fail_msg("%s", err);
@@ -717,7 +717,7 @@ static const bad_case bad_cases[] = {
      "daemon.channels.accel", "characters long"},
     /* issue 13: events of vehicles weighed together */
     {"daemon_event_axles_one", "daemon:\n  max_event_axles: 1\n", 2, "daemon.max_event_axles",
-     "2 .. 12"},
+     "2 .. 48"},
     {"daemon_event_negative", "daemon:\n  max_event_s: -1\n", 2, "daemon.max_event_s",
      "[0, 600]"},
     {"daemon_event_beyond_ring", "daemon:\n  ring_s: 20\n  max_event_s: 30\n", 3,

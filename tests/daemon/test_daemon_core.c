@@ -11,6 +11,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -491,7 +492,7 @@ static void tracker_event_limits(void **state)
     (void)state;
     amfi_tracker_params bad = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 1, 0.0, 0.0};
     assert_null(amfi_tracker_create(&bad));
-    bad.max_event_axles = AMFI_MAX_AXLES + 1;
+    bad.max_event_axles = AMFI_MAX_EVENT_AXLES + 1;
     assert_null(amfi_tracker_create(&bad));
     bad.max_event_axles = 0;
     bad.max_event_s = -1.0;
@@ -563,19 +564,23 @@ static void tracker_event_limits(void **state)
     assert_int_equal(w.outside[1], 0);
     amfi_tracker_destroy(t);
 
-    /* vehicles: nine one-axle vehicles 0.1 s apart, 8 at most together */
+    /* vehicles: AMFI_MAX_VEHICLES + 1 one-axle vehicles 0.05 s apart,
+     * AMFI_MAX_VEHICLES at most together */
     amfi_tracker_params pv = {20.0, 0.35, 0.05, 5.0, 1, 10.0, 0, 0.0, 0.0};
     t = amfi_tracker_create(&pv);
-    for (int i = 0; i < 9; i++) {
-        amfi_vehicle_ev v = vehicle_in(20 + i, 1.0 + 0.1 * i, 1, 25.0, 1);
+    for (int i = 0; i < AMFI_MAX_VEHICLES + 1; i++) {
+        amfi_vehicle_ev v = vehicle_in(20 + i, 1.0 + 0.05 * i, 1, 25.0, 1);
         assert_int_equal(amfi_tracker_add(t, &v, NULL, NULL), 0);
     }
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
     assert_string_equal(w.status, "multiple");
     assert_int_equal(w.n_vehicles, AMFI_MAX_VEHICLES);
-    assert_non_null(strstr(w.reason, "vehicle 28 joins an event of 8"));
+    char joins[64];
+    snprintf(joins, sizeof joins, "vehicle %d joins an event of %d", 20 + AMFI_MAX_VEHICLES,
+             AMFI_MAX_VEHICLES);
+    assert_non_null(strstr(w.reason, joins));
     assert_int_equal(amfi_tracker_next(t, rings, 0, &w), 1);
-    assert_int_equal(w.v.vehicle_id, 28);
+    assert_int_equal(w.v.vehicle_id, 20 + AMFI_MAX_VEHICLES);
     assert_string_equal(w.status, "multiple");
     assert_int_equal(amfi_tracker_pending(t), 0);
     amfi_tracker_destroy(t);

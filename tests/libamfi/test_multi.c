@@ -28,7 +28,7 @@ static const double sensors[3] = {10.0, 5.0, 15.0}; /* mid-span first */
 /* An event: vehicles with entry times, spacings and constant axle forces. */
 typedef struct event {
     amfi_multi_passage p;
-    double force_N[AMFI_MAX_AXLES]; /* all axles, vehicle by vehicle */
+    double force_N[AMFI_MAX_EVENT_AXLES]; /* all axles, vehicle by vehicle */
     int na;
     double *accel[3];
 } event;
@@ -43,7 +43,7 @@ static double const_force(double t, int a, void *user)
  * it) to the last exit + 0.05 s; the clock of entry_s is shifted by t0. */
 static void record(event *ev, int ns, double t0)
 {
-    double off[AMFI_MAX_AXLES];
+    double off[AMFI_MAX_EVENT_AXLES];
     int i = 0;
     for (int v = 0; v < ev->p.n_vehicles; v++) {
         const amfi_vehicle *ve = &ev->p.vehicle[v];
@@ -585,13 +585,24 @@ static void rejects_bad_events(void **state)
     p = ev.p;
     p.vehicle[1].entry_s = NAN;
     assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
-    /* more axles in all than AMFI_MAX_AXLES */
+    /* more axles in all than AMFI_MAX_EVENT_AXLES (five of ten), and a
+     * vehicle of more than AMFI_MAX_AXLES */
     p = ev.p;
-    p.vehicle[1].n_axles = AMFI_MAX_AXLES - 1;
-    for (int a = 0; a < AMFI_MAX_AXLES - 2; a++)
-        p.vehicle[1].axle_spacing_m[a] = 1.2;
+    p.n_vehicles = 5;
+    for (int v = 0; v < 5; v++) {
+        p.vehicle[v] = ev.p.vehicle[0];
+        p.vehicle[v].entry_s = 0.1 * v;
+        p.vehicle[v].n_axles = 10;
+        for (int a = 0; a < 9; a++)
+            p.vehicle[v].axle_spacing_m[a] = 1.2;
+    }
+    assert_true(5 * 10 > AMFI_MAX_EVENT_AXLES);
     assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
     assert_non_null(strstr(err, "axles in all"));
+    p = ev.p;
+    p.vehicle[1].n_axles = AMFI_MAX_AXLES + 1;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, &r, err, sizeof err), AMFI_EINVAL);
+    assert_non_null(strstr(err, "vehicle 2"));
     /* the second vehicle leaving after the data ends */
     p = ev.p;
     p.vehicle[1].entry_s = 0.9;
@@ -613,6 +624,105 @@ static void rejects_bad_events(void **state)
     event_free(&ev);
 }
 
+/* Three five-axle trucks on the span in a chain (15 axles: more than one
+ * vehicle's AMFI_MAX_AXLES, refused before the event limit was apart),
+ * on a solver sized for 6 axles a vehicle. Then the same event under a
+ * memory budget far below its gains (the sweep keeps checkpoints and
+ * recomputes: the same weights), and, with a free initial state and a
+ * pre-roll, two such chains apart solved in two segments cut where the
+ * span is empty. */
+static const double sp5[4] = {3.6, 1.3, 5.8, 1.3};
+static const double f5a[5] = {70000.0, 100000.0, 95000.0, 72000.0, 70000.0};
+static const double f5b[5] = {60000.0, 80000.0, 78000.0, 65000.0, 64000.0};
+static const double f5c[5] = {75000.0, 105000.0, 99000.0, 80000.0, 79000.0};
+
+static void three_trucks_fifteen_axles(void **state)
+{
+    (void)state;
+    event ev;
+    memset(&ev, 0, sizeof ev);
+    add_vehicle(&ev, 0.0, 5, sp5, f5a);
+    add_vehicle(&ev, 0.75, 5, sp5, f5b);
+    add_vehicle(&ev, 1.5, 5, sp5, f5c);
+    ev.na = 0;
+    record(&ev, 1, 0.0);
+    amfi_solver *s = make_solver(1, 6, AMFI_COORDS_MODAL);
+    amfi_lambda lam;
+    amfi_lambda_default(&lam);
+    amfi_multi_result *r = malloc(sizeof *r), *rc = malloc(sizeof *rc);
+    char err[256];
+    amfi_multi_passage p = ev.p;
+    p.max_segment_bytes = (size_t)1 << 40; /* gains kept whole */
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, r, err, sizeof err), 0);
+    double e[3];
+    double et = errors(&ev, r, e);
+    printf("# 3 trucks, 15 axles: total %+.3f %%, %+.3f %% %+.3f %% %+.3f %%, %d segment(s), "
+           "%.1f MB\n",
+           100 * et, 100 * e[0], 100 * e[1], 100 * e[2], r->n_segments,
+           r->max_segment_bytes / 1048576.0);
+    assert_int_equal(r->all.n_axles, 15);
+    for (int v = 0; v < 3; v++)
+        assert_true(fabs(e[v]) < 0.02);
+    /* a budget of 1 MB: checkpoints, the same solve */
+    p.max_segment_bytes = (size_t)1 << 20;
+    assert_true(r->max_segment_bytes > 4 * p.max_segment_bytes);
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, rc, err, sizeof err), 0);
+    assert_int_equal(rc->n_segments, 1); /* no free initial state: never cut */
+    for (int v = 0; v < 3; v++)
+        assert_true(fabs(rc->vehicle[v].gvw_kg / r->vehicle[v].gvw_kg - 1.0) < 1e-9);
+    size_t held = amfi_solver_workspace_bytes(s);
+    amfi_solver_destroy(s);
+    amfi_solver *s1 = make_solver(1, 6, AMFI_COORDS_MODAL);
+    assert_int_equal(amfi_solve_multi(s1, &p, &lam, rc, err, sizeof err), 0);
+    printf("# workspace: %.1f MB whole, %.1f MB under a 1 MB budget\n", held / 1048576.0,
+           amfi_solver_workspace_bytes(s1) / 1048576.0);
+    assert_true(amfi_solver_workspace_bytes(s1) < held / 2);
+    amfi_solver_destroy(s1);
+    event_free(&ev);
+
+    /* two chains of two trucks, the span empty between them */
+    memset(&ev, 0, sizeof ev);
+    add_vehicle(&ev, 0.3, 5, sp5, f5a); /* the pre-roll's data from t = 0, at rest */
+    add_vehicle(&ev, 1.05, 5, sp5, f5b);
+    add_vehicle(&ev, 2.9, 5, sp5, f5c);
+    add_vehicle(&ev, 3.6, 5, sp5, f5a);
+    ev.na = 0;
+    record(&ev, 1, 0.0);
+    amfi_solver_params sp;
+    amfi_solver_params_default(&sp, 20.0);
+    sp.calc_rate_hz = 5000.0;
+    sp.max_axles = 6;
+    sp.free_initial_state = 1;
+    sp.pre_roll_s = 0.3;
+    assert_int_equal(amfi_solver_create(bridge, &sp, &s, err, sizeof err), 0);
+    p = ev.p;
+    p.max_segment_bytes = (size_t)8 << 20;
+    assert_int_equal(amfi_solve_multi(s, &p, &lam, r, err, sizeof err), 0);
+    assert_int_equal(amfi_solve_multi(s, &ev.p, &lam, rc, err, sizeof err), 0);
+    double e4[4], e4w[4];
+    double truth[4] = {0};
+    for (int v = 0, i = 0; v < 4; v++)
+        for (int a = 0; a < 5; a++, i++)
+            truth[v] += ev.force_N[i] / AMFI_GRAVITY;
+    for (int v = 0; v < 4; v++) {
+        e4[v] = r->vehicle[v].gvw_kg / truth[v] - 1.0;
+        e4w[v] = rc->vehicle[v].gvw_kg / truth[v] - 1.0;
+    }
+    printf("# 2 + 2 trucks: %d segments: %+.3f %+.3f %+.3f %+.3f %%; whole (%d): %+.3f %+.3f "
+           "%+.3f %+.3f %%\n",
+           r->n_segments, 100 * e4[0], 100 * e4[1], 100 * e4[2], 100 * e4[3], rc->n_segments,
+           100 * e4w[0], 100 * e4w[1], 100 * e4w[2], 100 * e4w[3]);
+    assert_int_equal(r->n_segments, 2);
+    assert_int_equal(r->vehicle[0].segment, 0);
+    assert_int_equal(r->vehicle[3].segment, 1);
+    for (int v = 0; v < 4; v++)
+        assert_true(fabs(e4[v]) < 0.02);
+    amfi_solver_destroy(s);
+    event_free(&ev);
+    free(r);
+    free(rc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -624,6 +734,7 @@ int main(void)
         cmocka_unit_test(quality_ranks_traded_load),
         cmocka_unit_test(lambda_factor_solves_pairs_looser),
         cmocka_unit_test(rejects_bad_events),
+        cmocka_unit_test(three_trucks_fifteen_axles),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

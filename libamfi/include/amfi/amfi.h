@@ -41,7 +41,10 @@ extern "C" {
 
 #define AMFI_MAX_SUPPORTS 16
 #define AMFI_MAX_SENSORS 8
-#define AMFI_MAX_AXLES 12
+#define AMFI_MAX_AXLES 12 /* axles of one vehicle (amfi_passage, amfi_vehicle) */
+/* Axles of one event of several vehicles (amfi_solve_multi), apart from one
+ * vehicle's: three or four trucks share a 20 m span at a dense flow. */
+#define AMFI_MAX_EVENT_AXLES 48
 #define AMFI_GRAVITY 9.81 /* m/s², paper §3.2 */
 
 const char *amfi_strerror(int status); /* static string; never NULL */
@@ -290,8 +293,9 @@ typedef struct amfi_result {
     const double *force_N; /* (N + 1) × n_axles, row-major; owned by the
                               solver, valid until the next solve */
     const double *model_accel; /* N × n_sensors: fitted y_1 .. y_N */
-    double mean_force_N[AMFI_MAX_AXLES]; /* mean of g_a while axle a is on span */
-    double axle_kg[AMFI_MAX_AXLES];      /* mean_force / g */
+    /* (AMFI_MAX_EVENT_AXLES: the joint solve of an event uses this too) */
+    double mean_force_N[AMFI_MAX_EVENT_AXLES]; /* mean of g_a while axle a is on span */
+    double axle_kg[AMFI_MAX_EVENT_AXLES];      /* mean_force / g */
     double gvw_kg;                       /* Σ axle_kg */
     double residual_norm;  /* sqrt Σ_j (y_j − d_j)ᵀ W (y_j − d_j) */
     double smoothing_norm; /* sqrt Σ_j r_jᵀ r_j, N */
@@ -433,7 +437,7 @@ double amfi_speed_dip_at(const amfi_speed_prior *p, const double *j, int n, int 
 
 /* ---- several vehicles on the span, solved jointly (multi.c) ------------ */
 
-#define AMFI_MAX_VEHICLES 8
+#define AMFI_MAX_VEHICLES 16
 
 /* amfi_vehicle_result.quality of a vehicle whose axles share an unknown
  * with another vehicle's (coincident axles, below): the data fix only the
@@ -459,7 +463,8 @@ double amfi_speed_dip_at(const amfi_speed_prior *p, const double *j, int n, int 
 typedef struct amfi_vehicle {
     double entry_s;                        /* finite */
     double speed_mps;                      /* > 0 */
-    int n_axles;                           /* >= 1; all vehicles <= AMFI_MAX_AXLES */
+    int n_axles;                           /* 1 .. AMFI_MAX_AXLES; all vehicles
+                                              <= AMFI_MAX_EVENT_AXLES */
     double axle_spacing_m[AMFI_MAX_AXLES]; /* n_axles − 1 spacings, > 0 */
 } amfi_vehicle;
 
@@ -486,12 +491,27 @@ typedef struct amfi_multi_passage {
      * weighed at λ. The quality figure is the same in the default and at
      * f = 1 (the change between λ and λ/10). */
     double lambda_factor;
+    /* Memory budget of one sweep, bytes: an event whose gain array (steps
+     * × unknowns × (2·modes + unknowns) doubles, in modal coordinates)
+     * would exceed it is solved in segments (amfi_multi_result.n_segments):
+     * its vehicles by entry, each segment owning the next ones whose joint
+     * window (first owner's entry − pre-roll .. last owner's exit +
+     * post-roll) with every axle on the span inside it stays within the
+     * budget (at least one owner: a single vehicle's segment may exceed
+     * it). 0: AMFI_MULTI_SEGMENT_BYTES. Memory then scales with one
+     * vehicle's window and its neighbours' axles, not with the event's
+     * length (docs/results/multi-vehicle.md, round seven). */
+    size_t max_segment_bytes;
 } amfi_multi_passage;
+
+/* The default memory budget of one sweep of amfi_solve_multi, bytes. */
+#define AMFI_MULTI_SEGMENT_BYTES ((size_t)32 << 20)
 
 typedef struct amfi_vehicle_result {
     int first_axle;   /* index of its first axle in the joint result */
     int n_axles;
     double axle_kg[AMFI_MAX_AXLES]; /* mean force of its own axles on the span / g */
+    int segment;      /* the segment it was weighed in, 0-based (0 when one) */
     double gvw_kg;
     /* Coincident axles (AMFI_MULTI_COINCIDENT_M): the index, in the order
      * given, of the first vehicle of this one's inseparable group (vehicles
@@ -539,9 +559,19 @@ typedef struct amfi_multi_result {
                         and mean of an unknown of coincident axles split
                         evenly among them */
     int n_unknowns;  /* the axles' unknowns: all.n_axles less coincident ones */
-    int axle_unknown[AMFI_MAX_AXLES]; /* the unknown of each axle (numbered in
-                                         order of first axle); axles sharing
-                                         one were coincident */
+    int axle_unknown[AMFI_MAX_EVENT_AXLES]; /* the unknown of each axle (numbered
+                                         in order of first axle); axles sharing
+                                         one were coincident. A segmented event
+                                         (n_segments > 1): numbered within each
+                                         vehicle's segment */
+    /* 1: the event was solved in one sweep over its window. > 1: it was too
+     * large for the memory budget (amfi_multi_passage.max_segment_bytes) and
+     * was solved in that many segments, each over the windows of some of its
+     * vehicles (the segment's owners, weighed there) with every axle on the
+     * span inside that window as an unknown; `all` is then the last
+     * segment's joint solve (its window, its axles). */
+    int n_segments;
+    size_t max_segment_bytes; /* the largest segment's gain array, bytes */
     int n_vehicles;
     amfi_vehicle_result vehicle[AMFI_MAX_VEHICLES];
     double total_gvw_kg; /* Σ of the vehicles' GVW */
@@ -556,9 +586,11 @@ amfi_passage_times amfi_multi_window(double span_m, const amfi_multi_passage *p,
  * (AMFI_MULTI_COINCIDENT_M). The workspace grows (outside the
  * time loop) to the event's total axles and duration, the quality figures'
  * scratch included; an event no larger than one before allocates nothing.
- * Refused: no vehicles,
- * more than AMFI_MAX_VEHICLES, more than AMFI_MAX_AXLES axles in all
- * (AMFI_EINVAL); data not covering the window (AMFI_ERANGE). */
+ * An event over the memory budget is solved in segments
+ * (amfi_multi_passage.max_segment_bytes). Refused: no vehicles, more than
+ * AMFI_MAX_VEHICLES, a vehicle of more than AMFI_MAX_AXLES axles, more
+ * than AMFI_MAX_EVENT_AXLES axles in all (AMFI_EINVAL); data not covering
+ * the window (AMFI_ERANGE). */
 int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lambda *lam,
                      amfi_multi_result *res, char *err, size_t errlen);
 
