@@ -144,12 +144,14 @@ run vehicle_and_speed 2 "--vehicle: not with" $config --accel "$good" --vehicle 
 # shellcheck disable=SC2086
 run vehicle_and_entry 2 "--vehicle: not with" $config --accel "$good" --vehicle 0:25:4 --entry-time 0
 # shellcheck disable=SC2086
-run vehicle_too_many 2 "--vehicle: more than 8" $config --accel "$good" --vehicle 0:25:4 \
-    --vehicle 0:25:4 --vehicle 0:25:4 --vehicle 0:25:4 --vehicle 0:25:4 --vehicle 0:25:4 \
-    --vehicle 0:25:4 --vehicle 0:25:4 --vehicle 0:25:4
+# 17 vehicles (at most AMFI_MAX_VEHICLES, 16); 9 six-axle vehicles, 54 axles
+# (at most AMFI_MAX_EVENT_AXLES, 48)
+many=$(for _ in $(seq 17); do printf ' --vehicle 0:25:4'; done)
+heavy=$(for _ in $(seq 9); do printf ' --vehicle 0:25:1,1,1,1,1'; done)
 # shellcheck disable=SC2086
-run vehicle_axles 2 "--vehicle: 13 axles in all" $config --accel "$good" \
-    --vehicle 0:25:1,1,1,1,1,1 --vehicle 0.2:25:1,1,1,1,1
+run vehicle_too_many 2 "--vehicle: more than 16" $config --accel "$good" $many
+# shellcheck disable=SC2086
+run vehicle_axles 2 "--vehicle: 54 axles in all .at most 48." $config --accel "$good" $heavy
 # the second vehicle leaves after the data ends (2 s of data)
 f=$(csv two_s.csv 2000)
 # shellcheck disable=SC2086

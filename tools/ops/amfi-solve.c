@@ -341,9 +341,9 @@ static int parse_args(int argc, char **argv, options *o)
         int total = 0;
         for (int v = 0; v < o->n_vehicles; v++)
             total += o->vehicle[v].n_axles;
-        if (total > AMFI_MAX_AXLES)
+        if (total > AMFI_MAX_EVENT_AXLES)
             return usage_error("--vehicle", "%d axles in all (at most %d)", total,
-                               AMFI_MAX_AXLES);
+                               AMFI_MAX_EVENT_AXLES);
         return 0;
     }
     if (isnan(o->speed_mps))
