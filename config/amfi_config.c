@@ -175,6 +175,7 @@ void amfi_config_defaults(amfi_site_config *c)
     /* The model_mismatch and natfreq alerts (docs/indicators.md section 10,
      * docs/results/model-fit.md and natural-frequency.md for the figures). */
     d->model_fit_free_s = 0.5;
+    d->model_fit_calc_rate_hz = 2000;
     d->model_fit = (amfi_level_params){1, 25, 0.1, 0.05, 10, 25, 0, 0};
     d->natfreq_alert = (amfi_level_params){1, 15, 0.015, 0.0075, 5, 15, 0, 0};
     /* Bounded intake (docs/daemon.md): generous against real traffic. */

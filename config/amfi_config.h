@@ -137,6 +137,8 @@ typedef struct amfi_daemon_config {
      * is watched by a median level rule (level_rule.h). */
     double model_fit_free_s;      /* alerts.model_fit.free_s: s of free vibration fitted,
                                      [0.2, 10], at most daemon.natural_frequency.free_s */
+    double model_fit_calc_rate_hz; /* alerts.model_fit.calc_rate_hz: the fit's calculation
+                                      rate, (0, 1e6] Hz, at most solver.calc_rate_hz */
     amfi_level_params model_fit;  /* its rule: window, raise, clear, raise_after, clear_after */
     /* alerts.natfreq.*: the natfreq alert (daemon/natalert.c): the relative
      * drop 1 − f1_comp / f1_ref of the temperature-compensated first natural

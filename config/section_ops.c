@@ -92,6 +92,8 @@ static const field known_truck_fields[] = {
 
 static const field model_fit_fields[] = {
     {.key = "free_s", .kind = &amfi_cfg_k_double, .off = OPS(model_fit_free_s), .lo = 0.2, .hi = 10},
+    {.key = "calc_rate_hz", .kind = &amfi_cfg_k_double, .off = OPS(model_fit_calc_rate_hz), .lo = 0,
+     .hi = 1e6, .flags = F_LO_OPEN},
     LEVEL_FIELDS(model_fit, 10),
     {.key = NULL}};
 

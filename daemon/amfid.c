@@ -283,7 +283,7 @@ static int start_runtime(amfid *h)
                    h->cfg.daemon.model_fit.enabled && h->cfg.daemon.natfreq_free_s > 0
                        ? h->cfg.daemon.model_fit_free_s
                        : 0.0,
-                   h->cfg.daemon.workers,
+                   h->cfg.daemon.model_fit_calc_rate_hz, h->cfg.daemon.workers,
                    h->cfg.daemon.queue_size, err, sizeof err)) {
         LOG_ERR("%s", err);
         return 1;

@@ -106,12 +106,14 @@ typedef struct pool {
 
 /* Queues (jobs: queue_size; results: room for every job in flight), the
  * eventfd, one solver per thread and the threads; fit_free_s > 0: a second
- * solver per thread whose post-roll is fit_free_s longer, for the model fit
- * (a job with accel_fit is solved again over its free vibration). 0, or −1
+ * solver per thread whose post-roll is fit_free_s longer and whose
+ * calculation rate is fit_rate_hz (at most sp's), for the model fit (a job
+ * with accel_fit is solved again over its free vibration). 0, or −1
  * with the reason in err (the pool is then half built: pool_stop releases
  * it). */
 int pool_start(pool *p, const amfi_bridge *bridge, const amfi_solver_params *sp,
-               double fit_free_s, int n_threads, int queue_size, char *err, size_t errlen);
+               double fit_free_s, double fit_rate_hz, int n_threads, int queue_size,
+               char *err, size_t errlen);
 
 /* Close the job queue, let the threads finish what is queued, join them,
  * free the solvers. The results stay queued for the caller. Idempotent. */
