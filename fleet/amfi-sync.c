@@ -646,12 +646,19 @@ static int check_role(PGconn *pg, const char *site)
     PGresult *r = PQexec(pg, "SELECT row_security_active('passages'), current_user, "
                              "(SELECT site_id FROM fleet_site_roles WHERE role_name = current_user)");
     if (PQresultStatus(r) != PGRES_TUPLES_OK) {
-        fprintf(stderr, "amfi-sync: PostgreSQL: the role's site: %s"
-                        "amfi-sync: this role is not a site's role: the owner creates one per site "
-                        "with 'amfi-sync --init-site-role SITE' (docs/fleet.md, Roles)\n",
-                PQresultErrorMessage(r));
+        /* Only a refusal of this role is a usage error; a server that went
+         * away (shut down between the connection and this query) or another
+         * failure is retried: follow mode must outlive a restart of the
+         * server at any point of a pass. */
+        const char *state = PQresultErrorField(r, PG_DIAG_SQLSTATE);
+        const int refused = PQstatus(pg) == CONNECTION_OK && state &&
+                            (strcmp(state, "42501") == 0 || strcmp(state, "42P01") == 0);
+        fprintf(stderr, "amfi-sync: PostgreSQL: the role's site: %s", PQresultErrorMessage(r));
+        if (refused)
+            fprintf(stderr, "amfi-sync: this role is not a site's role: the owner creates one per "
+                            "site with 'amfi-sync --init-site-role SITE' (docs/fleet.md, Roles)\n");
         PQclear(r);
-        return EX_USAGE;
+        return refused ? EX_USAGE : EX_RETRY;
     }
     int rc = 0;
     if (PQgetvalue(r, 0, 0)[0] == 't') {

@@ -226,7 +226,16 @@ pg_stop
 add_rows "$tmp/r.db" 2000
 sleep 2
 pg_restart_start
-sleep 3
+# follow mode retries with a capped backoff (1, 2, 4 ... 60 s): wait until it
+# has shipped what was added while the server was away (at most 90 s), not a
+# fixed time, which a loaded machine's slow first pass outlasts
+want=$(sqlite3 "$tmp/r.db" 'SELECT count(*) FROM passages')
+k=0
+while [ $k -lt 900 ] && kill -0 $f 2> /dev/null &&
+    [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-r'")" != "$want" ]; do
+    sleep 0.1
+    k=$((k + 1))
+done
 kill -TERM $f
 wait $f || fail "follow mode did not stop cleanly on SIGTERM: $?"
 same "$tmp/r.db" site-r
