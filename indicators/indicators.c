@@ -19,10 +19,9 @@
  * by construction: F >= 0, degrees of freedom >= 1).
  */
 #include "indicators.h"
+#include "ind_internal.h"
 
-#include <errno.h>
 #include <gsl/gsl_cdf.h>
-#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -167,11 +166,7 @@ int amfi_indicator_params_check(const amfi_indicator_params *p, const char **fie
 }
 
 /* The fields of the text form, in its order: 1 an int, 0 a double. */
-static const struct {
-    const char *key;
-    size_t off;
-    int is_int;
-} param_fields[] = {
+static const ind_field param_fields[] = {
 #define PF_I(f) {#f, offsetof(amfi_indicator_params, f), 1}
 #define PF_D(f) {#f, offsetof(amfi_indicator_params, f), 0}
     PF_I(window), PF_I(every), PF_I(baseline_n), PF_D(std_alert_ratio), PF_D(std_alert_p),
@@ -184,82 +179,20 @@ static const struct {
 
 int amfi_indicator_params_format(const amfi_indicator_params *p, char *buf, size_t len)
 {
-    size_t at = 0;
-    if (p == NULL || buf == NULL || len == 0)
-        return AMFI_IND_EINVAL;
-    buf[0] = '\0';
-    for (size_t i = 0; i < N_PARAM_FIELDS; i++) {
-        const char *f = (const char *)p + param_fields[i].off;
-        int n = param_fields[i].is_int
-                    ? snprintf(buf + at, len - at, "%s%s=%d", i ? " " : "", param_fields[i].key,
-                               *(const int *)(const void *)f)
-                    : snprintf(buf + at, len - at, "%s%s=%.17g", i ? " " : "",
-                               param_fields[i].key, *(const double *)(const void *)f);
-        if (n < 0 || (size_t)n >= len - at)
-            return AMFI_IND_EINVAL;
-        at += (size_t)n;
-    }
-    return AMFI_IND_OK;
+    return ind_record_format(param_fields, N_PARAM_FIELDS, p, buf, len);
 }
 
 int amfi_indicator_params_parse(const char *s, amfi_indicator_params *p, char *err,
                                 size_t errlen)
 {
-    int seen[N_PARAM_FIELDS] = {0};
     amfi_indicator_params q;
     memset(&q, 0, sizeof q);
-    if (s == NULL || p == NULL) {
+    if (p == NULL) {
         set_err(err, errlen, "NULL argument");
         return AMFI_IND_EINVAL;
     }
-    const char *c = s;
-    while (*c) {
-        while (*c == ' ')
-            c++;
-        if (!*c)
-            break;
-        const char *eq = strchr(c, '=');
-        size_t i = 0, kl = eq ? (size_t)(eq - c) : 0;
-        for (; eq && i < N_PARAM_FIELDS; i++)
-            if (strlen(param_fields[i].key) == kl && strncmp(c, param_fields[i].key, kl) == 0)
-                break;
-        if (!eq || i == N_PARAM_FIELDS) {
-            set_err(err, errlen, "unknown field at '%.40s'", c);
-            return AMFI_IND_EINVAL;
-        }
-        if (seen[i]++) {
-            set_err(err, errlen, "%s given twice", param_fields[i].key);
-            return AMFI_IND_EINVAL;
-        }
-        char *end = NULL;
-        errno = 0;
-        void *f = (char *)&q + param_fields[i].off;
-        if (param_fields[i].is_int) {
-            long v = strtol(eq + 1, &end, 10);
-            if (end == eq + 1 || errno || v < INT_MIN || v > INT_MAX) {
-                set_err(err, errlen, "%s: not an integer", param_fields[i].key);
-                return AMFI_IND_EINVAL;
-            }
-            *(int *)f = (int)v;
-        } else {
-            double v = strtod(eq + 1, &end);
-            if (end == eq + 1 || errno) {
-                set_err(err, errlen, "%s: not a number", param_fields[i].key);
-                return AMFI_IND_EINVAL;
-            }
-            *(double *)f = v;
-        }
-        if (*end != ' ' && *end != '\0') {
-            set_err(err, errlen, "%s: trailing text '%.20s'", param_fields[i].key, end);
-            return AMFI_IND_EINVAL;
-        }
-        c = end;
-    }
-    for (size_t i = 0; i < N_PARAM_FIELDS; i++)
-        if (!seen[i]) {
-            set_err(err, errlen, "%s missing", param_fields[i].key);
-            return AMFI_IND_EINVAL;
-        }
+    if (ind_record_parse(param_fields, N_PARAM_FIELDS, s, &q, err, errlen) != AMFI_IND_OK)
+        return AMFI_IND_EINVAL;
     int rc = amfi_indicator_params_check(&q, NULL, err, errlen);
     if (rc == AMFI_IND_OK)
         *p = q;

@@ -7,8 +7,6 @@
 
 #include "ind_internal.h"
 
-#include <errno.h>
-#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -56,11 +54,7 @@ int amfi_level_params_check(const amfi_level_params *p, const char **field, char
 }
 
 /* The fields of the text form, in its order: 1 an int, 0 a double. */
-static const struct {
-    const char *key;
-    size_t off;
-    int is_int;
-} level_fields[] = {
+static const ind_field level_fields[] = {
 #define LF_I(f) {#f, offsetof(amfi_level_params, f), 1}
 #define LF_D(f) {#f, offsetof(amfi_level_params, f), 0}
     LF_I(enabled), LF_I(window), LF_D(raise), LF_D(clear), LF_I(raise_after), LF_I(clear_after),
@@ -71,76 +65,20 @@ static const struct {
 
 int amfi_level_params_format(const amfi_level_params *p, char *buf, size_t len)
 {
-    size_t at = 0;
-    if (!p || !buf || len == 0)
-        return AMFI_IND_EINVAL;
-    buf[0] = '\0';
-    for (size_t i = 0; i < N_LEVEL_FIELDS; i++) {
-        const char *f = (const char *)p + level_fields[i].off;
-        int n = level_fields[i].is_int
-                    ? snprintf(buf + at, len - at, "%s%s=%d", i ? " " : "", level_fields[i].key,
-                               *(const int *)(const void *)f)
-                    : snprintf(buf + at, len - at, "%s%s=%.17g", i ? " " : "",
-                               level_fields[i].key, *(const double *)(const void *)f);
-        if (n < 0 || (size_t)n >= len - at) {
-            buf[0] = '\0';
-            return AMFI_IND_EINVAL;
-        }
-        at += (size_t)n;
-    }
-    return AMFI_IND_OK;
+    return ind_record_format(level_fields, N_LEVEL_FIELDS, p, buf, len);
 }
-
-#define PARSE_FAIL(...)                                                                       \
-    do {                                                                                      \
-        if (err && errlen)                                                                    \
-            snprintf(err, errlen, __VA_ARGS__);                                               \
-        return AMFI_IND_EINVAL;                                                               \
-    } while (0)
 
 int amfi_level_params_parse(const char *s, amfi_level_params *p, char *err, size_t errlen)
 {
-    int seen[N_LEVEL_FIELDS] = {0};
     amfi_level_params q;
     memset(&q, 0, sizeof q);
-    if (!s || !p)
-        PARSE_FAIL("NULL argument");
-    const char *c = s;
-    while (*c) {
-        while (*c == ' ')
-            c++;
-        if (!*c)
-            break;
-        const char *eq = strchr(c, '=');
-        size_t i = 0, kl = eq ? (size_t)(eq - c) : 0;
-        for (; eq && i < N_LEVEL_FIELDS; i++)
-            if (strlen(level_fields[i].key) == kl && strncmp(c, level_fields[i].key, kl) == 0)
-                break;
-        if (!eq || i == N_LEVEL_FIELDS)
-            PARSE_FAIL("unknown field at '%.40s'", c);
-        if (seen[i]++)
-            PARSE_FAIL("%s given twice", level_fields[i].key);
-        char *end = NULL;
-        errno = 0;
-        void *f = (char *)&q + level_fields[i].off;
-        if (level_fields[i].is_int) {
-            long v = strtol(eq + 1, &end, 10);
-            if (end == eq + 1 || errno || v < INT_MIN || v > INT_MAX)
-                PARSE_FAIL("%s: not an integer", level_fields[i].key);
-            *(int *)f = (int)v;
-        } else {
-            double v = strtod(eq + 1, &end);
-            if (end == eq + 1 || errno)
-                PARSE_FAIL("%s: not a number", level_fields[i].key);
-            *(double *)f = v;
-        }
-        if (*end != ' ' && *end != '\0')
-            PARSE_FAIL("%s: trailing text '%.20s'", level_fields[i].key, end);
-        c = end;
+    if (!p) {
+        if (err && errlen)
+            snprintf(err, errlen, "NULL argument");
+        return AMFI_IND_EINVAL;
     }
-    for (size_t i = 0; i < N_LEVEL_FIELDS; i++)
-        if (!seen[i])
-            PARSE_FAIL("%s missing", level_fields[i].key);
+    if (ind_record_parse(level_fields, N_LEVEL_FIELDS, s, &q, err, errlen) != AMFI_IND_OK)
+        return AMFI_IND_EINVAL;
     if (amfi_level_params_check(&q, NULL, err, errlen) != AMFI_IND_OK)
         return AMFI_IND_EINVAL;
     *p = q;
