@@ -183,36 +183,30 @@ int amfi_store_get_baseline(amfi_store *s, amfi_baseline *b, int *found,
     return rc;
 }
 
-int amfi_store_recent_ok_gvw(amfi_store *s, int max, double *gvw, int *n,
-                             char *err, size_t errlen)
+/* The rows of a bound statement "SELECT id, gvw_kg, gvw_comp_kg ... ORDER BY
+ * utime DESC ... LIMIT max" into gvw[], oldest first: the weight fed
+ * (version 8), else the GVW, each checked by its own name. what names the
+ * read in messages. */
+static int recent_gvw_rows(amfi_store *s, sqlite3_stmt *st, int max, const char *what,
+                           double *gvw, int *n, char *err, size_t errlen)
 {
-    int rc = st_check_handle(s, 0, err, errlen), src = SQLITE_OK, count = 0;
-    if (rc == 0 && (!gvw || !n))
-        rc = st_fail(err, errlen, AMFI_EINVAL, "recent ok GVW: output is NULL");
-    if (rc == 0 && max < 1)
-        rc = st_fail(err, errlen, AMFI_EINVAL, "recent ok GVW: max %d must be >= 1",
-                  max);
-    if (rc != 0)
-        return rc;
-    *n = 0;
-    sqlite3_stmt *st = s->st[ST_RECENT_OK];
-    src = sqlite3_bind_int(st, 1, max);
+    int rc = 0, src, count = 0;
     /* newest first into gvw[0 ..], reversed below */
-    while (rc == 0 && src == SQLITE_OK && (src = sqlite3_step(st)) == SQLITE_ROW) {
+    while (rc == 0 && (src = sqlite3_step(st)) == SQLITE_ROW) {
         origin o = {"passages", sqlite3_column_int64(st, 0)};
         if (count >= max)
-            rc = st_fail(err, errlen, AMFI_STORE_EDB,
-                      "recent ok GVW: more rows than the LIMIT");
-        else /* the weight fed (version 8), else the GVW, each by its own name */
+            rc = st_fail(err, errlen, AMFI_STORE_EDB, "%s: more rows than the LIMIT", what);
+        else
             rc = st_read_real(st, sqlite3_column_type(st, 2) == SQLITE_NULL ? 1 : 2, &R_KG_POS,
                               &o, &gvw[count], err, errlen);
         if (rc == 0)
             count++;
-        src = SQLITE_OK;
     }
-    if (rc == 0 && src != SQLITE_DONE)
-        rc = st_db_fail(s, src, "passages: read recent ok GVW", err, errlen);
-    st_done_with(st);
+    if (rc == 0 && src != SQLITE_DONE) {
+        char m[64];
+        snprintf(m, sizeof m, "passages: read %s", what);
+        rc = st_db_fail(s, src, m, err, errlen);
+    }
     if (rc != 0)
         return rc;
     for (int i = 0, j = count - 1; i < j; i++, j--) {
@@ -224,11 +218,33 @@ int amfi_store_recent_ok_gvw(amfi_store *s, int max, double *gvw, int *n,
     return 0;
 }
 
+int amfi_store_recent_ok_gvw(amfi_store *s, int max, double *gvw, int *n,
+                             char *err, size_t errlen)
+{
+    int rc = st_check_handle(s, 0, err, errlen), src = SQLITE_OK;
+    if (rc == 0 && (!gvw || !n))
+        rc = st_fail(err, errlen, AMFI_EINVAL, "recent ok GVW: output is NULL");
+    if (rc == 0 && max < 1)
+        rc = st_fail(err, errlen, AMFI_EINVAL, "recent ok GVW: max %d must be >= 1",
+                  max);
+    if (rc != 0)
+        return rc;
+    *n = 0;
+    sqlite3_stmt *st = s->st[ST_RECENT_OK];
+    src = sqlite3_bind_int(st, 1, max);
+    if (src == SQLITE_OK)
+        rc = recent_gvw_rows(s, st, max, "recent ok GVW", gvw, n, err, errlen);
+    else
+        rc = st_db_fail(s, src, "passages: read recent ok GVW", err, errlen);
+    st_done_with(st);
+    return rc;
+}
+
 int amfi_store_recent_fed_gvw(amfi_store *s, int max, const char *const *classes,
                               int n_classes, double min_kg, int single_only, double *gvw,
                               int *n, char *err, size_t errlen)
 {
-    int rc = st_check_handle(s, 0, err, errlen), src = SQLITE_OK, count = 0;
+    int rc = st_check_handle(s, 0, err, errlen), src = SQLITE_OK;
     if (rc == 0 && (!gvw || !n))
         rc = st_fail(err, errlen, AMFI_EINVAL, "recent fed GVW: output is NULL");
     if (rc == 0 && max < 1)
@@ -265,30 +281,12 @@ int amfi_store_recent_fed_gvw(amfi_store *s, int max, const char *const *classes
         src = sqlite3_bind_double(st, 2, min_kg);
     for (int k = 0; src == SQLITE_OK && k < n_classes; k++)
         src = sqlite3_bind_text(st, k + 3, classes[k], -1, SQLITE_TRANSIENT);
-    /* newest first into gvw[0 ..], reversed below */
-    while (rc == 0 && src == SQLITE_OK && (src = sqlite3_step(st)) == SQLITE_ROW) {
-        origin o = {"passages", sqlite3_column_int64(st, 0)};
-        if (count >= max)
-            rc = st_fail(err, errlen, AMFI_STORE_EDB, "recent fed GVW: more rows than the LIMIT");
-        else
-            rc = st_read_real(st, sqlite3_column_type(st, 2) == SQLITE_NULL ? 1 : 2, &R_KG_POS,
-                              &o, &gvw[count], err, errlen);
-        if (rc == 0)
-            count++;
-        src = SQLITE_OK;
-    }
-    if (rc == 0 && src != SQLITE_DONE)
+    if (src == SQLITE_OK)
+        rc = recent_gvw_rows(s, st, max, "recent fed GVW", gvw, n, err, errlen);
+    else
         rc = st_db_fail(s, src, "passages: read recent fed GVW", err, errlen);
     sqlite3_finalize(st);
-    if (rc != 0)
-        return rc;
-    for (int i = 0, j = count - 1; i < j; i++, j--) {
-        double t = gvw[i];
-        gvw[i] = gvw[j];
-        gvw[j] = t;
-    }
-    *n = count;
-    return 0;
+    return rc;
 }
 
 int amfi_store_meta_get(amfi_store *s, const char *key, char *val,
