@@ -265,6 +265,19 @@ static void spread_forces(struct amfi_solver *s, int nu, int na, const int *unk,
     }
 }
 
+/* The event's samples as a passage (its vehicle fields unset): what the
+ * checks and the solve read of the data. */
+static amfi_passage samples_of(const amfi_multi_passage *p)
+{
+    amfi_passage samples;
+    memset(&samples, 0, sizeof samples);
+    samples.n_samples = p->n_samples;
+    samples.scan_rate_hz = p->scan_rate_hz;
+    samples.t_first_s = p->t_first_s;
+    memcpy(samples.accel, p->accel, sizeof samples.accel);
+    return samples;
+}
+
 /* The joint solve of the vehicles of p (validated by amfi_solve_multi,
  * at most AMFI_MAX_EVENT_AXLES axles) over the window [t_start, t_end] on
  * the samples' clock, inside the samples. Every axle must be on the span
@@ -281,12 +294,7 @@ static int solve_joint(struct amfi_solver *s, const amfi_multi_passage *p, doubl
     int na = 0, rc;
     for (int v = 0; v < p->n_vehicles; v++)
         na += p->vehicle[v].n_axles;
-    amfi_passage samples;
-    memset(&samples, 0, sizeof samples);
-    samples.n_samples = p->n_samples;
-    samples.scan_rate_hz = p->scan_rate_hz;
-    samples.t_first_s = p->t_first_s;
-    memcpy(samples.accel, p->accel, sizeof samples.accel);
+    const amfi_passage samples = samples_of(p);
     const double L = s->b->p.span_m;
     if (amfi_solver_grow_axles(s, na) != 0 || mq_reserve(s, na) != 0)
         return amfi_fail(err, errlen, AMFI_ENOMEM, "out of memory for %d axles", na);
@@ -575,12 +583,7 @@ int amfi_solve_multi(amfi_solver *s, const amfi_multi_passage *p, const amfi_lam
         AMFI_EINVAL, "lambda_factor %g: 0 (off) or 1e-4 .. 1", p->lambda_factor);
     REQ(na <= AMFI_MAX_EVENT_AXLES, AMFI_EINVAL, "%d axles in all: at most %d in one event", na,
         AMFI_MAX_EVENT_AXLES);
-    amfi_passage samples;
-    memset(&samples, 0, sizeof samples);
-    samples.n_samples = p->n_samples;
-    samples.scan_rate_hz = p->scan_rate_hz;
-    samples.t_first_s = p->t_first_s;
-    memcpy(samples.accel, p->accel, sizeof samples.accel);
+    const amfi_passage samples = samples_of(p);
     int rc = amfi_check_samples_lambda(s, &samples, lam, err, errlen);
     if (rc)
         return rc;
