@@ -51,6 +51,17 @@ fleet_same() {
     c=$(pg_q "SELECT count(*) FROM axles WHERE site_id = '$2'")
     [ "$l" = "$c" ] || fail "$2 axles: store '$l' central '$c'"
 }
+# fleet_synced DB SITE: 0 when the central rows of the site have the store's
+# counts and last ids in every table (fleet_same's check, silent)
+fleet_synced() {
+    for t in passages indicators alerts baseline runs environment scale_evals; do
+        [ "$(sqlite3 "$1" "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t")" = \
+          "$(pg_q "SELECT count(*) || ' ' || coalesce(max(id), 0) FROM $t WHERE site_id = '$2'")" ] ||
+            return 1
+    done
+    [ "$(sqlite3 "$1" "SELECT count(*) FROM axles")" = \
+      "$(pg_q "SELECT count(*) FROM axles WHERE site_id = '$2'")" ]
+}
 # fleet_columns_same DB SITE TABLE [WHERE]: every row of TABLE (the store's
 # columns, in its order; WHERE on both sides) equal in the store and the
 # central database, column by column. Both print reals with 15 significant
