@@ -229,11 +229,17 @@ sleep 2
 pg_restart_start
 # follow mode retries with a capped backoff (1, 2, 4 ... 60 s): wait until it
 # has shipped what was added while the server was away (at most 90 s), not a
-# fixed time, which a loaded machine's slow first pass outlasts
-want=$(sqlite3 "$tmp/r.db" 'SELECT count(*) FROM passages')
+# fixed time, which a loaded machine's slow first pass outlasts; every table
+# counted, as a pass ships them one after the other and SIGTERM stops it
+# after the batch in flight (the passages alone were seen shipped with half
+# the alerts still to come)
+rows="(SELECT count(*) FROM passages) || ' ' || (SELECT count(*) FROM indicators) || ' ' ||
+      (SELECT count(*) FROM alerts) || ' ' || (SELECT count(*) FROM baseline) || ' ' ||
+      (SELECT count(*) FROM runs)"
+want=$(sqlite3 "$tmp/r.db" "SELECT $rows")
 k=0
 while [ $k -lt 900 ] && kill -0 $f 2> /dev/null &&
-    [ "$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'site-r'")" != "$want" ]; do
+    [ "$(pg_q "SELECT $(echo "$rows" | sed "s/FROM \([a-z]*\))/FROM \1 WHERE site_id = 'site-r')/g")")" != "$want" ]; do
     sleep 0.1
     k=$((k + 1))
 done
