@@ -10,7 +10,8 @@
  * solved get their class and groups too (their overload stays NULL, as it
  * does when the classifier refuses the loads: a single axle or a whole
  * group below zero; an axle below zero inside a group is not separable and
- * its group's sum is judged); a
+ * its group's sum is judged; or a group above ten times any legal load:
+ * the reason is stored, passages.loads_refused); a
  * passage without axles or with a spacing the classifier refuses gets none
  * (NULL), which the detector's checks make rare (intake validates the
  * spacings before a vehicle becomes a passage).
@@ -29,6 +30,7 @@
 static struct {
     char name[AMFI_CLASS_NAME_LEN];
     char groups[32];
+    char refused[sizeof(((amfi_classification *)0)->loads_why)];
 } C;
 
 /* "1-1-3": the axles per group, front to back; 0 when it does not fit. */
@@ -48,15 +50,16 @@ static int groups_text(const amfi_classification *k, char *buf, size_t len)
 static void classes_row(amfid_ctx *c, const amfid_passage *p, amfi_passage_row *r)
 {
     (void)p;
-    r->vclass = r->axle_groups = NULL;
+    r->vclass = r->axle_groups = r->loads_refused = NULL;
     r->has_overload = r->overload = 0;
     if (r->n_axles < 1 || r->n_axles > AMFI_MAX_AXLES)
         return;
     /* finite loads go to the classifier as they are: an axle below zero
      * inside a group is the solve's split of the group's load (not
      * separable), the group's sum is judged; a single axle or a group below
-     * zero refuses the loads (k.loads_ok 0), class and groups still stored,
-     * the overload NULL */
+     * zero, or one above ten times any legal load of its axle count,
+     * refuses the loads (k.loads_ok 0): class and groups still stored, the
+     * overload NULL, the reason in loads_refused */
     int loads = !isnan(r->gvw_kg);
     for (int a = 0; loads && a < r->n_axles; a++)
         loads = isfinite(r->axle_kg[a]);
@@ -74,6 +77,9 @@ static void classes_row(amfid_ctx *c, const amfid_passage *p, amfi_passage_row *
     if (loads && k.loads_ok) {
         r->has_overload = 1;
         r->overload = k.over != 0;
+    } else if (loads && k.loads_why[0]) {
+        snprintf(C.refused, sizeof C.refused, "%s", k.loads_why);
+        r->loads_refused = C.refused;
     }
 }
 

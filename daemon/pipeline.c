@@ -100,6 +100,7 @@ static void publish_passage(amfid_ctx *d, const amfid_passage *p)
     double g_kg[AMFI_MAX_AXLES] = {0};
     m.vehicle_class = (char *)(r->vclass ? r->vclass : "");
     m.overload = (int8_t)(r->has_overload ? r->overload : -1);
+    m.loads_refused = (char *)(r->loads_refused ? r->loads_refused : "");
     if (r->vclass && r->axle_groups) {
         amfi_axle_group g[AMFI_MAX_AXLES];
         int ng = amfi_axle_groups(r->n_axles, r->spacing_m, j->solved ? r->axle_kg : NULL,

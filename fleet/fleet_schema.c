@@ -287,6 +287,11 @@ static const char fleet_v8[] =
  * modelfit module stores it. Rows shipped before keep NULL. */
 static const char fleet_v9[] = "ALTER TABLE passages ADD COLUMN fit_ratio double precision;\n";
 
+/* Version 10 (site store version 13): why amfid's classification refused a
+ * passage's loads (its overload is then NULL). Rows shipped before keep
+ * NULL. */
+static const char fleet_v10[] = "ALTER TABLE passages ADD COLUMN loads_refused text;\n";
+
 /* roles.sql (the roles and row-level security as they stand now), compiled
  * in by fleet/CMakeLists.txt */
 #include "fleet_roles_sql.h"
@@ -311,6 +316,7 @@ const struct fleet_migration fleet_migrations[] = {
     {8, "fleet_sites: name, position, bridge type and store of each site; fleet_summary; "
         "times in the views as timestamptz", fleet_v8},
     {9, "passages: fit_ratio (the model fit)", fleet_v9},
+    {10, "passages: loads_refused (why the classification refused the loads)", fleet_v10},
 };
 const char *const fleet_roles_sql = fleet_roles_sql_text;
 const int fleet_n_migrations = (int)(sizeof fleet_migrations / sizeof fleet_migrations[0]);

@@ -55,7 +55,7 @@ int fleet_hash_cols(const char *table);
 
 /* The oldest site store schema (PRAGMA user_version) whose columns
  * fleet_tables names: amfid migrates older stores when it starts. */
-#define FLEET_MIN_STORE_VERSION 12
+#define FLEET_MIN_STORE_VERSION 13
 
 /* A site's facts (fleet_sites; the site store's meta site.*) as
  * amfid.yaml(5) allows them, checked by amfi-sync before it ships them and

@@ -74,7 +74,7 @@ extern "C" {
 const char *amfi_store_strerror(int status);
 
 /* Schema version this code creates and migrates to (PRAGMA user_version). */
-#define AMFI_STORE_SCHEMA_VERSION 12
+#define AMFI_STORE_SCHEMA_VERSION 13
 /* PRAGMA application_id of an amfi store: "AMFI" in ASCII. */
 #define AMFI_STORE_APPLICATION_ID 0x414D4649
 /* How long a statement waits for another connection's lock, ms. */
@@ -196,7 +196,17 @@ typedef struct amfi_passage_row {
                             the model solved over the free vibration after the last
                             axle, relative to the signal there, (0, 1000]; NaN
                             or 0: not fitted (NULL) */
+    const char *loads_refused; /* why the classification refused the loads
+                            (classify/ amfi_classification.loads_why: a single
+                            axle or a group below zero, or above
+                            AMFI_CLASS_IMPLAUSIBLE_FACTOR x any legal load), 1 ..
+                            AMFI_STORE_LOADS_REFUSED_MAX bytes, valid UTF-8
+                            without control characters; NULL: the loads were
+                            judged, or there were none (NULL) */
 } amfi_passage_row;
+/* The longest passages.loads_refused, bytes (amfi_classification.loads_why
+ * holds 111). */
+#define AMFI_STORE_LOADS_REFUSED_MAX 111
 /* The range of a reference GVW (a calibration truck), kg. */
 #define AMFI_STORE_MIN_REF_KG 1000.0
 #define AMFI_STORE_MAX_REF_KG 100000.0
@@ -496,9 +506,9 @@ int amfi_store_gvw_errors(amfi_store *s, double **pct, size_t *n,
 
 /* ---- passage listing (store_export.c) ------------------------------------ */
 
-/* Called once per passage; row->status, row->reason, row->vclass and
-   row->axle_groups (NULL where the column is NULL; has_overload 0 where
-   overload is) are valid during the call only. A nonzero return stops the
+/* Called once per passage; row->status, row->reason, row->vclass,
+   row->axle_groups and row->loads_refused (NULL where the column is NULL;
+   has_overload 0 where overload is) are valid during the call only. A nonzero return stops the
    listing and is returned. */
 typedef int (*amfi_store_passage_fn)(void *ctx, int64_t id,
                                      const amfi_passage_row *row);

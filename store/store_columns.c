@@ -118,6 +118,11 @@ static const amfi_store_coldef passages[] = {
     REAL("fit_ratio", fit_ratio, AMFI_NULL_ZERO, 1, 0, 1000, "", 12, 9,
          "the model's RMS residual over the free vibration after the last axle / the "
          "signal's there; NULL not fitted"),
+    TEXT("loads_refused", loads_refused, AMFI_NULL_PTR, AMFI_TEXT_UTF8, 1,
+         AMFI_STORE_LOADS_REFUSED_MAX, 13, 10,
+         "why the classification refused the loads (a single axle or a group below zero, or "
+         "above 10 x any legal load): never an overload; NULL judged, not solved, or before "
+         "v13"),
 };
 #undef ROW
 

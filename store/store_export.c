@@ -43,7 +43,7 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
     src = sqlite3_prepare_v2(s->db,
         "SELECT id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, "
         "reason, speed_given_mps, speed_estimated, n_vehicles, quality, class, axle_groups, "
-        "overload FROM passages WHERE utime >= ?1 AND utime <= ?2 "
+        "overload, loads_refused FROM passages WHERE utime >= ?1 AND utime <= ?2 "
         "AND (?3 IS NULL OR status = ?3) AND (?4 IS NULL OR lane = ?4) "
         "ORDER BY utime, id", -1, &p, NULL);
     if (src == SQLITE_OK)
@@ -64,7 +64,8 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
         origin o = {"passages", sqlite3_column_int64(p, 0)};
         amfi_passage_row r;
         int64_t v = 0;
-        char st_name[16], reason[AMFI_STORE_REASON_MAX + 1], vclass[16], groups[32];
+        char st_name[16], reason[AMFI_STORE_REASON_MAX + 1], vclass[16], groups[32],
+            refused[AMFI_STORE_LOADS_REFUSED_MAX + 1];
         memset(&r, 0, sizeof r);
         for (int k = 0; k < AMFI_MAX_AXLES; k++)
             r.spacing_m[k] = r.axle_kg[k] = NAN;
@@ -106,6 +107,13 @@ int amfi_store_each_passage_where(amfi_store *s, const amfi_passage_filter *f,
             rc = st_read_int(p, 15, 0, 1, &o, &v, err, errlen);
             r.overload = (int)v;
             r.has_overload = 1;
+        }
+        if (rc == 0 && sqlite3_column_type(p, 16) != SQLITE_NULL) {
+            rc = st_read_text(p, 16, AMFI_STORE_LOADS_REFUSED_MAX, &o, refused, sizeof refused,
+                              err, errlen);
+            if (rc == 0 && !refused[0])
+                rc = st_corrupt(&o, p, 16, err, errlen, "is empty (NULL when the loads were judged)");
+            r.loads_refused = refused;
         }
         if (rc == 0) {
             int asrc;

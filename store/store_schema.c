@@ -339,6 +339,16 @@ static const char schema_v12[] =
     "ALTER TABLE passages ADD COLUMN fit_ratio REAL\n"
     "  CHECK (fit_ratio > 0 AND fit_ratio <= 1000);\n";
 
+/* Version 13: why the classification refused a passage's loads (classify/
+ * loads_why: a single axle or a group below zero, or above ten times any
+ * legal load of its axle count), written by amfid's classes module; such a
+ * passage's overload stays NULL. NULL where the loads were judged, where
+ * there were none, and in rows written before (amfi-report recomputes the
+ * refusal for those). */
+static const char schema_v13[] =
+    "ALTER TABLE passages ADD COLUMN loads_refused TEXT\n"
+    "  CHECK (length(loads_refused) BETWEEN 1 AND 111);\n";
+
 const st_migration st_migrations[] = {
     {1, "passages, axles, truth, truth_axles, indicators, alerts, baseline, "
         "meta; views daily_trend, window_trend, passage_errors", schema_v1},
@@ -355,6 +365,7 @@ const st_migration st_migrations[] = {
     {11, "raw_windows, passage_raw: each passage's raw samples (retention by age and size)",
      schema_v11},
     {12, "passages: fit_ratio (the model's residual over the free vibration)", schema_v12},
+    {13, "passages: loads_refused (why the classification refused the loads)", schema_v13},
 };
 const int st_n_migrations = (int)(sizeof st_migrations / sizeof st_migrations[0]);
 _Static_assert(sizeof st_migrations / sizeof st_migrations[0]

@@ -378,6 +378,49 @@ static void implausible_loads(void **state)
     assert_non_null(strstr(c.loads_why, "single axle 6"));
 }
 
+/* The reason amfid stores (passages.loads_refused, 1 .. 111 bytes of text
+ * without control characters) and publishes (passage_t.loads_refused, at
+ * most 111 bytes): the longest refusals of the loads the store holds
+ * (|load| <= 1e6 kg, 12 axles, limits raised to the checks' largest) fit
+ * whole, printable. */
+static void refusal_fits_the_store(void **state)
+{
+    (void)state;
+    assert_int_equal(sizeof(((amfi_classification *)0)->loads_why) - 1, 111);
+    amfi_class_params p = eu();
+    p.single_axle_kg = p.driving_axle_kg = 99999.0; /* the widest legal figure */
+    amfi_classification c;
+    char err[128] = "";
+    /* 12 axles: singles, one group of 12, 10 singles and a tandem, 9 singles
+     * and a tridem; the last axle (or every axle) at the store's extremes */
+    static const struct {
+        int last_group;  /* axles in the last group (the others single), 12: one group */
+        double last_kg, other_kg;
+        const char *want; /* the reason's start */
+    } cases[] = {
+        {1, -999999.0, 1000.0, "axle 12: load -999999 kg < 0"},
+        {1, 999999.0, 1000.0, "single axle 12: load 999999 kg, over 10 x"},
+        {12, -83333.0, -83333.0, "group 1 (axles 1-12): load -999996 kg < 0"},
+        {2, -999999.0, 1000.0, "group 11 (axles 11-12): load -998999 kg < 0"},
+        {3, 997999.0, 1000.0, "group 10: load 999999 kg, over 10 x any legal load of 3 axles"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        double sp[11], kg[12];
+        for (int a = 0; a < 11; a++)
+            sp[a] = a >= 11 - (cases[k].last_group - 1) ? 1.3 : 3.0;
+        for (int a = 0; a < 12; a++)
+            kg[a] = cases[k].other_kg;
+        kg[11] = cases[k].last_kg;
+        assert_int_equal(amfi_classify(&p, 12, sp, kg, &c, err, sizeof err), 0);
+        assert_int_equal(c.loads_ok, 0);
+        size_t n = strlen(c.loads_why);
+        assert_true(strncmp(c.loads_why, cases[k].want, strlen(cases[k].want)) == 0);
+        assert_true(n >= 1 && n < sizeof c.loads_why - 1); /* whole, not cut */
+        for (size_t i = 0; i < n; i++)
+            assert_true(c.loads_why[i] >= 0x20 && c.loads_why[i] < 0x7f);
+    }
+}
+
 /* The text form amfid records in the store (meta daemon.classes): every
  * field round-trips exactly; a damaged text is refused naming the field,
  * *p untouched. */
@@ -436,6 +479,7 @@ int main(void)
         cmocka_unit_test(eu_limits),            cmocka_unit_test(fhwa_typical),
         cmocka_unit_test(refusals),             cmocka_unit_test(params_text),
         cmocka_unit_test(negative_loads),       cmocka_unit_test(implausible_loads),
+        cmocka_unit_test(refusal_fits_the_store),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

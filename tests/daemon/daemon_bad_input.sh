@@ -5,9 +5,14 @@
 # random bytes on each input channel, an invalid vehicle, two blocks out of
 # order. amfid must count them, store the invalid vehicle with its reason,
 # weigh the real vehicles, and exit cleanly.
-# Usage: daemon_bad_input.sh AMFID SIM_PUBLISHER LCM_INJECT CONFIG
+# Loads no vehicle carries (samples x 30: single axles over 10 x any legal
+# load) and a detector record the samples do not match (spacings x 4: a rear
+# axle below zero): stored ok with the classification's refusal in
+# passages.loads_refused, the overload NULL, and amfi-report --overloads
+# lists them as refused with that reason, never as overloads.
+# Usage: daemon_bad_input.sh AMFID SIM_PUBLISHER LCM_INJECT CONFIG AMFI_REPORT
 set -u
-amfid=$1 sim=$2 inject=$3 config=$4
+amfid=$1 sim=$2 inject=$3 config=$4 report=$5
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 . "$(dirname "$0")/../common/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
@@ -65,6 +70,46 @@ n=$(sqlite3 "$dir/c.db" "SELECT count(*) FROM passages WHERE status = 'error' AN
 [ "$n" -eq 3 ] || fail "absurd samples: $(sqlite3 "$dir/c.db" "SELECT status, reason FROM passages")"
 grep -q "store_degraded" "$dir/amfid.log" && fail "absurd samples made the store degraded"
 echo "absurd samples: 3 passages stored as error (result not storable), store never degraded"
+
+# Loads the classification refuses (classify/: a single axle or a group
+# below zero, or above 10 x any legal load of its axle count). Samples x 30:
+# each axle of the three two-axle vehicles carries over 115 t (10 x the
+# 11.5 t any single axle may carry); spacings x 4: the solve puts the rear
+# axle below zero (at least the third vehicle's, about -2.4 t). Each such
+# passage is stored ok with its class, a NULL overload and the reason; a
+# passage is refused exactly when one of its stored axle loads is below zero
+# or above 115 t. amfi-report --overloads counts none of them as an
+# overload and lists each as refused with the stored reason.
+refused_check() { # DB WHAT GLOB MIN
+  q() { sqlite3 "$1" "$2"; }
+  n=$(q "$1" "SELECT count(*) FROM passages WHERE status = 'ok' AND class = 'R2' AND overload IS NULL
+             AND loads_refused GLOB '$3'")
+  [ "$n" -ge "$4" ] || fail "$2: $n passages stored with a refusal '$3', want >= $4: $(q "$1" "SELECT id, status, class, overload, loads_refused FROM passages")"
+  bad=$(q "$1" "SELECT count(*) FROM passages p WHERE status = 'ok' AND (loads_refused IS NOT NULL) <>
+                EXISTS (SELECT 1 FROM axles a WHERE a.passage_id = p.id AND (a.load_kg < 0 OR a.load_kg > 115000))")
+  [ "$bad" -eq 0 ] || fail "$2: $bad passages whose refusal does not match their loads: $(q "$1" "SELECT p.id, p.loads_refused, group_concat(a.load_kg) FROM passages p JOIN axles a ON a.passage_id = p.id GROUP BY p.id")"
+  "$report" --db "$1" --overloads > "$dir/over.txt" 2> "$dir/over.err" || fail "$2: amfi-report --overloads: $(cat "$dir/over.err")"
+  grep -q "^checked $((3 - n)) ok passages: .*, 0 overloaded in all" "$dir/over.txt" ||
+    fail "$2: amfi-report counts a refused passage as checked or overloaded: $(cat "$dir/over.txt")"
+  grep -q "^== loads refused ($n ok passages" "$dir/over.txt" || fail "$2: no section of refused loads: $(cat "$dir/over.txt")"
+  for id in $(q "$1" "SELECT id FROM passages WHERE loads_refused IS NOT NULL"); do
+    grep -qF " $id  $(q "$1" "SELECT printf('%10d  %4d  %-7.7s', vehicle_id, lane, class) FROM passages WHERE id = $id")" "$dir/over.txt" &&
+      grep -qF "loads refused: $(q "$1" "SELECT loads_refused FROM passages WHERE id = $id")" "$dir/over.txt" ||
+      fail "$2: passage $id not listed refused with its stored reason: $(cat "$dir/over.txt")"
+  done
+  "$report" --db "$1" --overloads --format csv > "$dir/over.csv" 2> "$dir/over.err" || fail "$2: --format csv"
+  [ "$(grep -c ',refused,' "$dir/over.csv")" -eq "$n" ] && [ "$(wc -l < "$dir/over.csv")" -eq $((n + 1)) ] ||
+    fail "$2: the CSV is not one refused line per refused passage: $(cat "$dir/over.csv")"
+}
+"$inject" --scale-accel 30 "$dir/clean.log" "$dir/heavy.log" || fail "lcm_inject --scale-accel 30"
+"$amfid" --config "$config" --db "$dir/h.db" --lcm-url "file://$dir/heavy.log?speed=0" \
+  2> "$dir/amfid.log" || fail "amfid on loads over 10 x legal: exit status $?"
+refused_check "$dir/h.db" "loads x 30" 'single axle [12]: load * kg, over 10 x any legal load of 1 axle (11500 kg)' 3
+"$inject" --scale-spacing 4 "$dir/clean.log" "$dir/long.log" || fail "lcm_inject --scale-spacing 4"
+"$amfid" --config "$config" --db "$dir/l.db" --lcm-url "file://$dir/long.log?speed=0" \
+  2> "$dir/amfid.log" || fail "amfid on spacings x 4: exit status $?"
+refused_check "$dir/l.db" "spacings x 4" 'axle 2: load -* kg < 0 (a single axle)' 1
+echo "refused loads: $(sqlite3 "$dir/h.db" "SELECT count(*) FROM passages WHERE loads_refused IS NOT NULL") of 3 over 10 x legal, $(sqlite3 "$dir/l.db" "SELECT count(*) FROM passages WHERE loads_refused IS NOT NULL") of 3 below zero; stored with the reason, listed refused by amfi-report"
 
 # Two vehicles side by side (every vehicle with a twin on the other lane:
 # same entry, speed and spacings; the samples hold one vehicle): axles at

@@ -181,6 +181,7 @@ DROP TABLE fleet_sites;
 DROP TABLE fleet_site_roles;
 ALTER TABLE passages DROP COLUMN class, DROP COLUMN axle_groups, DROP COLUMN overload;
 ALTER TABLE passages DROP COLUMN fit_ratio;
+ALTER TABLE passages DROP COLUMN loads_refused;
 DELETE FROM fleet_migrations WHERE version > 5;
 CREATE ROLE amfi_sync LOGIN;
 GRANT USAGE ON SCHEMA public TO amfi_sync;
@@ -195,8 +196,8 @@ psql -X -q -v ON_ERROR_STOP=1 "$upw" -c "INSERT INTO fleet_migrations VALUES (77
 [ "$(pg_q "SELECT count(*) FROM fleet_open_alerts WHERE site_id = 'site-v'")" = 0 ] ||
     fail "at version 5, the forged cleared alert did not close site-v's alert"
 pg_q "DELETE FROM alerts WHERE site_id = 'site-v' AND id = 9999; DELETE FROM fleet_migrations WHERE version = 77"
-"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 5 -> 9"
-[ "$(psql -X -At "$up" -c 'SELECT max(version) FROM fleet_migrations')" = 9 ] || fail "not migrated to 9"
+"$sync" --pg "$up" --init-schema --quiet || fail "--init-schema 5 -> 10"
+[ "$(psql -X -At "$up" -c 'SELECT max(version) FROM fleet_migrations')" = 10 ] || fail "not migrated to 10"
 add_rows "$tmp/u.db" 200
 "$sync" --db "$tmp/u.db" --pg "$upw" --once 2> "$tmp/upw.log"
 [ $? = 2 ] || fail "the shared writer after the migration: not refused"

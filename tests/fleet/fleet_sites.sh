@@ -33,7 +33,7 @@ meta() { # DB KEY VALUE
                   ON CONFLICT (key) DO UPDATE SET value = excluded.value"
 }
 "$sync" --pg "$PG_CONNINFO" --init-schema --quiet || fail "--init-schema"
-[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 9 ] || fail "schema version"
+[ "$(pg_q 'SELECT max(version) FROM fleet_migrations')" = 10 ] || fail "schema version"
 
 case=facts
 mkstore "$tmp/a.db" a1-km12 300
@@ -112,7 +112,7 @@ pg_q "CREATE DATABASE up7"
 U="host=$PG_DIR dbname=up7 user=postgres"
 "$sync" --pg "$U" --init-schema --quiet || fail "up7: --init-schema"
 "$sync" --db "$tmp/a.db" --pg "$U" --once --quiet || fail "up7: a: exit $?"
-psql -X -q -v ON_ERROR_STOP=1 "$U" -c "ALTER TABLE passages DROP COLUMN fit_ratio;
+psql -X -q -v ON_ERROR_STOP=1 "$U" -c "ALTER TABLE passages DROP COLUMN loads_refused, DROP COLUMN fit_ratio;
     DROP VIEW fleet_summary; DROP TABLE fleet_sites;
     DELETE FROM fleet_migrations WHERE version >= 8" > "$tmp/up7.log" 2>&1 || fail "down to 7: $(cat "$tmp/up7.log")"
 "$sync" --db "$tmp/a.db" --pg "$U" --once 2> "$tmp/up7.log"

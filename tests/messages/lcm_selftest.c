@@ -179,6 +179,10 @@ static void round_make(struct round *r, int i)
     r->passage.group_load_kg = r->passage_group_kg;
     r->passage.overload = (int8_t)(i % 2);
     r->passage.fit_ratio = i % 3 ? 0.0042 : NAN; /* an event's vehicle: not fitted */
+    /* every fifth: loads the classification refused (overload not decided) */
+    r->passage.loads_refused = i % 5 == 4 ? "group 2 (axles 2-3): load -3200 kg < 0" : "";
+    if (i % 5 == 4)
+        r->passage.overload = -1;
 
     r->unsolved = r->passage;
     r->unsolved.passage_id = 100000 + i;
@@ -198,6 +202,7 @@ static void round_make(struct round *r, int i)
     r->unsolved.group_load_kg = NULL;
     r->unsolved.overload = -1;
     r->unsolved.fit_ratio = NAN;
+    r->unsolved.loads_refused = "";
 
     r->indicator.utime = r->vehicle.utime;
     r->indicator.indicator_id = 700 + i;
@@ -345,7 +350,8 @@ static void print_round(const struct round *r)
     put_i16a("group_axles", p->group_axles, p->n_groups, ";");
     put_da("group_load_kg", p->group_load_kg, p->n_groups, ";");
     put_i("overload", p->overload, ";");
-    put_d("fit_ratio", p->fit_ratio, "\n");
+    put_d("fit_ratio", p->fit_ratio, ";");
+    put_s("loads_refused", p->loads_refused, "\n");
 
     const amfi_indicator_t *d = &r->indicator;
     printf("%s\tamfi.indicator_t\t", AMFI_CHANNEL_INDICATOR);
@@ -537,7 +543,8 @@ static int same_passage(const char *c, const amfi_passage_t *a, const amfi_passa
             same_s(c, "vehicle_class", a->vehicle_class, b->vehicle_class) +
             same_i(c, "n_groups", a->n_groups, b->n_groups) +
             same_i(c, "overload", a->overload, b->overload) +
-            same_d(c, "fit_ratio", a->fit_ratio, b->fit_ratio);
+            same_d(c, "fit_ratio", a->fit_ratio, b->fit_ratio) +
+            same_s(c, "loads_refused", a->loads_refused, b->loads_refused);
     for (int k = 0; !e && k < a->n_groups; k++)
         e += same_i(c, "group_axles", a->group_axles[k], b->group_axles[k]);
     if (!e && a->n_groups)

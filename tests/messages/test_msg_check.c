@@ -145,7 +145,8 @@ static enc random_message(amfi_msg_type t, int big)
                             rnd_double(), NULL, NULL, rnd_double(), 0, NULL, rnd_double(),
                             rnd_double(), NULL, rnd_double(), NULL, rnd_double(),
                             (int8_t)rnd(), (int16_t)rnd(), rnd_double(), rnd_double(),
-                            rnd_double(), rnd_double(), NULL, 0, NULL, NULL, 0, rnd_double()};
+                            rnd_double(), rnd_double(), NULL, 0, NULL, NULL, 0, rnd_double(),
+                            NULL};
         m.status = rnd_string(AMFI_MSG_MAX_PASSAGE_STATUS);
         m.site_id = rnd_string(AMFI_MSG_MAX_PASSAGE_SITE_ID);
         m.reason = rnd_string(AMFI_MSG_MAX_PASSAGE_REASON);
@@ -162,12 +163,14 @@ static enc random_message(amfi_msg_type t, int big)
         m.group_axles = ga;
         m.group_load_kg = rnd_doubles(m.n_groups);
         m.overload = (int8_t)rnd();
+        m.loads_refused = rnd_string(AMFI_MSG_MAX_PASSAGE_LOADS_REFUSED);
         ENCODE(passage_t, m);
         free(m.site_id);
         free(m.status);
         free(m.reason);
         free(m.axle_kg);
         free(m.vehicle_class);
+        free(m.loads_refused);
         free(m.group_load_kg);
         free(m.formulation);
         break;
@@ -484,7 +487,7 @@ static enc empty_arrays(amfi_msg_type t)
     case AMFI_MSG_PASSAGE_T: {
         amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
                             1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0,
-                            5.73, 5.70, (char *)"A23", 0, NULL, NULL, 0, 0.004};
+                            5.73, 5.70, (char *)"A23", 0, NULL, NULL, 0, 0.004, (char *)""};
         ENCODE(passage_t, m);
         break;
     }
@@ -555,7 +558,7 @@ static void test_counts(void **state)
 /* passage_t's class and groups: n_groups up to its limit, one over refused
  * (over_limit, naming the array), a negative count refused, a class name
  * over its 15 bytes refused. */
-static enc passage_with(const char *vclass, int n_groups)
+static enc passage_with_refused(const char *vclass, int n_groups, const char *refused)
 {
     enc e = {0};
     double none[1] = {0}, kg[AMFI_MSG_MAX_PASSAGE_N_GROUPS + 1];
@@ -566,9 +569,14 @@ static enc passage_with(const char *vclass, int n_groups)
     }
     amfi_passage_t m = {1, 2, 3, 1, 20.0, (char *)"ok", (char *)"", 1e4, 0, none,
                         1e-3, 0.1, (char *)"modal", 5.0, (char *)"site-1", 20.0, 0, 1, 1.5, 0.0,
-                        5.73, 5.70, (char *)vclass, (int8_t)n_groups, ax, kg, 1, 0.004};
+                        5.73, 5.70, (char *)vclass, (int8_t)n_groups, ax, kg, 1, 0.004,
+                        (char *)refused};
     ENCODE(passage_t, m);
     return e;
+}
+static enc passage_with(const char *vclass, int n_groups)
+{
+    return passage_with_refused(vclass, n_groups, "");
 }
 
 static void test_passage_groups(void **state)
@@ -586,10 +594,10 @@ static void test_passage_groups(void **state)
         }
         free(e.buf);
     }
-    /* n_groups is the last message's tenth byte from the end (then overload
-     * and fit_ratio) */
+    /* n_groups is the last message's fifteenth byte from the end (then
+     * overload, fit_ratio and loads_refused: "" is a 4-byte length and a NUL) */
     enc e = passage_with("A23", 0);
-    e.buf[e.len - 10] = 0xff; /* -1 */
+    e.buf[e.len - 15] = 0xff; /* -1 */
     assert_int_equal(amfi_msg_check(AMFI_MSG_PASSAGE_T, e.buf, e.len, why, sizeof why),
                      AMFI_MSG_NEGATIVE_COUNT);
     assert_non_null(strstr(why, "passage_t.group_axles"));
@@ -603,6 +611,19 @@ static void test_passage_groups(void **state)
     free(e.buf);
     big[sizeof big - 2] = '\0'; /* 15 bytes: the limit */
     e = passage_with(big, 0);
+    expect_reason(AMFI_MSG_PASSAGE_T, e.buf, e.len, AMFI_MSG_OK);
+    free(e.buf);
+    /* the refusal's reason: at most 111 bytes */
+    char why_refused[AMFI_MSG_MAX_PASSAGE_LOADS_REFUSED + 2];
+    memset(why_refused, 'r', sizeof why_refused - 1);
+    why_refused[sizeof why_refused - 1] = '\0';
+    e = passage_with_refused("A23", 0, why_refused);
+    assert_int_equal(amfi_msg_check(AMFI_MSG_PASSAGE_T, e.buf, e.len, why, sizeof why),
+                     AMFI_MSG_OVER_LIMIT);
+    assert_non_null(strstr(why, "passage_t.loads_refused"));
+    free(e.buf);
+    why_refused[sizeof why_refused - 2] = '\0'; /* 111 bytes: the limit */
+    e = passage_with_refused("A23", 0, why_refused);
     expect_reason(AMFI_MSG_PASSAGE_T, e.buf, e.len, AMFI_MSG_OK);
     free(e.buf);
 }

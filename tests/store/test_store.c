@@ -1402,6 +1402,112 @@ static void test_class_and_migration_from_v9(void **state)
     assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
 }
 
+/* ---- version 13: why the loads were refused; a version-12 file migrates ------- */
+
+/* The reasons read back, by vehicle id ("-" where NULL). */
+typedef struct refused_seen {
+    char why[4][AMFI_STORE_LOADS_REFUSED_MAX + 1];
+    int n;
+} refused_seen;
+
+static int each_refused(void *ctx, int64_t id, const amfi_passage_row *r)
+{
+    (void)id;
+    refused_seen *c = ctx;
+    if (r->vehicle_id >= 1 && r->vehicle_id <= 4)
+        snprintf(c->why[r->vehicle_id - 1], sizeof c->why[0], "%s",
+                 r->loads_refused ? r->loads_refused : "-");
+    c->n++;
+    return 0;
+}
+
+static void test_loads_refused_and_migration_from_v12(void **state)
+{
+    fixture *f = *state;
+    char err[ERRLEN], buf[AMFI_STORE_LOADS_REFUSED_MAX + 2];
+    const char *why = "group 3: load 276000 kg, over 10 x any legal load of 3 axles (24000 kg)";
+    amfi_passage_row r;
+    refused_seen c;
+    raw_db *db;
+
+    ok_row(&r, 1, DAY_US, 18000.0); /* memset: judged (NULL) */
+    r.vclass = "R2";
+    r.axle_groups = "1-1";
+    r.has_overload = 1;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    ok_row(&r, 2, DAY_US + 1000, 300000.0);
+    r.vclass = "R2";
+    r.axle_groups = "1-1";
+    r.loads_refused = why; /* refused: overload NULL */
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    /* refused when written, naming the field: empty, too long, a control character */
+    r.vehicle_id = 3;
+    r.loads_refused = "";
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.loads_refused"));
+    memset(buf, 'x', sizeof buf - 1);
+    buf[sizeof buf - 1] = '\0'; /* 112 bytes */
+    r.loads_refused = buf;
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.loads_refused"));
+    r.loads_refused = "axle 2: load -683 kg\n< 0";
+    assert_int_equal(AMFI_EINVAL, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    assert_non_null(strstr(err, "passages.loads_refused"));
+    buf[sizeof buf - 2] = '\0'; /* 111 bytes: the limit */
+    r.loads_refused = buf;
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    /* read back by the reports' listing */
+    memset(&c, 0, sizeof c);
+    assert_int_equal(0, amfi_store_each_passage(f->s, 0, AMFI_STORE_MAX_UTIME, "ok", each_refused,
+                                                &c, err, sizeof err));
+    assert_int_equal(3, c.n);
+    assert_string_equal("-", c.why[0]);
+    assert_string_equal(why, c.why[1]);
+    assert_string_equal(buf, c.why[2]);
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    db = raw_open(f->path);
+    /* the schema refuses an empty or too long reason */
+    assert_int_not_equal(0, raw_try(db, "UPDATE passages SET loads_refused = '' WHERE vehicle_id = 2"));
+    assert_int_not_equal(0, raw_try(db, "UPDATE passages SET loads_refused = loads_refused || 'y' "
+                                        "WHERE vehicle_id = 3"));
+    /* a control character the schema lets through is refused when read back */
+    assert_int_equal(0, raw_try(db, "UPDATE passages SET loads_refused = 'a' || char(9) || 'b' "
+                                    "WHERE vehicle_id = 3"));
+    raw_close(db);
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    memset(&c, 0, sizeof c);
+    assert_int_equal(AMFI_STORE_ECORRUPT,
+                     amfi_store_each_passage(f->s, 0, AMFI_STORE_MAX_UTIME, "ok", each_refused, &c,
+                                             err, sizeof err));
+    assert_non_null(strstr(err, "loads_refused"));
+    assert_non_null(strstr(err, "control character"));
+    amfi_store_close(f->s);
+    f->s = NULL;
+
+    /* make it a version-12 file, as amfid before the reason left it: migrated,
+     * every row NULL (the reports recompute the refusal), then written */
+    db = raw_open(f->path);
+    raw_downgrade(db, 12);
+    assert_int_not_equal(0, raw_try(db, "SELECT loads_refused FROM passages"));
+    raw_close(db);
+    assert_int_equal(0, amfi_store_open(f->path, 0, &f->s, err, sizeof err));
+    db = raw_open(f->path);
+    assert_int_equal(AMFI_STORE_SCHEMA_VERSION, raw_int(db, "PRAGMA user_version"));
+    assert_int_equal(3, raw_int(db, "SELECT count(*) FROM passages WHERE loads_refused IS NULL"));
+    raw_close(db);
+    ok_row(&r, 4, 2 * DAY_US, 18000.0);
+    r.loads_refused = "axle 2: load -683 kg < 0 (a single axle)";
+    assert_int_equal(0, amfi_store_add_passage(f->s, &r, NULL, err, sizeof err));
+    memset(&c, 0, sizeof c);
+    assert_int_equal(0, amfi_store_each_passage(f->s, 0, AMFI_STORE_MAX_UTIME, "ok", each_refused,
+                                                &c, err, sizeof err));
+    assert_int_equal(4, c.n);
+    assert_string_equal("-", c.why[1]);
+    assert_string_equal("axle 2: load -683 kg < 0 (a single axle)", c.why[3]);
+}
+
 /* ---- version 8: the weight the STD and mean rules were fed; a version-7 file --- */
 
 static void test_gvw_comp_and_migration_from_v7(void **state)
@@ -1908,6 +2014,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_f1_and_migration_from_v6, setup, teardown),
         cmocka_unit_test_setup_teardown(test_gvw_comp_and_migration_from_v7, setup, teardown),
         cmocka_unit_test_setup_teardown(test_class_and_migration_from_v9, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_loads_refused_and_migration_from_v12, setup, teardown),
         cmocka_unit_test_setup_teardown(test_alert_open_and_report_queries, setup, teardown),
         cmocka_unit_test_setup_teardown(test_schema_doc_matches, setup, teardown),
         cmocka_unit_test_setup_teardown(test_many_passages, setup, teardown),

@@ -61,7 +61,7 @@ int main(void)
                         .speed_given_mps = 20, .n_vehicles = 1, .quality = 1,
                         .reference_gvw_kg = 0, .f1_hz = 0, .f1_comp_hz = 0,
                         .vehicle_class = "R2", .n_groups = 2, .group_axles = groups,
-                        .group_load_kg = gload, .overload = 0};
+                        .group_load_kg = gload, .overload = 0, .loads_refused = ""};
     n = amfi_passage_t_encode(buf, 0, sizeof buf, &p);
     if (n < 0 || amfi_auth_publish(lcm, NULL, AMFI_CHANNEL_PASSAGE, buf, (size_t)n) != 0 ||
         amfi_auth_publish(lcm, &bad, AMFI_CHANNEL_PASSAGE, buf, (size_t)n) != 0)

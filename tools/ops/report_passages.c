@@ -367,7 +367,9 @@ typedef struct over_row {
     const amfi_passage_row *r;
     char t[32], cls[AMFI_CLASS_NAME_LEN], axles[64];
     double gvw_limit_kg;
-    const over_item *it; /* the CSV line's item */
+    const over_item *it; /* the CSV line's item; NULL: a refused passage's line */
+    const char *refused; /* why its loads were refused, or NULL */
+    int recomputed;      /* 1: refused by the report's classification (no stored reason) */
 } over_row;
 
 #define O(row) ((const over_row *)(row))
@@ -379,23 +381,45 @@ static void o_lane(const void *w, report_val *v) { v->i = O(w)->r->lane; }
 static void o_class(const void *w, report_val *v) { v->s = O(w)->cls; }
 static void o_gvw(const void *w, report_val *v) { v->x = O(w)->r->gvw_kg; }
 static void o_gvw_limit(const void *w, report_val *v) { v->x = O(w)->gvw_limit_kg; }
-static void o_limit(const void *w, report_val *v) { v->s = O(w)->it->group ? "group" : "gvw"; }
+static void o_limit(const void *w, report_val *v)
+{
+    v->s = !O(w)->it ? "refused" : O(w)->it->group ? "group" : "gvw";
+}
 static void o_axles(const void *w, report_val *v)
 {
     v->s = O(w)->axles;
-    v->null = !O(w)->it->group;
+    v->null = !O(w)->it || !O(w)->it->group;
 }
-static void o_kind(const void *w, report_val *v) { v->s = O(w)->it->kind; }
-static void o_load(const void *w, report_val *v) { v->x = O(w)->it->load_kg; }
-static void o_limit_kg(const void *w, report_val *v) { v->x = O(w)->it->limit_kg; }
+static void o_kind(const void *w, report_val *v)
+{
+    v->s = O(w)->it ? O(w)->it->kind : "";
+    v->null = !O(w)->it;
+}
+static void o_load(const void *w, report_val *v) { v->x = O(w)->it ? O(w)->it->load_kg : NAN; }
+static void o_limit_kg(const void *w, report_val *v)
+{
+    v->x = O(w)->it ? O(w)->it->limit_kg : NAN;
+}
 static void o_pct(const void *w, report_val *v)
 {
-    v->x = 100.0 * (O(w)->it->load_kg / O(w)->it->limit_kg - 1);
+    v->x = O(w)->it ? 100.0 * (O(w)->it->load_kg / O(w)->it->limit_kg - 1) : NAN;
+}
+static void o_refused(const void *w, report_val *v)
+{
+    v->s = O(w)->refused ? O(w)->refused : "";
+    v->null = !O(w)->refused;
+}
+static void o_source(const void *w, report_val *v)
+{
+    v->s = O(w)->recomputed ? "recomputed" : "stored";
 }
 #undef O
 
-/* CSV: one line per limit exceeded; JSON: these inside each passage's
- * "exceeded" array (over_item_cols) after its columns (over_cols). */
+/* CSV: one line per limit exceeded, and one line (limit "refused", the
+ * reason in loads_refused) per passage whose loads were refused; JSON:
+ * the limits inside each passage's "exceeded" array (over_item_cols) after
+ * its columns (over_cols), the refused passages in "refused_passages"
+ * (refused_cols). */
 static const report_col over_cols[] = {
     REPORT_COL("time_utc", COL_WORD, "", NULL, COL_BOTH, o_time),
     REPORT_COL("utime", COL_INT, "us", NULL, COL_BOTH, o_utime),
@@ -411,6 +435,18 @@ static const report_col over_cols[] = {
     REPORT_COL("load_kg", COL_NUM, "kg", "%.1f", COL_CSV, o_load),
     REPORT_COL("limit_kg", COL_NUM, "kg", "%.1f", COL_CSV, o_limit_kg),
     REPORT_COL("over_pct", COL_NUM, "%", "%.3f", COL_CSV, o_pct),
+    REPORT_COL("loads_refused", COL_TEXT, "", NULL, COL_CSV, o_refused),
+};
+static const report_col refused_cols[] = {
+    REPORT_COL("time_utc", COL_WORD, "", NULL, COL_JSON, o_time),
+    REPORT_COL("utime", COL_INT, "us", NULL, COL_JSON, o_utime),
+    REPORT_COL("passage_id", COL_INT, "", NULL, COL_JSON, o_id),
+    REPORT_COL("vehicle_id", COL_INT, "", NULL, COL_JSON, o_vehicle),
+    REPORT_COL("lane", COL_INT, "", NULL, COL_JSON, o_lane),
+    REPORT_COL("class", COL_TEXT, "", NULL, COL_JSON, o_class),
+    REPORT_COL("gvw_kg", COL_NUM, "kg", "%.1f", COL_JSON, o_gvw),
+    REPORT_COL("loads_refused", COL_TEXT, "", NULL, COL_JSON, o_refused),
+    REPORT_COL("reason_from", COL_WORD, "", NULL, COL_JSON, o_source),
 };
 static const report_col over_item_cols[] = {
     REPORT_COL("limit", COL_WORD, "", NULL, COL_JSON, o_limit),
@@ -426,8 +462,17 @@ static const report_col over_item_cols[] = {
 /* The counts of one class. */
 typedef struct over_class {
     char name[AMFI_CLASS_NAME_LEN];
-    int64_t checked, over_gvw, over_group, over_any;
+    int64_t checked, over_gvw, over_group, over_any, refused;
 } over_class;
+
+/* A passage whose loads were refused, kept for the table's own section. */
+typedef struct refused_pas {
+    int64_t id, utime, vehicle_id;
+    int lane, recomputed;
+    double gvw_kg;
+    char cls[AMFI_CLASS_NAME_LEN];
+    char why[AMFI_STORE_LOADS_REFUSED_MAX + 1];
+} refused_pas;
 
 typedef struct over_ctx {
     const export_opts *o;
@@ -435,10 +480,13 @@ typedef struct over_ctx {
     const amfi_class_params *cp;
     int fmt;
     FILE *f;
-    json_t *arr;
-    int64_t checked, over_gvw, over_group, over_any, unclassified;
+    json_t *arr, *refused_arr;
+    int64_t checked, over_gvw, over_group, over_any, unclassified, refused, recomputed;
     over_class cls[MAX_OVER_CLASSES + 1]; /* the last: every further class */
     int n_cls;
+    refused_pas *rp; /* the table's refused passages */
+    size_t n_rp, cap_rp;
+    int oom;
 } over_ctx;
 
 static over_class *class_counts(over_ctx *c, const char *name)
@@ -462,6 +510,44 @@ static void axle_words(int first, int n, char *buf, size_t len)
         snprintf(buf, len, "%d-%d", first + 1, first + n);
 }
 
+/* A passage whose loads were refused: counted apart (its class's count
+ * and the whole), never judged against the limits; CSV and JSON now, the
+ * table's section after the overloads. */
+static int over_refused(over_ctx *c, over_row *w)
+{
+    c->refused++;
+    c->recomputed += w->recomputed;
+    class_counts(c, w->cls)->refused++;
+    report_iso(w->r->utime, w->t);
+    if (c->fmt == FMT_CSV) {
+        w->it = NULL;
+        w->axles[0] = '\0';
+        report_cols_csv_row(c->f, over_cols, REPORT_NCOLS(over_cols), w);
+    } else if (c->fmt == FMT_JSON) {
+        json_array_append_new(c->refused_arr, report_cols_json_row(refused_cols,
+                                                                   REPORT_NCOLS(refused_cols),
+                                                                   w, COL_JSON));
+    } else {
+        if (c->n_rp == c->cap_rp) {
+            size_t cap = c->cap_rp ? 2 * c->cap_rp : 64;
+            refused_pas *v = realloc(c->rp, cap * sizeof *v);
+            if (!v) {
+                c->oom = 1;
+                return 1;
+            }
+            c->rp = v;
+            c->cap_rp = cap;
+        }
+        refused_pas *q = &c->rp[c->n_rp++];
+        *q = (refused_pas){.id = w->id, .utime = w->r->utime, .vehicle_id = w->r->vehicle_id,
+                           .lane = w->r->lane, .recomputed = w->recomputed,
+                           .gvw_kg = w->r->gvw_kg};
+        snprintf(q->cls, sizeof q->cls, "%s", w->cls);
+        snprintf(q->why, sizeof q->why, "%s", w->refused);
+    }
+    return 0;
+}
+
 static int over_one(void *vctx, int64_t id, const amfi_passage_row *r)
 {
     over_ctx *c = vctx;
@@ -470,7 +556,6 @@ static int over_one(void *vctx, int64_t id, const amfi_passage_row *r)
     over_row w = {.id = id, .r = r};
     over_item it[AMFI_MAX_AXLES + 1];
     int n_it = 0;
-    c->checked++;
     /* the class, its groups and their limits (classes: of --config, else
      * the defaults); the report.limits where no class limit is known */
     if (amfi_classify(c->cp, r->n_axles, r->spacing_m, r->axle_kg, &cl, why, sizeof why) != 0) {
@@ -486,6 +571,16 @@ static int over_one(void *vctx, int64_t id, const amfi_passage_row *r)
     snprintf(w.cls, sizeof w.cls, "%s", cl.name);
     w.gvw_limit_kg = isfinite(cl.gvw_limit_kg) && cl.gvw_limit_kg > 0 ? cl.gvw_limit_kg
                                                                       : c->o->gvw_limit_kg;
+    /* loads amfid's classification refused (passages.loads_refused, store
+     * version 13), or, in rows without a stored reason (written before),
+     * that the same classification refuses now: never an overload */
+    w.refused = r->loads_refused;
+    if (!w.refused && cl.n_axles > 0 && !cl.loads_ok && cl.loads_why[0]) {
+        w.refused = cl.loads_why;
+        w.recomputed = 1;
+    }
+    if (w.refused)
+        return over_refused(c, &w);
     if (r->gvw_kg > w.gvw_limit_kg)
         it[n_it++] = (over_item){0, 0, 0, "gross", r->gvw_kg, w.gvw_limit_kg};
     int og = n_it > 0, ogr = 0;
@@ -500,6 +595,7 @@ static int over_one(void *vctx, int64_t id, const amfi_passage_row *r)
             ogr = 1;
         }
     }
+    c->checked++;
     over_class *k = class_counts(c, cl.name);
     k->checked++;
     k->over_gvw += og;
@@ -576,12 +672,18 @@ static int overloads(report_ctx *rc, int fmt)
                 "time (UTC)", "id", "vehicle", "lane", "class", hg, hl, "exceeded");
     else if (fmt == FMT_CSV)
         report_cols_csv_header(c->f, over_cols, REPORT_NCOLS(over_cols), NULL, 0);
-    else
+    else {
         c->arr = json_array();
+        c->refused_arr = json_array();
+    }
     if (each(rc, "ok", over_one, c) != 0) {
         json_decref(c->arr);
+        json_decref(c->refused_arr);
+        int oom = c->oom;
+        free(c->rp);
         free(c);
-        return -1;
+        return oom ? report_fail(rc, "out of memory for the passages whose loads were refused")
+                   : -1;
     }
     qsort(c->cls, (size_t)c->n_cls, sizeof *c->cls, cmp_class);
     if (fmt == FMT_TABLE) {
@@ -590,17 +692,43 @@ static int overloads(report_ctx *rc, int fmt)
                 (long long)c->checked, (long long)c->over_gvw, (long long)c->over_group,
                 (long long)c->over_any,
                 c->checked ? 100.0 * (double)c->over_any / (double)c->checked : 0.0);
+        if (c->refused)
+            fprintf(c->f, "(%lld ok passages not checked: their loads were refused, below)\n",
+                    (long long)c->refused);
         if (c->unclassified)
             fprintf(c->f, "(%lld passages could not be classified: their limits are "
                           "report.limits')\n", (long long)c->unclassified);
         if (c->n_cls > 0)
-            fprintf(c->f, "%-8s  %8s  %8s  %10s  %10s  %7s\n", "class", "checked", "over GVW",
-                    "over group", "overloaded", "%");
-        for (int i = 0; i < c->n_cls; i++)
-            fprintf(c->f, "%-8s  %8lld  %8lld  %10lld  %10lld  %7.2f\n", c->cls[i].name,
+            fprintf(c->f, "%-8s  %8s  %8s  %10s  %10s  %7s  %7s\n", "class", "checked",
+                    "over GVW", "over group", "overloaded", "%", "refused");
+        for (int i = 0; i < c->n_cls; i++) {
+            char pct[16] = "-";
+            if (c->cls[i].checked)
+                snprintf(pct, sizeof pct, "%.2f",
+                         100.0 * (double)c->cls[i].over_any / (double)c->cls[i].checked);
+            fprintf(c->f, "%-8s  %8lld  %8lld  %10lld  %10lld  %7s  %7lld\n", c->cls[i].name,
                     (long long)c->cls[i].checked, (long long)c->cls[i].over_gvw,
-                    (long long)c->cls[i].over_group, (long long)c->cls[i].over_any,
-                    100.0 * (double)c->cls[i].over_any / (double)c->cls[i].checked);
+                    (long long)c->cls[i].over_group, (long long)c->cls[i].over_any, pct,
+                    (long long)c->cls[i].refused);
+        }
+        if (c->refused) {
+            char m1[32];
+            fprintf(c->f, "== loads refused (%lld ok passages: a single axle or a group below "
+                          "zero, or above %g x any legal load of its axle count; not judged "
+                          "against the limits, never an overload)\n"
+                          "%-20s  %8s  %10s  %4s  %-7s  %8s  %s\n",
+                    (long long)c->refused, AMFI_CLASS_IMPLAUSIBLE_FACTOR, "time (UTC)", "id",
+                    "vehicle", "lane", "class", hg, "why");
+            for (size_t i = 0; i < c->n_rp; i++) {
+                const refused_pas *q = &c->rp[i];
+                char t[32];
+                report_iso(q->utime, t);
+                fprintf(c->f, "%-20s  %8lld  %10lld  %4d  %-7.7s  %8s  loads refused: %s%s\n", t,
+                        (long long)q->id, (long long)q->vehicle_id, q->lane, q->cls,
+                        report_mass(c->units, q->gvw_kg, m1), q->why,
+                        q->recomputed ? " (recomputed: no reason stored)" : "");
+            }
+        }
     } else if (fmt == FMT_JSON) {
         json_t *ob = json_object(), *bc = json_array();
         json_object_set_new(ob, "scheme", json_string(scheme));
@@ -613,6 +741,8 @@ static int overloads(report_ctx *rc, int fmt)
         json_object_set_new(ob, "over_group", json_integer(c->over_group));
         json_object_set_new(ob, "overloaded", json_integer(c->over_any));
         json_object_set_new(ob, "unclassified", json_integer(c->unclassified));
+        json_object_set_new(ob, "refused", json_integer(c->refused));
+        json_object_set_new(ob, "refused_recomputed", json_integer(c->recomputed));
         for (int i = 0; i < c->n_cls; i++) {
             json_t *k = json_object();
             json_object_set_new(k, "class", json_string(c->cls[i].name));
@@ -620,12 +750,15 @@ static int overloads(report_ctx *rc, int fmt)
             json_object_set_new(k, "over_gvw", json_integer(c->cls[i].over_gvw));
             json_object_set_new(k, "over_group", json_integer(c->cls[i].over_group));
             json_object_set_new(k, "overloaded", json_integer(c->cls[i].over_any));
+            json_object_set_new(k, "refused", json_integer(c->cls[i].refused));
             json_array_append_new(bc, k);
         }
         json_object_set_new(ob, "by_class", bc);
         json_object_set_new(ob, "passages", c->arr);
+        json_object_set_new(ob, "refused_passages", c->refused_arr);
         json_object_set_new(rc->root, "overloads", ob);
     }
+    free(c->rp);
     free(c);
     return 0;
 }
