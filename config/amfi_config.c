@@ -172,6 +172,9 @@ void amfi_config_defaults(amfi_site_config *c)
     amfi_natfreq_params_default(&d->natfreq);
     d->natfreq_free_s = 2.0;  /* 11 periods of paper-20m's 5.7 Hz (docs/indicators.md) */
     d->natfreq_baseline_n = 200;
+    d->natfreq_mode = 1;      /* follow the model's first mode (continuous bridges:
+                                 docs/results/continuous-sensors.md) */
+    d->natfreq_band = 0.2;
     /* The model_mismatch and natfreq alerts (docs/indicators.md section 10,
      * docs/results/model-fit.md and natural-frequency.md for the figures). */
     d->model_fit_free_s = 0.5;
