@@ -18,14 +18,14 @@
 #   MODE      daemon.natural_frequency.mode values (default: 0 1)
 # Environment: DAMAGE and STEP (sim_publisher --damage DAMAGE
 # --damage-step-at STEP; default none), BASELINE_N (baseline_n, default
-# 200), SOLVER_RATE (solver.calc_rate_hz, default 5000: the weighing's
+# 200), FIT_MODES (daemon.natural_frequency.modes, default 2), SOLVER_RATE (solver.calc_rate_hz, default 5000: the weighing's
 # rate; the natural frequency is estimated from the samples of the free
 # vibration and does not depend on it, 1000 costs a fifth). The model fit
 # (alerts.model_fit) is off: it does not touch the natural frequency and
 # would double amfid's CPU.
 # Prints per MODE: estimates (of ok passages), mean, SD, min, max of f1 per
 # state (before STEP, from STEP on), how many within 3 % of each of the
-# model's first two frequencies, and every natfreq alert with the vehicle
+# model's first frequencies, and every natfreq alert with the vehicle
 # it came at. CPU: about 0.6 s of amfid per vehicle on 20 + 20 m at 5000 Hz.
 set -u
 [ $# -ge 5 ] || { echo "usage: $0 BUILD OUT VEHICLES single|two|three \"SENSORS\" [MODE ...]" >&2; exit 2; }
@@ -39,6 +39,13 @@ out=$(cd "$out" && pwd)
 pop="$out/population-235.csv"
 awk -F, 'NR == 1 || $6 == 2 || $6 == 3 || $6 == 5' \
   "$src/sim_publisher/data/population-eu.csv" > "$pop" || die "cannot write $pop"
+# the model's first natural frequencies (amfi_bridge_omega of the site
+# model; healthy), for the counts near each
+case $bridge in
+  single) model_f="5.7338 22.935" ;;
+  two) model_f="5.7338 8.9573" ;;
+  three) model_f="7.5954 12.433 14.915" ;;
+esac
 case $bridge in
   single) span=20 sup='    - {at_m: 0, type: pinned}
     - {at_m: 20, type: roller}' ;;
@@ -83,6 +90,7 @@ site() {
     echo "  simulation: true"
     echo "  natural_frequency:"
     echo "    mode: $1"
+    echo "    modes: ${FIT_MODES:-2}"
     echo "    baseline_n: ${BASELINE_N:-200}"
     echo "alerts:"
     echo "  model_fit:"
@@ -117,17 +125,19 @@ for m in "$@"; do
      WHERE status = 'ok' AND f1_hz IS NOT NULL ORDER BY vehicle_id" > "$out/f1-$m.csv"
   ok=$(sqlite3 "$db" "SELECT count(*) FROM passages WHERE status = 'ok'")
   echo "mode=$m model_f=${f1m:-none} ok_passages=$ok"
-  awk -F, -v step="$step" -v d="${DAMAGE:-0}" '
+  awk -F, -v step="$step" -v d="${DAMAGE:-0}" -v fm="$model_f" '
+    BEGIN { nm = split(fm, f, " ") }
     { s = $1 >= step; n[s]++; x[s] += $2; xx[s] += $2 * $2
       if (!(s in lo) || $2 < lo[s]) lo[s] = $2; if (!(s in hi) || $2 > hi[s]) hi[s] = $2
-      # the two-span beam'"'"'s first two modes, healthy and damaged (sqrt(1 - d))
+      # the model'"'"'s first modes, healthy and damaged (sqrt(1 - d)): within 3 %
       k = s ? sqrt(1 - d) : 1
-      if ($2 > 5.7338 * k * 0.97 && $2 < 5.7338 * k * 1.03) a[s]++
-      if ($2 > 8.96 * k * 0.97 && $2 < 8.96 * k * 1.03) b[s]++ }
+      for (j = 1; j <= nm; j++) if ($2 > f[j] * k * 0.97 && $2 < f[j] * k * 1.03) c[s, j]++ }
     END { for (s = 0; s <= 1; s++) if (n[s]) {
             mu = x[s] / n[s]; sd = n[s] > 1 ? sqrt((xx[s] - n[s] * mu * mu) / (n[s] - 1)) : 0
-            printf "  %s: estimates=%d mean=%.4f sd=%.4f (%.2f %%) min=%.4f max=%.4f near_5.73=%d near_8.96=%d\n",
-              s ? "damaged" : "healthy", n[s], mu, sd, 100 * sd / mu, lo[s], hi[s], a[s] + 0, b[s] + 0 } }' \
+            printf "  %s: estimates=%d mean=%.4f sd=%.4f (%.2f %%) min=%.4f max=%.4f",
+              s ? "damaged" : "healthy", n[s], mu, sd, 100 * sd / mu, lo[s], hi[s]
+            for (j = 1; j <= nm; j++) printf " near_%s=%d", f[j], c[s, j] + 0
+            printf "\n" } }' \
     "$out/f1-$m.csv"
   sqlite3 -separator ' ' "$db" "SELECT a.raised, (SELECT max(p.vehicle_id) FROM passages p
       WHERE p.utime <= a.utime), a.message FROM alerts a WHERE a.kind = 'natfreq' ORDER BY a.id" |
