@@ -18,15 +18,19 @@
 #   MODE      daemon.natural_frequency.mode values (default: 0 1)
 # Environment: DAMAGE and STEP (sim_publisher --damage DAMAGE
 # --damage-step-at STEP; default none), BASELINE_N (baseline_n, default
-# 200), FIT_MODES (daemon.natural_frequency.modes, default 2), SOLVER_RATE (solver.calc_rate_hz, default 5000: the weighing's
-# rate; the natural frequency is estimated from the samples of the free
-# vibration and does not depend on it, 1000 costs a fifth). The model fit
+# 200), FIT_MODES (daemon.natural_frequency.modes, default 3 as amfid's;
+# 2 was amfid's before it followed a mode), SOLVER_RATE
+# (solver.calc_rate_hz, default 5000: the weighing's rate; the natural
+# frequency is estimated from the samples of the free vibration and does
+# not depend on it: the same estimates per passage at 1000, which costs
+# far less). The model fit
 # (alerts.model_fit) is off: it does not touch the natural frequency and
 # would double amfid's CPU.
 # Prints per MODE: estimates (of ok passages), mean, SD, min, max of f1 per
 # state (before STEP, from STEP on), how many within 3 % of each of the
 # model's first frequencies, and every natfreq alert with the vehicle
-# it came at. CPU: about 0.6 s of amfid per vehicle on 20 + 20 m at 5000 Hz.
+# it came at. CPU: about 1 s of amfid per vehicle on 20 + 20 m at 5000
+# Hz, a tenth of it at 1000.
 set -u
 [ $# -ge 5 ] || { echo "usage: $0 BUILD OUT VEHICLES single|two|three \"SENSORS\" [MODE ...]" >&2; exit 2; }
 bin=$1 out=$2 nveh=$3 bridge=$4 sensors=$5
@@ -90,7 +94,7 @@ site() {
     echo "  simulation: true"
     echo "  natural_frequency:"
     echo "    mode: $1"
-    echo "    modes: ${FIT_MODES:-2}"
+    echo "    modes: ${FIT_MODES:-3}"
     echo "    baseline_n: ${BASELINE_N:-200}"
     echo "alerts:"
     echo "  model_fit:"
