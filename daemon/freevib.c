@@ -41,6 +41,7 @@ static struct freevib_state {
     int64_t refused[AMFI_NATFREQ_NREFUSALS]; /* by amfi_natfreq_estimate's code; [0] invalid */
     int64_t no_temperature;   /* baseline candidates without a deck temperature */
     amfi_natfreq_params est;  /* the estimator's: the site's, the band the followed mode's */
+    double f_mode_hz;         /* the site model's frequency of that mode; NaN: none followed */
 } F;
 
 /* At start (the baseline from the store): readings at most
@@ -61,6 +62,10 @@ static int freevib_restore(amfid_ctx *d)
     struct freevib_state *fv = &F;
     if (!(d->cfg->daemon.natfreq_free_s > 0))
         return 0;
+    if (d->cfg->daemon.natfreq_mode > 0)
+        LOG_INFO("natural frequency: following the site model's mode %d (%.4f Hz), its peak "
+                 "searched in %.3f .. %.3f Hz",
+                 d->cfg->daemon.natfreq_mode, fv->f_mode_hz, fv->est.f_lo_hz, fv->est.f_hi_hz);
     /* the site's temperature model: alerts.scale's knee, floor, calibration
      * temperature and prior slopes (halved and turned for f1 by natfreq.c) */
     if (amfi_natfreq_comp_create(&d->cfg->daemon.scale, d->cfg->daemon.natfreq_baseline_n,
@@ -308,10 +313,7 @@ static int freevib_start(amfid_ctx *c, char *err, size_t errlen)
     if (amfi_natfreq_follow(&dc->natfreq, amfi_bridge_omega(c->bridge), amfi_bridge_ndof(c->bridge),
                             dc->natfreq_mode, dc->natfreq_band, &F.est, &f, err, errlen) != 0)
         return 1;
-    if (dc->natfreq_mode > 0)
-        LOG_INFO("natural frequency: following the site model's mode %d (%.4f Hz), its peak "
-                 "searched in %.3f .. %.3f Hz",
-                 dc->natfreq_mode, f, F.est.f_lo_hz, F.est.f_hi_hz);
+    F.f_mode_hz = f;
     return 0;
 }
 

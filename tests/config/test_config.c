@@ -736,6 +736,8 @@ static const bad_case bad_cases[] = {
      "daemon.natural_frequency.mode", "0 .. 20"},
     {"daemon_natfreq_band", "daemon:\n  natural_frequency:\n    band: 0\n", 3,
      "daemon.natural_frequency.band", "(0, 0.5]"},
+    {"daemon_natfreq_mode_model", "daemon:\n  natural_frequency:\n    mode: 12\n", 3,
+     "daemon.natural_frequency.mode", "is not inside [f_lo_hz, f_hi_hz] = [0.5, 50] Hz"},
     {"daemon_single_presence_bad", "daemon:\n  indicators: {single_presence_only: yes}\n", 2,
      "daemon.indicators.single_presence_only", "off"},
     {"daemon_temperature_bad", "daemon:\n  indicators: {temperature: on}\n", 2,
