@@ -105,6 +105,7 @@ site() {
   } > "$out/site-$1.yaml"
 }
 site 0
+rm -f "$out/bus.key"
 "$bin/daemon/amfid" --make-bus-key "$out/bus.key" > /dev/null 2>&1 || die "amfid --make-bus-key"
 dmg=""
 [ -n "${DAMAGE:-}" ] && dmg="--damage $DAMAGE --damage-step-at ${STEP:-1}"
