@@ -170,8 +170,14 @@ void amfi_config_defaults(amfi_site_config *c)
     amfi_known_truck_params_default(&d->known_truck);
     d->known_truck_enabled = 1;
     amfi_natfreq_params_default(&d->natfreq);
+    d->natfreq.n_modes = 3;   /* the mode followed and two others: an end-span sensor of
+                                 15 + 20 + 15 m sees modes 2 and 3 stronger than mode 1
+                                 (docs/results/continuous-sensors.md) */
     d->natfreq_free_s = 2.0;  /* 11 periods of paper-20m's 5.7 Hz (docs/indicators.md) */
     d->natfreq_baseline_n = 200;
+    d->natfreq_mode = 1;      /* follow the model's first mode (continuous bridges:
+                                 docs/results/continuous-sensors.md) */
+    d->natfreq_band = 0.2;
     /* The model_mismatch and natfreq alerts (docs/indicators.md section 10,
      * docs/results/model-fit.md and natural-frequency.md for the figures). */
     d->model_fit_free_s = 0.5;

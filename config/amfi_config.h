@@ -158,6 +158,12 @@ typedef struct amfi_daemon_config {
                                  the last exit, s, [0, 30]; 0: off */
     int natfreq_baseline_n;   /* daemon.natural_frequency.baseline_n: passages with an
                                  f1 whose temperature fit is the baseline, 10 .. 100000 */
+    int natfreq_mode;         /* daemon.natural_frequency.mode: the site model's mode
+                                 (1-based, ascending frequency) the estimate follows, in a
+                                 band around its frequency, 0 .. 20; 0: the strongest peak
+                                 in [f_lo_hz, f_hi_hz] (daemon/freevib.c) */
+    double natfreq_band;      /* daemon.natural_frequency.band: that band's half-width
+                                 relative to the model's frequency, (0, 0.5] */
     /* daemon.intake.*: bounds on what the bus may bring (daemon/intake.c,
      * docs/daemon.md "Bounded intake"); each refusal is counted and stored
      * as a periodic summary (table refusals). */

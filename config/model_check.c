@@ -17,6 +17,8 @@
  *    (sections.h, documented in amfid.yaml(5)) is refused here, with the
  *    line of the key that set it and the limit, instead of ending later in
  *    "out of memory for N steps".
+ * 3. The natural frequency's mode followed (daemon.natural_frequency.mode):
+ *    one of the model's modes, its frequency inside [f_lo_hz, f_hi_hz].
  *
  * Runs on the loader's thread; the bridge lives only for the check.
  */
@@ -130,6 +132,27 @@ static int workspace_check(ctx *x, const amfi_site_config *c, const amfi_bridge 
     return 0;
 }
 
+/* The natural frequency's mode followed (natfreq.h, amfi_natfreq_follow):
+ * within the model's modes, its frequency inside [f_lo_hz, f_hi_hz]. */
+static int natfreq_check(ctx *x, const amfi_site_config *c, const amfi_bridge *b)
+{
+    static const char *const keys[] = {"daemon.natural_frequency.mode",
+                                       "daemon.natural_frequency.f_hi_hz",
+                                       "daemon.natural_frequency.f_lo_hz",
+                                       "daemon.natural_frequency.band", "bridge", NULL};
+    const amfi_daemon_config *d = &c->daemon;
+    amfi_natfreq_params out;
+    double f;
+    char why[256] = "";
+
+    if (!(d->natfreq_free_s > 0) ||
+        amfi_natfreq_follow(&d->natfreq, amfi_bridge_omega(b), amfi_bridge_ndof(b),
+                            d->natfreq_mode, d->natfreq_band, &out, &f, why, sizeof why) == 0)
+        return 0;
+    const char *k = given(x, keys, "daemon.natural_frequency.mode");
+    return amfi_cfg_fail(x, amfi_cfg_noted(x, k), k, "%s", why);
+}
+
 int amfi_cfg_model_check(ctx *x, amfi_site_config *c)
 {
     amfi_bridge *b = NULL;
@@ -142,6 +165,8 @@ int amfi_cfg_model_check(ctx *x, amfi_site_config *c)
         return amfi_cfg_fail(x, amfi_cfg_noted(x, k), k, "the bridge model is refused: %s", why);
     }
     rc = workspace_check(x, c, b);
+    if (rc == 0)
+        rc = natfreq_check(x, c, b);
     amfi_bridge_destroy(b);
     return rc;
 }

@@ -115,6 +115,9 @@ static const field natfreq_fields[] = {
      .flags = F_LO_OPEN},
     {.key = "baseline_n", .kind = &amfi_cfg_k_int, .off = DC(natfreq_baseline_n), .lo = 10,
      .hi = 100000},
+    {.key = "mode", .kind = &amfi_cfg_k_int, .off = DC(natfreq_mode), .lo = 0, .hi = 20},
+    {.key = "band", .kind = &amfi_cfg_k_double, .off = DC(natfreq_band), .lo = 0, .hi = 0.5,
+     .flags = F_LO_OPEN},
     {.key = NULL}};
 
 static const field intake_fields[] = {

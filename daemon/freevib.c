@@ -40,6 +40,8 @@ static struct freevib_state {
     int64_t no_segment;       /* ok passages without free vibration (cut, data missing) */
     int64_t refused[AMFI_NATFREQ_NREFUSALS]; /* by amfi_natfreq_estimate's code; [0] invalid */
     int64_t no_temperature;   /* baseline candidates without a deck temperature */
+    amfi_natfreq_params est;  /* the estimator's: the site's, the band the followed mode's */
+    double f_mode_hz;         /* the site model's frequency of that mode; NaN: none followed */
 } F;
 
 /* At start (the baseline from the store): readings at most
@@ -60,6 +62,10 @@ static int freevib_restore(amfid_ctx *d)
     struct freevib_state *fv = &F;
     if (!(d->cfg->daemon.natfreq_free_s > 0))
         return 0;
+    if (d->cfg->daemon.natfreq_mode > 0)
+        LOG_INFO("natural frequency: following the site model's mode %d (%.4f Hz), its peak "
+                 "searched in %.3f .. %.3f Hz",
+                 d->cfg->daemon.natfreq_mode, fv->f_mode_hz, fv->est.f_lo_hz, fv->est.f_hi_hz);
     /* the site's temperature model: alerts.scale's knee, floor, calibration
      * temperature and prior slopes (halved and turned for f1 by natfreq.c) */
     if (amfi_natfreq_comp_create(&d->cfg->daemon.scale, d->cfg->daemon.natfreq_baseline_n,
@@ -145,8 +151,7 @@ void freevib_estimate(amfid_ctx *d, job *j, amfi_ring *const *rings)
         if (!rings[s] || amfi_ring_get(rings[s], j->w.free_k0[s], n, x) != 0)
             continue;
         amfi_natfreq_result r;
-        const int code = amfi_natfreq_estimate(x, n, amfi_ring_rate(rings[s]),
-                                               &d->cfg->daemon.natfreq, &r);
+        const int code = amfi_natfreq_estimate(x, n, amfi_ring_rate(rings[s]), &fv->est, &r);
         if (s == 0 || first_code == AMFI_NATFREQ_EINVAL)
             first_code = code;
         if (code == AMFI_NATFREQ_OK &&
@@ -298,8 +303,17 @@ static int freevib_tick(amfid_ctx *c)
 
 static int freevib_start(amfid_ctx *c, char *err, size_t errlen)
 {
-    (void)c, (void)err, (void)errlen;
     memset(&F, 0, sizeof F);
+    const amfi_daemon_config *dc = &c->cfg->daemon;
+    double f = NAN;
+    if (!(dc->natfreq_free_s > 0))
+        return 0;
+    /* the site model's mode followed: its peak in a band around it
+     * (natfreq.h, amfi_natfreq_follow) */
+    if (amfi_natfreq_follow(&dc->natfreq, amfi_bridge_omega(c->bridge), amfi_bridge_ndof(c->bridge),
+                            dc->natfreq_mode, dc->natfreq_band, &F.est, &f, err, errlen) != 0)
+        return 1;
+    F.f_mode_hz = f;
     return 0;
 }
 

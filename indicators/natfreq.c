@@ -54,6 +54,47 @@ int amfi_natfreq_params_check(const amfi_natfreq_params *p, char *err, size_t er
     return bad ? -1 : 0;
 }
 
+int amfi_natfreq_follow(const amfi_natfreq_params *site, const double *omega, int n, int mode,
+                        double band, amfi_natfreq_params *out, double *f_mode_hz, char *err,
+                        size_t errlen)
+{
+    *out = *site;
+    out->follow = 0;
+    *f_mode_hz = NAN;
+    if (mode <= 0)
+        return 0;
+    if (mode > n) {
+        snprintf(err, errlen,
+                 "daemon.natural_frequency.mode %d: the site's bridge model has %d modes", mode,
+                 n);
+        return -1;
+    }
+    if (!(band > 0 && band <= 0.5)) {
+        snprintf(err, errlen, "daemon.natural_frequency.band %g must be in (0, 0.5]", band);
+        return -1;
+    }
+    const double f = omega[mode - 1] / TWO_PI;
+    double lo = f * (1 - band), hi = f * (1 + band);
+    if (mode > 1)
+        lo = fmax(lo, sqrt(f * omega[mode - 2] / TWO_PI));
+    if (mode < n)
+        hi = fmin(hi, sqrt(f * omega[mode] / TWO_PI));
+    lo = fmax(lo, site->f_lo_hz);
+    hi = fmin(hi, site->f_hi_hz);
+    if (!(f > lo && f < hi)) {
+        snprintf(err, errlen,
+                 "daemon.natural_frequency.mode %d: the site model's frequency %.4f Hz is not "
+                 "inside [f_lo_hz, f_hi_hz] = [%g, %g] Hz (or a neighbouring mode is as near)",
+                 mode, f, site->f_lo_hz, site->f_hi_hz);
+        return -1;
+    }
+    out->f_lo_hz = lo;
+    out->f_hi_hz = hi;
+    out->follow = 1;
+    *f_mode_hz = f;
+    return 0;
+}
+
 const char *amfi_natfreq_code_name(int code)
 {
     switch (code) {
@@ -273,9 +314,18 @@ int amfi_natfreq_estimate(const double *x, int n, double rate_hz, const amfi_nat
     int kk[AMFI_NATFREQ_MAX_MODES] = {k1};
     int m = 1;
     const int lobe = (int)ceil(2.0 * s.nfft / n); /* Hann main lobe half-width, bins */
+    const int k_top = (int)floor(0.45 * rate_hz / s.df);
     while (m < p->n_modes) {
-        const int k = strongest(&s, (int)ceil(1.5 * k1), (int)floor(0.45 * rate_hz / s.df),
-                                0.01 * s.pw[k1], kk, m, lobe);
+        int k;
+        if (p->follow) {
+            /* below the band (clear of the mean's lobe) or above it, the
+             * stronger of the two */
+            const int kb = strongest(&s, lobe + 1, k_lo - 1, 0.01 * s.pw[k1], kk, m, lobe);
+            const int ka = strongest(&s, k_hi + 1, k_top, 0.01 * s.pw[k1], kk, m, lobe);
+            k = kb < 0 ? ka : ka < 0 ? kb : s.pw[ka] >= s.pw[kb] ? ka : kb;
+        } else {
+            k = strongest(&s, (int)ceil(1.5 * k1), k_top, 0.01 * s.pw[k1], kk, m, lobe);
+        }
         if (k < 0)
             break;
         kk[m] = k;

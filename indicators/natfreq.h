@@ -11,7 +11,11 @@
  *      the three bins around it;
  *   2. the further peaks above 1.5 f_peak (up to 0.45 of the sample
  *      rate, at least 1 % of the first peak's power) start the other modes,
- *      up to n_modes in all;
+ *      up to n_modes in all; with `follow` set the band holds the one mode
+ *      followed (amfid: a band around the site model's frequency of that
+ *      mode), and the other modes are the strongest peaks outside the band,
+ *      below or above it, however strong (a continuous bridge's second
+ *      mode may be stronger than its first at a sensor);
  *   3. a sum of damped sinusoids plus an offset,
  *        y(t) = c + sum_k exp(−sigma_k t) (a_k cos w_k t + b_k sin w_k t),
  *      is fitted by nonlinear least squares (GSL gsl_multifit_nlinear,
@@ -46,13 +50,33 @@ typedef struct amfi_natfreq_params {
     double min_r2;           /* least fit R², [0, 1) */
     double max_zeta;         /* largest damping ratio accepted, (0, 1) */
     double max_se_frac;      /* largest standard error of f1 over f1, > 0 */
+    int follow;              /* 0: mode 1 is the strongest peak in the band and the
+                                other modes lie above 1.5 times it; 1: the band
+                                holds the mode followed only, the other modes are
+                                searched on both sides of it */
 } amfi_natfreq_params;
 
-/* Defaults: band 0.5 .. 50 Hz, 2 modes, 4 periods, R² 0.8, zeta 0.2, SE 1 %. */
+/* Defaults: band 0.5 .. 50 Hz, 2 modes, 4 periods, R² 0.8, zeta 0.2, SE 1 %,
+ * follow 0 (amfid sets the band and follow from its site model). */
 void amfi_natfreq_params_default(amfi_natfreq_params *p);
 
 /* 0 when valid, else -1 with err naming the parameter. */
 int amfi_natfreq_params_check(const amfi_natfreq_params *p, char *err, size_t errlen);
+
+/* The estimator's parameters for following one mode of a site model whose
+ * natural circular frequencies are omega[0 .. n − 1] (rad/s, ascending:
+ * amfi_bridge_omega): mode k (1-based) at f_k = omega[k − 1] / 2 pi is
+ * searched in [f_k (1 − band), f_k (1 + band)], but no nearer its
+ * neighbours than their geometric means with f_k (a continuous bridge's
+ * first two modes may be 1.2 to 1.6 times apart and alike at a sensor:
+ * docs/results/continuous-sensors.md), within site's [f_lo_hz, f_hi_hz];
+ * out is site with that band and follow set, *f_mode_hz f_k. mode 0: out is
+ * site unchanged (the strongest peak in its band), *f_mode_hz NaN. 0, or -1
+ * with err (daemon.natural_frequency.mode beyond the model's modes, or f_k
+ * outside [f_lo_hz, f_hi_hz], or band not in (0, 0.5]). */
+int amfi_natfreq_follow(const amfi_natfreq_params *site, const double *omega, int n, int mode,
+                        double band, amfi_natfreq_params *out, double *f_mode_hz, char *err,
+                        size_t errlen);
 
 enum {
     AMFI_NATFREQ_OK = 0,
