@@ -162,10 +162,14 @@ int amfi_axle_groups(int n_axles, const double *spacing_m, const double *axle_kg
 
 /* ---- the European classes -------------------------------------------------- */
 
-/* Group sizes as a number: [1,1,3] is 113. */
+/* Group sizes as a number: [1,1,3] is 113; 0 (no class) for more than four
+ * groups: no class has more than three, and twelve single axles would
+ * overflow the number. */
 static int pattern(const amfi_classification *c)
 {
     int v = 0;
+    if (c->n_groups > 4)
+        return 0;
     for (int i = 0; i < c->n_groups; i++)
         v = 10 * v + (c->group[i].n_axles < 9 ? c->group[i].n_axles : 9);
     return v;
