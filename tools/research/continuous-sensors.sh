@@ -40,56 +40,24 @@ die() { echo "continuous-sensors: $*" >&2; exit 1; }
 mkdir -p "$out" || die "cannot create $out"
 out=$(cd "$out" && pwd)
 
+. "$src/tools/research/continuous-bridge.sh"
 # the traffic: 2-, 3- and 5-axle vehicles of the EU mix, in their order
 pop="$out/population-235.csv"
-awk -F, 'NR == 1 || $6 == 2 || $6 == 3 || $6 == 5' \
-  "$src/sim_publisher/data/population-eu.csv" > "$pop" || die "cannot write $pop"
+continuous_traffic "$src" "$pop" || die "cannot write $pop"
 
 # site BRIDGE LAYOUT "POS ..." -> OUT/BRIDGE-LAYOUT/site.yaml
 site() {
   d="$out/$1-$2"
   rm -rf "$d" && mkdir -p "$d" || die "cannot create $d"
-  case $1 in
-    single) span=20 sup='    - {at_m: 0, type: pinned}
-    - {at_m: 20, type: roller}' ;;
-    two) span=40 sup='    - {at_m: 0, type: pinned}
-    - {at_m: 20, type: roller}
-    - {at_m: 40, type: roller}' ;;
-    three) span=50 sup='    - {at_m: 0, type: pinned}
-    - {at_m: 15, type: roller}
-    - {at_m: 35, type: roller}
-    - {at_m: 50, type: roller}' ;;
-    *) die "unknown bridge $1" ;;
-  esac
   {
     echo "# SPDX-License-Identifier: GPL-3.0-or-later"
     echo "# continuous-sensors.sh: bridge $1, layout $2"
-    echo "site:"
-    echo "  id: continuous-$1-$2"
-    echo "bridge:"
-    echo "  name: $1"
-    echo "  span_m: $span"
-    echo "  elements: $span"
-    echo "  E_pa: 3.5e10"
-    echo "  A_m2: 2.046"
-    echo "  I_m4: 0.2991"
-    echo "  density_kgm3: 2400"
-    echo "  damping:"
-    echo "    ratio: 0.03"
-    echo "    modes: [1, 2]"
-    echo "  supports:"
-    echo "$sup"
-    echo "sensors:"
-    i=0
-    for x in $3; do
-      echo "  - {id: $i, at_m: $x, weight: 1}"
-      i=$((i + 1))
-    done
+    continuous_bridge_yaml "$1" "continuous-$1-$2" "$3" || die "unknown bridge $1"
     echo "daemon:"
     echo "  simulation: true"
     echo "simulation:"
     echo "  population: $pop"
-  } > "$d/site.yaml"
+  } > "$d/site.yaml" || exit 1
 }
 
 # weigh BRIDGE LAYOUT "POS ...": simulate and weigh into OUT/BRIDGE-LAYOUT

@@ -40,9 +40,9 @@ src=$(cd "$(dirname "$0")/../.." && pwd)
 die() { echo "natfreq-continuous: $*" >&2; exit 1; }
 mkdir -p "$out" || die "cannot create $out"
 out=$(cd "$out" && pwd)
+. "$src/tools/research/continuous-bridge.sh"
 pop="$out/population-235.csv"
-awk -F, 'NR == 1 || $6 == 2 || $6 == 3 || $6 == 5' \
-  "$src/sim_publisher/data/population-eu.csv" > "$pop" || die "cannot write $pop"
+continuous_traffic "$src" "$pop" || die "cannot write $pop"
 # the model's first natural frequencies (amfi_bridge_omega of the site
 # model; healthy), for the counts near each
 case $bridge in
@@ -50,44 +50,13 @@ case $bridge in
   two) model_f="5.7338 8.9573" ;;
   three) model_f="7.5954 12.433 14.915" ;;
 esac
-case $bridge in
-  single) span=20 sup='    - {at_m: 0, type: pinned}
-    - {at_m: 20, type: roller}' ;;
-  two) span=40 sup='    - {at_m: 0, type: pinned}
-    - {at_m: 20, type: roller}
-    - {at_m: 40, type: roller}' ;;
-  three) span=50 sup='    - {at_m: 0, type: pinned}
-    - {at_m: 15, type: roller}
-    - {at_m: 35, type: roller}
-    - {at_m: 50, type: roller}' ;;
-  *) die "unknown bridge $bridge" ;;
-esac
+continuous_bridge_yaml "$bridge" x "" > /dev/null || die "unknown bridge $bridge"
 # site MODE -> OUT/site-MODE.yaml
 site() {
   {
     echo "# SPDX-License-Identifier: GPL-3.0-or-later"
     echo "# natfreq-continuous.sh: bridge $bridge, sensors $sensors, mode $1"
-    echo "site:"
-    echo "  id: natfreq-$bridge"
-    echo "bridge:"
-    echo "  name: $bridge"
-    echo "  span_m: $span"
-    echo "  elements: $span"
-    echo "  E_pa: 3.5e10"
-    echo "  A_m2: 2.046"
-    echo "  I_m4: 0.2991"
-    echo "  density_kgm3: 2400"
-    echo "  damping:"
-    echo "    ratio: 0.03"
-    echo "    modes: [1, 2]"
-    echo "  supports:"
-    echo "$sup"
-    echo "sensors:"
-    i=0
-    for x in $sensors; do
-      echo "  - {id: $i, at_m: $x, weight: 1}"
-      i=$((i + 1))
-    done
+    continuous_bridge_yaml "$bridge" "natfreq-$bridge" "$sensors"
     echo "solver:"
     echo "  calc_rate_hz: ${SOLVER_RATE:-5000}"
     echo "daemon:"
