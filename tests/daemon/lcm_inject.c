@@ -79,7 +79,15 @@ static int open_logs(const char *inp, const char *outp, lcm_eventlog_t **in,
     return 1;
 }
 
-static int vehicles_only(const char *inp, const char *outp)
+/* One event of a rewrite: writes what replaces e in out (nothing, e, a
+ * changed copy, or more) with the factor f; counts the vehicles it handled in
+ * *n. Returns 0, or non-zero when a write failed. */
+typedef int (*rewrite_fn)(lcm_eventlog_t *out, int64_t *num, const lcm_eventlog_event_t *e,
+                          double f, int *n);
+
+/* IN to OUT, each event through fn: 0, or 1 (reported) when a write failed
+ * or, with need_vehicle, no vehicle was handled. */
+static int rewrite(const char *inp, const char *outp, rewrite_fn fn, double f, int need_vehicle)
 {
     lcm_eventlog_t *in, *out;
     if (open_logs(inp, outp, &in, &out))
@@ -88,118 +96,96 @@ static int vehicles_only(const char *inp, const char *outp)
     int64_t num = 0;
     int rc = 0, n = 0;
     while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
-        if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0) {
-            rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
-            n++;
-        }
+        rc |= fn(out, &num, e, f, &n);
         lcm_eventlog_free_event(e);
     }
     lcm_eventlog_destroy(in);
     lcm_eventlog_destroy(out);
-    if (rc || n == 0) {
+    if (rc || (need_vehicle && n == 0)) {
         fprintf(stderr, "lcm_inject: %s\n", rc ? "write failed" : "no vehicle in the log");
         return 1;
     }
     return 0;
 }
 
-static int twin_lanes(const char *inp, const char *outp)
+static int put_same(lcm_eventlog_t *out, int64_t *num, const lcm_eventlog_event_t *e)
 {
-    lcm_eventlog_t *in, *out;
-    if (open_logs(inp, outp, &in, &out))
-        return 1;
-    lcm_eventlog_event_t *e;
-    int64_t num = 0;
-    int rc = 0, n = 0;
-    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
-        rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
-        amfi_vehicle_t m;
-        if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0 &&
-            amfi_vehicle_t_decode(e->data, 0, e->datalen, &m) >= 0) {
-            m.vehicle_id += 1000000;
-            m.lane = m.lane == 1 ? 2 : 1;
-            unsigned char b[4096];
-            int len = amfi_vehicle_t_encode(b, 0, sizeof b, &m);
-            rc |= len < 0 || put(out, &num, e->timestamp, e->channel, b, len);
-            amfi_vehicle_t_decode_cleanup(&m);
-            n++;
-        }
-        lcm_eventlog_free_event(e);
+    return put(out, num, e->timestamp, e->channel, e->data, e->datalen);
+}
+
+/* A decoded vehicle_t, encoded again and written. */
+static int put_vehicle(lcm_eventlog_t *out, int64_t *num, const lcm_eventlog_event_t *e,
+                       const amfi_vehicle_t *m)
+{
+    unsigned char b[4096];
+    int len = amfi_vehicle_t_encode(b, 0, sizeof b, m);
+    return len < 0 || put(out, num, e->timestamp, e->channel, b, len);
+}
+
+/* The vehicle_t events only. */
+static int ev_vehicles_only(lcm_eventlog_t *out, int64_t *num, const lcm_eventlog_event_t *e,
+                            double f, int *n)
+{
+    (void)f;
+    if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) != 0)
+        return 0;
+    (*n)++;
+    return put_same(out, num, e);
+}
+
+/* Every event; after each vehicle_t its twin on the other lane. */
+static int ev_twin_lanes(lcm_eventlog_t *out, int64_t *num, const lcm_eventlog_event_t *e,
+                         double f, int *n)
+{
+    (void)f;
+    int rc = put_same(out, num, e);
+    amfi_vehicle_t m;
+    if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0 &&
+        amfi_vehicle_t_decode(e->data, 0, e->datalen, &m) >= 0) {
+        m.vehicle_id += 1000000;
+        m.lane = m.lane == 1 ? 2 : 1;
+        rc |= put_vehicle(out, num, e, &m);
+        amfi_vehicle_t_decode_cleanup(&m);
+        (*n)++;
     }
-    lcm_eventlog_destroy(in);
-    lcm_eventlog_destroy(out);
-    if (rc || n == 0) {
-        fprintf(stderr, "lcm_inject: %s\n", rc ? "write failed" : "no vehicle in the log");
-        return 1;
-    }
-    return 0;
+    return rc;
 }
 
 /* Every vehicle_t's axle spacings multiplied by f: a detector record the
  * samples do not match. */
-static int scale_spacing(double f, const char *inp, const char *outp)
+static int ev_scale_spacing(lcm_eventlog_t *out, int64_t *num, const lcm_eventlog_event_t *e,
+                            double f, int *n)
 {
-    lcm_eventlog_t *in, *out;
-    if (open_logs(inp, outp, &in, &out))
-        return 1;
-    lcm_eventlog_event_t *e;
-    int64_t num = 0;
-    int rc = 0, n = 0;
-    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
-        amfi_vehicle_t m;
-        if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) == 0 &&
-            amfi_vehicle_t_decode(e->data, 0, e->datalen, &m) >= 0) {
-            for (int k = 0; k < m.n_spacings; k++)
-                m.axle_spacing_m[k] *= f;
-            unsigned char b[4096];
-            int len = amfi_vehicle_t_encode(b, 0, sizeof b, &m);
-            rc |= len < 0 || put(out, &num, e->timestamp, e->channel, b, len);
-            amfi_vehicle_t_decode_cleanup(&m);
-            n++;
-        } else {
-            rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
-        }
-        lcm_eventlog_free_event(e);
-    }
-    lcm_eventlog_destroy(in);
-    lcm_eventlog_destroy(out);
-    if (rc || n == 0) {
-        fprintf(stderr, "lcm_inject: %s\n", rc ? "write failed" : "no vehicle in the log");
-        return 1;
-    }
-    return 0;
+    amfi_vehicle_t m;
+    if (strcmp(e->channel, AMFI_CHANNEL_VEHICLE) != 0 ||
+        amfi_vehicle_t_decode(e->data, 0, e->datalen, &m) < 0)
+        return put_same(out, num, e);
+    for (int k = 0; k < m.n_spacings; k++)
+        m.axle_spacing_m[k] *= f;
+    int rc = put_vehicle(out, num, e, &m);
+    amfi_vehicle_t_decode_cleanup(&m);
+    (*n)++;
+    return rc;
 }
 
-static int scale_accel(double f, const char *inp, const char *outp)
+/* Every sample multiplied by f, held within ±999. */
+static int ev_scale_accel(lcm_eventlog_t *out, int64_t *num, const lcm_eventlog_event_t *e,
+                          double f, int *n)
 {
-    lcm_eventlog_t *in, *out;
-    if (open_logs(inp, outp, &in, &out))
-        return 1;
-    lcm_eventlog_event_t *e;
-    int64_t num = 0;
-    int rc = 0;
-    while ((e = lcm_eventlog_read_next_event(in)) != NULL) {
-        amfi_accel_block_t m;
-        if (strcmp(e->channel, AMFI_CHANNEL_ACCEL) == 0 &&
-            amfi_accel_block_t_decode(e->data, 0, e->datalen, &m) >= 0) {
-            for (int i = 0; i < m.n; i++) {
-                double v = m.accel[i] * f;
-                m.accel[i] = v > 999 ? 999 : v < -999 ? -999 : v;
-            }
-            unsigned char b[4096];
-            int n = amfi_accel_block_t_encode(b, 0, sizeof b, &m);
-            rc |= n < 0 || put(out, &num, e->timestamp, e->channel, b, n);
-            amfi_accel_block_t_decode_cleanup(&m);
-        } else {
-            rc |= put(out, &num, e->timestamp, e->channel, e->data, e->datalen);
-        }
-        lcm_eventlog_free_event(e);
+    (void)n;
+    amfi_accel_block_t m;
+    if (strcmp(e->channel, AMFI_CHANNEL_ACCEL) != 0 ||
+        amfi_accel_block_t_decode(e->data, 0, e->datalen, &m) < 0)
+        return put_same(out, num, e);
+    for (int i = 0; i < m.n; i++) {
+        double v = m.accel[i] * f;
+        m.accel[i] = v > 999 ? 999 : v < -999 ? -999 : v;
     }
-    lcm_eventlog_destroy(in);
-    lcm_eventlog_destroy(out);
-    if (rc)
-        fprintf(stderr, "lcm_inject: write failed\n");
-    return rc ? 1 : 0;
+    unsigned char b[4096];
+    int len = amfi_accel_block_t_encode(b, 0, sizeof b, &m);
+    int rc = len < 0 || put(out, num, e->timestamp, e->channel, b, len);
+    amfi_accel_block_t_decode_cleanup(&m);
+    return rc;
 }
 
 static int put_env(lcm_eventlog_t *out, int64_t *num, int64_t ts, int64_t utime, double deck,
@@ -319,13 +305,13 @@ int main(int argc, char **argv)
     if (argc == 4 && strcmp(argv[1], "--bad-environment") == 0)
         return bad_environment(argv[2], argv[3]);
     if (argc == 5 && strcmp(argv[1], "--scale-accel") == 0)
-        return scale_accel(atof(argv[2]), argv[3], argv[4]);
+        return rewrite(argv[3], argv[4], ev_scale_accel, atof(argv[2]), 0);
     if (argc == 5 && strcmp(argv[1], "--scale-spacing") == 0)
-        return scale_spacing(atof(argv[2]), argv[3], argv[4]);
+        return rewrite(argv[3], argv[4], ev_scale_spacing, atof(argv[2]), 1);
     if (argc == 4 && strcmp(argv[1], "--vehicles-only") == 0)
-        return vehicles_only(argv[2], argv[3]);
+        return rewrite(argv[2], argv[3], ev_vehicles_only, 0.0, 1);
     if (argc == 4 && strcmp(argv[1], "--twin-lanes") == 0)
-        return twin_lanes(argv[2], argv[3]);
+        return rewrite(argv[2], argv[3], ev_twin_lanes, 0.0, 1);
     if (argc != 3) {
         fprintf(stderr, "usage: lcm_inject [--vehicles-only | --bad-environment | --bad-reference | "
                         "--scale-accel F | --scale-spacing F] IN.log OUT.log\n");
