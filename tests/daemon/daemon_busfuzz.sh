@@ -33,7 +33,7 @@ sed "s/^    vehicles_per_s: 10 .*/    vehicles_per_s: 100000/" "$config" > "$dir
 grep -q "^    vehicles_per_s: 100000$" "$dir/fuzz.yaml" || { echo "FAIL: no daemon.intake.vehicles_per_s in $config"; exit 1; }
 config=$dir/fuzz.yaml
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
-"$sim" --lcm-url none --log "$dir/clean.log" --vehicles "$nveh" --headway 3 --speedup max --seed 8 \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/clean.log" --vehicles "$nveh" --headway 3 --speedup max --seed 8 \
   2> "$dir/sim.log" || fail "sim_publisher"
 "$fuzzlog" "$dir/clean.log" "$dir/fuzz.log" "$count" 11 > "$dir/fuzzlog.txt" || fail "lcm_fuzzlog"
 t0=$(date +%s.%N)

@@ -34,7 +34,7 @@ printf 'detector:\n  clock_offset_s: 0.02\n  speed_scale: 1.03\n  spacing_scale:
 # AS_BUILT detector (the same vehicles each run); the store kept as NAME.db
 run() {
   amfid_start "$amfid" "$2"
-  timeout 120 "$sim" --allow-production-bus --config "$dir/design.yaml" --as-built "$3" --vehicles $N --headway 3 \
+  timeout 120 "$sim" --dt 2.5e-4 --allow-production-bus --config "$dir/design.yaml" --as-built "$3" --vehicles $N --headway 3 \
     --speedup 10 --seed 7 2> "$dir/sim_$1.log" || fail "$1: sim_publisher exited $?"
   sleep 1
   amfid_stop

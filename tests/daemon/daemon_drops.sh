@@ -35,7 +35,7 @@ wait_for running "$dir/amfid.log" $apid 60 || fail "no start"
 lcm-logger -c AMFI_STATUS -f "$dir/status.lcmlog" > /dev/null 2>&1 &
 lpid=$!; pids="$pids $lpid"
 kill -STOP $apid
-timeout 60 "$sim" --allow-production-bus --vehicles 4 --headway 2 --speedup 50 --seed 6 2> "$dir/sim.log" || fail "sim_publisher"
+timeout 60 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles 4 --headway 2 --speedup 50 --seed 6 2> "$dir/sim.log" || fail "sim_publisher"
 kill -CONT $apid
 sleep 2.5
 kill -TERM $apid; wait $apid; rc=$?
@@ -59,7 +59,7 @@ grep -q "^  simulation: true$" "$dir/sim.yaml" || fail "daemon.simulation did no
 bpid=$!; pids="$pids $bpid"
 wait_for running "$dir/burst.log" $bpid 60 || fail "no start"
 kill -STOP $bpid
-timeout 60 "$sim" --allow-production-bus --vehicles 4 --headway 2 --speedup 50 --seed 6 2> "$dir/sim3.log" || fail "sim_publisher (3)"
+timeout 60 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles 4 --headway 2 --speedup 50 --seed 6 2> "$dir/sim3.log" || fail "sim_publisher (3)"
 kill -CONT $bpid
 sleep 3
 kill -TERM $bpid; wait $bpid; rc=$?

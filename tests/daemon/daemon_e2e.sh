@@ -32,7 +32,7 @@ apid=$!; pids="$pids $apid"
 wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
 lcm-logger -f "$dir/recorded.lcmlog" > "$dir/logger.log" 2>&1 &  # every channel
 lpid=$!; pids="$pids $lpid"
-timeout 120 "$sim" --allow-production-bus --vehicles $N --headway 3 --speedup 20 --seed 3 2> "$dir/sim.log" &
+timeout 120 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles $N --headway 3 --speedup 20 --seed 3 2> "$dir/sim.log" &
 spid=$!; pids="$pids $spid"
 sleep 0.5
 kill -HUP $apid  # reload while the traffic streams
@@ -68,7 +68,7 @@ wait_for running "$dir/term.log" $apid 60 || fail "amfid did not start"
 # -k 10: sim_publisher once did not exit after its SIGTERM summary under
 # ASan and the test hung at the wait below until ctest's 600 s (not
 # diagnosed); amfid is what this section tests
-timeout -k 10 120 "$sim" --allow-production-bus --vehicles $N --headway 3 --speedup 20 --seed 5 2> "$dir/simterm.log" &
+timeout -k 10 120 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles $N --headway 3 --speedup 20 --seed 5 2> "$dir/simterm.log" &
 spid=$!; pids="$pids $spid"
 sleep 1.2  # about half the traffic
 kill -TERM $apid
@@ -106,7 +106,7 @@ echo "lcm-logger log: $N identical rows replayed at speed 0 and 8, the same as l
 
 # 4. A log written by sim_publisher itself, read twice through file:// at
 #    two speeds: same rows.
-"$sim" --lcm-url none --log "$dir/traffic.log" --vehicles $N --headway 3 --speedup max --seed 4 \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/traffic.log" --vehicles $N --headway 3 --speedup max --seed 4 \
   2> "$dir/simlog.log" || fail "sim_publisher --log"
 for speed in 0 8; do
   "$amfid" --config "$dir/amfid.yaml" --db "$dir/replay$speed.db" \

@@ -19,7 +19,7 @@ sed "s/^  simulation: false .*/  simulation: true/" "$config" > "$dir/sim.yaml"
 grep -q "^  simulation: true$" "$dir/sim.yaml" || { echo "FAIL: daemon.simulation did not apply"; exit 1; }
 config=$dir/sim.yaml
 amfid_start "$amfid" "$config"
-timeout 300 "$sim" --allow-production-bus --vehicles $N --flow 1800 --lanes 1 --speedup 10 --seed 7 \
+timeout 300 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles $N --flow 1800 --lanes 1 --speedup 10 --seed 7 \
   --population "$population" 2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 2
 amfid_stop

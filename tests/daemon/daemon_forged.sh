@@ -73,7 +73,7 @@ lcm-logger "$dir/capture.lcmlog" > "$dir/logger.log" 2>&1 &
 lpid=$!; pids="$pids $lpid"
 sleep 0.5
 simkey=""; [ $auth = 0 ] || simkey="--bus-key $dir/bus.key"
-"$sim" --allow-production-bus --vehicles $N --headway 3 --speedup 3 --seed 21 $simkey 2> "$dir/sim.log" &
+"$sim" --dt 2.5e-4 --allow-production-bus --vehicles $N --headway 3 --speedup 3 --seed 21 $simkey 2> "$dir/sim.log" &
 spid=$!; pids="$pids $spid"
 
 # --- the attack, once the sniffer holds two vehicles ------------------------

@@ -19,7 +19,7 @@ sed "s/^  simulation: false .*/  simulation: true/" "$config" > "$dir/sim.yaml"
 grep -q "^  simulation: true$" "$dir/sim.yaml" || { echo "FAIL: daemon.simulation did not apply"; exit 1; }
 config=$dir/sim.yaml
 fail() { echo "FAIL: $*"; tail -30 "$dir/amfid.log"; exit 1; }
-"$sim" --lcm-url none --log "$dir/clean.log" --vehicles 3 --headway 4 --speedup max --seed 2 \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/clean.log" --vehicles 3 --headway 4 --speedup max --seed 2 \
   2> "$dir/sim.log" || fail "sim_publisher"
 "$hostile" "$dir/clean.log" "$dir/bad.log" "$issue9" $extra || fail "lcm_hostile"
 "$amfid" --config "$config" --db "$dir/a.db" --lcm-url "file://$dir/bad.log?speed=0" \

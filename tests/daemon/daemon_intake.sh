@@ -26,7 +26,7 @@ trap 'rm -rf "$dir"' EXIT
 fail() { echo "FAIL: $case: $*"; tail -20 "$dir/$case.log" 2>/dev/null; exit 1; }
 q() { sqlite3 "$dir/$case.db" "$1"; }
 case=clean
-"$sim" --lcm-url none --log "$dir/clean.lcmlog" --vehicles $N --headway 4 --speedup max --seed 2 \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/clean.lcmlog" --vehicles $N --headway 4 --speedup max --seed 2 \
   2> "$dir/sim.log" || fail "sim_publisher: $(tail -3 "$dir/sim.log")"
 for case in $cases; do
   "$forge" "$case" "$dir/clean.lcmlog" "$dir/$case.lcmlog" || fail "lcm_intake_forge"

@@ -13,7 +13,7 @@ set -u
 amfid=$1 sim=$2 passages=$3 config=$4 kills=${5:-20}
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 # 120 vehicles, one every 2 s of data: 240 s played at 8x = 30 s of wall time
-"$sim" --lcm-url none --log "$dir/traffic.log" --vehicles 120 --headway 2 --speedup max --seed 5 \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/traffic.log" --vehicles 120 --headway 2 --speedup max --seed 5 \
   2> "$dir/sim.log" || fail "sim_publisher"
 lcm-logger -c AMFI_PASSAGE -f "$dir/acked.log" > "$dir/logger.log" 2>&1 &
 pids="$pids $!"

@@ -21,7 +21,7 @@ sed -e 's/^    window: 500 /    window: 10 /' -e 's/^    every: 100 /    every: 
 grep -q "^    window: 10 " "$dir/amfid.yaml" && grep -q "^    every: 1 " "$dir/amfid.yaml" &&
   grep -q "^    baseline_n: 10 " "$dir/amfid.yaml" || fail "could not set the indicator window"
 amfid_start "$amfid" "$dir/amfid.yaml"
-timeout 300 "$sim" --allow-production-bus --vehicles $N --flow 1200 --lanes 2 --speedup 20 --seed 3 \
+timeout 300 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles $N --flow 1200 --lanes 2 --speedup 20 --seed 3 \
   2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1
 amfid_stop

@@ -18,7 +18,7 @@ mkdir "$dir/m"
 "$amfid" --config "$dir/a.yaml" --db "$dir/a.db" 2> "$dir/amfid.log" &
 apid=$!; pids="$pids $apid"
 wait_for running "$dir/amfid.log" $apid 60 || fail "amfid did not start"
-timeout 120 "$sim" --allow-production-bus --vehicles 30 --headway 2 --speedup 15 --seed 9 2> "$dir/sim.log" &
+timeout 120 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles 30 --headway 2 --speedup 15 --seed 9 2> "$dir/sim.log" &
 spid=$!; pids="$pids $spid"
 copies=0 seen=""
 while kill -0 $spid 2>/dev/null; do

@@ -37,7 +37,7 @@ grep -q "^  calc_rate_hz: 1000" "$dir/amfid.yaml" || fail "no solver.calc_rate_h
 
 # ---- 1. the design bridge, a climate, then a 10 % loss ---------------------
 amfid_start "$amfid" "$dir/amfid.yaml"
-timeout 300 "$sim" --allow-production-bus --vehicles 130 --headway 4 --speedup 40 --seed 3 \
+timeout 300 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles 130 --headway 4 --speedup 40 --seed 3 \
   --environment site --time-compression 2000 --environment-period 0.5 \
   --damage 0.1 --damage-step-at 100 2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1
@@ -73,7 +73,7 @@ grep -q "ALERT natfreq (warning)" "$dir/amfid.log" || fail "natfreq not in the j
 # ---- 2. the main job's scenario, shortened: no deck temperature -------------
 rm -f "$dir"/s.db*
 amfid_start "$amfid" "$dir/amfid.yaml"
-timeout 300 "$sim" --allow-production-bus --vehicles 75 --headway 2 --speedup 25 --seed 1 \
+timeout 300 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles 75 --headway 2 --speedup 25 --seed 1 \
   --damage 0.2 --damage-step-at 50 2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1
 amfid_stop
@@ -94,7 +94,7 @@ amfid_start "$amfid" "$dir/amfid.yaml"
 lcm-logger -c AMFI_ALERT -f "$dir/alerts.log" > "$dir/logger.log" 2>&1 &
 lpid=$!; pids="$pids $lpid"
 sleep 0.3
-timeout 300 "$sim" --allow-production-bus --vehicles 60 --headway 4 --speedup 40 --seed 4 \
+timeout 300 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles 60 --headway 4 --speedup 40 --seed 4 \
   --as-built "$cases/bearings-2.yaml" 2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1
 amfid_stop
@@ -112,7 +112,7 @@ grep -q "ALERT model_mismatch (warning)" "$dir/amfid.log" || fail "model_mismatc
 grep -a -q model_mismatch "$dir/alerts.log" || fail "model_mismatch not published"
 # a restart: the alert stays open, not raised twice
 amfid_start "$amfid" "$dir/amfid.yaml"
-timeout 300 "$sim" --allow-production-bus --vehicles 15 --headway 4 --speedup 40 --seed 6 \
+timeout 300 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles 15 --headway 4 --speedup 40 --seed 6 \
   --start-utime $(( $(q "SELECT max(utime) FROM passages") + 10000000 )) \
   --as-built "$cases/bearings-2.yaml" 2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1

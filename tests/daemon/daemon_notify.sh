@@ -30,7 +30,7 @@ dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 . "$(dirname "$0")/../common/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log" 2>/dev/null; exit 1; }
-"$sim" --lcm-url none --log "$dir/t.lcmlog" --vehicles 60 --headway 2 --speedup max \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/t.lcmlog" --vehicles 60 --headway 2 --speedup max \
   --damage 0.3 --damage-step-at 30 --seed 3 2> "$dir/sim.log" || fail "sim_publisher"
 # CONF COMMAND TIMEOUT: the shipped file with small windows, the command, the metrics file
 # (a simulation: the truth is read too, every message sent is counted)

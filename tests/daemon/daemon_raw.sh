@@ -34,7 +34,7 @@ grep -q "^      keep: all " "$dir/amfid.yaml" || fail "$config: daemon.store.raw
 
 run_traffic() { # $1: the site file; the store $dir/s.db
   amfid_start "$amfid" "$1"
-  timeout 240 "$sim" --allow-production-bus --vehicles $N --flow 600 --lanes 2 --min-headway 0.5 --speedup 20 \
+  timeout 240 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles $N --flow 600 --lanes 2 --min-headway 0.5 --speedup 20 \
     --seed 3 2> "$dir/sim.log" || { cat "$dir/sim.log"; fail "sim_publisher exited $?"; }
   sleep 1
   amfid_stop

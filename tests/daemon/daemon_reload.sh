@@ -29,7 +29,7 @@ L1=7.94e-9 L2=2.5e-8
 export TSAN_OPTIONS="halt_on_error=1 exitcode=66 ${TSAN_OPTIONS:-}"
 export OPENBLAS_NUM_THREADS=1
 
-"$sim" --lcm-url none --log "$dir/traffic.lcmlog" --vehicles $N --headway 2 --speedup max \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/traffic.lcmlog" --vehicles $N --headway 2 --speedup max \
   --seed 17 2> "$dir/sim.log" || fail "sim_publisher exited $?"
 grep -q "^  lambda: $L1 " "$config" || fail "$config: no '  lambda: $L1' line to rewrite"
 # A queue of 2: the replay waits for the solvers, so the log lasts as long

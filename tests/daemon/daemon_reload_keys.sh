@@ -182,7 +182,7 @@ done_keys=""
 # Traffic: 40 vehicles 4 s apart (vehicle k enters at t0 + 4 k + 1.58 s), the
 # bridge half as stiff from vehicle 28 on (the indicator's mean-shift alert).
 write_config
-"$sim" --config "$dir/amfid.yaml" --lcm-url none --log "$dir/sim.log" --vehicles 40 --headway 4 --speedup max --seed 5 \
+"$sim" --dt 2.5e-4 --config "$dir/amfid.yaml" --lcm-url none --log "$dir/sim.log" --vehicles 40 --headway 4 --speedup max --seed 5 \
   --damage 0.5 --damage-step-at 27 2> "$dir/sim.err" || fail "sim_publisher: $(tail -2 "$dir/sim.err")"
 t0=$("$tool" t0 "$dir/sim.log") || fail "lcm_reload t0"
 # seconds (data time after t0) and µs, in awk's doubles (exact below 2^53)

@@ -29,7 +29,7 @@ grep -q '^    baseline_n: 10 ' "$dir/a.yaml" || fail "the indicator settings did
 "$amfid" --config "$dir/a.yaml" --check-config > /dev/null || fail "check-config"
 
 # 1. First start: claimed, and every output message carries the id.
-"$sim" --lcm-url none --log "$dir/traffic.log" --vehicles 24 --headway 2 --speedup max --seed 7 \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/traffic.log" --vehicles 24 --headway 2 --speedup max --seed 7 \
   2> "$dir/sim.log" || fail "sim_publisher"
 lcm-logger -f "$dir/out.lcmlog" > "$dir/logger.log" 2>&1 &
 pids="$pids $!"

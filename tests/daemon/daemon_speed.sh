@@ -18,7 +18,7 @@ sed -e "s/^  speed: measured /  speed: estimate /" -e "s/^  simulation: false .*
 grep -q "^  simulation: true$" "$dir/amfid.yaml" || fail "daemon.simulation did not apply"
 grep -q "^  speed: estimate " "$dir/amfid.yaml" || fail "the test's solver.speed did not apply"
 amfid_start "$amfid" "$dir/amfid.yaml"
-timeout 120 "$sim" --allow-production-bus --vehicles $N --headway 3 --speedup 10 --seed 7 --speed-error 0.04,0 \
+timeout 120 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles $N --headway 3 --speedup 10 --seed 7 --speed-error 0.04,0 \
   2> "$dir/sim.log" || fail "sim_publisher exited $?"
 sleep 1
 # an estimated passage is ~100 sweeps: the drain takes minutes under ASan

@@ -45,7 +45,7 @@ run() {
   lcm-logger -c 'AMFI_ALERT' -f "$dir/$1.lcmlog" > "$dir/$1-logger.log" 2>&1 &
   lpid=$!; pids="$pids $lpid"
   sleep 0.3
-  timeout 120 "$sim" --allow-production-bus --vehicles $N --headway 3 --speedup 10 --seed 7 --speed-error "$2" \
+  timeout 120 "$sim" --dt 2.5e-4 --allow-production-bus --vehicles $N --headway 3 --speedup 10 --seed 7 --speed-error "$2" \
     2> "$dir/$1-sim.log" || fail "sim_publisher exited $? ($1)"
   sleep 1
   stop

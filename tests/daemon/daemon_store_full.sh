@@ -18,7 +18,7 @@ command -v unshare >/dev/null || { echo "no unshare"; exit 1; }
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 . "$(dirname "$0")/../common/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
-"$sim" --lcm-url none --log "$dir/traffic.log" --vehicles 16 --headway 2 --speedup max --seed 4 \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/traffic.log" --vehicles 16 --headway 2 --speedup max --seed 4 \
   2> "$dir/sim.log" || { echo "FAIL: sim_publisher"; exit 1; }
 unshare --mount sh -s "$amfid" "$config" "$dir" <<'INNER'
 set -u

@@ -16,7 +16,7 @@ trap 'rm -rf "$dir"' EXIT
 . "$(dirname "$0")/../common/bus_key.sh" # the test's site bus key, CREDENTIALS_DIRECTORY
 fail() { echo "FAIL: $*"; tail -20 "$dir/amfid.log"; exit 1; }
 q() { sqlite3 "$dir/$1" "$2"; }
-"$sim" --lcm-url none --log "$dir/clean.log" --vehicles 8 --headway 4 --speedup max --seed 3 \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/clean.log" --vehicles 8 --headway 4 --speedup max --seed 3 \
   2> "$dir/sim.log" || fail "sim_publisher"
 
 "$shift_" poison "$dir/clean.log" "$dir/poison.log" || fail "lcm_timeshift poison"

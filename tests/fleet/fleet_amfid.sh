@@ -46,7 +46,7 @@ wait_for running "$tmp/amfid.log" $apid 60 || die "amfid did not start"
 spid=$!
 # 120 vehicles 2 s apart, 12 times faster than real time: about 20 s; the
 # site's climate (issue 14) on, time-compressed, a reading every second
-"$sim" --allow-production-bus --vehicles 120 --headway 2 --speedup 12 --seed 11 \
+"$sim" --dt 2.5e-4 --allow-production-bus --vehicles 120 --headway 2 --speedup 12 --seed 11 \
     --environment site --time-compression 73000 --environment-period 1 2> "$tmp/sim.log" || die "sim_publisher"
 sleep 2
 mid=$(pg_q "SELECT count(*) FROM passages WHERE site_id = 'live-1'")

@@ -33,7 +33,7 @@ YAML
 "$ingest" --config "$dir/amfid.yaml" --check-config > /dev/null || fail "amfi-ingest --check-config"
 
 # The simulation, and amfid on its log: the LCM path.
-"$sim" --config "$dir/amfid.yaml" --lcm-url none --log "$dir/sim.lcmlog" --vehicles $N \
+"$sim" --dt 2.5e-4 --config "$dir/amfid.yaml" --lcm-url none --log "$dir/sim.lcmlog" --vehicles $N \
   --headway 3 --speedup max --seed 4 2> "$dir/sim.log" || fail "sim_publisher"
 "$amfid" --config "$dir/amfid.yaml" --db "$dir/lcm.db" \
   --lcm-url "file://$dir/sim.lcmlog?speed=0" 2> "$dir/lcm.log" || fail "amfid on the log"

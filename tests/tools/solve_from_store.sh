@@ -26,7 +26,7 @@ expect() {
 # a recorded bus of 4 vehicles, unsigned (a lab bus: daemon.bus.auth off)
 sed -e "s/^    auth: required /    auth: off /" "$config" > "$dir/site.yaml"
 grep -q "^    auth: off " "$dir/site.yaml" || fail "the test's daemon.bus.auth did not apply"
-"$sim" --lcm-url none --log "$dir/bus.log" --vehicles 4 --headway 3 --speedup max --seed 5 \
+"$sim" --dt 2.5e-4 --lcm-url none --log "$dir/bus.log" --vehicles 4 --headway 3 --speedup max --seed 5 \
   2> "$dir/sim.log" || { cat "$dir/sim.log"; fail "sim_publisher"; }
 "$amfid" --config "$dir/site.yaml" --db "$dir/s.db" --lcm-url "file://$dir/bus.log?speed=0" \
   2> "$dir/amfid.log" || { tail "$dir/amfid.log"; fail "amfid on the recorded bus"; }
