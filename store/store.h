@@ -538,6 +538,7 @@ typedef struct amfi_class_row {
     double gvw_kg;      /* > 0 */
     const char *vclass; /* passages.class */
     int overload;       /* passages.overload; 0 where NULL */
+    int refused;        /* 1: passages.loads_refused holds a reason */
 } amfi_class_row;
 typedef int (*amfi_store_class_fn)(void *ctx, const amfi_class_row *row);
 
@@ -625,6 +626,7 @@ int amfi_store_web_trend(amfi_store *s, int which, int64_t from, int64_t to, int
 typedef struct amfi_web_class {
     char vclass[16];        /* "" : none recorded (rows before version 10) */
     int64_t n, n_ok, n_overload;
+    int64_t n_refused;      /* loads refused by the classification (stored from version 13) */
     double gvw_mean_kg, gvw_max_kg; /* of the ok ones; NaN: none */
 } amfi_web_class;
 

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * store_classrows.c: the class, lane, GVW and overload flag of the ok
+ * store_classrows.c: the class, lane, GVW, overload flag and refusal of the ok
  * passages with a GVW in a time range (and lane), in one query without
  * their axle rows, for amfi-report's --classes and --class-histogram.
  * Every value read back is checked as in store_read.c. The caller's
@@ -25,7 +25,8 @@ int amfi_store_each_class_row(amfi_store *s, const amfi_passage_filter *f,
         return rc;
     sqlite3_stmt *p = NULL;
     int src = sqlite3_prepare_v2(s->db,
-        "SELECT id, lane, gvw_kg, class, overload FROM passages WHERE utime >= ?1 "
+        "SELECT id, lane, gvw_kg, class, overload, coalesce(loads_refused, '') <> '' "
+        "FROM passages WHERE utime >= ?1 "
         "AND utime <= ?2 AND status = 'ok' AND gvw_kg IS NOT NULL "
         "AND (?3 IS NULL OR lane = ?3) ORDER BY utime, id", -1, &p, NULL);
     if (src != SQLITE_OK) {
@@ -54,6 +55,10 @@ int amfi_store_each_class_row(amfi_store *s, const amfi_passage_filter *f,
         if (rc == 0 && sqlite3_column_type(p, 4) != SQLITE_NULL) {
             rc = st_read_int(p, 4, 0, 1, &o, &v, err, errlen);
             r.overload = (int)v;
+        }
+        if (rc == 0) {
+            rc = st_read_int(p, 5, 0, 1, &o, &v, err, errlen);
+            r.refused = (int)v;
         }
         if (rc == 0)
             rc = fn(ctx, &r);

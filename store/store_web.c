@@ -378,7 +378,7 @@ int amfi_store_web_classes(amfi_store *s, int64_t from, int64_t to, amfi_web_cla
     sqlite3_stmt *st = NULL;
     rc = st_prepare(s,
                     "SELECT class, count(*), sum(status = 'ok'), sum(coalesce(overload, 0)), "
-                    "avg(CASE WHEN status = 'ok' THEN gvw_kg END), "
+                    "sum(coalesce(loads_refused, '') <> ''), avg(CASE WHEN status = 'ok' THEN gvw_kg END), "
                     "max(CASE WHEN status = 'ok' THEN gvw_kg END) FROM passages "
                     "WHERE utime >= ?1 AND utime <= ?2 GROUP BY class ORDER BY count(*) DESC, class",
                     &st, "classes", err, errlen);
@@ -397,8 +397,9 @@ int amfi_store_web_classes(amfi_store *s, int64_t from, int64_t to, amfi_web_cla
         if (rc == 0) rc = st_read_int(st, 1, 1, INT64_MAX, &o, &c.n, err, errlen);
         if (rc == 0) rc = st_read_int(st, 2, 0, INT64_MAX, &o, &c.n_ok, err, errlen);
         if (rc == 0) rc = st_read_int(st, 3, 0, INT64_MAX, &o, &c.n_overload, err, errlen);
-        if (rc == 0) rc = st_read_real_or_null(st, 4, &R_KG, &o, &c.gvw_mean_kg, err, errlen);
-        if (rc == 0) rc = st_read_real_or_null(st, 5, &R_KG, &o, &c.gvw_max_kg, err, errlen);
+        if (rc == 0) rc = st_read_int(st, 4, 0, INT64_MAX, &o, &c.n_refused, err, errlen);
+        if (rc == 0) rc = st_read_real_or_null(st, 5, &R_KG, &o, &c.gvw_mean_kg, err, errlen);
+        if (rc == 0) rc = st_read_real_or_null(st, 6, &R_KG, &o, &c.gvw_max_kg, err, errlen);
         if (rc == 0 && *n < max)
             out[(*n)++] = c;
     }

@@ -186,6 +186,12 @@ grep -q "\"passage_id\":41,\"vehicle_id\":1041,\"lane\":1,\"class\":\"A23\",\"gv
     fail "--overloads json: refused_passages: 41"
 grep -q "\"passage_id\":42,.*\"loads_refused\":\"$why42\",\"reason_from\":\"recomputed\"}" "$tmp/out" ||
     fail "--overloads json: refused_passages: 42"
+# --classes counts the refusals stored (41's), not the recomputed ones (42's)
+run --db "$tmp/refused.db" --classes --format csv
+[ "$(head -1 "$tmp/out" | cut -d, -f11,12)" = "overloaded,loads_refused" ] ||
+    fail "--classes csv: no loads_refused column: $(head -1 "$tmp/out")"
+[ "$(awk -F, '$2 == "" && ($1 == "A23" || $1 == "R3") { printf "%s=%s ", $1, $12 }' "$tmp/out")" = "A23=1 R3=0 " ] ||
+    fail "--classes csv: the stored refusals by class: $(grep '^A23,,\|^R3,,' "$tmp/out")"
 # a reason the store holds is checked when read: a control character is refused
 sqlite3 "$tmp/refused.db" "UPDATE passages SET loads_refused = 'bad' || char(10) || 'reason' WHERE id = 41" || exit 1
 run --db "$tmp/refused.db" --overloads

@@ -9,7 +9,8 @@
 # screen is redrawn with ANSI escapes; bad options exit 2.
 # A hostile producer (top_inject): an alert with terminal escapes is shown
 # with them replaced; unsigned, wrongly signed and lying passages are
-# counted as refused and never shown.
+# counted as refused and never shown; a good passage whose loads were refused
+# shows the reason (its escape replaced), and the end counts it.
 #   amfi_top.sh AMFI_TOP AMFID SIM_PUBLISHER CONFIG TOP_INJECT
 set -u
 . "$(dirname "$0")/../common/bus_prologue.sh"
@@ -64,6 +65,7 @@ hpid=$!; pids="$pids $hpid"
 wait_for "^# amfi-top on udpm://" "$dir/hostile.out" $hpid 60 || fail "amfi-top --plain did not start"
 "$inject" > "$dir/inject.log" 2>&1 || fail "top_inject: $(cat "$dir/inject.log")"
 wait_for "^alert " "$dir/hostile.out" $hpid 30 || fail "the injected alert was not shown: $(cat "$dir/hostile.out")"
+wait_for "^passage " "$dir/hostile.out" $hpid 30 || fail "the injected passage was not shown: $(cat "$dir/hostile.out")"
 sleep 1
 kill -INT $hpid; wait $hpid || fail "amfi-top --plain on SIGINT: exit $?"
 cat "$dir/hostile.out"
@@ -71,7 +73,10 @@ grep -q "$(printf '\033')" "$dir/hostile.out" && fail "an escape from the bus re
 grep -q "$(printf '\a')" "$dir/hostile.out" && fail "a bell from the bus reached the terminal"
 grep -q "^alert   2026-01-01T00:00:00Z RAISED  warning std_?]0;owned? evil?\[2J??more$" "$dir/hostile.out" ||
     fail "the alert not shown with its control characters replaced"
-grep -q "^passage " "$dir/hostile.out" && fail "a refused passage was shown"
+[ "$(grep -c "^passage " "$dir/hostile.out")" = 1 ] || fail "not only the good passage shown"
+grep -q "^passage .*  901    1  R2 .*ok; loads refused: group 2: 276000 kg, over ten times any legal load?\[2J$" \
+  "$dir/hostile.out" || fail "the loads' refusal not shown (or not made safe)"
+grep -q "^passages 1: ok 1; loads refused 1$" "$dir/hostile.out" || fail "the loads refused not counted"
 grep -q "^refused here: 3 (unsigned 1, bad_mac 1, malformed 1); last: AMFI_PASSAGE: passage_t.status" "$dir/hostile.out" ||
     fail "the refusals not counted: $(tail -2 "$dir/hostile.out")"
 

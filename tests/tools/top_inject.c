@@ -72,9 +72,16 @@ int main(void)
     buf[at] = 0x7f;
     if (amfi_auth_publish(lcm, &good, AMFI_CHANNEL_PASSAGE, buf, (size_t)n) != 0)
         return die("lying passage");
+    /* a good passage whose loads were refused, the reason with an escape */
+    p.passage_id = p.vehicle_id = 901;
+    p.overload = -1;
+    p.loads_refused = "group 2: 276000 kg, over ten times any legal load\033[2J";
+    n = amfi_passage_t_encode(buf, 0, sizeof buf, &p);
+    if (n < 0 || amfi_auth_publish(lcm, &good, AMFI_CHANNEL_PASSAGE, buf, (size_t)n) != 0)
+        return die("refused passage");
     lcm_destroy(lcm);
     amfi_auth_signer_free(&good);
     amfi_auth_signer_free(&bad);
-    printf("top_inject: 1 alert, 3 bad passages\n");
+    printf("top_inject: 1 alert, 3 bad passages, 1 with its loads refused\n");
     return 0;
 }

@@ -86,6 +86,7 @@ pages() {
     [ "$(ids "$k-passages" passages)" = "$(seq 40 -1 1 | tr '\n' ' ' | sed 's/ $//')" ] ||
         fail "$k-passages: '$(ids "$k-passages" passages)'"
     has "$k-passages" 'solver: &lt;img src=x onerror="window.__xss=1"&gt;' 1
+    has "$k-passages" '<td>loads refused: group 2: &lt;img src=x onerror="window.__xss=1"&gt;' 1
     page "$base/passages?status=invalid&limit=3" "$k-invalid"
     [ "$(ids "$k-invalid" passages)" = "33 23 13" ] || fail "$k-invalid: '$(ids "$k-invalid" passages)'"
     page "$base/passages?status=bogus" "$k-passages-error"
@@ -145,7 +146,7 @@ pages() {
     [ "$(ids "$k-alerts" alerts)" = "3 2 1" ] || fail "$k-alerts: events '$(ids "$k-alerts" alerts)'"
 
     page "$base/classes" "$k-classes"
-    has "$k-classes" '<td>FHWA9</td><td class="num">11</td><td class="num">11</td><td class="num">1</td>' 1
+    has "$k-classes" '<td>FHWA9</td><td class="num">11</td><td class="num">11</td><td class="num">1</td><td class="num">1</td>' 1
     canvas "$k-classes" chart-classes 4
 
     # the hostile text never became an element, on any page

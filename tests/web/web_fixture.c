@@ -5,7 +5,8 @@
  * 2026-01-10T01:00:00Z (ids 1 .. 40): k % 3 == 0 class FHWA9 (groups 1-2-2),
  * 1 A23 (1-1-3), 2 unknown (1-1); k % 10 == 3 invalid (no axles, reason
  * "detector: axle count 0"); k == 7 status error with a hostile reason
- * (HOSTILE below); k == 9 overloaded; axle j (1-based) of passage k weighs
+ * (HOSTILE below); k == 9 overloaded; k == 12 its loads refused by the
+ * classification (overload NULL, the reason hostile); axle j (1-based) of passage k weighs
  * 1000 k + 100 j kg; residual 0.001 k; f1 5.7 − 0.001 k Hz on even k;
  * model fit ratio 0.01 k on odd k (15 ok passages); deck 10 °C; amfid's
  * model_mismatch rule recorded (meta alerts.model_fit: MODEL_FIT). Eight indicator rows, a baseline, three alerts (std_increase
@@ -142,8 +143,10 @@ int main(int argc, char **argv)
             r.formulation = "displacement";
             r.lambda = 1e-3;
             r.solve_ms = 2.5;
-            r.has_overload = 1;
+            r.has_overload = k != 12;
             r.overload = k == 9;
+            if (k == 12) /* the classification refused the loads: never an overload */
+                r.loads_refused = "group 2: " HOSTILE;
             if (k % 2 == 0) {
                 r.f1_hz = 5.7 - 0.001 * k;
                 r.f1_r2 = 0.95;

@@ -389,6 +389,12 @@ int main(int argc, char **argv)
     CHECK(json_real_value(at(j, "residual_rms")) > 0.0069
               && json_real_value(at(j, "residual_rms")) < 0.0071,
           "passage 7: residual");
+    CHECK(json_is_null(at(j, "loads_refused")), "passage 7: loads refused");
+    json_decref(j);
+    j = get_json("/api/passages/12", 200);
+    CHECK(strcmp(sval(j, "status"), "ok") == 0 && json_is_null(at(j, "overload"))
+              && strcmp(sval(j, "loads_refused"), "group 2: " HOSTILE) == 0,
+          "passage 12: loads refused %s", sval(j, "loads_refused"));
     json_decref(j);
     j = get_json("/api/passages/3", 200);
     CHECK(strcmp(sval(j, "status"), "invalid") == 0 && json_is_null(at(j, "gvw_kg"))
@@ -478,8 +484,12 @@ int main(int argc, char **argv)
             && strcmp(json_string_value(json_object_get(c, "class")), "FHWA9") == 0) {
             seen = 1;
             CHECK(json_integer_value(json_object_get(c, "n")) == 11
-                      && json_integer_value(json_object_get(c, "n_overload")) == 1,
+                      && json_integer_value(json_object_get(c, "n_overload")) == 1
+                      && json_integer_value(json_object_get(c, "n_refused")) == 1,
                   "classes: FHWA9");
+        } else {
+            CHECK(json_integer_value(json_object_get(c, "n_refused")) == 0, "classes: refused %s",
+                  json_string_value(json_object_get(c, "class")));
         }
     }
     CHECK(seen, "classes: no FHWA9");

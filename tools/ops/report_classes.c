@@ -23,6 +23,7 @@ typedef struct cls_pas {
     int cls;  /* index into names */
     int lane;
     int over; /* passages.overload: 1 */
+    int refused; /* passages.loads_refused set */
 } cls_pas;
 
 typedef struct cls_data {
@@ -68,6 +69,7 @@ static int collect(void *ctx, const amfi_class_row *r)
     q->cls = name_index(d, r->vclass && *r->vclass ? r->vclass : UNCLASSIFIED);
     q->lane = r->lane;
     q->over = r->overload;
+    q->refused = r->refused;
     return 0;
 }
 
@@ -116,7 +118,7 @@ static int cmp_int(const void *a, const void *b)
 typedef struct cls_row {
     const char *name;
     int lane, all;
-    int64_t n, over;
+    int64_t n, over, refused;
     double share_pct, mean, std, p5, p50, p95, max;
 } cls_row;
 
@@ -124,11 +126,12 @@ typedef struct cls_row {
 static int stats_of(const cls_data *d, int k, int all, int lane, double *buf, cls_row *r)
 {
     size_t m = 0;
-    r->over = 0;
+    r->over = r->refused = 0;
     for (size_t i = 0; i < d->n; i++)
         if (d->p[i].cls == k && (all || d->p[i].lane == lane)) {
             buf[m++] = d->p[i].gvw;
             r->over += d->p[i].over;
+            r->refused += d->p[i].refused;
         }
     r->name = d->names[k];
     r->all = all;
@@ -160,6 +163,7 @@ static void c_p50(const void *w, report_val *v) { v->x = C(w)->p50; }
 static void c_p95(const void *w, report_val *v) { v->x = C(w)->p95; }
 static void c_max(const void *w, report_val *v) { v->x = C(w)->max; }
 static void c_over(const void *w, report_val *v) { v->i = C(w)->over; }
+static void c_refused(const void *w, report_val *v) { v->i = C(w)->refused; }
 #undef C
 
 static const report_col class_cols[] = {
@@ -174,6 +178,8 @@ static const report_col class_cols[] = {
     REPORT_COL("gvw_p95_kg", COL_NUM, "kg", "%.1f", COL_BOTH, c_p95),
     REPORT_COL("gvw_max_kg", COL_NUM, "kg", "%.1f", COL_BOTH, c_max),
     REPORT_COL("overloaded", COL_INT, "", NULL, COL_BOTH, c_over),
+    /* stored refusals (store version 13 on; --overloads recomputes older ones) */
+    REPORT_COL("loads_refused", COL_INT, "", NULL, COL_BOTH, c_refused),
 };
 
 /* Calls fn for every row: each class over all lanes, then per lane. */

@@ -6,7 +6,8 @@
  * verifies every message's signature as amfid does (messages/amfi_auth.h:
  * the same key lookup, daemon.bus.auth, daemon.bus.max_skew_s), checks its
  * bytes before decoding (amfi_msg_check.h), and shows the newest passages
- * (time, lane, class, speed, GVW, status), the counts by status, the alerts
+ * (time, lane, class, speed, GVW, status, and why the axle and group loads
+ * were refused when they were), the counts by status, the alerts
  * and amfid's status. No curses: on a terminal the screen is redrawn every
  * --interval with ANSI escapes; with --count N, --once, --plain or when
  * stdout is not a terminal it prints plain lines (one per passage, alert or
@@ -53,6 +54,7 @@ struct row {
     int64_t utime, passage_id;
     int lane;
     char cls[16], status[16];
+    char refused[112]; /* why the axle and group loads were refused ("" when they were not) */
     double speed_mps, gvw_kg;
 };
 struct alert_row {
@@ -70,7 +72,7 @@ static struct {
     /* what was seen */
     struct row ring[MAX_ROWS];
     int n_ring, head;
-    long by_status[N_STATUS], passages;
+    long by_status[N_STATUS], passages, loads_refused;
     struct alert_row alerts[MAX_ALERTS];
     int n_alerts;
     long alerts_seen;
@@ -149,8 +151,9 @@ static void print_row(FILE *f, const struct row *r)
     utc(r->utime, t, sizeof t);
     kmh(r->speed_mps, sp, sizeof sp);
     tonnes(r->gvw_kg, w, sizeof w);
-    fprintf(f, "%-20s %6" PRId64 " %4d  %-7s %11s %10s  %s\n", t, r->passage_id, r->lane,
-            r->cls[0] ? r->cls : "-", sp, w, r->status);
+    fprintf(f, "%-20s %6" PRId64 " %4d  %-7s %11s %10s  %s%s%s\n", t, r->passage_id, r->lane,
+            r->cls[0] ? r->cls : "-", sp, w, r->status, r->refused[0] ? "; loads refused: " : "",
+            r->refused);
 }
 static const char row_head[] = "time (UTC)               id lane  class         speed        GVW  status\n";
 
@@ -168,6 +171,8 @@ static void print_counts(FILE *f)
     for (int i = 0; i < N_STATUS; i++)
         if (T.by_status[i] || i == 0)
             fprintf(f, " %s %ld", status_names[i], T.by_status[i]);
+    if (T.loads_refused)
+        fprintf(f, "; loads refused %ld", T.loads_refused);
     fputc('\n', f);
 }
 
@@ -273,6 +278,8 @@ static void on_passage(const lcm_recv_buf_t *rb, const char *ch, void *user)
     r->gvw_kg = m.gvw_kg;
     safe(m.vehicle_class, r->cls, sizeof r->cls);
     safe(m.status, r->status, sizeof r->status);
+    safe(m.loads_refused, r->refused, sizeof r->refused);
+    T.loads_refused += r->refused[0] != '\0';
     T.head = (T.head + 1) % MAX_ROWS;
     if (T.n_ring < MAX_ROWS)
         T.n_ring++;

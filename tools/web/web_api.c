@@ -211,6 +211,9 @@ static json_t *passage_json(const amfi_web_passage *wp, int full)
     json_object_set_new(o, "gvw_kg", amfi_json_num(r->gvw_kg));
     json_object_set_new(o, "speed_mps", amfi_json_num(r->speed_mps));
     json_object_set_new(o, "overload", r->has_overload ? json_boolean(r->overload) : json_null());
+    json_object_set_new(o, "loads_refused",
+                        r->loads_refused && r->loads_refused[0] ? json_string(r->loads_refused)
+                                                                : json_null());
     json_object_set_new(o, "residual_rms", amfi_json_num(r->residual_rms));
     json_object_set_new(o, "quality", amfi_json_num(r->quality));
     json_object_set_new(o, "n_vehicles", json_integer(r->n_vehicles));
@@ -659,6 +662,7 @@ static web_reply api_classes(const web_source *src, const web_param *p, int np)
         json_object_set_new(e, "n", json_integer(c[k].n));
         json_object_set_new(e, "n_ok", json_integer(c[k].n_ok));
         json_object_set_new(e, "n_overload", json_integer(c[k].n_overload));
+        json_object_set_new(e, "n_refused", json_integer(c[k].n_refused));
         json_object_set_new(e, "gvw_mean_kg", amfi_json_num(c[k].gvw_mean_kg));
         json_object_set_new(e, "gvw_max_kg", amfi_json_num(c[k].gvw_max_kg));
         json_array_append_new(arr, e);

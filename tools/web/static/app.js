@@ -74,7 +74,8 @@ function passageRow(p) {
     cell(el('a', {href: '/vehicle?id=' + encodeURIComponent(p.id)}, String(p.id))),
     cell(when(p.utime_utc)), cell(p.lane, 'num'), cell(p.class || '—'),
     cell(p.n_axles, 'num'), cell(p.axle_groups || '—'), cell(num(p.gvw_kg, 0), 'num'),
-    cell(num(p.speed_mps, 1), 'num'), cell(p.status, 'status'), cell(p.reason));
+    cell(num(p.speed_mps, 1), 'num'), cell(p.status, 'status'),
+    cell(p.reason || (p.loads_refused ? 'loads refused: ' + p.loads_refused : '')));
 }
 const passageHead = ['id', 'time (UTC)', 'lane', 'class', 'axles', 'groups', 'GVW kg',
                      'speed m/s', 'status', 'reason'];
@@ -162,6 +163,7 @@ async function pageVehicle() {
     ['status', p.status], ['reason', p.reason || '—'], ['class', p.class || '—'],
     ['axle groups', p.axle_groups || '—'], ['GVW kg', num(p.gvw_kg, 0)],
     ['overload', p.overload === null ? '—' : (p.overload ? 'yes' : 'no')],
+    ['loads refused', p.loads_refused || '—'],
     ['speed m/s', num(p.speed_mps, 2) + (p.speed_estimated ? ' (estimated)' : '')],
     ['detector speed m/s', num(p.speed_given_mps, 2)], ['residual RMS m/s²', num(p.residual_rms, 5)],
     ['quality', num(p.quality, 2)], ['vehicles in the event', p.n_vehicles],
@@ -316,9 +318,10 @@ async function pageClasses() {
   const c = await api('/api/classes' + (range.toString() ? '?' + range : ''));
   const name = x => x.class === null ? '(none)' : x.class;
   main.replaceChildren(rangeForm('/classes', q, c), el('h2', {}, 'Passages per class'),
-    table('classes', ['class', 'passages', 'ok', 'overloaded', 'mean GVW kg', 'max GVW kg'],
+    table('classes', ['class', 'passages', 'ok', 'overloaded', 'loads refused', 'mean GVW kg',
+                      'max GVW kg'],
       c.classes.map(x => el('tr', {}, cell(name(x)), cell(x.n, 'num'), cell(x.n_ok, 'num'),
-        cell(x.n_overload, 'num'), cell(num(x.gvw_mean_kg, 0), 'num'),
+        cell(x.n_overload, 'num'), cell(x.n_refused, 'num'), cell(num(x.gvw_mean_kg, 0), 'num'),
         cell(num(x.gvw_max_kg, 0), 'num')))),
     chart('chart-classes', 'bar', c.classes.map(name),
           [{label: 'passages', data: c.classes.map(x => x.n)}], 'passages'));
