@@ -576,6 +576,7 @@ typedef struct amfi_web_passage {
     char formulation[64];
     char vclass[16];
     char groups[32];
+    char refused[AMFI_STORE_LOADS_REFUSED_MAX + 1];
 } amfi_web_passage;
 
 /* Called once per passage (valid during the call only); nonzero stops. */

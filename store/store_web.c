@@ -86,7 +86,7 @@ int amfi_store_web_status(amfi_store *s, int64_t since, amfi_web_status *out, ch
     "id, vehicle_id, utime, lane, speed_mps, n_axles, gvw_kg, status, reason, lambda, "           \
     "residual_rms, formulation, solve_ms, speed_given_mps, speed_estimated, n_vehicles, quality, " \
     "reference_gvw_kg, deck_c, f1_hz, f1_comp_hz, f1_zeta, f1_r2, gvw_comp_kg, class, "            \
-    "axle_groups, overload"
+    "axle_groups, overload, loads_refused"
 
 /* Optional text column col into buf (NULL: *ptr NULL). */
 static int opt_text(sqlite3_stmt *st, int col, const origin *o, char *buf, size_t len,
@@ -158,6 +158,8 @@ static int read_passage(sqlite3_stmt *st, amfi_web_passage *p, char *err, size_t
         r->has_overload = 1;
         r->overload = (int)v;
     }
+    if (rc == 0)
+        rc = opt_text(st, 27, &o, p->refused, sizeof p->refused, &r->loads_refused, err, errlen);
     return rc;
 }
 
