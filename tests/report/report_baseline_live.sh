@@ -22,7 +22,7 @@ for k in "window: 50 " "every: 10 " "baseline_n: 100 "; do
   grep -q "^    $k" "$dir/amfid.yaml" || fail "the test's indicator setting '$k' did not apply"
 done
 amfid_start "$amfid" "$dir/amfid.yaml"
-"$sim" --dt 2.5e-4 --allow-production-bus --vehicles 400 --headway 2 --speedup 20 --seed 7 2> "$dir/sim.log" &
+"$sim" --dt 2.5e-4 --allow-production-bus --vehicles 200 --headway 2 --speedup 20 --seed 7 2> "$dir/sim.log" &
 spid=$!; pids="$pids $spid"
 wait_for "baseline established" "$dir/amfid.log" $apid 300 || fail "no automatic baseline"
 auto=$(sqlite3 "$dir/s.db" "SELECT mean_kg FROM baseline ORDER BY id DESC LIMIT 1")
