@@ -156,6 +156,10 @@ pages() {
 }
 
 serve() { # serve ARGS...: amfi-web started, $base its address
+    # emptied here, not only by the background child's redirection: the
+    # wait below must not see the previous server's "serving" and port (the
+    # central pass once failed with "no fetch line" that way, under load)
+    : > "$tmp/web.err"
     "$web" "$@" --listen 127.0.0.1:0 2> "$tmp/web.err" &
     pid=$!
     wait_for "serving" "$tmp/web.err" "$pid" 120 || { cat "$tmp/web.err"; exit 1; }
