@@ -510,11 +510,12 @@ static int alias_candidates(const amfi_speed_prior *pr, const amfi_passage *ps, 
  * below ALIAS_LEAVE times the estimate's, and then for the nearest alias
  * (the least change) whose residual is below ALIAS_TAKE times it. The
  * residual, not J: J's trend towards slow speeds, where the axles stay on
- * the span and their forces absorb the misfit, made the slower candidate
- * win (branch speedcand). The residual has that trend too (a slow alias
- * fits 10-50 % better than the truth, more on a softer bridge), but the
- * fast alias of the truth misses the exit transients of an axle group and
- * fits 4-20 times worse than the truth: hence the wide margins. */
+ * the span and their forces absorb the misfit, made slower candidates win
+ * (branch speedcand). The residual has that trend too (on the Table 5
+ * batch a slower alias of a right estimate fit up to 3 times better, 4
+ * times on a 10 % softer bridge), but the fast alias of the truth misses
+ * the exit transients of an axle group, and the truth fit 3-14 times
+ * better than it (2-4 for a single tandem): hence the wide margins. */
 #define ALIAS_SCREEN 0.6
 #define ALIAS_LEAVE 0.2
 #define ALIAS_TAKE 0.3

@@ -420,7 +420,8 @@ typedef struct amfi_speed_result {
 /* Estimate the passage's speed (p->speed_mps is the detector's, the prior
  * mean): J on a grid (on the coarse model, prior->coarse_rate_hz), then a
  * Brent search (GSL gsl_min) on the full model around the grid's minimum,
- * then solve at the
+ * the pick's axle-group aliases judged on the full model by the residual
+ * (docs/solver.md, "Axle groups' aliases"), then solve at the
  * estimate as amfi_solve does: `res` is amfi_solve's result at speed_mps
  * (res->n_solves counts every sweep, search included). λ is fixed during
  * the search (the L-curve's at v0 when lam is automatic). The axle spacings
