@@ -620,6 +620,9 @@ static int print_json(const amfi_site_config *c, const amfi_result *r,
               json_object_set_new(o, "speed_estimated", json_boolean(estimated)) ||
               json_object_set_new(o, "speed_coarse_sweeps", json_integer(sr->n_coarse)) ||
               json_object_set_new(o, "speed_dip", amfi_json_num(sr->dip)) ||
+              json_object_set_new(o, "speed_aliases", json_integer(sr->n_aliases)) ||
+              json_object_set_new(o, "speed_aliases_judged", json_integer(sr->n_aliases_judged)) ||
+              json_object_set_new(o, "speed_alias", json_boolean(sr->alias)) ||
               json_object_set_new(o, "n_solves", json_integer(r->n_solves)))) {
         json_decref(o);
         o = NULL;

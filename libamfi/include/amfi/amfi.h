@@ -405,12 +405,23 @@ typedef struct amfi_speed_result {
     int grid_n;             /* the grid: J at grid_lo_mps + k·grid_step_mps, */
     double grid_lo_mps, grid_step_mps; /* k = 0 .. grid_n − 1, on the grid's */
     const double *grid_j;   /* model; held by the solver until its next search */
+    int n_aliases;          /* two levels, pick dip: the coarse pick's axle-group aliases
+                               with a coarse dip (0 .. AMFI_SPEED_ALIASES; 0 for a
+                               vehicle without an axle pair that aliases within the
+                               range, e.g. two axles: docs/solver.md) */
+    int n_aliases_judged;   /* those the coarse residual did not rule out, judged on
+                               the full model */
+    int alias;              /* 1: an alias replaced the coarse pick's estimate */
 } amfi_speed_result;
+
+/* The most axle-group aliases of the coarse pick the full model judges. */
+#define AMFI_SPEED_ALIASES 4
 
 /* Estimate the passage's speed (p->speed_mps is the detector's, the prior
  * mean): J on a grid (on the coarse model, prior->coarse_rate_hz), then a
  * Brent search (GSL gsl_min) on the full model around the grid's minimum,
- * then solve at the
+ * the pick's axle-group aliases judged on the full model by the residual
+ * (docs/solver.md, "Axle groups' aliases"), then solve at the
  * estimate as amfi_solve does: `res` is amfi_solve's result at speed_mps
  * (res->n_solves counts every sweep, search included). λ is fixed during
  * the search (the L-curve's at v0 when lam is automatic). The axle spacings
