@@ -107,8 +107,8 @@ static void write_header(FILE *f, int ns, const int *ids)
     fputc('\n', f);
 }
 
-static int write_accel(const char *path, int n, int ns, const int *ids, double rate,
-                       const double *acc, char *err, size_t errlen)
+int amfi_sim_write_accel(const char *path, int n, int ns, const int *ids, double rate,
+                         const double *acc, char *err, size_t errlen)
 {
     FILE *f = fopen(path, "w");
     if (!f)
@@ -303,7 +303,7 @@ int amfi_cal_runs_write(const char *dir, const amfi_bridge *b, const amfi_profil
             char name[32];
             snprintf(name, sizeof name, "run%03d.csv", run + 1);
             snprintf(path, sizeof path, "%s/%s", dir, name);
-            if (write_accel(path, n, ns, p->sensor_id, sp->scan_rate_hz, acc, err, errlen))
+            if (amfi_sim_write_accel(path, n, ns, p->sensor_id, sp->scan_rate_hz, acc, err, errlen))
                 goto out;
             /* what the detector reports: its clock, its speed and spacing scales */
             const double det_speed = speed_meas * p->det.speed_scale;
@@ -412,7 +412,7 @@ int amfi_ambient_write(const char *path, const amfi_bridge *b, const amfi_sim_pa
         }
     }
     add_noise(acc, (int)n_rec, ns, p->noise_frac, p->noise_ms2, r);
-    rc = write_accel(path, (int)n_rec, ns, p->sensor_id, fs, acc, err, errlen);
+    rc = amfi_sim_write_accel(path, (int)n_rec, ns, p->sensor_id, fs, acc, err, errlen);
 out:
     free(phi_node);
     free(phi_s);

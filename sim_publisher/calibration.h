@@ -92,4 +92,11 @@ typedef struct amfi_ambient_params {
 int amfi_ambient_write(const char *path, const amfi_bridge *b, const amfi_sim_params *sp,
                        const amfi_ambient_params *p, char *err, size_t errlen);
 
+/* Write an acceleration record in amfi-solve's format: n rows of ns sensors
+ * (acc row per sample) at `rate` Hz, header "t,accel" with one sensor and
+ * "t,accel_ID,..." (ids: the site's sensors[].id) with several. 0, or −1
+ * with a message. */
+int amfi_sim_write_accel(const char *path, int n, int ns, const int *ids, double rate,
+                         const double *acc, char *err, size_t errlen);
+
 #endif /* AMFI_SIM_CALIBRATION_H */

@@ -1299,16 +1299,10 @@ int main(int argc, char **argv)
         char name[32];
         snprintf(name, sizeof name, "v%05ld", o.first + i + 1);
         snprintf(path, sizeof path, "%s/%s.csv", o.out, name);
-        FILE *f = fopen(path, "w");
-        if (!f) {
-            fprintf(stderr, "%s: %s: cannot create: %s\n", PROG, path, strerror(errno));
-            goto out;
-        }
-        fprintf(f, "t,accel\n");
-        for (int k = 0; k < pr.n; k++)
-            fprintf(f, "%.6f,%.9g\n", k / o.scan_rate, acc[(size_t)k * pr.n_sensors]);
-        if (fclose(f) != 0) {
-            fprintf(stderr, "%s: %s: write failed\n", PROG, path);
+        /* every sensor of the site: one column, or accel_ID per sensor */
+        if (amfi_sim_write_accel(path, pr.n, pr.n_sensors, cfg.sensor_id, o.scan_rate, acc, err,
+                                 sizeof err)) {
+            fprintf(stderr, "%s: %s\n", PROG, err);
             goto out;
         }
         /* the first two axles in the two-axle columns, every axle in the lists
@@ -1322,21 +1316,27 @@ int main(int argc, char **argv)
             gvw += akg[a];
             lost += pr.truth.lost_contact_steps[a];
         }
-        fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,%g,%d,",
+        fprintf(meta, "%s,%.9g,%.9g,%.9g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%g,%g,%s,%d,%.6g,%ld,%g,",
                 name, pr.speed_measured_mps * w.det.speed_scale, spec.speed_mps,
                 spacing * w.det.spacing_scale, -pr.t_first_s + w.det.clock_offset_s,
                 na == 2 ? rec->axle_kg[0] + rec->axle_kg[1] : gvw, akg[0], akg[1],
                 pr.truth.mean_force_N[0], pr.truth.mean_force_N[1], o.damage, o.noise,
                 o.profile_class ? (char[]){o.profile_class, 0} : "smooth", spec.track, gap, lost,
-                o.scan_rate, cfg.solver.sensor_x_m[0], na);
+                o.scan_rate);
+        for (int si = 0; si < pr.n_sensors; si++) /* the design's positions, ';' */
+            fprintf(meta, "%s%g", si ? ";" : "", cfg.solver.sensor_x_m[si]);
+        fprintf(meta, ",%d,", na);
         for (int a = 1; a < na; a++)
             fprintf(meta, "%s%.9g", a > 1 ? ";" : "", xa[a] - xa[a - 1]);
         for (int a = 0; a < na; a++)
             fprintf(meta, "%s%.6f", a ? ";" : ",", akg[a]);
         for (int a = 0; a < na; a++)
             fprintf(meta, "%s%.6f", a ? ";" : ",", pr.truth.mean_force_N[a]);
-        if (w.as_built)
-            fprintf(meta, ",%.6f,%.9g,%g", -pr.t_first_s, spacing, sp.sensor_x_m[0]);
+        if (w.as_built) {
+            fprintf(meta, ",%.6f,%.9g,", -pr.t_first_s, spacing);
+            for (int si = 0; si < pr.n_sensors; si++)
+                fprintf(meta, "%s%g", si ? ";" : "", sp.sensor_x_m[si]);
+        }
         fputc('\n', meta);
     }
     if (fclose(meta) != 0) {

@@ -60,6 +60,31 @@ printf '%s\n' 'daemon: {channels: {accel: SITE_A, vehicle: SITE_V, truth: SITE_T
 for c in SITE_A SITE_V SITE_T; do grep -aq "$c" "$dir/ch.log" || fail "nothing on channel $c"; done
 grep -aq AMFI_ "$dir/ch.log" && fail "published on a default channel"
 
+# A site with three sensors: every sensor's column, named by its id, and
+# their positions in meta.csv; amfi-solve weighs from all three (it refuses
+# a file with fewer columns than the site has sensors).
+printf '%s\n' 'bridge: {span_m: 20}' 'sensors:' '  - {id: 3, at_m: 5}' '  - {id: 7, at_m: 10}' \
+  '  - {id: 12, at_m: 15}' > "$dir/cfg/three.yaml"
+"$sim" --config "$dir/cfg/three.yaml" --out "$dir/h" --vehicles 2 --seed 5 || fail "three sensors: exited $?"
+head -1 "$dir/h/v00001.csv" | grep -qx 't,accel_3,accel_7,accel_12' ||
+  fail "three sensors: header $(head -1 "$dir/h/v00001.csv")"
+awk -F, 'NR > 1 && NF != 4 { print "row " NR ": " NF " fields"; bad = 1 } END { exit bad }' "$dir/h/v00001.csv" ||
+  fail "three sensors: a row without every sensor"
+# the middle sensor's column is the one-sensor site's at 10 m (same seed, same vehicle)
+awk -F, 'NR == FNR { if (FNR > 1) m[FNR] = $2; next }
+  FNR > 1 { d = $3 - m[FNR]; if (d < 0) d = -d; s = $3 < 0 ? -$3 : $3; if (d > 1e-9 * s + 1e-12) bad = 1 }
+  END { exit bad }' "$dir/a/v00001.csv" "$dir/h/v00001.csv" || fail "three sensors: accel_7 is not the 10 m sensor's record"
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next } { print $c["sensor_x_m"] }' "$dir/h/meta.csv" |
+  grep -qx '5;10;15' || fail "three sensors: meta.csv sensor_x_m"
+tail -n +2 "$dir/h/meta.csv" | while IFS=, read -r name speed _ spacing entry gvw _; do
+  out=$("$solve" --config "$dir/cfg/three.yaml" --accel "$dir/h/$name.csv" --speed "$speed" \
+        --axle-spacing "$spacing" --entry-time "$entry") || fail "amfi-solve, three sensors, $name: exit $?"
+  inferred=$(printf '%s' "$out" | sed 's/.*"gvw_kg":\([-0-9.e+]*\).*/\1/')
+  awk -v a="$inferred" -v b="$gvw" -v n="$name" 'BEGIN {
+    e = (a - b) / b; printf "%s, three sensors: true %.0f kg, inferred %.0f kg (%+.2f %%)\n", n, b, a, 100 * e;
+    exit (e < -0.05 || e > 0.05) }' || fail "$name, three sensors: GVW error over 5 %"
+done || exit 1
+
 # Bad command lines are refused with one line and status 2.
 "$sim" --lcm-url none --vehicles 3 2>/dev/null; [ $? -eq 2 ] || fail "streaming to nothing not refused"
 "$sim" --out "$dir/d" --damage 2 2>/dev/null; [ $? -eq 2 ] || fail "damage 2 not refused"
