@@ -6,8 +6,8 @@
 # COST 323's names), the numbers and classes read back from amfi-accuracy's
 # JSON lines for every row, the vehicles' classes as amfi-solve decided them,
 # its vehicles.csv and pairs.txt, the same table again from the run's files
-# (SOLVED), and refusals of a bad sample size and of a population without
-# classes.
+# (SOLVED), a run with three sensors (SENSORS), and refusals of a bad
+# sample size, a bad position and a population without classes.
 # Not the accuracy targets (docs/results/class-accuracy.md).
 # Usage: class_accuracy.sh TOOL BIN_DIR POPULATION_EU
 set -u
@@ -79,6 +79,19 @@ head -1 "$t/weights-all.csv" | grep -qx "criterion,measured_kg,reference_kg" || 
 SOLVED=$t sh "$tool" "$bin" "$dir/again" 3 "$pop" > "$dir/again.txt" 2> "$dir/err" ||
   { cat "$dir/err"; fail "SOLVED: exit $?"; }
 cmp -s "$dir/table.txt" "$dir/again.txt" || fail "SOLVED: another table: $(diff "$dir/table.txt" "$dir/again.txt")"
+
+# SENSORS: three sensors in the run's site file, used by both the simulator
+# and amfi-solve (one vehicle of each class; every one weighed)
+SENSORS="5 10 15" SIM_ARGS="--dt 2.5e-4" sh "$tool" "$bin" "$dir/three" 1 "$pop" > "$dir/three.txt" 2> "$dir/err" ||
+  { cat "$dir/err"; fail "SENSORS: exit $?"; }
+[ "$(grep -c '^  - {id: [0-2], at_m: \(5\|10\|15\), weight: 1}$' "$dir/three/site.yaml")" -eq 3 ] &&
+  [ "$(grep -c '^sensors:' "$dir/three/site.yaml")" -eq 1 ] || fail "SENSORS: site.yaml: $(cat "$dir/three/site.yaml")"
+head -1 "$dir/three/sim/v00001.csv" | grep -qx 't,accel_0,accel_1,accel_2' ||
+  fail "SENSORS: the record's header $(head -1 "$dir/three/sim/v00001.csv")"
+grep -qx "refused by amfi-solve: 0 *" "$dir/three.txt" || fail "SENSORS: $(tail -1 "$dir/three.txt")"
+grep -q "^all  *7  gross " "$dir/three.txt" || fail "SENSORS: no gross row of 7"
+SENSORS="5 x" sh "$tool" "$bin" "$dir/bad" 1 "$pop" > /dev/null 2> "$dir/err" && fail "SENSORS 5 x accepted"
+grep -q "SENSORS: 'x' is not a position in m" "$dir/err" || fail "SENSORS 5 x: $(cat "$dir/err")"
 
 # refusals: a bad sample size, a population without a class column
 sh "$tool" "$bin" "$dir/bad" x "$pop" > /dev/null 2> "$dir/err" && fail "PER_CLASS x accepted"

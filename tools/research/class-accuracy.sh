@@ -36,6 +36,9 @@
 #              SIM_ARGS (extra sim_publisher options; the paper's Table 5:
 #                "--noise 0.03 --speed-error 0,0.03"),
 #              SOLVE_ARGS (extra amfi-solve options, e.g. --estimate-speed),
+#              SENSORS (positions in m, e.g. "5 10 15": CONFIG's sensors
+#                replaced by these, ids 0, 1, ..., in OUT/site.yaml, which
+#                both sim_publisher and amfi-solve then use),
 #              SEED (sim_publisher's seed, 1),
 #              CONDITION (RR2), ENVIRONMENT (I): amfi-accuracy's,
 #              REFERENCE: static (the static loads, the default) or span (each
@@ -63,6 +66,19 @@ case $per in ''|*[!0-9]*) die "PER_CLASS: '$per' is not a whole number";; esac
 [ -r "$cfg" ] || die "$cfg: cannot read the site file"
 
 rm -rf "$out" && mkdir -p "$out" || die "cannot create $out"
+if [ -n "${SENSORS:-}" ]; then
+  # CONFIG without its sensors block (the top-level key and its indented or
+  # comment lines), then the sensors at SENSORS; the site file's own checks
+  # judge the positions
+  for x in $SENSORS; do
+    case $x in ''|*[!0-9.]*|*.*.*|.*) die "SENSORS: '$x' is not a position in m";; esac
+  done
+  { awk '/^sensors:/ { skip = 1; next } skip && /^([ \t]|#|$)/ { next } { skip = 0; print }' "$cfg"
+    echo "sensors:"
+    i=0; for x in $SENSORS; do echo "  - {id: $i, at_m: $x, weight: 1}"; i=$((i + 1)); done
+  } > "$out/site.yaml" || die "cannot write $out/site.yaml"
+  cfg=$out/site.yaml
+fi
 if [ -n "${SOLVED:-}" ]; then
   # an earlier run's sample, passages and weights, judged again (REFERENCE)
   for f in sample.csv sim/meta.csv solve.txt; do
