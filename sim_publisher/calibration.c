@@ -143,7 +143,7 @@ static void add_noise(double *acc, int n, int ns, double frac, double ms2, gsl_r
     }
 }
 
-static void put_list(FILE *f, const double *v, int n, const char *fmt)
+void amfi_sim_put_list(FILE *f, const double *v, int n, const char *fmt)
 {
     for (int i = 0; i < n; i++) {
         if (i)
@@ -312,18 +312,18 @@ int amfi_cal_runs_write(const char *dir, const amfi_bridge *b, const amfi_profil
             for (int a = 0; a + 1 < t->n_axles; a++)
                 det_sp[a] = t->spacing_m[a] * p->det.spacing_scale;
             fprintf(runs, "%s,%.6f,", name, det_speed);
-            put_list(runs, det_sp, t->n_axles - 1, "%.4f");
+            amfi_sim_put_list(runs, det_sp, t->n_axles - 1, "%.4f");
             fprintf(runs, ",%.6f,", det_entry);
-            put_list(runs, static_kg, t->n_axles, "%.1f");
+            amfi_sim_put_list(runs, static_kg, t->n_axles, "%.1f");
             fputc('\n', runs);
             fprintf(truth, "%s,%d,%s,%.6f,%.6f,", name, ti + 1, model, v, entry_true);
-            put_list(truth, t->spacing_m, t->n_axles - 1, "%.4f");
+            amfi_sim_put_list(truth, t->spacing_m, t->n_axles - 1, "%.4f");
             fputc(',', truth);
-            put_list(truth, static_kg, t->n_axles, "%.1f");
+            amfi_sim_put_list(truth, static_kg, t->n_axles, "%.1f");
             fputc(',', truth);
-            put_list(truth, mean_force, t->n_axles, "%.3f");
+            amfi_sim_put_list(truth, mean_force, t->n_axles, "%.3f");
             fputc(',', truth);
-            put_list(truth, sp->sensor_x_m, ns, "%.4f");
+            amfi_sim_put_list(truth, sp->sensor_x_m, ns, "%.4f");
             fprintf(truth, ",%d,%ld,%.6f,%.6f\n", track, lost, det_speed, det_entry);
         }
     }

@@ -99,4 +99,8 @@ int amfi_ambient_write(const char *path, const amfi_bridge *b, const amfi_sim_pa
 int amfi_sim_write_accel(const char *path, int n, int ns, const int *ids, double rate,
                          const double *acc, char *err, size_t errlen);
 
+/* v[0 .. n) with fmt, separated by ';' (the list columns of RUNS.csv,
+ * TRUTH.csv and meta.csv). */
+void amfi_sim_put_list(FILE *f, const double *v, int n, const char *fmt);
+
 #endif /* AMFI_SIM_CALIBRATION_H */

@@ -1323,19 +1323,17 @@ int main(int argc, char **argv)
                 pr.truth.mean_force_N[0], pr.truth.mean_force_N[1], o.damage, o.noise,
                 o.profile_class ? (char[]){o.profile_class, 0} : "smooth", spec.track, gap, lost,
                 o.scan_rate);
-        for (int si = 0; si < pr.n_sensors; si++) /* the design's positions, ';' */
-            fprintf(meta, "%s%g", si ? ";" : "", cfg.solver.sensor_x_m[si]);
+        amfi_sim_put_list(meta, cfg.solver.sensor_x_m, pr.n_sensors, "%g"); /* the design's */
         fprintf(meta, ",%d,", na);
         for (int a = 1; a < na; a++)
             fprintf(meta, "%s%.9g", a > 1 ? ";" : "", xa[a] - xa[a - 1]);
-        for (int a = 0; a < na; a++)
-            fprintf(meta, "%s%.6f", a ? ";" : ",", akg[a]);
-        for (int a = 0; a < na; a++)
-            fprintf(meta, "%s%.6f", a ? ";" : ",", pr.truth.mean_force_N[a]);
+        fputc(',', meta);
+        amfi_sim_put_list(meta, akg, na, "%.6f");
+        fputc(',', meta);
+        amfi_sim_put_list(meta, pr.truth.mean_force_N, na, "%.6f");
         if (w.as_built) {
             fprintf(meta, ",%.6f,%.9g,", -pr.t_first_s, spacing);
-            for (int si = 0; si < pr.n_sensors; si++)
-                fprintf(meta, "%s%g", si ? ";" : "", sp.sensor_x_m[si]);
+            amfi_sim_put_list(meta, sp.sensor_x_m, pr.n_sensors, "%g");
         }
         fputc('\n', meta);
     }
